@@ -1,0 +1,21 @@
+#pragma once
+// Sub-commands of the `egress` program. Each Add*Command registers its CLI11 sub-command and the
+// callback that runs it; a callback reports failure by throwing, and main() turns any exception
+// into a one-line error and exit code 1.
+
+#include <CLI/CLI.hpp>
+
+namespace egress::apps {
+
+/// `egress --version`: the text printed (egress version, git revision, library versions).
+std::string VersionText();
+
+/// `egress model ...`: inspect the HSR robot model (joints, limits, forward kinematics).
+void AddModelCommand(CLI::App& app);
+
+/// A sub-command reserved for a capability that is not built yet: it is listed in --help with
+/// what it will do, and running it fails with a clear message.
+void AddPlannedCommand(CLI::App& app, const std::string& name, const std::string& description,
+                       const std::string& arrives_with);
+
+}  // namespace egress::apps

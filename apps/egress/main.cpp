@@ -1,0 +1,45 @@
+// egress: command line of the HSR evacuation-assistance system.
+
+#include <cstdio>
+#include <exception>
+
+#include <fmt/format.h>
+#include <CLI/CLI.hpp>
+
+#include "commands.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "egress: an HSR robot brain that opens ADA doors ahead of evacuees, yields to people and "
+      "fetches rescue equipment, run against a Bullet digital twin or the real robot.",
+      "egress"};
+  app.require_subcommand(0, 1);
+  app.set_version_flag("-V,--version", egress::apps::VersionText,
+                       "Print the egress version and the library versions it was built with");
+
+  egress::apps::AddModelCommand(app);
+  egress::apps::AddPlannedCommand(app, "sim", "Run one twin scenario end to end",
+                                  "the robot-brain issue (twin + executive)");
+  egress::apps::AddPlannedCommand(app, "batch",
+                                  "Run many seeded trials with a progress bar and success table",
+                                  "the robot-brain issue");
+  egress::apps::AddPlannedCommand(app, "render", "Render a recorded run to PNG/MP4",
+                                  "the digital-twin issue");
+  egress::apps::AddPlannedCommand(app, "plan", "Plan a base path (via egress-navd or --local)",
+                                  "the navigation-service issue");
+  egress::apps::AddPlannedCommand(app, "bench", "Benchmark planners over the regression suite",
+                                  "the navigation-service issue");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "egress: error: %s\n", e.what());
+    return 1;
+  }
+  if (argc == 1) {
+    std::fputs(app.help().c_str(), stdout);
+  }
+  return 0;
+}

@@ -1,0 +1,113 @@
+#!/usr/bin/env bash
+# egress set-up, build and run. On a fresh Debian bookworm machine, as root:
+#   ./egress.sh demo    install missing packages, build (Release), run the main job
+#   ./egress.sh test    install missing packages, build (Release), run the whole test suite
+# Other sub-commands:
+#   ./egress.sh deps       install the missing Debian packages only (deps/apt-packages.txt)
+#   ./egress.sh build      configure and build only
+#   ./egress.sh sanitize   build with AddressSanitizer + UBSan in build-asan/ and run the tests
+#   ./egress.sh bench      build and run the Google Benchmark programs in bench/
+# Environment: EGRESS_BUILD_DIR (default build), EGRESS_ASAN_BUILD_DIR (default build-asan),
+# EGRESS_JOBS (default: all cores),
+# EGRESS_REFERENCE_DIR (shared reference data; default ../shared/reference).
+set -euo pipefail
+
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+cd "$root"
+jobs=${EGRESS_JOBS:-$(nproc)}
+
+say() { printf '\033[1m[egress]\033[0m %s\n' "$*"; }
+die() { printf '[egress] error: %s\n' "$*" >&2; exit 1; }
+
+# Installs the packages of deps/apt-packages.txt that are not installed yet. Silent when
+# everything is present; apt-get update runs only when something must be installed.
+install_deps() {
+  local wanted missing=()
+  wanted=$(sed -e 's/#.*//' -e '/^[[:space:]]*$/d' deps/apt-packages.txt)
+  for pkg in $wanted; do
+    if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q 'install ok installed'; then
+      missing+=("$pkg")
+    fi
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  say "installing ${#missing[@]} missing Debian package(s): ${missing[*]}"
+  local sudo=()
+  if [ "$(id -u)" -ne 0 ]; then
+    command -v sudo >/dev/null || die "packages missing (${missing[*]}); run as root or install sudo"
+    sudo=(sudo)
+  fi
+  export DEBIAN_FRONTEND=noninteractive
+  "${sudo[@]}" apt-get update -qq
+  "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+}
+
+# configure_and_build <build-dir> [extra cmake args...]
+configure_and_build() {
+  local dir=$1; shift
+  local generator=()
+  command -v ninja >/dev/null && generator=(-G Ninja)
+  if [ ! -f "$dir/CMakeCache.txt" ]; then
+    say "configuring $dir"
+    mkdir -p "$dir"
+    cmake -S . -B "$dir" "${generator[@]}" -DCMAKE_BUILD_TYPE=Release -DEGRESS_WERROR=ON "$@" \
+      >"$dir/configure.log" 2>&1 || { cat "$dir/configure.log"; die "configure failed"; }
+  fi
+  say "building $dir ($jobs jobs)"
+  cmake --build "$dir" -j "$jobs"
+}
+
+run_tests() {
+  local dir=$1
+  say "running the tests in $dir"
+  ctest --test-dir "$dir" --output-on-failure -j "$jobs"
+}
+
+build_dir=${EGRESS_BUILD_DIR:-build}
+asan_dir=${EGRESS_ASAN_BUILD_DIR:-build-asan}
+command=${1:-help}
+case "$command" in
+  deps)
+    install_deps
+    ;;
+  build)
+    install_deps
+    configure_and_build "$build_dir"
+    ;;
+  demo)
+    install_deps
+    configure_and_build "$build_dir"
+    say "the main job: egress --version, then the HSR model the robot brain plans with"
+    "$build_dir/apps/egress" --version
+    echo
+    "$build_dir/apps/egress" model info
+    echo
+    say "forward kinematics, arm horizontal (arm_flex = -pi/2): palm reach"
+    "$build_dir/apps/egress" model fk --arm 0 -1.5707963267948966
+    ;;
+  test)
+    install_deps
+    configure_and_build "$build_dir"
+    run_tests "$build_dir"
+    ;;
+  sanitize)
+    install_deps
+    configure_and_build "$asan_dir" -DEGRESS_SANITIZE=ON \
+      -DEGRESS_BUILD_BENCHMARKS=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo
+    ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1 \
+      run_tests "$asan_dir"
+    ;;
+  bench)
+    install_deps
+    configure_and_build "$build_dir"
+    for program in "$build_dir"/bench/*_bench; do
+      say "$program"
+      "$program"
+    done
+    ;;
+  help|-h|--help)
+    sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'
+    ;;
+  *)
+    die "unknown sub-command '$command' (try: demo, test, deps, build, sanitize, bench)"
+    ;;
+esac

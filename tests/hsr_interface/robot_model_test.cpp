@@ -1,0 +1,261 @@
+#include "egress/hsr_interface/robot_model.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <random>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "egress/hsr_interface/error.h"
+
+namespace egress {
+namespace {
+
+using ::testing::HasSubstr;
+constexpr double kPi = std::numbers::pi;
+constexpr double kFkToleranceM = 1e-3;  // The issue's bound: within 1 mm.
+
+WholeBodyVector Arm(double lift, double flex, double roll, double wrist_flex, double wrist_roll) {
+  WholeBodyVector q = WholeBodyVector::Zero();
+  q << 0, 0, 0, lift, flex, roll, wrist_flex, wrist_roll;
+  return q;
+}
+
+class RobotModelTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { model_ = new RobotModel(RobotModel::LoadDefault()); }
+  static void TearDownTestSuite() { delete model_; }
+  static const RobotModel& model() { return *model_; }
+
+ private:
+  static inline RobotModel* model_ = nullptr;
+};
+
+// Reference positions of hand_palm_link from ../shared/reference/upstream_code_notes.md §1.2,
+// computed from the vendor's HSR-B description.
+TEST_F(RobotModelTest, PalmForwardKinematicsMatchesVendorModel) {
+  struct Case {
+    const char* name;
+    WholeBodyVector q;
+    Eigen::Vector3d p_BG;
+    Eigen::Vector3d palm_z;
+  };
+  const std::vector<Case> cases = {
+      {"all zero", Arm(0, 0, 0, 0, 0), {0.158, 0.078, 0.826}, {0, 0, 1}},
+      {"tucked", Arm(0.01, -0.01, 0, 0, 0), {0.163, 0.078, 0.835}, {0, 0, 1}},
+      {"flex -pi/2", Arm(0, -kPi / 2, 0, 0, 0), {0.627, 0.078, 0.323}, {1, 0, 0}},
+      {"flex -pi/2, lift 0.69", Arm(0.69, -kPi / 2, 0, 0, 0), {0.627, 0.078, 1.013}, {1, 0, 0}},
+      {"wrist_flex -pi/2", Arm(0, 0, 0, -kPi / 2, 0), {0.287, 0.078, 0.673}, {1, 0, 0}},
+  };
+  for (const auto& c : cases) {
+    const Pose3 X_BG = model().CalcPalmPose(c.q);
+    EXPECT_LT((X_BG.translation() - c.p_BG).norm(), kFkToleranceM)
+        << c.name << ": palm at " << X_BG.translation().transpose();
+    // The palm's approach axis; the tucked pose leans by only 0.01 rad.
+    EXPECT_GT(X_BG.rotation().col(2).dot(c.palm_z), std::cos(0.02)) << c.name;
+  }
+}
+
+TEST_F(RobotModelTest, FingertipPointLiesAheadOfThePalm) {
+  // Expected from the URDF numbers by hand: proximal joint at z = -0.0175 in the palm, distal
+  // 0.07 further, fingertip frame (y, z) = (±0.01865, 0.04289) on the distal link, which sits
+  // at -0.087 rad (its mimic offset) when hand_motor_joint = 0. Without that offset the tip
+  // would be 0.095 m ahead of the palm (upstream_code_notes §1.2).
+  const double kDistalAngle = -0.087;
+  const double z =
+      -0.0175 + 0.07 + std::sin(kDistalAngle) * 0.01865 + std::cos(kDistalAngle) * 0.04289;
+  EXPECT_LT((model().fingertip_in_palm() - Eigen::Vector3d(0, 0, z)).norm(), 1e-9)
+      << model().fingertip_in_palm().transpose();
+  // With the arm vertical the fingertip point is straight above the palm.
+  const Eigen::Vector3d p_BF = model().CalcFingertipPosition(Arm(0, 0, 0, 0, 0));
+  EXPECT_LT((p_BF - Eigen::Vector3d(0.158, 0.078, 0.826 + z)).norm(), kFkToleranceM)
+      << p_BF.transpose();
+}
+
+TEST_F(RobotModelTest, BaseJointsMoveThePalmRigidly) {
+  const WholeBodyVector q_arm = Arm(0.2, -1.0, 0.3, -0.5, 0.7);
+  WholeBodyVector q = q_arm;
+  q[kBaseX] = 1.5;
+  q[kBaseY] = -2.0;
+  q[kBaseYaw] = 0.8;
+  const Pose3 X_MB = Pose3::FromPose2({1.5, -2.0, 0.8});
+  EXPECT_TRUE(model().CalcPalmPose(q).IsNearlyEqualTo(X_MB * model().CalcPalmPose(q_arm), 1e-12));
+}
+
+// The Jacobian equals a central finite difference of FK: linear rows against the point's
+// position, angular rows against the rotation (R(q+h) R(q-h)^T ≈ exp(2h [w]x)).
+TEST_F(RobotModelTest, JacobianMatchesCentralFiniteDifferences) {
+  std::mt19937 generator(20261121);
+  constexpr int kConfigurations = 200;
+  constexpr double kStep = 1e-6;
+  const WholeBodyVector lower = model().lower_limits();
+  const WholeBodyVector upper = model().upper_limits();
+  for (int n = 0; n < kConfigurations; ++n) {
+    WholeBodyVector q;
+    for (int i = 0; i < kNumWholeBodyJoints; ++i) {
+      const double lo = std::isfinite(lower[i]) ? lower[i] : -3.0;
+      const double hi = std::isfinite(upper[i]) ? upper[i] : 3.0;
+      q[i] = std::uniform_real_distribution<double>(lo, hi)(generator);
+    }
+    ASSERT_TRUE(model().IsWithinLimits(q));
+    for (const bool fingertip : {false, true}) {
+      const WholeBodyJacobian J =
+          fingertip ? model().CalcFingertipJacobian(q) : model().CalcPalmJacobian(q);
+      for (int i = 0; i < kNumWholeBodyJoints; ++i) {
+        WholeBodyVector plus = q, minus = q;
+        plus[i] += kStep;
+        minus[i] -= kStep;
+        const auto point = [&](const WholeBodyVector& x) {
+          return fingertip ? model().CalcFingertipPosition(x)
+                           : Eigen::Vector3d(model().CalcPalmPose(x).translation());
+        };
+        const Eigen::Vector3d v = (point(plus) - point(minus)) / (2 * kStep);
+        const Eigen::Matrix3d dR = model().CalcPalmPose(plus).rotation() *
+                                   model().CalcPalmPose(minus).rotation().transpose();
+        const Eigen::AngleAxisd w_aa(dR);
+        const Eigen::Vector3d w = w_aa.axis() * w_aa.angle() / (2 * kStep);
+        EXPECT_LT((J.block<3, 1>(0, i) - v).norm(), 1e-6)
+            << "linear column " << WholeBodyJointNames()[i] << " at q = " << q.transpose();
+        EXPECT_LT((J.block<3, 1>(3, i) - w).norm(), 1e-6)
+            << "angular column " << WholeBodyJointNames()[i] << " at q = " << q.transpose();
+      }
+    }
+  }
+}
+
+TEST_F(RobotModelTest, JointLimitsComeFromTheUrdf) {
+  EXPECT_DOUBLE_EQ(model().limits(kArmLift).upper, 0.69);
+  EXPECT_DOUBLE_EQ(model().limits(kArmFlex).lower, -2.62);
+  EXPECT_DOUBLE_EQ(model().limits(kWristRoll).upper, 3.67);
+  EXPECT_FALSE(std::isfinite(model().limits(kBaseX).upper));
+  EXPECT_DOUBLE_EQ(model().GetJointLimits("head_tilt_joint").lower, -1.57);
+  EXPECT_THROW(model().GetJointLimits("elbow_joint"), InvalidArgument);
+
+  WholeBodyVector q = Arm(1.0, 0.5, 0, 0, 0);
+  EXPECT_FALSE(model().IsWithinLimits(q));
+  const WholeBodyVector clamped = model().ClampToLimits(q);
+  EXPECT_DOUBLE_EQ(clamped[kArmLift], 0.69);
+  EXPECT_DOUBLE_EQ(clamped[kArmFlex], 0.0);
+  EXPECT_TRUE(model().IsWithinLimits(clamped));
+}
+
+TEST_F(RobotModelTest, SensorMountsAndFootprint) {
+  EXPECT_DOUBLE_EQ(model().footprint_radius(), 0.215);
+  EXPECT_LT((model().laser_pose().translation() - Eigen::Vector3d(0.1675, 0, 0.1844)).norm(), 1e-9);
+  // The RGB-D optical origin (−0.060, 0.022, 0.967) at zero lift rises by half the arm lift.
+  const Pose3 X_BC0 = model().CalcHeadCameraPose(0.0, {});
+  EXPECT_LT((X_BC0.translation() - Eigen::Vector3d(-0.060, 0.022, 0.967)).norm(), kFkToleranceM)
+      << X_BC0.translation().transpose();
+  const Pose3 X_BC1 = model().CalcHeadCameraPose(0.69, {});
+  EXPECT_NEAR(X_BC1.translation().z(), 1.312, kFkToleranceM);
+  // Optical convention: camera z looks forward along base x when pan = tilt = 0.
+  EXPECT_GT(X_BC0.rotation().col(2).dot(Eigen::Vector3d::UnitX()), 0.9999);
+  // Tilting down (negative tilt) turns the optical axis towards the floor.
+  const Pose3 X_BC_down = model().CalcHeadCameraPose(0.0, {0.0, -0.5});
+  EXPECT_LT(X_BC_down.rotation().col(2).z(), -0.4);
+}
+
+TEST_F(RobotModelTest, RejectsNonFiniteConfigurations) {
+  WholeBodyVector q = WholeBodyVector::Zero();
+  q[kArmFlex] = std::nan("");
+  try {
+    model().CalcPalmPose(q);
+    FAIL() << "expected InvalidArgument";
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("arm_flex_joint"));
+  }
+  EXPECT_THROW(model().CalcLinkPoseInBase("hand_palm_link", {{"no_such_joint", 0.0}}),
+               InvalidArgument);
+  EXPECT_THROW(model().CalcLinkPoseInBase("no_such_link", {}), InvalidArgument);
+}
+
+// --- Loading errors name the file and what is wrong.
+
+std::string DefaultUrdfText() {
+  std::ifstream file(RobotModel::DefaultUrdfPath());
+  return {std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+}
+
+// Replaces every occurrence of `from` in `text` by `to`; fails the test if there is none.
+std::string ReplaceAll(std::string text, const std::string& from, const std::string& to) {
+  std::size_t count = 0;
+  for (std::size_t at = text.find(from); at != std::string::npos; at = text.find(from, at)) {
+    text.replace(at, from.size(), to);
+    at += to.size();
+    ++count;
+  }
+  EXPECT_GT(count, 0u) << "'" << from << "' is not in the URDF";
+  return text;
+}
+
+std::string LoadErrorOf(const std::string& xml) {
+  try {
+    RobotModel::LoadFromString(xml, "test.urdf");
+  } catch (const LoadError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(RobotModelLoadTest, MissingFileIsNamed) {
+  try {
+    RobotModel::LoadFromFile("/nonexistent/dir/hsrb.urdf");
+    FAIL() << "expected LoadError";
+  } catch (const LoadError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("/nonexistent/dir/hsrb.urdf"));
+    EXPECT_THAT(e.what(), HasSubstr("does not exist"));
+  }
+}
+
+TEST(RobotModelLoadTest, MalformedXmlIsReported) {
+  const std::string message = LoadErrorOf("<robot name='x'><link name='a'></robot");
+  EXPECT_THAT(message, HasSubstr("test.urdf"));
+  EXPECT_THAT(message, ::testing::ContainsRegex("XML|xml|parse"));
+  EXPECT_THAT(LoadErrorOf("   \n"), HasSubstr("empty"));
+}
+
+TEST(RobotModelLoadTest, MissingJointIsNamed) {
+  std::string xml = DefaultUrdfText();
+  ASSERT_FALSE(xml.empty());
+  // Turn the wrist flex into a fixed joint: the whole-body chain then lacks it.
+  xml = ReplaceAll(xml, R"(<joint name="wrist_flex_joint" type="revolute">)",
+                   R"(<joint name="wrist_flex_joint" type="fixed">)");
+  const std::string message = LoadErrorOf(xml);
+  EXPECT_THAT(message, HasSubstr("test.urdf"));
+  EXPECT_THAT(message, HasSubstr("wrist_flex_joint"));
+}
+
+TEST(RobotModelLoadTest, MissingLinkIsNamed) {
+  std::string xml = DefaultUrdfText();
+  xml = ReplaceAll(xml, "base_range_sensor_link", "laser_link");
+  EXPECT_THAT(LoadErrorOf(xml), HasSubstr("'base_range_sensor_link'"));
+}
+
+TEST(RobotModelLoadTest, DanglingJointParentIsReported) {
+  std::string xml = DefaultUrdfText();
+  xml = ReplaceAll(xml, R"(<parent link="arm_roll_link"/>)", R"(<parent link="forearm_link"/>)");
+  const std::string message = LoadErrorOf(xml);
+  EXPECT_THAT(message, HasSubstr("test.urdf"));
+  EXPECT_THAT(message, HasSubstr("forearm_link"));
+}
+
+TEST(RobotModelLoadTest, FootprintRadiusFollowsTheBaseCylinder) {
+  std::string xml = DefaultUrdfText();
+  xml = ReplaceAll(xml, R"(<cylinder radius="0.215")", R"(<cylinder radius="0.25")");
+  EXPECT_DOUBLE_EQ(RobotModel::LoadFromString(xml, "wide.urdf").footprint_radius(), 0.25);
+}
+
+TEST(RobotModelLoadTest, CopiesAreIndependentAndEqual) {
+  const RobotModel a = RobotModel::LoadDefault();
+  RobotModel b = a;
+  const WholeBodyVector q = Arm(0.3, -1.2, 0.4, -0.3, 1.0);
+  EXPECT_TRUE(a.CalcPalmPose(q).IsNearlyEqualTo(b.CalcPalmPose(q), 0.0));
+  RobotModel c = std::move(b);
+  EXPECT_EQ(c.name(), "hsrb");
+}
+
+}  // namespace
+}  // namespace egress
