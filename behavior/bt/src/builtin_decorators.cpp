@@ -1,0 +1,301 @@
+// Decorators: Inverter, ForceSuccess, ForceFailure, Repeat, RetryUntilSuccessful,
+// KeepRunningUntilFailure, Delay, Timeout, RunOnce, Precondition; and the SubTree node.
+
+#include "builtin_nodes.h"
+#include "egress/bt/factory.h"
+
+namespace egress::bt::internal {
+namespace {
+
+/// Inverter, ForceSuccess, ForceFailure: map a completed child's result; RUNNING and SKIPPED
+/// pass through.
+class MapResultNode : public DecoratorNode {
+ public:
+  enum class Mode { kInvert, kForceSuccess, kForceFailure, kPassThrough };
+  MapResultNode(std::string name, NodeConfig config, Mode mode)
+      : DecoratorNode(std::move(name), std::move(config)), mode_(mode) {}
+
+ protected:
+  NodeStatus Tick() override {
+    SetStatus(NodeStatus::kRunning);
+    const NodeStatus child_status = child_->ExecuteTick();
+    if (!IsCompleted(child_status)) return child_status;
+    child_->ResetStatus();
+    switch (mode_) {
+      case Mode::kInvert:
+        return child_status == NodeStatus::kSuccess ? NodeStatus::kFailure : NodeStatus::kSuccess;
+      case Mode::kForceSuccess:
+        return NodeStatus::kSuccess;
+      case Mode::kForceFailure:
+        return NodeStatus::kFailure;
+      case Mode::kPassThrough:
+        return child_status;
+    }
+    return child_status;
+  }
+
+ private:
+  Mode mode_;
+};
+
+/// Repeat (while the child succeeds) and RetryUntilSuccessful (while it fails). A synchronous
+/// child loops within the tick; an asynchronous one yields (RUNNING) after each cycle, and so
+/// does every cycle of an endless (-1) loop, so that a tick always ends.
+class LoopNode : public DecoratorNode {
+ public:
+  LoopNode(std::string name, NodeConfig config, bool repeat_on_success)
+      : DecoratorNode(std::move(name), std::move(config)), repeat_on_success_(repeat_on_success) {}
+
+ protected:
+  NodeStatus Tick() override {
+    const char* port = repeat_on_success_ ? "num_cycles" : "num_attempts";
+    int limit = GetInput<int>(port).value();
+    SetStatus(NodeStatus::kRunning);
+    const NodeStatus continue_on = repeat_on_success_ ? NodeStatus::kSuccess : NodeStatus::kFailure;
+    while (limit == -1 || count_ < limit) {
+      const NodeStatus previous = child_->status();
+      const NodeStatus child_status = child_->ExecuteTick();
+      if (child_status == NodeStatus::kRunning) return child_status;
+      if (child_status == NodeStatus::kSkipped) {
+        child_->ResetStatus();
+        return NodeStatus::kSkipped;  // keeps the counter
+      }
+      child_->ResetStatus();
+      if (child_status != continue_on) {
+        count_ = 0;
+        return child_status;
+      }
+      ++count_;
+      if (!repeat_on_success_) limit = GetInput<int>(port).value();  // re-read after a failure
+      if ((previous == NodeStatus::kRunning || limit == -1) && (limit == -1 || count_ < limit)) {
+        return NodeStatus::kRunning;
+      }
+    }
+    count_ = 0;
+    return continue_on;
+  }
+  void Halt() override {
+    count_ = 0;
+    HaltChild();
+  }
+
+ private:
+  bool repeat_on_success_;
+  int count_{0};
+};
+
+class KeepRunningUntilFailureNode : public DecoratorNode {
+ public:
+  using DecoratorNode::DecoratorNode;
+
+ protected:
+  NodeStatus Tick() override {
+    SetStatus(NodeStatus::kRunning);
+    const NodeStatus child_status = child_->ExecuteTick();
+    if (child_status == NodeStatus::kFailure) {
+      child_->ResetStatus();
+      return NodeStatus::kFailure;
+    }
+    if (child_status == NodeStatus::kSuccess) {
+      child_->ResetStatus();
+      return NodeStatus::kRunning;
+    }
+    return child_status;
+  }
+};
+
+/// Delay: RUNNING for delay_msec of the tree's clock, then ticks the child.
+class DelayNode : public DecoratorNode {
+ public:
+  using DecoratorNode::DecoratorNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<unsigned>("delay_msec", "milliseconds to wait before ticking the child")};
+  }
+
+ protected:
+  NodeStatus Tick() override {
+    if (!started_) {
+      started_ = true;
+      start_ = context().Now();
+      delay_ = std::chrono::milliseconds(GetInput<unsigned>("delay_msec").value());
+      SetStatus(NodeStatus::kRunning);
+    }
+    if (context().Now() - start_ < delay_) return NodeStatus::kRunning;
+    const NodeStatus child_status = child_->ExecuteTick();
+    if (IsCompleted(child_status)) {
+      started_ = false;
+      child_->ResetStatus();
+    }
+    return child_status;
+  }
+  void Halt() override {
+    started_ = false;
+    HaltChild();
+  }
+
+ private:
+  bool started_{false};
+  Duration start_{};
+  Duration delay_{};
+};
+
+/// Timeout: halts a child still RUNNING msec after the first tick and returns FAILURE. The
+/// deadline is checked in the ticking thread (never from a timer thread).
+class TimeoutNode : public DecoratorNode {
+ public:
+  using DecoratorNode::DecoratorNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<unsigned>("msec", "milliseconds before the child is halted (0: never)")};
+  }
+
+ protected:
+  NodeStatus Tick() override {
+    if (!started_) {
+      started_ = true;
+      start_ = context().Now();
+      timeout_ = std::chrono::milliseconds(GetInput<unsigned>("msec").value());
+      SetStatus(NodeStatus::kRunning);
+    }
+    if (timeout_.count() > 0 && context().Now() - start_ >= timeout_ &&
+        child_->status() == NodeStatus::kRunning) {
+      started_ = false;
+      HaltChild();
+      return NodeStatus::kFailure;
+    }
+    const NodeStatus child_status = child_->ExecuteTick();
+    if (IsCompleted(child_status)) {
+      started_ = false;
+      child_->ResetStatus();
+    }
+    return child_status;
+  }
+  void Halt() override {
+    started_ = false;
+    HaltChild();
+  }
+
+ private:
+  bool started_{false};
+  Duration start_{};
+  Duration timeout_{};
+};
+
+class RunOnceNode : public DecoratorNode {
+ public:
+  using DecoratorNode::DecoratorNode;
+  static PortsList ProvidedPorts() {
+    return {
+        InputPort<bool>("then_skip", true, "after the first run: SKIPPED (true) or its result")};
+  }
+
+ protected:
+  NodeStatus Tick() override {
+    if (done_) return GetInput<bool>("then_skip").value() ? NodeStatus::kSkipped : result_;
+    SetStatus(NodeStatus::kRunning);
+    const NodeStatus child_status = child_->ExecuteTick();
+    if (IsCompleted(child_status)) {
+      done_ = true;
+      result_ = child_status;
+      child_->ResetStatus();
+    }
+    return child_status;
+  }
+
+ private:
+  bool done_{false};
+  NodeStatus result_{NodeStatus::kIdle};
+};
+
+/// Precondition: ticks the child if the `if` script is true, else returns `else`. The script is
+/// not re-checked while the child is RUNNING (BT.CPP 4.7+).
+class PreconditionNode : public DecoratorNode {
+ public:
+  PreconditionNode(std::string name, NodeConfig config)
+      : DecoratorNode(std::move(name), std::move(config)) {
+    if (auto text = PortText("if"); text && !BlackboardKeyOf(*text, "if"))
+      script_ = Script::Parse(*text);
+  }
+  static PortsList ProvidedPorts() {
+    PortsList ports = {InputPort<std::string>("if", "the condition script"),
+                       InputPort<NodeStatus>("else", NodeStatus::kFailure,
+                                             "returned when the condition is false")};
+    ports.at("if").script = true;
+    return ports;
+  }
+
+ protected:
+  NodeStatus Tick() override {
+    if (child_->status() != NodeStatus::kRunning) {
+      std::shared_ptr<const Script> script = script_;
+      if (!script) script = Script::Parse(GetInput<std::string>("if").value());
+      bool condition;
+      try {
+        condition = script->EvaluateCondition(script_environment());
+      } catch (const RuntimeError& e) {
+        throw RuntimeError(Cat("[", path(), "] if: ", e.what()));
+      }
+      if (!condition) return GetInput<NodeStatus>("else").value();
+    }
+    SetStatus(NodeStatus::kRunning);
+    const NodeStatus child_status = child_->ExecuteTick();
+    if (IsCompleted(child_status)) child_->ResetStatus();
+    return child_status;
+  }
+
+ private:
+  std::shared_ptr<const Script> script_;
+};
+
+}  // namespace
+
+NodeStatus SubTreeNode::Tick() {
+  if (status() == NodeStatus::kIdle) SetStatus(NodeStatus::kRunning);
+  const NodeStatus child_status = child_->ExecuteTick();
+  if (IsCompleted(child_status)) child_->ResetStatus();
+  return child_status;
+}
+
+std::unique_ptr<TreeNode> MakeStandInDecorator(std::string name, NodeConfig config) {
+  return std::make_unique<MapResultNode>(std::move(name), std::move(config),
+                                         MapResultNode::Mode::kPassThrough);
+}
+
+void RegisterBuiltinDecorators(BehaviorTreeFactory& factory) {
+  const auto reg = [&](const std::string& id, PortsList ports, NodeBuilder builder) {
+    factory.RegisterBuilder({id, NodeKind::kDecorator, std::move(ports), "", true},
+                            std::move(builder));
+  };
+  using Mode = MapResultNode::Mode;
+  for (auto [id, mode] :
+       {std::pair{"Inverter", Mode::kInvert}, std::pair{"ForceSuccess", Mode::kForceSuccess},
+        std::pair{"ForceFailure", Mode::kForceFailure}}) {
+    reg(id, {}, [mode](const std::string& n, NodeConfig c) {
+      return std::make_unique<MapResultNode>(n, std::move(c), mode);
+    });
+  }
+  reg("Repeat", {InputPort<int>("num_cycles", "repetitions; -1 repeats forever")},
+      [](const std::string& n, NodeConfig c) {
+        return std::make_unique<LoopNode>(n, std::move(c), true);
+      });
+  reg("RetryUntilSuccessful", {InputPort<int>("num_attempts", "attempts; -1 retries forever")},
+      [](const std::string& n, NodeConfig c) {
+        return std::make_unique<LoopNode>(n, std::move(c), false);
+      });
+  reg("KeepRunningUntilFailure", {}, [](const std::string& n, NodeConfig c) {
+    return std::make_unique<KeepRunningUntilFailureNode>(n, std::move(c));
+  });
+  reg("Delay", DelayNode::ProvidedPorts(), [](const std::string& n, NodeConfig c) {
+    return std::make_unique<DelayNode>(n, std::move(c));
+  });
+  reg("Timeout", TimeoutNode::ProvidedPorts(), [](const std::string& n, NodeConfig c) {
+    return std::make_unique<TimeoutNode>(n, std::move(c));
+  });
+  reg("RunOnce", RunOnceNode::ProvidedPorts(), [](const std::string& n, NodeConfig c) {
+    return std::make_unique<RunOnceNode>(n, std::move(c));
+  });
+  reg("Precondition", PreconditionNode::ProvidedPorts(), [](const std::string& n, NodeConfig c) {
+    return std::make_unique<PreconditionNode>(n, std::move(c));
+  });
+}
+
+}  // namespace egress::bt::internal
