@@ -133,8 +133,13 @@ NodeStatus TreeNode::ExecuteTick() {
                            " returned RUNNING"));
     }
   }
-  // A skipped node keeps IDLE as its own status; the parent sees SKIPPED.
-  if (result != NodeStatus::kSkipped) SetStatus(result);
+  // A skipped node keeps IDLE as its own status (a control node that set itself RUNNING
+  // before all its children skipped goes back to IDLE); the parent sees SKIPPED.
+  if (result != NodeStatus::kSkipped) {
+    SetStatus(result);
+  } else if (status_ != NodeStatus::kIdle) {
+    ResetStatus();
+  }
   RunPostConditions(result);
   return result;
 }

@@ -3,6 +3,7 @@
 /// Port declarations. Each node type declares its ports (name, direction, C++ type, default,
 /// description) in a static `ProvidedPorts()`; the XML loader checks a tree against them.
 
+#include <charconv>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -77,6 +78,10 @@ std::string DefaultToText(const T& value) {
     return std::string(std::string_view(value));
   } else if constexpr (std::is_same_v<T, NodeStatus>) {
     return std::string(ToString(value));
+  } else if constexpr (std::is_floating_point_v<T>) {
+    char buffer[32];  // shortest text that reads back to the same value: "0.004", not 0.00400…1
+    const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+    return std::string(buffer, result.ptr);
   } else {
     std::ostringstream out;
     out.precision(17);
