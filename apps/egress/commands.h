@@ -5,13 +5,26 @@
 
 #include <CLI/CLI.hpp>
 
+#include <stdexcept>
+
 namespace egress::apps {
+
+/// A sub-command failed; its message (if not empty) is printed by main(), which exits with 1.
+/// An empty message means the command has reported the failure itself.
+class CommandFailed : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 /// `egress --version`: the text printed (egress version, git revision, library versions).
 std::string VersionText();
 
 /// `egress model ...`: inspect the HSR robot model (joints, limits, forward kinematics).
 void AddModelCommand(CLI::App& app);
+
+/// `egress bt validate|trace`: check BehaviorTree.CPP v4 trees and run them with scripted
+/// stand-in leaves.
+void AddBtCommand(CLI::App& app);
 
 /// A sub-command reserved for a capability that is not built yet: it is listed in --help with
 /// what it will do, and running it fails with a clear message.

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
                        "Print the egress version and the library versions it was built with");
 
   egress::apps::AddModelCommand(app);
+  egress::apps::AddBtCommand(app);
   egress::apps::AddPlannedCommand(app, "sim", "Run one twin scenario end to end",
                                   "the robot-brain issue (twin + executive)");
   egress::apps::AddPlannedCommand(app, "batch",
@@ -34,6 +35,9 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const egress::apps::CommandFailed& e) {
+    if (*e.what() != '\0') std::fprintf(stderr, "egress: error: %s\n", e.what());
+    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "egress: error: %s\n", e.what());
     return 1;

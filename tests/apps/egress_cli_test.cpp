@@ -4,6 +4,9 @@
 
 #include <array>
 #include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include <gmock/gmock.h>
@@ -75,6 +78,95 @@ TEST(EgressCliTest, ClearErrors) {
 
   result = RunEgress("no-such-command");
   EXPECT_NE(result.exit_code, 0);
+}
+
+// ---- egress bt
+
+std::string WriteTemp(const std::string& name, const std::string& text) {
+  const auto path = std::filesystem::temp_directory_path() / ("egress_cli_test_" + name);
+  std::ofstream(path) << text;
+  return path.string();
+}
+
+const char* kDoorTree = R"(<root BTCPP_format="4">
+  <BehaviorTree ID="Door">
+    <ReactiveSequence>
+      <IsPathClear/>
+      <Fallback>
+        <IsDoorOpen/>
+        <PressButton stroke="0.004"/>
+      </Fallback>
+      <TraverseDoor/>
+    </ReactiveSequence>
+  </BehaviorTree>
+</root>)";
+
+TEST(EgressCliTest, BtValidateListsUnknownNodes) {
+  const std::string tree = WriteTemp("door.xml", kDoorTree);
+  const Result result = RunEgress("bt validate " + tree);
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("door.xml:4: unknown node type 'IsPathClear'"));
+  EXPECT_THAT(
+      result.output,
+      HasSubstr("unknown node types (4): IsPathClear, IsDoorOpen, PressButton, TraverseDoor"));
+
+  const std::string ok = WriteTemp("ok.xml",
+                                   "<root BTCPP_format='4'><BehaviorTree ID='A'><AlwaysSuccess/>"
+                                   "</BehaviorTree></root>");
+  const Result valid = RunEgress("bt validate " + ok);
+  EXPECT_EQ(valid.exit_code, 0) << valid.output;
+  EXPECT_THAT(valid.output, HasSubstr("OK"));
+
+  const std::string broken = WriteTemp("broken.xml",
+                                       "<root BTCPP_format='4'>\n<BehaviorTree ID='A'>\n<Repeat>"
+                                       "<AlwaysSuccess/></Repeat></BehaviorTree></root>");
+  const Result bad = RunEgress("bt validate " + broken);
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_THAT(bad.output,
+              HasSubstr("broken.xml:3: node 'Repeat': missing required port 'num_cycles'"));
+}
+
+TEST(EgressCliTest, BtTracePrintsTransitionsTickByTick) {
+  const std::string tree = WriteTemp("door.xml", kDoorTree);
+  const std::string script = WriteTemp("door.yaml", R"(tick_period_ms: 100
+max_ticks: 10
+default: SUCCESS
+ticks:
+  - outcomes: {IsDoorOpen: FAILURE, PressButton: SUCCESS, TraverseDoor: RUNNING}
+  - outcomes: {IsPathClear: FAILURE}
+  - outcomes: {IsDoorOpen: SUCCESS, TraverseDoor: SUCCESS}
+)");
+  const Result result = RunEgress("bt trace " + tree + " --script " + script);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_THAT(result.output,
+              HasSubstr("stand-ins: IsPathClear, IsDoorOpen, PressButton, TraverseDoor"));
+  EXPECT_THAT(result.output, HasSubstr("tick 2 (t = 100 ms)"));
+  EXPECT_THAT(result.output,
+              ::testing::ContainsRegex("TraverseDoor::6 +RUNNING -> IDLE"));  // preempted
+  EXPECT_THAT(result.output, HasSubstr("result: FAILURE after 2 ticks"));
+
+  const Result json = RunEgress("bt trace " + tree + " --script " + script + " --json");
+  ASSERT_EQ(json.exit_code, 0) << json.output;
+  const auto parsed = nlohmann::json::parse(json.output);
+  EXPECT_EQ(parsed.at("result"), "FAILURE");
+  EXPECT_EQ(parsed.at("ticks").size(), 2u);
+}
+
+TEST(EgressCliTest, BtTraceScriptErrorsNameTheLine) {
+  const std::string tree = WriteTemp("door.xml", kDoorTree);
+  const std::string bad_status =
+      WriteTemp("bad.yaml", "ticks:\n  - outcomes: {PressButton: DONE}\n");
+  Result result = RunEgress("bt trace " + tree + " --script " + bad_status);
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_THAT(result.output,
+              HasSubstr("bad.yaml:2: outcome of 'PressButton': 'DONE' is not an outcome"));
+  const std::string bad_key = WriteTemp("key.yaml", "tick_period: 100\n");
+  result = RunEgress("bt trace " + tree + " --script " + bad_key);
+  EXPECT_THAT(result.output, HasSubstr("key.yaml:1: unknown field 'tick_period'"));
+  const std::string bad_node =
+      WriteTemp("node.yaml", "ticks:\n  - outcomes: {OpenDoor: SUCCESS}\n");
+  result = RunEgress("bt trace " + tree + " --script " + bad_node);
+  EXPECT_THAT(result.output, HasSubstr("no node is named 'OpenDoor'"));
 }
 
 }  // namespace
