@@ -11,42 +11,40 @@
 namespace egress::bt::internal {
 namespace {
 
-/// Sequence and SequenceWithMemory. On FAILURE a Sequence restarts from child 0; one with
-/// memory retries the failed child. Neither re-ticks completed children while one runs.
-class SequenceNode : public ControlNode {
+/// Sequence, SequenceWithMemory and Fallback: tick children in order and resume at a RUNNING
+/// child without re-ticking completed ones. A Sequence stops at the first FAILURE (and starts
+/// over next time; with memory it retries the failed child), a Fallback at the first SUCCESS.
+class OrderedNode : public ControlNode {
  public:
-  SequenceNode(std::string name, NodeConfig config, bool with_memory)
-      : ControlNode(std::move(name), std::move(config)), with_memory_(with_memory) {}
+  OrderedNode(std::string name, NodeConfig config, bool is_sequence, bool with_memory)
+      : ControlNode(std::move(name), std::move(config)),
+        is_sequence_(is_sequence),
+        with_memory_(with_memory) {}
 
  protected:
   NodeStatus Tick() override {
     if (status() == NodeStatus::kIdle) all_skipped_ = true;
     SetStatus(NodeStatus::kRunning);
+    const NodeStatus stop_on = is_sequence_ ? NodeStatus::kFailure : NodeStatus::kSuccess;
     while (index_ < children_.size()) {
       const NodeStatus child_status = children_[index_]->ExecuteTick();
       all_skipped_ = all_skipped_ && child_status == NodeStatus::kSkipped;
-      switch (child_status) {
-        case NodeStatus::kRunning:
-          return NodeStatus::kRunning;
-        case NodeStatus::kFailure:
-          if (with_memory_) {
-            HaltChildren(index_);  // keep the index: the next tick retries this child
-          } else {
-            HaltChildren();
-            index_ = 0;
-          }
-          return NodeStatus::kFailure;
-        case NodeStatus::kSuccess:
-        case NodeStatus::kSkipped:
-          ++index_;
-          break;
-        case NodeStatus::kIdle:
-          break;
+      if (child_status == NodeStatus::kRunning) return NodeStatus::kRunning;
+      if (child_status == stop_on) {
+        if (with_memory_) {
+          HaltChildren(index_);  // keep the index: the next tick retries this child
+        } else {
+          HaltChildren();
+          index_ = 0;
+        }
+        return stop_on;
       }
+      ++index_;  // the other result, or SKIPPED: move on
     }
     HaltChildren();
     index_ = 0;
-    return all_skipped_ ? NodeStatus::kSkipped : NodeStatus::kSuccess;
+    if (all_skipped_) return NodeStatus::kSkipped;
+    return is_sequence_ ? NodeStatus::kSuccess : NodeStatus::kFailure;
   }
 
   void Halt() override {
@@ -56,6 +54,7 @@ class SequenceNode : public ControlNode {
   }
 
  private:
+  bool is_sequence_;
   bool with_memory_;
   std::size_t index_{0};
   bool all_skipped_{true};
@@ -116,46 +115,6 @@ class ReactiveNode : public ControlNode {
     return kNone;
   }
   bool is_sequence_;
-};
-
-class FallbackNode : public ControlNode {
- public:
-  using ControlNode::ControlNode;
-
- protected:
-  NodeStatus Tick() override {
-    if (status() == NodeStatus::kIdle) all_skipped_ = true;
-    SetStatus(NodeStatus::kRunning);
-    while (index_ < children_.size()) {
-      const NodeStatus child_status = children_[index_]->ExecuteTick();
-      all_skipped_ = all_skipped_ && child_status == NodeStatus::kSkipped;
-      switch (child_status) {
-        case NodeStatus::kRunning:
-          return NodeStatus::kRunning;
-        case NodeStatus::kSuccess:
-          HaltChildren();
-          index_ = 0;
-          return NodeStatus::kSuccess;
-        case NodeStatus::kFailure:
-        case NodeStatus::kSkipped:
-          ++index_;
-          break;
-        case NodeStatus::kIdle:
-          break;
-      }
-    }
-    HaltChildren();
-    index_ = 0;
-    return all_skipped_ ? NodeStatus::kSkipped : NodeStatus::kFailure;
-  }
-  void Halt() override {
-    index_ = 0;
-    HaltChildren();
-  }
-
- private:
-  std::size_t index_{0};
-  bool all_skipped_{true};
 };
 
 /// Resolves a negative threshold t to N + t + 1 (so -1 means "all").
@@ -412,10 +371,10 @@ class SwitchNode : public ControlNode {
 };
 
 /// Stand-in for an unknown control node: a Sequence.
-class StandInControl final : public SequenceNode {
+class StandInControl final : public OrderedNode {
  public:
   StandInControl(std::string name, NodeConfig config)
-      : SequenceNode(std::move(name), std::move(config), false) {}
+      : OrderedNode(std::move(name), std::move(config), true, false) {}
 };
 
 }  // namespace
@@ -432,16 +391,16 @@ void RegisterBuiltinControls(BehaviorTreeFactory& factory) {
                             });
   };
   reg("Sequence", {}, [](const std::string& n, NodeConfig c) {
-    return std::make_unique<SequenceNode>(n, std::move(c), false);
+    return std::make_unique<OrderedNode>(n, std::move(c), true, false);
   });
   reg("SequenceWithMemory", {}, [](const std::string& n, NodeConfig c) {
-    return std::make_unique<SequenceNode>(n, std::move(c), true);
+    return std::make_unique<OrderedNode>(n, std::move(c), true, true);
   });
   reg("ReactiveSequence", {}, [](const std::string& n, NodeConfig c) {
     return std::make_unique<ReactiveNode>(n, std::move(c), true);
   });
   reg("Fallback", {}, [](const std::string& n, NodeConfig c) {
-    return std::make_unique<FallbackNode>(n, std::move(c));
+    return std::make_unique<OrderedNode>(n, std::move(c), false, false);
   });
   reg("ReactiveFallback", {}, [](const std::string& n, NodeConfig c) {
     return std::make_unique<ReactiveNode>(n, std::move(c), false);
