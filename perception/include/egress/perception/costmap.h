@@ -1,0 +1,104 @@
+#pragma once
+/// @file
+/// Costmap2D: the 2D world model the base planner reads. Layers, combined into one master grid:
+///  - static: the occupancy map (walls);
+///  - obstacle: marked and cleared by ray tracing each laser scan;
+///  - projection: obstacles the laser misses, projected from the OctoMap (table tops, overhangs);
+///  - door leaves: each known door's leaf at its current estimated angle;
+///  - inflation: cost decaying with distance to the nearest lethal cell (Nav2's formula:
+///    lethal at 0, kInscribedCost within the robot radius, 252·exp(−k·(d − r)) beyond);
+///  - doorways: inside a known doorway's threshold the decaying part of the inflation is dropped
+///    (only lethal and inscribed remain), so inflation never seals a door the robot fits through
+///    — the paper's S7 failure.
+/// Updates are local: a scan recomputes only the window it touched plus the inflation margin.
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "egress/hsr_interface/sensor_types.h"
+#include "egress/perception/occupancy_grid.h"
+
+namespace egress::perception {
+
+struct CostmapConfig {
+  double robot_radius{0.215};        ///< Inscribed radius of the round footprint [m].
+  double inflation_radius{0.55};     ///< Cost decays to 0 at this distance [m].
+  double cost_scaling_factor{10.0};  ///< k in the exponential decay [1/m].
+  double obstacle_max_range{2.5};    ///< Scan returns beyond this do not mark [m].
+  double raytrace_max_range{3.0};    ///< Scan rays clear free space up to this range [m].
+  /// @throws InvalidArgument naming the field.
+  void Validate() const;
+};
+
+/// A doorway: the two jambs in M. The leaf (if any) hangs on `p_MHinge`'s jamb and swings to
+/// the side given by `swing_sign` (+1: counter-clockwise from the closed line, seen from above).
+struct Doorway {
+  std::string id;
+  Eigen::Vector2d p_MHinge{Eigen::Vector2d::Zero()};  ///< Hinge-side jamb [m].
+  Eigen::Vector2d p_MLatch{Eigen::Vector2d::Zero()};  ///< Latch-side jamb [m].
+  double swing_sign{1.0};
+  double threshold_depth{
+      0.3};  ///< How far the threshold zone reaches each side of the door line [m].
+  double width() const { return (p_MLatch - p_MHinge).norm(); }
+};
+
+class Costmap2D {
+ public:
+  /// A costmap the size of `static_map`. @throws InvalidArgument for a bad config.
+  Costmap2D(const OccupancyGrid& static_map, CostmapConfig config = {});
+
+  /// Marks returns within obstacle_max_range and clears cells along every ray (up to
+  /// raytrace_max_range). X_ML is the laser's pose in M at the scan's time.
+  /// @throws InvalidArgument for an invalid scan or pose.
+  void UpdateWithScan(const LaserScan& scan, const Pose2& X_ML);
+  /// Replaces the projected 3D obstacles (points in M).
+  void SetProjectedObstacles(const std::vector<Eigen::Vector2d>& p_MObstacles);
+  /// Clears the obstacle layer (e.g. after relocalization).
+  void ClearObstacles();
+
+  /// Adds a known doorway. @throws InvalidArgument if its id exists or its jambs coincide.
+  void AddDoorway(const Doorway& doorway);
+  /// Marks the leaf of doorway `id` at `angle` [rad] from closed (0 = closed; nullopt removes it:
+  /// no leaf or unknown). @throws InvalidArgument for an unknown id.
+  void SetDoorLeafAngle(const std::string& id, std::optional<double> angle);
+  const std::map<std::string, Doorway>& doorways() const { return doorways_; }
+
+  /// Cost of the cell holding p_MQ (kUnknownCost outside the map).
+  std::uint8_t CostAt(const Eigen::Vector2d& p_MQ) const;
+  /// Highest cost over the round footprint centred at X_MB (kUnknownCost if it leaves the map).
+  std::uint8_t FootprintCost(const Pose2& X_MB) const;
+  /// True when the robot centred at p_MB touches no obstacle (centre cost below inscribed).
+  bool IsFree(const Eigen::Vector2d& p_MB) const { return CostAt(p_MB) < kInscribedCost; }
+
+  const GridGeometry& geometry() const { return geometry_; }
+  const CostmapConfig& config() const { return config_; }
+  /// The master grid, row-major (see GridGeometry).
+  const std::vector<std::uint8_t>& costs() const { return master_; }
+  /// The master grid as an 8-bit image, row 0 = highest y (for PNG output).
+  cv::Mat ToImage() const;
+
+ private:
+  void RecomputeWindow(int x0, int y0, int x1, int y1);
+  void MarkLeaf(const Doorway& doorway, double angle, std::uint8_t value);
+  std::uint8_t InflatedCost(double distance) const;
+
+  CostmapConfig config_;
+  GridGeometry geometry_;
+  std::vector<std::uint8_t> static_;
+  std::vector<std::uint8_t> obstacle_;
+  std::vector<std::uint8_t> projection_;
+  std::vector<std::uint8_t> leaves_;
+  std::vector<std::uint8_t> doorway_zone_;  ///< 1 inside a doorway threshold.
+  std::vector<std::uint8_t> master_;
+  std::vector<Eigen::Vector2i> projected_cells_;
+  std::map<std::string, Doorway> doorways_;
+  std::map<std::string, double> leaf_angles_;
+  std::vector<std::uint8_t> inflation_lookup_;  // cost by distance in 1/8 cells
+};
+
+}  // namespace egress::perception

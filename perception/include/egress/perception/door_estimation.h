@@ -1,0 +1,119 @@
+#pragma once
+/// @file
+/// Doors as a continuous angle (the paper's future work, and the fix for its S3 failure where a
+/// half-open door was read as closed).
+///  - FitLineRansac: robust line through laser points (RANSAC, then least squares on the
+///    inliers) — for glass leaves, whose depth is invalid: the detector's box selects the
+///    angular slice of the scan (BoxBearingsInLaser, ScanPointsInBearings).
+///  - MeasureDoorAngle: the leaf angle from laser points near the hinge (median of their polar
+///    angles about the hinge), or DoorAngleFromLine from a fitted leaf line.
+///  - DoorStateTracker: smooths the angle over time and reports open_fraction, the clear width
+///    of the opening, and the motion (closed, opening, open, held open, closing).
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "egress/hsr_interface/geometry.h"
+#include "egress/hsr_interface/sensor_types.h"
+
+namespace egress::perception {
+
+/// A hinged door in M: the hinge-side and latch-side jambs of the closed leaf.
+struct DoorModel {
+  std::string id;
+  Eigen::Vector2d p_MHinge{Eigen::Vector2d::Zero()};
+  Eigen::Vector2d p_MLatch{Eigen::Vector2d::Zero()};
+  double swing_sign{1.0};  ///< +1: the leaf opens counter-clockwise seen from above.
+  double max_open_angle{1.5707963267948966};  ///< [rad]
+  double width() const { return (p_MLatch - p_MHinge).norm(); }
+  double closed_yaw() const;
+  /// Where the leaf's free edge is at `angle` [m, in M].
+  Eigen::Vector2d LeafTip(double angle) const;
+  /// Clear width of the opening at `angle`: w·(1 − cos θ) up to 90°, w beyond [m].
+  double ClearanceWidth(double angle) const;
+  void Validate() const;
+};
+
+struct LineFit {
+  Eigen::Vector2d p_M{Eigen::Vector2d::Zero()};         ///< Centroid of the inliers [m].
+  Eigen::Vector2d direction{Eigen::Vector2d::UnitX()};  ///< Unit direction.
+  std::size_t inliers{0};
+  double rms{0.0};  ///< RMS distance of the inliers to the line [m].
+};
+
+struct LineFitConfig {
+  int iterations{100};
+  double inlier_distance{0.03};  ///< [m]
+  std::size_t min_inliers{5};
+  std::uint64_t seed{7};
+};
+
+/// nullopt when fewer than min_inliers points support a line.
+std::optional<LineFit> FitLineRansac(const std::vector<Eigen::Vector2d>& points,
+                                     const LineFitConfig& config = {});
+
+/// Bearings in the laser frame L (angle about +z from L's x axis) of the left and right edges
+/// of a camera box, at the box's middle row. X_LC is the camera pose in L.
+std::pair<double, double> BoxBearingsInLaser(const PixelBox& box,
+                                             const CameraIntrinsics& intrinsics, const Pose3& X_LC);
+/// Points in M of the valid returns whose bearing lies in [bearing_min, bearing_max].
+std::vector<Eigen::Vector2d> ScanPointsInBearings(const LaserScan& scan, const Pose2& X_ML,
+                                                  double bearing_min, double bearing_max);
+/// Every valid return of the scan, in M.
+std::vector<Eigen::Vector2d> ScanPoints(const LaserScan& scan, const Pose2& X_ML);
+
+struct DoorAngleMeasurement {
+  double angle{0.0};       ///< From closed [rad], in [0, max_open_angle].
+  std::size_t support{0};  ///< Points that voted.
+};
+
+/// The leaf angle from points near the door: those between 15% and 95% of the leaf width from
+/// the hinge, within the swept sector (±10° margin), vote with their polar angle; the median
+/// wins. nullopt with fewer than `min_support` votes (leaf not seen).
+std::optional<DoorAngleMeasurement> MeasureDoorAngle(const DoorModel& door,
+                                                     const std::vector<Eigen::Vector2d>& p_MPoints,
+                                                     std::size_t min_support = 4);
+/// The leaf angle of a fitted leaf line (a glass door): the line's direction against the closed
+/// line, on the swing side, clamped to [0, max_open_angle].
+double DoorAngleFromLine(const DoorModel& door, const LineFit& line);
+
+enum class DoorMotion { kUnknown, kClosed, kOpening, kOpen, kHeldOpen, kClosing };
+std::string_view ToString(DoorMotion motion);
+
+struct DoorState {
+  bool observed{false};
+  double angle{0.0};            ///< Smoothed, from closed [rad].
+  double rate{0.0};             ///< [rad/s], positive while opening.
+  double open_fraction{0.0};    ///< angle / max_open_angle in [0, 1].
+  double clearance_width{0.0};  ///< Clear width of the opening [m].
+  DoorMotion motion{DoorMotion::kUnknown};
+  double steady_for{0.0};  ///< How long the angle has been steady [s].
+  Time stamp{};
+};
+
+struct DoorStateConfig {
+  double smoothing{0.5};        ///< Weight of a new measurement.
+  double closed_angle{0.0873};  ///< Below this the door is closed [rad] (5°).
+  double motion_rate{0.1};      ///< |rate| above this is moving [rad/s].
+  double held_after{1.0};       ///< Open and steady this long: held open [s].
+};
+
+class DoorStateTracker {
+ public:
+  DoorStateTracker(DoorModel door, DoorStateConfig config = {});
+  /// A new angle measurement at `stamp` (stamps must not decrease).
+  void Update(double angle, Time stamp);
+  const DoorState& state() const { return state_; }
+  const DoorModel& door() const { return door_; }
+
+ private:
+  DoorModel door_;
+  DoorStateConfig config_;
+  DoorState state_;
+};
+
+}  // namespace egress::perception

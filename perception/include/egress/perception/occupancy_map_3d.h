@@ -1,0 +1,47 @@
+#pragma once
+/// @file
+/// OccupancyMap3D: an OctoMap of obstacles seen by the head depth camera, for what the planar
+/// laser misses (table tops, overhangs), with a projection into the costmap and the tree itself
+/// for FCL collision checks.
+
+#include <memory>
+#include <vector>
+
+#include <octomap/OcTree.h>
+
+#include "egress/hsr_interface/geometry.h"
+#include "egress/hsr_interface/sensor_types.h"
+
+namespace egress::perception {
+
+struct OccupancyMap3DConfig {
+  double resolution{0.05};           ///< Voxel size [m].
+  double max_range{4.0};             ///< Depth returns beyond this only clear space [m].
+  int pixel_stride{1};               ///< Use every n-th pixel in u and v.
+  double min_obstacle_height{0.05};  ///< Projection band in M's z [m]: the floor is below it,
+  double max_obstacle_height{1.5};   ///< and what the robot passes under is above it.
+  void Validate() const;
+};
+
+class OccupancyMap3D {
+ public:
+  explicit OccupancyMap3D(OccupancyMap3DConfig config = {});
+
+  /// Inserts a depth image seen from camera pose X_MC (optical frame: z forward). Invalid
+  /// pixels (NaN, 0) are skipped. Returns the number of points inserted.
+  /// @throws InvalidArgument if the image and intrinsics disagree or the pose is not finite.
+  std::size_t InsertDepthImage(const DepthImage& depth, const CameraIntrinsics& intrinsics,
+                               const Pose3& X_MC);
+  /// Centres (x, y) of occupied voxels whose z lies within the obstacle band.
+  std::vector<Eigen::Vector2d> ProjectObstacles() const;
+  bool IsOccupied(const Eigen::Vector3d& p_MQ) const;
+  /// The OctoMap (shared so that FCL can hold it).
+  std::shared_ptr<const octomap::OcTree> tree() const { return tree_; }
+  const OccupancyMap3DConfig& config() const { return config_; }
+
+ private:
+  OccupancyMap3DConfig config_;
+  std::shared_ptr<octomap::OcTree> tree_;
+};
+
+}  // namespace egress::perception

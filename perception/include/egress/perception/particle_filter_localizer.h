@@ -1,0 +1,88 @@
+#pragma once
+/// @file
+/// ParticleFilterLocalizer: AMCL-style Monte Carlo localization of the base on the static map.
+/// Motion model: the omnidirectional odometry model (AMCL's "omni"): each increment is a
+/// translation along its bearing, a strafe across it and a rotation, each with Gaussian noise
+/// growing with the translation and rotation of the increment. Measurement model: likelihood field
+/// (distance from each beam endpoint to the nearest occupied cell, Gaussian with sigma_hit, mixed
+/// with a uniform term). Resampling: low-variance, when the effective sample size falls below a
+/// fraction of N. Deterministic for a given seed.
+
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "egress/hsr_interface/geometry.h"
+#include "egress/hsr_interface/sensor_types.h"
+#include "egress/perception/occupancy_grid.h"
+
+namespace egress::perception {
+
+struct LocalizerConfig {
+  int num_particles{500};
+  /// Odometry noise (variance per squared motion): rotation from rotation, rotation from
+  /// translation, translation from translation, translation from rotation, strafe from
+  /// translation.
+  double alpha_rot_rot{0.05};
+  double alpha_rot_trans{0.02};
+  double alpha_trans_trans{0.05};
+  double alpha_trans_rot{0.02};
+  double alpha_strafe_trans{0.02};
+  double sigma_hit{0.08};            ///< Std. dev. of the likelihood field [m].
+  double z_hit{0.9};                 ///< Weight of the hit term; the rest is uniform.
+  int max_beams{60};                 ///< Beams used per scan (evenly spread).
+  double laser_max_range{20.0};      ///< Returns beyond this are ignored [m].
+  double resample_threshold{0.5};    ///< Resample when N_eff < threshold * N.
+  double update_min_distance{0.02};  ///< Skip a correction unless the base moved this far [m]…
+  double update_min_angle{0.02};     ///< …or turned this much [rad].
+  std::uint64_t seed{1};
+  void Validate() const;
+};
+
+class ParticleFilterLocalizer {
+ public:
+  /// `X_BL` is the laser's pose in the base frame.
+  ParticleFilterLocalizer(const OccupancyGrid& map, const Pose2& X_BL, LocalizerConfig config = {});
+
+  /// Spreads the particles as a Gaussian around X_MB with the given (x, y, yaw) covariance.
+  /// @throws InvalidArgument for a non-finite pose or a covariance that is not PSD.
+  void Initialize(const Pose2& X_MB, const Eigen::Matrix3d& covariance);
+  /// Moves the particles by the odometry increment from X_OB_previous to X_OB_current.
+  void Predict(const Pose2& X_OB_previous, const Pose2& X_OB_current);
+  /// Weighs the particles by the scan and resamples if needed. Returns false when skipped
+  /// (not moved enough since the last correction, or no usable beam).
+  bool Correct(const LaserScan& scan);
+  /// Convenience for one cycle: Predict from the last odometry seen, then Correct.
+  void Update(const Pose2& X_OB, const LaserScan& scan);
+
+  /// Weighted mean pose (circular mean for yaw).
+  Pose2 Estimate() const;
+  /// Weighted covariance of (x, y, yaw) [m², rad²].
+  Eigen::Matrix3d Covariance() const;
+  bool initialized() const { return !particles_.empty(); }
+  int resample_count() const { return resample_count_; }
+
+ private:
+  struct Particle {
+    Pose2 X_MB;
+    double weight;
+  };
+  double LikelihoodFieldDistance(const Eigen::Vector2d& p_MQ) const;
+  void Resample();
+
+  LocalizerConfig config_;
+  GridGeometry geometry_;
+  std::vector<float> distance_;  // to the nearest occupied cell [m], per cell
+  Pose2 X_BL_;
+  std::vector<Particle> particles_;
+  std::mt19937_64 random_;
+  std::optional<Pose2> last_odometry_;
+  double moved_distance_{0.0};
+  double moved_angle_{0.0};
+  bool moved_since_correction_{true};
+  int resample_count_{0};
+};
+
+}  // namespace egress::perception

@@ -1,0 +1,102 @@
+#pragma once
+/// @file
+/// WorldState: the snapshot of the world the behavior tree reasons over each tick, and
+/// PerceptionPipeline, which builds it from sensor data: per camera frame (confidence filter,
+/// 3D placement, object and person tracking), per scan (door angles, glass-door line fits).
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <octomap/OcTree.h>
+
+#include "egress/perception/costmap.h"
+#include "egress/perception/detection.h"
+#include "egress/perception/door_estimation.h"
+#include "egress/perception/object_tracker.h"
+#include "egress/perception/person_tracker.h"
+
+namespace egress::perception {
+
+/// Detector labels perception knows (the paper's classes).
+namespace labels {
+inline constexpr std::string_view kPerson = "person";
+inline constexpr std::string_view kDoor = "door";
+inline constexpr std::string_view kGlassDoor = "glass_door";
+inline constexpr std::string_view kPushButton = "push_button";
+inline constexpr std::string_view kProximityPlate = "proximity_plate";
+inline constexpr std::string_view kBottle = "bottle";
+inline constexpr std::string_view kFlashlight = "flashlight";
+}  // namespace labels
+
+struct TrackedDoor {
+  DoorModel model;
+  DoorState state;
+};
+
+struct TrackedPersonWithIntent {
+  TrackedPerson person;
+  PersonIntent intent{PersonIntent::kUnknown};
+  std::string door_id;  ///< The door the intent refers to (the nearest), empty if none.
+};
+
+struct WorldState {
+  Time stamp{};
+  Pose2 X_MB;  ///< Robot base in the map.
+  Eigen::Matrix3d X_MB_covariance{Eigen::Matrix3d::Zero()};
+  std::vector<TrackedDoor> doors;
+  std::vector<TrackedObject> buttons;   ///< Confirmed push buttons and proximity plates.
+  std::vector<TrackedObject> payloads;  ///< Confirmed bottles and flashlights.
+  std::vector<TrackedPersonWithIntent> people;
+  /// Per door id: doorway zone occupied now and at each forecast step.
+  std::map<std::string, std::vector<bool>> door_zone_forecast;
+  const Costmap2D* costmap{nullptr};
+  std::shared_ptr<const octomap::OcTree> octree;
+};
+
+struct PerceptionConfig {
+  ConfidenceFilter confidence;
+  PlacementConfig placement;
+  ObjectTrackerConfig objects;
+  PersonTrackerConfig people;
+  DoorStateConfig door_state;
+  IntentConfig intent;
+  double door_zone_depth{1.0};  ///< [m]
+  LineFitConfig glass_line;
+};
+
+class PerceptionPipeline {
+ public:
+  PerceptionPipeline(std::vector<DoorModel> doors, PerceptionConfig config = {});
+
+  /// One camera frame: filter, place and track. `detection_image` is the size of the image the
+  /// boxes refer to. Boxes that cannot be placed (no valid depth: glass) are kept for
+  /// ProcessScan's line fit.
+  void ProcessCameraFrame(const std::vector<Detection2D>& detections, cv::Size detection_image,
+                          const DepthImage& depth, const CameraIntrinsics& intrinsics,
+                          const Pose3& X_MC);
+  /// One laser scan: every door's angle from the points near its hinge; glass doors from the
+  /// last frame's unplaced glass_door boxes (the scan slice under the box, RANSAC line).
+  /// X_LC (camera in laser frame) maps those boxes to bearings.
+  void ProcessScan(const LaserScan& scan, const Pose2& X_ML, const CameraIntrinsics& intrinsics,
+                   const Pose3& X_LC);
+
+  /// The current snapshot; intents refer to each person's nearest door.
+  WorldState Snapshot(Time stamp, const Pose2& X_MB, const Eigen::Matrix3d& X_MB_covariance,
+                      const Costmap2D* costmap = nullptr,
+                      std::shared_ptr<const octomap::OcTree> octree = nullptr) const;
+
+  const ObjectTracker& objects() const { return objects_; }
+  const PersonTracker& people() const { return people_; }
+  const std::vector<DoorStateTracker>& doors() const { return doors_; }
+
+ private:
+  PerceptionConfig config_;
+  std::vector<DoorStateTracker> doors_;
+  ObjectTracker objects_;
+  PersonTracker people_;
+  std::vector<Detection2D> unplaced_glass_;
+};
+
+}  // namespace egress::perception

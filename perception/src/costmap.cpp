@@ -1,0 +1,279 @@
+#include "egress/perception/costmap.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <opencv2/imgproc.hpp>
+
+#include "egress/hsr_interface/error.h"
+
+namespace egress::perception {
+
+void CostmapConfig::Validate() const {
+  ThrowUnless(std::isfinite(robot_radius) && robot_radius > 0.0,
+              "Invalid CostmapConfig: robot_radius (", robot_radius, ") must be > 0.");
+  ThrowUnless(std::isfinite(inflation_radius) && inflation_radius >= robot_radius,
+              "Invalid CostmapConfig: inflation_radius (", inflation_radius,
+              ") must be >= robot_radius (", robot_radius, ").");
+  ThrowUnless(std::isfinite(cost_scaling_factor) && cost_scaling_factor > 0.0,
+              "Invalid CostmapConfig: cost_scaling_factor (", cost_scaling_factor,
+              ") must be > 0.");
+  ThrowUnless(obstacle_max_range > 0.0 && raytrace_max_range > 0.0,
+              "Invalid CostmapConfig: obstacle_max_range and raytrace_max_range must be > 0.");
+}
+
+namespace {
+constexpr int kLookupSubdivisions = 8;
+}
+
+Costmap2D::Costmap2D(const OccupancyGrid& static_map, CostmapConfig config)
+    : config_(config), geometry_(static_map.geometry()), static_(static_map.cells()) {
+  config_.Validate();
+  geometry_.Validate();
+  obstacle_.assign(geometry_.size(), kFreeCost);
+  projection_.assign(geometry_.size(), kFreeCost);
+  leaves_.assign(geometry_.size(), kFreeCost);
+  doorway_zone_.assign(geometry_.size(), 0);
+  master_.assign(geometry_.size(), kFreeCost);
+  const int max_cells =
+      static_cast<int>(std::ceil(config_.inflation_radius / geometry_.resolution)) + 2;
+  inflation_lookup_.resize(std::size_t(max_cells * kLookupSubdivisions + 1));
+  for (std::size_t i = 0; i < inflation_lookup_.size(); ++i) {
+    inflation_lookup_[i] = InflatedCost(double(i) / kLookupSubdivisions * geometry_.resolution);
+  }
+  RecomputeWindow(0, 0, geometry_.width - 1, geometry_.height - 1);
+}
+
+std::uint8_t Costmap2D::InflatedCost(double distance) const {
+  if (distance <= 1e-9) return kLethalCost;
+  if (distance <= config_.robot_radius) return kInscribedCost;
+  if (distance > config_.inflation_radius) return kFreeCost;
+  const double factor = std::exp(-config_.cost_scaling_factor * (distance - config_.robot_radius));
+  return static_cast<std::uint8_t>((kInscribedCost - 1) * factor);
+}
+
+void Costmap2D::UpdateWithScan(const LaserScan& scan, const Pose2& X_ML) {
+  scan.Validate();
+  ThrowUnless(X_ML.IsFinite(), "Invalid laser pose X_ML: must be finite.");
+  const Eigen::Vector2d p_MO = X_ML.translation();
+  const double res = geometry_.resolution;
+  int x0 = geometry_.width, y0 = geometry_.height, x1 = -1, y1 = -1;
+  const auto touch = [&](int ix, int iy) {
+    x0 = std::min(x0, ix);
+    y0 = std::min(y0, iy);
+    x1 = std::max(x1, ix);
+    y1 = std::max(y1, iy);
+  };
+  const auto origin_cell = geometry_.CellOf(p_MO);
+  if (!origin_cell) return;  // the sensor is off the map: nothing to trace from
+  for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
+    const float r = scan.ranges[i];
+    if (std::isnan(r) || r < scan.range_min) continue;  // invalid beam
+    const bool hit = std::isfinite(r) && r <= scan.range_max;
+    const double clear_range =
+        std::min<double>(hit ? r : scan.range_max, config_.raytrace_max_range);
+    const double angle = X_ML.yaw + scan.AngleAt(i);
+    const Eigen::Vector2d direction(std::cos(angle), std::sin(angle));
+    // Clear with a DDA walk through the cells the ray crosses, stopping before the hit cell.
+    const Eigen::Vector2d end = p_MO + clear_range * direction;
+    const auto hit_cell = hit ? geometry_.CellOf(p_MO + double(r) * direction) : std::nullopt;
+    Eigen::Vector2d local = (p_MO - geometry_.origin) / res;
+    int ix = origin_cell->x(), iy = origin_cell->y();
+    const int step_x = direction.x() > 0 ? 1 : -1, step_y = direction.y() > 0 ? 1 : -1;
+    const double inv_x = direction.x() != 0 ? std::abs(1.0 / direction.x()) : 1e30;
+    const double inv_y = direction.y() != 0 ? std::abs(1.0 / direction.y()) : 1e30;
+    double t_x = (direction.x() > 0 ? (ix + 1 - local.x()) : (local.x() - ix)) * inv_x;
+    double t_y = (direction.y() > 0 ? (iy + 1 - local.y()) : (local.y() - iy)) * inv_y;
+    const double t_end = (end - p_MO).norm() / res;
+    while (geometry_.Contains(ix, iy)) {
+      if (hit_cell && ix == hit_cell->x() && iy == hit_cell->y()) break;
+      obstacle_[geometry_.Index(ix, iy)] = kFreeCost;
+      touch(ix, iy);
+      if (std::min(t_x, t_y) > t_end) break;
+      if (t_x < t_y) {
+        ix += step_x;
+        t_x += inv_x;
+      } else {
+        iy += step_y;
+        t_y += inv_y;
+      }
+    }
+    if (hit_cell && r <= config_.obstacle_max_range) {
+      obstacle_[geometry_.Index(hit_cell->x(), hit_cell->y())] = kLethalCost;
+      touch(hit_cell->x(), hit_cell->y());
+    }
+  }
+  if (x1 >= x0) RecomputeWindow(x0, y0, x1, y1);
+}
+
+void Costmap2D::SetProjectedObstacles(const std::vector<Eigen::Vector2d>& p_MObstacles) {
+  int x0 = geometry_.width, y0 = geometry_.height, x1 = -1, y1 = -1;
+  const auto touch = [&](const Eigen::Vector2i& c) {
+    x0 = std::min(x0, c.x());
+    y0 = std::min(y0, c.y());
+    x1 = std::max(x1, c.x());
+    y1 = std::max(y1, c.y());
+  };
+  for (const auto& c : projected_cells_) {
+    projection_[geometry_.Index(c.x(), c.y())] = kFreeCost;
+    touch(c);
+  }
+  projected_cells_.clear();
+  for (const auto& p : p_MObstacles) {
+    if (auto c = geometry_.CellOf(p)) {
+      projection_[geometry_.Index(c->x(), c->y())] = kLethalCost;
+      projected_cells_.push_back(*c);
+      touch(*c);
+    }
+  }
+  if (x1 >= x0) RecomputeWindow(x0, y0, x1, y1);
+}
+
+void Costmap2D::ClearObstacles() {
+  std::fill(obstacle_.begin(), obstacle_.end(), kFreeCost);
+  RecomputeWindow(0, 0, geometry_.width - 1, geometry_.height - 1);
+}
+
+void Costmap2D::AddDoorway(const Doorway& doorway) {
+  ThrowUnless(!doorways_.contains(doorway.id), "Invalid doorway: id '", doorway.id,
+              "' exists already.");
+  ThrowUnless(
+      doorway.p_MHinge.allFinite() && doorway.p_MLatch.allFinite() && doorway.width() > 1e-3,
+      "Invalid doorway '", doorway.id, "': jambs must be finite and distinct.");
+  ThrowUnless(doorway.threshold_depth >= 0.0, "Invalid doorway '", doorway.id,
+              "': threshold_depth must be >= 0.");
+  doorways_[doorway.id] = doorway;
+  // The threshold zone: the rectangle between the jambs, threshold_depth to each side.
+  const Eigen::Vector2d along = (doorway.p_MLatch - doorway.p_MHinge) / doorway.width();
+  const Eigen::Vector2d normal(-along.y(), along.x());
+  int x0 = geometry_.width, y0 = geometry_.height, x1 = -1, y1 = -1;
+  for (int iy = 0; iy < geometry_.height; ++iy) {
+    for (int ix = 0; ix < geometry_.width; ++ix) {
+      const Eigen::Vector2d d = geometry_.CellCenter(ix, iy) - doorway.p_MHinge;
+      const double s = d.dot(along), n = d.dot(normal);
+      if (s > 0.0 && s < doorway.width() && std::abs(n) <= doorway.threshold_depth) {
+        doorway_zone_[geometry_.Index(ix, iy)] = 1;
+        x0 = std::min(x0, ix);
+        y0 = std::min(y0, iy);
+        x1 = std::max(x1, ix);
+        y1 = std::max(y1, iy);
+      }
+    }
+  }
+  if (x1 >= x0) RecomputeWindow(x0, y0, x1, y1);
+}
+
+void Costmap2D::MarkLeaf(const Doorway& doorway, double angle, std::uint8_t value) {
+  const Eigen::Vector2d closed = doorway.p_MLatch - doorway.p_MHinge;
+  const double yaw = std::atan2(closed.y(), closed.x()) + doorway.swing_sign * angle;
+  const Eigen::Vector2d direction(std::cos(yaw), std::sin(yaw));
+  const double step = geometry_.resolution / 3.0;
+  for (double s = 0.0; s <= doorway.width(); s += step) {
+    if (auto c = geometry_.CellOf(doorway.p_MHinge + s * direction))
+      leaves_[geometry_.Index(c->x(), c->y())] = value;
+  }
+}
+
+void Costmap2D::SetDoorLeafAngle(const std::string& id, std::optional<double> angle) {
+  auto it = doorways_.find(id);
+  ThrowUnless(it != doorways_.end(), "Unknown doorway '", id, "'.");
+  ThrowUnless(!angle || std::isfinite(*angle), "Invalid leaf angle for doorway '", id,
+              "': must be finite.");
+  const Doorway& doorway = it->second;
+  if (auto previous = leaf_angles_.find(id); previous != leaf_angles_.end()) {
+    MarkLeaf(doorway, previous->second, kFreeCost);
+    leaf_angles_.erase(previous);
+  }
+  if (angle) {
+    MarkLeaf(doorway, *angle, kLethalCost);
+    leaf_angles_[id] = *angle;
+  }
+  // Other leaves may share cells with the one removed: mark them again.
+  for (const auto& [other, other_angle] : leaf_angles_)
+    MarkLeaf(doorways_.at(other), other_angle, kLethalCost);
+  const double reach = doorway.width();
+  const auto lo = geometry_.CellOf(doorway.p_MHinge - Eigen::Vector2d(reach, reach));
+  const auto hi = geometry_.CellOf(doorway.p_MHinge + Eigen::Vector2d(reach, reach));
+  RecomputeWindow(lo ? lo->x() : 0, lo ? lo->y() : 0, hi ? hi->x() : geometry_.width - 1,
+                  hi ? hi->y() : geometry_.height - 1);
+}
+
+void Costmap2D::RecomputeWindow(int x0, int y0, int x1, int y1) {
+  // Cells within the inflation radius of the window may change; obstacles within the radius of
+  // those cells affect them.
+  const int margin =
+      static_cast<int>(std::ceil(config_.inflation_radius / geometry_.resolution)) + 1;
+  const cv::Rect full(0, 0, geometry_.width, geometry_.height);
+  const cv::Rect affected =
+      cv::Rect(x0 - margin, y0 - margin, x1 - x0 + 1 + 2 * margin, y1 - y0 + 1 + 2 * margin) & full;
+  const cv::Rect source = cv::Rect(affected.x - margin, affected.y - margin,
+                                   affected.width + 2 * margin, affected.height + 2 * margin) &
+                          full;
+  // Distance transform input: 0 at lethal cells, 255 elsewhere.
+  cv::Mat free_mask(source.height, source.width, CV_8UC1);
+  bool any_lethal = false;
+  for (int r = 0; r < source.height; ++r) {
+    auto* row = free_mask.ptr<std::uint8_t>(r);
+    for (int c = 0; c < source.width; ++c) {
+      const std::size_t i = geometry_.Index(source.x + c, source.y + r);
+      const bool lethal = static_[i] == kLethalCost || obstacle_[i] == kLethalCost ||
+                          projection_[i] == kLethalCost || leaves_[i] == kLethalCost;
+      row[c] = lethal ? 0 : 255;
+      any_lethal = any_lethal || lethal;
+    }
+  }
+  cv::Mat distance;
+  if (any_lethal)
+    cv::distanceTransform(free_mask, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+  for (int r = affected.y; r < affected.y + affected.height; ++r) {
+    for (int c = affected.x; c < affected.x + affected.width; ++c) {
+      const std::size_t i = geometry_.Index(c, r);
+      std::uint8_t cost = kFreeCost;
+      if (any_lethal) {
+        const float cells = distance.at<float>(r - source.y, c - source.x);
+        const std::size_t k = static_cast<std::size_t>(cells * kLookupSubdivisions + 0.5f);
+        cost = k < inflation_lookup_.size() ? inflation_lookup_[k] : kFreeCost;
+        // A known doorway keeps only lethal and inscribed: inflation never seals its threshold.
+        if (doorway_zone_[i] != 0 && cost < kInscribedCost) cost = kFreeCost;
+      }
+      if (cost == kFreeCost && static_[i] == kUnknownCost) cost = kUnknownCost;
+      master_[i] = cost;
+    }
+  }
+}
+
+std::uint8_t Costmap2D::CostAt(const Eigen::Vector2d& p_MQ) const {
+  const auto cell = geometry_.CellOf(p_MQ);
+  return cell ? master_[geometry_.Index(cell->x(), cell->y())] : kUnknownCost;
+}
+
+std::uint8_t Costmap2D::FootprintCost(const Pose2& X_MB) const {
+  ThrowUnless(X_MB.IsFinite(), "Invalid pose X_MB: must be finite.");
+  const Eigen::Vector2d c = X_MB.translation();
+  const double r = config_.robot_radius;
+  const auto lo = geometry_.CellOf(c - Eigen::Vector2d(r, r));
+  const auto hi = geometry_.CellOf(c + Eigen::Vector2d(r, r));
+  if (!lo || !hi) return kUnknownCost;
+  for (int iy = lo->y(); iy <= hi->y(); ++iy) {
+    for (int ix = lo->x(); ix <= hi->x(); ++ix) {
+      // Inside the footprint only obstacles matter (inscribed cells there are expected).
+      if ((geometry_.CellCenter(ix, iy) - c).norm() <= r &&
+          master_[geometry_.Index(ix, iy)] == kLethalCost) {
+        return kLethalCost;
+      }
+    }
+  }
+  return CostAt(c);
+}
+
+cv::Mat Costmap2D::ToImage() const {
+  cv::Mat image(geometry_.height, geometry_.width, CV_8UC1);
+  for (int iy = 0; iy < geometry_.height; ++iy) {
+    for (int ix = 0; ix < geometry_.width; ++ix) {
+      image.at<std::uint8_t>(geometry_.height - 1 - iy, ix) = master_[geometry_.Index(ix, iy)];
+    }
+  }
+  return image;
+}
+
+}  // namespace egress::perception

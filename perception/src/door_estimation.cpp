@@ -1,0 +1,202 @@
+#include "egress/perception/door_estimation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include <Eigen/Eigenvalues>
+
+#include "egress/hsr_interface/error.h"
+
+namespace egress::perception {
+
+double DoorModel::closed_yaw() const {
+  const Eigen::Vector2d d = p_MLatch - p_MHinge;
+  return std::atan2(d.y(), d.x());
+}
+
+Eigen::Vector2d DoorModel::LeafTip(double angle) const {
+  const double yaw = closed_yaw() + swing_sign * angle;
+  return p_MHinge + width() * Eigen::Vector2d(std::cos(yaw), std::sin(yaw));
+}
+
+double DoorModel::ClearanceWidth(double angle) const {
+  const double a = std::clamp(angle, 0.0, std::numbers::pi / 2);
+  return width() * (1.0 - std::cos(a));
+}
+
+void DoorModel::Validate() const {
+  ThrowUnless(p_MHinge.allFinite() && p_MLatch.allFinite() && width() > 0.05, "Invalid door '", id,
+              "': jambs must be finite and at least 5 cm apart.");
+  ThrowUnless(swing_sign == 1.0 || swing_sign == -1.0, "Invalid door '", id,
+              "': swing_sign must be +1 or -1.");
+  ThrowUnless(max_open_angle > 0.0 && max_open_angle <= std::numbers::pi, "Invalid door '", id,
+              "': max_open_angle must be in (0, pi].");
+}
+
+std::optional<LineFit> FitLineRansac(const std::vector<Eigen::Vector2d>& points,
+                                     const LineFitConfig& config) {
+  if (points.size() < std::max<std::size_t>(2, config.min_inliers)) return std::nullopt;
+  std::mt19937_64 random(config.seed);
+  std::uniform_int_distribution<std::size_t> pick(0, points.size() - 1);
+  std::vector<std::size_t> best;
+  for (int it = 0; it < config.iterations; ++it) {
+    const std::size_t i = pick(random), j = pick(random);
+    const Eigen::Vector2d d = points[j] - points[i];
+    if (i == j || d.norm() < 1e-6) continue;
+    const Eigen::Vector2d normal = Eigen::Vector2d(-d.y(), d.x()).normalized();
+    std::vector<std::size_t> inliers;
+    for (std::size_t k = 0; k < points.size(); ++k) {
+      if (std::abs((points[k] - points[i]).dot(normal)) <= config.inlier_distance)
+        inliers.push_back(k);
+    }
+    if (inliers.size() > best.size()) best = std::move(inliers);
+  }
+  if (best.size() < config.min_inliers) return std::nullopt;
+  // Least squares on the inliers: the principal direction of their scatter.
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (std::size_t k : best)
+    mean += points[k];
+  mean /= double(best.size());
+  Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
+  for (std::size_t k : best)
+    scatter += (points[k] - mean) * (points[k] - mean).transpose();
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(scatter);
+  LineFit fit;
+  fit.p_M = mean;
+  fit.direction = eigen.eigenvectors().col(1).normalized();
+  fit.inliers = best.size();
+  const Eigen::Vector2d normal(-fit.direction.y(), fit.direction.x());
+  double sum = 0.0;
+  for (std::size_t k : best)
+    sum += std::pow((points[k] - mean).dot(normal), 2);
+  fit.rms = std::sqrt(sum / double(best.size()));
+  return fit;
+}
+
+std::pair<double, double> BoxBearingsInLaser(const PixelBox& box,
+                                             const CameraIntrinsics& intrinsics,
+                                             const Pose3& X_LC) {
+  intrinsics.Validate();
+  ThrowUnless(X_LC.IsFinite(), "Invalid camera pose X_LC: must be finite.");
+  const double v = (box.v_min + box.v_max) / 2;
+  const auto bearing = [&](double u) {
+    const Eigen::Vector3d ray_C((u - intrinsics.cx) / intrinsics.fx,
+                                (v - intrinsics.cy) / intrinsics.fy, 1.0);
+    const Eigen::Vector3d ray_L = X_LC.rotation() * ray_C;
+    return std::atan2(ray_L.y(), ray_L.x());
+  };
+  const double a = bearing(box.u_min), b = bearing(box.u_max);
+  return {std::min(a, b), std::max(a, b)};
+}
+
+std::vector<Eigen::Vector2d> ScanPointsInBearings(const LaserScan& scan, const Pose2& X_ML,
+                                                  double bearing_min, double bearing_max) {
+  scan.Validate();
+  ThrowUnless(X_ML.IsFinite(), "Invalid laser pose X_ML: must be finite.");
+  std::vector<Eigen::Vector2d> points;
+  for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
+    const double angle = scan.AngleAt(i);
+    if (angle < bearing_min || angle > bearing_max || !scan.IsValidReturn(i)) continue;
+    points.push_back(
+        X_ML * Eigen::Vector2d(scan.ranges[i] * std::cos(angle), scan.ranges[i] * std::sin(angle)));
+  }
+  return points;
+}
+
+std::vector<Eigen::Vector2d> ScanPoints(const LaserScan& scan, const Pose2& X_ML) {
+  return ScanPointsInBearings(scan, X_ML, -std::numeric_limits<double>::infinity(),
+                              std::numeric_limits<double>::infinity());
+}
+
+std::optional<DoorAngleMeasurement> MeasureDoorAngle(const DoorModel& door,
+                                                     const std::vector<Eigen::Vector2d>& p_MPoints,
+                                                     std::size_t min_support) {
+  door.Validate();
+  constexpr double kMargin = 10.0 * std::numbers::pi / 180.0;
+  const double w = door.width();
+  std::vector<double> votes;
+  for (const auto& p : p_MPoints) {
+    if (!p.allFinite()) continue;
+    const Eigen::Vector2d d = p - door.p_MHinge;
+    const double r = d.norm();
+    if (r < 0.15 * w || r > 0.95 * w) continue;
+    const double phi = door.swing_sign * WrapAngle(std::atan2(d.y(), d.x()) - door.closed_yaw());
+    if (phi < -kMargin || phi > door.max_open_angle + kMargin) continue;
+    votes.push_back(phi);
+  }
+  if (votes.size() < std::max<std::size_t>(1, min_support)) return std::nullopt;
+  auto middle = votes.begin() + std::ptrdiff_t(votes.size() / 2);
+  std::nth_element(votes.begin(), middle, votes.end());
+  return DoorAngleMeasurement{std::clamp(*middle, 0.0, door.max_open_angle), votes.size()};
+}
+
+double DoorAngleFromLine(const DoorModel& door, const LineFit& line) {
+  door.Validate();
+  // The line's direction is ambiguous by pi; take the orientation pointing away from the hinge.
+  Eigen::Vector2d direction = line.direction;
+  if ((line.p_M - door.p_MHinge).dot(direction) < 0.0) direction = -direction;
+  const double phi =
+      door.swing_sign * WrapAngle(std::atan2(direction.y(), direction.x()) - door.closed_yaw());
+  return std::clamp(phi, 0.0, door.max_open_angle);
+}
+
+std::string_view ToString(DoorMotion motion) {
+  switch (motion) {
+    case DoorMotion::kUnknown:
+      return "unknown";
+    case DoorMotion::kClosed:
+      return "closed";
+    case DoorMotion::kOpening:
+      return "opening";
+    case DoorMotion::kOpen:
+      return "open";
+    case DoorMotion::kHeldOpen:
+      return "held_open";
+    case DoorMotion::kClosing:
+      return "closing";
+  }
+  return "unknown";
+}
+
+DoorStateTracker::DoorStateTracker(DoorModel door, DoorStateConfig config)
+    : door_(std::move(door)), config_(config) {
+  door_.Validate();
+  ThrowUnless(config_.smoothing > 0.0 && config_.smoothing <= 1.0,
+              "Invalid DoorStateConfig: smoothing must be in (0, 1].");
+}
+
+void DoorStateTracker::Update(double angle, Time stamp) {
+  ThrowUnless(std::isfinite(angle), "Invalid door angle for '", door_.id, "': must be finite.");
+  angle = std::clamp(angle, 0.0, door_.max_open_angle);
+  if (!state_.observed) {
+    state_.angle = angle;
+    state_.rate = 0.0;
+    state_.steady_for = 0.0;
+  } else {
+    ThrowUnless(stamp >= state_.stamp, "Invalid door measurement for '", door_.id,
+                "': time went backwards.");
+    const double dt = ToSeconds(stamp - state_.stamp);
+    const double previous = state_.angle;
+    state_.angle += config_.smoothing * (angle - state_.angle);
+    if (dt > 0.0) state_.rate += config_.smoothing * ((state_.angle - previous) / dt - state_.rate);
+    state_.steady_for = std::abs(state_.rate) < config_.motion_rate ? state_.steady_for + dt : 0.0;
+  }
+  state_.observed = true;
+  state_.stamp = stamp;
+  state_.open_fraction = std::clamp(state_.angle / door_.max_open_angle, 0.0, 1.0);
+  state_.clearance_width = door_.ClearanceWidth(state_.angle);
+  if (state_.rate > config_.motion_rate) {
+    state_.motion = DoorMotion::kOpening;
+  } else if (state_.rate < -config_.motion_rate) {
+    state_.motion = DoorMotion::kClosing;
+  } else if (state_.angle < config_.closed_angle) {
+    state_.motion = DoorMotion::kClosed;
+  } else {
+    state_.motion =
+        state_.steady_for >= config_.held_after ? DoorMotion::kHeldOpen : DoorMotion::kOpen;
+  }
+}
+
+}  // namespace egress::perception

@@ -1,0 +1,73 @@
+#include "egress/perception/occupancy_map_3d.h"
+
+#include <cmath>
+
+#include "egress/hsr_interface/error.h"
+
+namespace egress::perception {
+
+void OccupancyMap3DConfig::Validate() const {
+  ThrowUnless(resolution > 0.0 && std::isfinite(resolution),
+              "Invalid OccupancyMap3DConfig: resolution (", resolution, ") must be > 0.");
+  ThrowUnless(max_range > 0.0, "Invalid OccupancyMap3DConfig: max_range must be > 0.");
+  ThrowUnless(pixel_stride >= 1, "Invalid OccupancyMap3DConfig: pixel_stride (", pixel_stride,
+              ") must be >= 1.");
+  ThrowUnless(max_obstacle_height > min_obstacle_height,
+              "Invalid OccupancyMap3DConfig: max_obstacle_height must exceed min_obstacle_height.");
+}
+
+OccupancyMap3D::OccupancyMap3D(OccupancyMap3DConfig config)
+    : config_(config), tree_(std::make_shared<octomap::OcTree>(config.resolution)) {
+  config_.Validate();
+}
+
+std::size_t OccupancyMap3D::InsertDepthImage(const DepthImage& depth,
+                                             const CameraIntrinsics& intrinsics,
+                                             const Pose3& X_MC) {
+  depth.Validate();
+  intrinsics.Validate();
+  ThrowUnless(depth.width == intrinsics.width && depth.height == intrinsics.height,
+              "Invalid depth image: ", depth.width, "x", depth.height,
+              " does not match its intrinsics ", intrinsics.width, "x", intrinsics.height, ".");
+  ThrowUnless(X_MC.IsFinite(), "Invalid camera pose X_MC: must be finite.");
+  octomap::Pointcloud cloud;
+  for (int v = 0; v < depth.height; v += config_.pixel_stride) {
+    for (int u = 0; u < depth.width; u += config_.pixel_stride) {
+      if (!depth.IsValidAt(u, v)) continue;
+      const Eigen::Vector3d p_MQ = X_MC * intrinsics.Unproject(u + 0.5, v + 0.5, depth.At(u, v));
+      cloud.push_back(float(p_MQ.x()), float(p_MQ.y()), float(p_MQ.z()));
+    }
+  }
+  const Eigen::Vector3d& o = X_MC.translation();
+  // Discretized insertion: one ray per voxel endpoint, which keeps an 80x60 frame fast.
+  tree_->insertPointCloud(cloud, octomap::point3d(float(o.x()), float(o.y()), float(o.z())),
+                          config_.max_range,
+                          /*lazy_eval=*/false, /*discretize=*/true);
+  return cloud.size();
+}
+
+std::vector<Eigen::Vector2d> OccupancyMap3D::ProjectObstacles() const {
+  std::vector<Eigen::Vector2d> points;
+  for (auto it = tree_->begin_leafs(), end = tree_->end_leafs(); it != end; ++it) {
+    if (!tree_->isNodeOccupied(*it)) continue;
+    const double z = it.getZ();
+    if (z < config_.min_obstacle_height || z > config_.max_obstacle_height) continue;
+    // A coarse leaf covers several voxels: emit each.
+    const double size = it.getSize();
+    const int n = std::max(1, static_cast<int>(std::round(size / config_.resolution)));
+    const double x0 = it.getX() - size / 2 + config_.resolution / 2,
+                 y0 = it.getY() - size / 2 + config_.resolution / 2;
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < n; ++j)
+        points.emplace_back(x0 + i * config_.resolution, y0 + j * config_.resolution);
+    }
+  }
+  return points;
+}
+
+bool OccupancyMap3D::IsOccupied(const Eigen::Vector3d& p_MQ) const {
+  const octomap::OcTreeNode* node = tree_->search(p_MQ.x(), p_MQ.y(), p_MQ.z());
+  return node != nullptr && tree_->isNodeOccupied(node);
+}
+
+}  // namespace egress::perception

@@ -1,0 +1,203 @@
+#include "egress/perception/particle_filter_localizer.h"
+
+#include <cmath>
+#include <numbers>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <opencv2/imgproc.hpp>
+
+#include "egress/hsr_interface/error.h"
+
+namespace egress::perception {
+
+void LocalizerConfig::Validate() const {
+  ThrowUnless(num_particles >= 10, "Invalid LocalizerConfig: num_particles (", num_particles,
+              ") must be >= 10.");
+  ThrowUnless(alpha_rot_rot >= 0 && alpha_rot_trans >= 0 && alpha_trans_trans >= 0 &&
+                  alpha_trans_rot >= 0 && alpha_strafe_trans >= 0,
+              "Invalid LocalizerConfig: the alpha noise terms must be >= 0.");
+  ThrowUnless(sigma_hit > 0.0, "Invalid LocalizerConfig: sigma_hit (", sigma_hit, ") must be > 0.");
+  ThrowUnless(z_hit > 0.0 && z_hit <= 1.0, "Invalid LocalizerConfig: z_hit (", z_hit,
+              ") must be in (0, 1].");
+  ThrowUnless(max_beams >= 1, "Invalid LocalizerConfig: max_beams must be >= 1.");
+  ThrowUnless(resample_threshold > 0.0 && resample_threshold <= 1.0,
+              "Invalid LocalizerConfig: resample_threshold must be in (0, 1].");
+}
+
+ParticleFilterLocalizer::ParticleFilterLocalizer(const OccupancyGrid& map, const Pose2& X_BL,
+                                                 LocalizerConfig config)
+    : config_(config), geometry_(map.geometry()), X_BL_(X_BL), random_(config.seed) {
+  config_.Validate();
+  ThrowUnless(X_BL.IsFinite(), "Invalid laser pose X_BL: must be finite.");
+  cv::Mat free_mask(geometry_.height, geometry_.width, CV_8UC1);
+  for (int iy = 0; iy < geometry_.height; ++iy) {
+    for (int ix = 0; ix < geometry_.width; ++ix) {
+      free_mask.at<std::uint8_t>(iy, ix) = map.at(ix, iy) == kLethalCost ? 0 : 255;
+    }
+  }
+  cv::Mat distance;
+  cv::distanceTransform(free_mask, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+  distance_.resize(geometry_.size());
+  for (int iy = 0; iy < geometry_.height; ++iy) {
+    for (int ix = 0; ix < geometry_.width; ++ix) {
+      distance_[geometry_.Index(ix, iy)] = distance.at<float>(iy, ix) * float(geometry_.resolution);
+    }
+  }
+}
+
+void ParticleFilterLocalizer::Initialize(const Pose2& X_MB, const Eigen::Matrix3d& covariance) {
+  ThrowUnless(X_MB.IsFinite(), "Invalid initial pose: must be finite.");
+  ThrowUnless(
+      covariance.allFinite() && (covariance - covariance.transpose()).cwiseAbs().maxCoeff() < 1e-12,
+      "Invalid initial covariance: must be finite and symmetric.");
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(covariance);
+  ThrowUnless(eigen.eigenvalues().minCoeff() >= 0.0,
+              "Invalid initial covariance: must be positive semi-definite.");
+  const Eigen::Matrix3d L = eigen.eigenvectors() * eigen.eigenvalues().cwiseSqrt().asDiagonal();
+  std::normal_distribution<double> normal(0.0, 1.0);
+  particles_.clear();
+  for (int i = 0; i < config_.num_particles; ++i) {
+    const Eigen::Vector3d z(normal(random_), normal(random_), normal(random_));
+    const Eigen::Vector3d d = L * z;
+    particles_.push_back({{X_MB.x + d.x(), X_MB.y + d.y(), WrapAngle(X_MB.yaw + d.z())},
+                          1.0 / config_.num_particles});
+  }
+  moved_since_correction_ = true;
+}
+
+void ParticleFilterLocalizer::Predict(const Pose2& X_OB_previous, const Pose2& X_OB_current) {
+  ThrowUnless(X_OB_previous.IsFinite() && X_OB_current.IsFinite(),
+              "Invalid odometry: poses must be finite.");
+  ThrowUnless(initialized(), "ParticleFilterLocalizer::Predict: call Initialize first.");
+  const Eigen::Vector2d delta = X_OB_current.translation() - X_OB_previous.translation();
+  const double translation = delta.norm();
+  const double rotation = WrapAngle(X_OB_current.yaw - X_OB_previous.yaw);
+  // Bearing of the translation relative to the base's previous heading.
+  const double bearing =
+      translation < 1e-9 ? 0.0 : WrapAngle(std::atan2(delta.y(), delta.x()) - X_OB_previous.yaw);
+  moved_distance_ += translation;
+  moved_angle_ += std::abs(rotation);
+  const double t2 = translation * translation, r2 = rotation * rotation;
+  constexpr double kMinStd = 1e-12;  // a normal distribution needs a positive deviation
+  std::normal_distribution<double> trans_noise(
+      0.0, kMinStd + std::sqrt(config_.alpha_trans_trans * t2 + config_.alpha_trans_rot * r2));
+  std::normal_distribution<double> rot_noise(
+      0.0, kMinStd + std::sqrt(config_.alpha_rot_rot * r2 + config_.alpha_rot_trans * t2));
+  std::normal_distribution<double> strafe_noise(
+      0.0, kMinStd + std::sqrt(config_.alpha_strafe_trans * t2 + config_.alpha_trans_rot * r2));
+  const bool still = t2 + r2 == 0.0;
+  for (Particle& p : particles_) {
+    const double heading = p.X_MB.yaw + bearing;
+    const double t = translation + (still ? 0.0 : trans_noise(random_));
+    const double strafe = still ? 0.0 : strafe_noise(random_);
+    const double r = rotation + (still ? 0.0 : rot_noise(random_));
+    p.X_MB.x += t * std::cos(heading) - strafe * std::sin(heading);
+    p.X_MB.y += t * std::sin(heading) + strafe * std::cos(heading);
+    p.X_MB.yaw = WrapAngle(p.X_MB.yaw + r);
+  }
+  if (moved_distance_ >= config_.update_min_distance || moved_angle_ >= config_.update_min_angle) {
+    moved_since_correction_ = true;
+  }
+}
+
+double ParticleFilterLocalizer::LikelihoodFieldDistance(const Eigen::Vector2d& p_MQ) const {
+  const auto cell = geometry_.CellOf(p_MQ);
+  if (!cell) return std::numeric_limits<double>::infinity();
+  return distance_[geometry_.Index(cell->x(), cell->y())];
+}
+
+bool ParticleFilterLocalizer::Correct(const LaserScan& scan) {
+  scan.Validate();
+  ThrowUnless(initialized(), "ParticleFilterLocalizer::Correct: call Initialize first.");
+  if (!moved_since_correction_) return false;
+  std::vector<std::pair<double, double>> beams;  // (angle in L, range)
+  const std::size_t n = scan.ranges.size();
+  const std::size_t step = std::max<std::size_t>(1, n / std::size_t(config_.max_beams));
+  for (std::size_t i = 0; i < n; i += step) {
+    if (!scan.IsValidReturn(i) || scan.ranges[i] > config_.laser_max_range) continue;
+    beams.emplace_back(scan.AngleAt(i), scan.ranges[i]);
+  }
+  if (beams.empty()) return false;
+  const double inv_2sigma2 = 1.0 / (2.0 * config_.sigma_hit * config_.sigma_hit);
+  const double uniform = (1.0 - config_.z_hit) / config_.laser_max_range;
+  std::vector<double> log_weights(particles_.size());
+  for (std::size_t k = 0; k < particles_.size(); ++k) {
+    const Pose2 X_ML = particles_[k].X_MB * X_BL_;
+    const double c = std::cos(X_ML.yaw), s = std::sin(X_ML.yaw);
+    double log_w = 0.0;
+    for (const auto& [angle, range] : beams) {
+      const double lx = range * std::cos(angle), ly = range * std::sin(angle);
+      const Eigen::Vector2d p(X_ML.x + c * lx - s * ly, X_ML.y + s * lx + c * ly);
+      const double d = LikelihoodFieldDistance(p);
+      const double hit = std::isfinite(d) ? config_.z_hit * std::exp(-d * d * inv_2sigma2) : 0.0;
+      log_w += std::log(hit + uniform);
+    }
+    log_weights[k] = std::log(particles_[k].weight) + log_w;
+  }
+  const double max_log = *std::max_element(log_weights.begin(), log_weights.end());
+  double total = 0.0;
+  for (std::size_t k = 0; k < particles_.size(); ++k) {
+    particles_[k].weight = std::exp(log_weights[k] - max_log);
+    total += particles_[k].weight;
+  }
+  double sum_sq = 0.0;
+  for (Particle& p : particles_) {
+    p.weight /= total;
+    sum_sq += p.weight * p.weight;
+  }
+  const double n_eff = 1.0 / sum_sq;
+  if (n_eff < config_.resample_threshold * double(particles_.size())) Resample();
+  moved_distance_ = moved_angle_ = 0.0;
+  moved_since_correction_ = false;
+  return true;
+}
+
+void ParticleFilterLocalizer::Resample() {
+  // Low-variance (systematic) resampling.
+  const std::size_t n = particles_.size();
+  std::vector<Particle> resampled;
+  resampled.reserve(n);
+  const double step = 1.0 / double(n);
+  double u = std::uniform_real_distribution<double>(0.0, step)(random_);
+  double cumulative = particles_[0].weight;
+  std::size_t i = 0;
+  for (std::size_t m = 0; m < n; ++m) {
+    while (u > cumulative && i + 1 < n)
+      cumulative += particles_[++i].weight;
+    resampled.push_back({particles_[i].X_MB, step});
+    u += step;
+  }
+  particles_ = std::move(resampled);
+  ++resample_count_;
+}
+
+void ParticleFilterLocalizer::Update(const Pose2& X_OB, const LaserScan& scan) {
+  if (last_odometry_) Predict(*last_odometry_, X_OB);
+  last_odometry_ = X_OB;
+  Correct(scan);
+}
+
+Pose2 ParticleFilterLocalizer::Estimate() const {
+  ThrowUnless(initialized(), "ParticleFilterLocalizer::Estimate: call Initialize first.");
+  double x = 0, y = 0, c = 0, s = 0;
+  for (const Particle& p : particles_) {
+    x += p.weight * p.X_MB.x;
+    y += p.weight * p.X_MB.y;
+    c += p.weight * std::cos(p.X_MB.yaw);
+    s += p.weight * std::sin(p.X_MB.yaw);
+  }
+  return {x, y, std::atan2(s, c)};
+}
+
+Eigen::Matrix3d ParticleFilterLocalizer::Covariance() const {
+  const Pose2 mean = Estimate();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (const Particle& p : particles_) {
+    const Eigen::Vector3d d(p.X_MB.x - mean.x, p.X_MB.y - mean.y, WrapAngle(p.X_MB.yaw - mean.yaw));
+    covariance += p.weight * d * d.transpose();
+  }
+  return covariance;
+}
+
+}  // namespace egress::perception
