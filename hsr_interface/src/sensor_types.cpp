@@ -29,9 +29,9 @@ void LaserScan::Validate() const {
               ") must be > 0.");
   ThrowUnless(range_min >= 0.0 && range_max > range_min, "Invalid LaserScan: range_min (",
               range_min, ") and range_max (", range_max, ") must satisfy 0 <= min < max.");
-  ThrowUnless(angle_increment * double(ranges.size()) <= 2.0 * std::numbers::pi + 1e-6,
-              "Invalid LaserScan: ranges (", ranges.size(), " beams of ", angle_increment,
-              " rad) span more than a full turn.");
+  const double span = ranges.empty() ? 0.0 : angle_increment * double(ranges.size() - 1);
+  ThrowUnless(span <= 2.0 * std::numbers::pi + 1e-6, "Invalid LaserScan: ranges (", ranges.size(),
+              " beams of ", angle_increment, " rad) span more than a full turn.");
   ThrowUnless(intensities.empty() || intensities.size() == ranges.size(),
               "Invalid LaserScan: intensities (", intensities.size(),
               ") must be empty or the same size as ranges (", ranges.size(), ").");

@@ -66,6 +66,9 @@ void Costmap2D::UpdateWithScan(const LaserScan& scan, const Pose2& X_ML) {
   };
   const auto origin_cell = geometry_.CellOf(p_MO);
   if (!origin_cell) return;  // the sensor is off the map: nothing to trace from
+  // All rays clear first, then all returns mark (as Nav2 does): otherwise a neighbouring beam
+  // with no return would clear the cell a hit has just marked.
+  std::vector<Eigen::Vector2i> marks;
   for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
     const float r = scan.ranges[i];
     if (std::isnan(r) || r < scan.range_min) continue;  // invalid beam
@@ -87,8 +90,11 @@ void Costmap2D::UpdateWithScan(const LaserScan& scan, const Pose2& X_ML) {
     const double t_end = (end - p_MO).norm() / res;
     while (geometry_.Contains(ix, iy)) {
       if (hit_cell && ix == hit_cell->x() && iy == hit_cell->y()) break;
-      obstacle_[geometry_.Index(ix, iy)] = kFreeCost;
-      touch(ix, iy);
+      // Only a cell that changes dirties the window: re-clearing free space costs nothing later.
+      if (std::uint8_t& cell = obstacle_[geometry_.Index(ix, iy)]; cell != kFreeCost) {
+        cell = kFreeCost;
+        touch(ix, iy);
+      }
       if (std::min(t_x, t_y) > t_end) break;
       if (t_x < t_y) {
         ix += step_x;
@@ -98,9 +104,13 @@ void Costmap2D::UpdateWithScan(const LaserScan& scan, const Pose2& X_ML) {
         t_y += inv_y;
       }
     }
-    if (hit_cell && r <= config_.obstacle_max_range) {
-      obstacle_[geometry_.Index(hit_cell->x(), hit_cell->y())] = kLethalCost;
-      touch(hit_cell->x(), hit_cell->y());
+    if (hit_cell && r <= config_.obstacle_max_range) marks.push_back(*hit_cell);
+  }
+  for (const Eigen::Vector2i& cell : marks) {
+    if (std::uint8_t& value = obstacle_[geometry_.Index(cell.x(), cell.y())];
+        value != kLethalCost) {
+      value = kLethalCost;
+      touch(cell.x(), cell.y());
     }
   }
   if (x1 >= x0) RecomputeWindow(x0, y0, x1, y1);
@@ -223,8 +233,8 @@ void Costmap2D::RecomputeWindow(int x0, int y0, int x1, int y1) {
     }
   }
   cv::Mat distance;
-  if (any_lethal)
-    cv::distanceTransform(free_mask, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+  // The 5x5 mask is within 2% of the exact distance and several times faster.
+  if (any_lethal) cv::distanceTransform(free_mask, distance, cv::DIST_L2, cv::DIST_MASK_5, CV_32F);
   for (int r = affected.y; r < affected.y + affected.height; ++r) {
     for (int c = affected.x; c < affected.x + affected.width; ++c) {
       const std::size_t i = geometry_.Index(c, r);

@@ -30,20 +30,43 @@ std::size_t OccupancyMap3D::InsertDepthImage(const DepthImage& depth,
               "Invalid depth image: ", depth.width, "x", depth.height,
               " does not match its intrinsics ", intrinsics.width, "x", intrinsics.height, ".");
   ThrowUnless(X_MC.IsFinite(), "Invalid camera pose X_MC: must be finite.");
-  octomap::Pointcloud cloud;
-  for (int v = 0; v < depth.height; v += config_.pixel_stride) {
-    for (int u = 0; u < depth.width; u += config_.pixel_stride) {
-      if (!depth.IsValidAt(u, v)) continue;
-      const Eigen::Vector3d p_MQ = X_MC * intrinsics.Unproject(u + 0.5, v + 0.5, depth.At(u, v));
-      cloud.push_back(float(p_MQ.x()), float(p_MQ.y()), float(p_MQ.z()));
+  const Eigen::Vector3d& p_MC = X_MC.translation();
+  const octomap::point3d origin(float(p_MC.x()), float(p_MC.y()), float(p_MC.z()));
+  octomap::KeySet occupied, free;
+  octomap::KeyRay ray;
+  std::size_t inserted = 0;
+  for (int v = 0; v < depth.height; ++v) {
+    for (int u = 0; u < depth.width; ++u) {
+      const bool mark = u % config_.pixel_stride == 0 && v % config_.pixel_stride == 0;
+      const bool carve = u % config_.clearing_stride == 0 && v % config_.clearing_stride == 0;
+      if ((!mark && !carve) || !depth.IsValidAt(u, v)) continue;
+      const double z = depth.At(u, v);
+      const Eigen::Vector3d p_MQ = X_MC * intrinsics.Unproject(u + 0.5, v + 0.5, z);
+      const Eigen::Vector3d ray_M = p_MQ - p_MC;
+      const double distance = ray_M.norm();
+      if (mark && distance <= config_.max_range) {
+        octomap::OcTreeKey key;
+        if (tree_->coordToKeyChecked(p_MQ.x(), p_MQ.y(), p_MQ.z(), key)) {
+          occupied.insert(key);
+          ++inserted;
+        }
+      }
+      if (carve && config_.clearing_range > 0.0) {
+        const Eigen::Vector3d end = p_MC + ray_M * std::min(1.0, config_.clearing_range / distance);
+        if (tree_->computeRayKeys(
+                origin, octomap::point3d(float(end.x()), float(end.y()), float(end.z())), ray)) {
+          free.insert(ray.begin(), ray.end());
+        }
+      }
     }
   }
-  const Eigen::Vector3d& o = X_MC.translation();
-  // Discretized insertion: one ray per voxel endpoint, which keeps an 80x60 frame fast.
-  tree_->insertPointCloud(cloud, octomap::point3d(float(o.x()), float(o.y()), float(o.z())),
-                          config_.max_range,
-                          /*lazy_eval=*/false, /*discretize=*/true);
-  return cloud.size();
+  for (const auto& key : free) {
+    if (occupied.count(key) == 0) tree_->updateNode(key, false, /*lazy_eval=*/true);
+  }
+  for (const auto& key : occupied)
+    tree_->updateNode(key, true, /*lazy_eval=*/true);
+  tree_->updateInnerOccupancy();
+  return inserted;
 }
 
 std::vector<Eigen::Vector2d> OccupancyMap3D::ProjectObstacles() const {

@@ -14,10 +14,16 @@
 
 namespace egress::perception {
 
+/// Marking and clearing are separate, as in Nav2's voxel layer: every return within max_range
+/// marks its voxel, but free space is carved only along every clearing_stride-th ray and only up
+/// to clearing_range. Carving the whole frustum at 5 cm costs ~30 ms per 80x60 frame; bounded
+/// like this an insert stays near 2 ms, and space is cleared as the robot comes near it.
 struct OccupancyMap3DConfig {
   double resolution{0.05};           ///< Voxel size [m].
-  double max_range{4.0};             ///< Depth returns beyond this only clear space [m].
-  int pixel_stride{1};               ///< Use every n-th pixel in u and v.
+  double max_range{4.0};             ///< Returns beyond this are ignored [m].
+  double clearing_range{1.5};        ///< Rays carve free space up to this distance [m].
+  int clearing_stride{4};            ///< Carve along every n-th pixel's ray in u and v.
+  int pixel_stride{1};               ///< Mark every n-th pixel in u and v.
   double min_obstacle_height{0.05};  ///< Projection band in M's z [m]: the floor is below it,
   double max_obstacle_height{1.5};   ///< and what the robot passes under is above it.
   void Validate() const;

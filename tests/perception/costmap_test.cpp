@@ -1,0 +1,139 @@
+#include "egress/perception/costmap.h"
+
+#include <cmath>
+#include <limits>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "egress/hsr_interface/error.h"
+#include "synthetic.h"
+
+namespace egress::perception {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+OccupancyGrid EmptyMap() {
+  return OccupancyGrid::FromBoxes({}, {0, 0}, {10, 10}, 0.05);
+}
+
+// A scan with every beam empty except the one closest to `angle`, at `range`.
+LaserScan SingleReturn(double angle, float range) {
+  LaserScan scan = testing::MakeScan(1081);
+  const auto i =
+      static_cast<std::size_t>(std::lround((angle - scan.angle_min) / scan.angle_increment));
+  scan.ranges[i] = range;
+  return scan;
+}
+
+double ExpectedCost(const CostmapConfig& c, double d) {
+  if (d <= c.robot_radius) return kInscribedCost;
+  if (d > c.inflation_radius) return 0;
+  return (kInscribedCost - 1) * std::exp(-c.cost_scaling_factor * (d - c.robot_radius));
+}
+
+TEST(CostmapTest, MarksInflatesAndClears) {
+  Costmap2D costmap(EmptyMap());
+  const Pose2 X_ML{5.0, 5.0, 0.0};
+  costmap.UpdateWithScan(SingleReturn(0.0, 2.0f), X_ML);
+  EXPECT_EQ(costmap.CostAt({7.02, 5.02}), kLethalCost);
+  EXPECT_EQ(costmap.CostAt({7.02 - 0.1, 5.02}), kInscribedCost);
+  // Inflation follows Nav2's decay (within a cell's quantization).
+  for (double d : {0.3, 0.4, 0.5}) {
+    const double cost = costmap.CostAt({7.025, 5.025 + d});
+    EXPECT_NEAR(cost, ExpectedCost(costmap.config(), d), 25.0) << "d = " << d;
+  }
+  EXPECT_EQ(costmap.CostAt({7.025, 5.025 + 0.7}), kFreeCost);
+  EXPECT_EQ(costmap.CostAt({6.0, 5.02}), kFreeCost);  // along the ray: free
+
+  // The obstacle moved away: a ray with no return clears it.
+  costmap.UpdateWithScan(SingleReturn(0.0, std::numeric_limits<float>::infinity()), X_ML);
+  EXPECT_EQ(costmap.CostAt({7.02, 5.02}), kFreeCost);
+  EXPECT_EQ(costmap.CostAt({7.02 - 0.1, 5.02}), kFreeCost);
+}
+
+TEST(CostmapTest, FarReturnsDoNotMarkAndStaticWallsAreNotCleared) {
+  const OccupancyGrid walls =
+      OccupancyGrid::FromBoxes({{{9.5, 5.0, 0.0}, {0.1, 10.0}}}, {0, 0}, {10, 10}, 0.05);
+  Costmap2D costmap(walls);
+  costmap.UpdateWithScan(SingleReturn(0.5, 2.9f),
+                         {5.0, 5.0, 0.0});  // beyond obstacle_max_range 2.5
+  EXPECT_EQ(costmap.CostAt(Eigen::Vector2d(5.0, 5.0) +
+                           2.9 * Eigen::Vector2d(std::cos(0.5), std::sin(0.5))),
+            kFreeCost);
+  costmap.UpdateWithScan(SingleReturn(0.0, std::numeric_limits<float>::infinity()),
+                         {7.0, 5.0, 0.0});
+  EXPECT_EQ(costmap.CostAt({9.5, 5.0}), kLethalCost);  // the ray passes the wall: static stays
+}
+
+// The paper's S7 failure: inflation sealing a doorway the robot fits through.
+TEST(CostmapTest, NarrowButPassableDoorwayStaysPassable) {
+  // A wall at x = 5 with a 0.50 m opening (robot diameter 0.43 m) at y in [4.75, 5.25].
+  const OccupancyGrid walls = OccupancyGrid::FromBoxes(
+      {{{5.0, 2.375, 0.0}, {0.1, 4.75}}, {{5.0, 7.625, 0.0}, {0.1, 4.75}}}, {0, 0}, {10, 10}, 0.05);
+  Costmap2D plain(walls);
+  Costmap2D door_aware(walls);
+  door_aware.AddDoorway({"lab", {5.0, 4.75}, {5.0, 5.25}, 1.0, 0.3});
+  // Along the crossing line through the middle of the opening, within the threshold zone.
+  int plain_worst = 0, aware_worst = 0;
+  for (double x = 4.72; x <= 5.28; x += 0.025) {
+    plain_worst = std::max<int>(plain_worst, plain.CostAt({x, 5.0}));
+    aware_worst = std::max<int>(aware_worst, door_aware.CostAt({x, 5.0}));
+    EXPECT_TRUE(door_aware.IsFree({x, 5.0})) << x;
+  }
+  EXPECT_GT(plain_worst, 128);  // plain inflation nearly seals it
+  EXPECT_EQ(aware_worst, kFreeCost);
+  // Too narrow for the robot: even the doorway layer keeps it blocked (inscribed).
+  const OccupancyGrid narrow = OccupancyGrid::FromBoxes(
+      {{{5.0, 2.4, 0.0}, {0.1, 4.8}}, {{5.0, 7.6, 0.0}, {0.1, 4.8}}}, {0, 0}, {10, 10}, 0.05);
+  Costmap2D too_narrow(narrow);
+  too_narrow.AddDoorway({"slot", {5.0, 4.8}, {5.0, 5.2}, 1.0, 0.3});
+  EXPECT_FALSE(too_narrow.IsFree({5.0, 5.0}));
+}
+
+TEST(CostmapTest, DoorLeafIsMarkedAsItSwings) {
+  const OccupancyGrid walls = OccupancyGrid::FromBoxes(
+      {{{5.0, 2.25, 0.0}, {0.1, 4.5}}, {{5.0, 7.75, 0.0}, {0.1, 4.5}}}, {0, 0}, {10, 10}, 0.05);
+  Costmap2D costmap(walls);
+  costmap.AddDoorway({"office", {5.0, 4.5}, {5.0, 5.5}, -1.0, 0.3});  // hinge south, opens to +x
+  EXPECT_TRUE(costmap.IsFree({5.0, 5.0}));
+  costmap.SetDoorLeafAngle("office", 0.0);  // closed
+  EXPECT_EQ(costmap.CostAt({5.0, 5.0}), kLethalCost);
+  EXPECT_FALSE(costmap.IsFree({5.1, 5.0}));
+  costmap.SetDoorLeafAngle("office", std::numbers::pi / 2);  // wide open, leaf along +x
+  EXPECT_TRUE(costmap.IsFree({5.0, 5.0}));
+  EXPECT_EQ(costmap.CostAt({5.8, 4.52}), kLethalCost);
+  costmap.SetDoorLeafAngle("office", std::nullopt);
+  EXPECT_EQ(costmap.CostAt({5.8, 4.52}), kFreeCost);
+  EXPECT_THROW(costmap.SetDoorLeafAngle("attic", 0.0), InvalidArgument);
+  EXPECT_THROW(costmap.AddDoorway({"office", {1, 1}, {2, 1}, 1.0, 0.3}), InvalidArgument);
+}
+
+TEST(CostmapTest, ProjectedObstaclesAndFootprint) {
+  Costmap2D costmap(EmptyMap());
+  costmap.SetProjectedObstacles({{3.0, 3.0}});
+  EXPECT_EQ(costmap.CostAt({3.0, 3.0}), kLethalCost);
+  EXPECT_EQ(costmap.FootprintCost({3.1, 3.0, 0.0}), kLethalCost);  // inside the 0.215 m disc
+  EXPECT_LT(costmap.FootprintCost({3.5, 3.0, 0.0}), kInscribedCost);
+  costmap.SetProjectedObstacles({});
+  EXPECT_EQ(costmap.CostAt({3.0, 3.0}), kFreeCost);
+  EXPECT_EQ(costmap.FootprintCost({0.1, 0.1, 0.0}), kUnknownCost);  // leaves the map
+}
+
+TEST(CostmapTest, MalformedInputIsRejectedWithoutCrashing) {
+  Costmap2D costmap(EmptyMap());
+  LaserScan empty = testing::MakeScan(2);
+  empty.ranges.clear();
+  EXPECT_NO_THROW(costmap.UpdateWithScan(empty, {5, 5, 0}));  // an empty scan changes nothing
+  LaserScan bad = testing::MakeScan(10);
+  bad.angle_increment = 0.0;
+  EXPECT_THROW(costmap.UpdateWithScan(bad, {5, 5, 0}), InvalidArgument);
+  EXPECT_THROW(costmap.UpdateWithScan(testing::MakeScan(10), {kInf, 5, 0}), InvalidArgument);
+  EXPECT_NO_THROW(costmap.UpdateWithScan(testing::MakeScan(10), {50, 50, 0}));  // off the map
+  EXPECT_THROW(Costmap2D(EmptyMap(), CostmapConfig{0.3, 0.2}), InvalidArgument);
+  EXPECT_THROW(costmap.FootprintCost({std::nan(""), 0, 0}), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace egress::perception

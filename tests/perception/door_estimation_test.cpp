@@ -1,0 +1,117 @@
+#include "egress/perception/door_estimation.h"
+
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "egress/hsr_interface/error.h"
+
+namespace egress::perception {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+using std::chrono::milliseconds;
+
+// A 0.9 m door in a wall along y = 0, hinge at x = 0, latch at x = 0.9, opening toward +y.
+DoorModel LabDoor() {
+  return {"lab", {0.0, 0.0}, {0.9, 0.0}, 1.0, std::numbers::pi / 2};
+}
+
+// Laser-like samples of the leaf at `angle` and of the wall on both sides, with noise.
+std::vector<Eigen::Vector2d> DoorPoints(const DoorModel& door, double angle, std::mt19937& random) {
+  std::normal_distribution<double> noise(0.0, 0.01);
+  std::vector<Eigen::Vector2d> points;
+  const Eigen::Vector2d tip = door.LeafTip(angle);
+  for (double s = 0.02; s <= 1.0; s += 0.04) {
+    points.push_back(door.p_MHinge + s * (tip - door.p_MHinge) +
+                     Eigen::Vector2d(noise(random), noise(random)));
+  }
+  for (double x = -1.5; x < -0.05; x += 0.05)
+    points.emplace_back(x, noise(random));  // wall, hinge side
+  for (double x = 0.95; x < 2.5; x += 0.05)
+    points.emplace_back(x, noise(random));  // wall, latch side
+  return points;
+}
+
+TEST(DoorEstimationTest, AngleOpenFractionAndClearanceAtKeyAngles) {
+  const DoorModel door = LabDoor();
+  std::mt19937 random(3);
+  for (double degrees : {0.0, 30.0, 60.0, 90.0}) {
+    const auto measurement = MeasureDoorAngle(door, DoorPoints(door, degrees * kDeg, random));
+    ASSERT_TRUE(measurement.has_value()) << degrees;
+    EXPECT_NEAR(measurement->angle / kDeg, degrees, 3.0);
+    DoorStateTracker tracker(door);
+    tracker.Update(measurement->angle, milliseconds(0));
+    EXPECT_NEAR(tracker.state().open_fraction, degrees / 90.0, 0.04) << degrees;
+    EXPECT_NEAR(tracker.state().clearance_width, 0.9 * (1 - std::cos(degrees * kDeg)), 0.05)
+        << degrees;
+  }
+  // The paper's S3 failure: a half-open door is not "closed".
+  DoorStateTracker half(door);
+  half.Update(45 * kDeg, milliseconds(0));
+  EXPECT_NE(half.state().motion, DoorMotion::kClosed);
+  EXPECT_GT(half.state().clearance_width, 0.25);
+}
+
+TEST(DoorEstimationTest, NoLeafSeenIsNoMeasurement) {
+  EXPECT_FALSE(MeasureDoorAngle(LabDoor(), {{5.0, 5.0}, {-2.0, 0.0}}).has_value());
+}
+
+TEST(DoorEstimationTest, GlassDoorLineFitRecoversTheAngleWithin3Degrees) {
+  const DoorModel door = LabDoor();
+  std::mt19937 random(11);
+  std::normal_distribution<double> noise(0.0, 0.012);
+  std::uniform_real_distribution<double> clutter(-0.5, 1.5);
+  for (double degrees : {20.0, 37.0, 75.0}) {
+    const Eigen::Vector2d tip = door.LeafTip(degrees * kDeg);
+    std::vector<Eigen::Vector2d> points;
+    for (double s = 0.1; s <= 0.95; s += 0.03) {
+      points.push_back(s * tip + Eigen::Vector2d(noise(random), noise(random)));
+    }
+    for (int i = 0; i < 10; ++i)
+      points.emplace_back(clutter(random), clutter(random));  // ~30% outliers
+    const auto fit = FitLineRansac(points);
+    ASSERT_TRUE(fit.has_value());
+    EXPECT_NEAR(DoorAngleFromLine(door, *fit) / kDeg, degrees, 3.0);
+    EXPECT_LT(fit->rms, 0.02);
+  }
+  EXPECT_FALSE(FitLineRansac({{0, 0}, {1, 1}}).has_value());  // too few points
+}
+
+TEST(DoorEstimationTest, BoxBearingsFollowTheCameraMount) {
+  // Camera optical frame looking along the laser's x axis.
+  const Pose3 X_LC =
+      Pose3::FromXyzRpy({0.0, 0.0, 0.8}, {-std::numbers::pi / 2, 0.0, -std::numbers::pi / 2});
+  const CameraIntrinsics K = CameraIntrinsics::FromHorizontalFov(640, 480, 1.047);
+  const auto [lo, hi] = BoxBearingsInLaser({0, 200, 640, 280}, K, X_LC);
+  EXPECT_NEAR(lo, -1.047 / 2, 1e-6);  // the image's right edge is to the robot's right
+  EXPECT_NEAR(hi, 1.047 / 2, 1e-6);
+}
+
+TEST(DoorStateTrackerTest, OpeningHeldAndClosing) {
+  DoorStateTracker tracker(LabDoor());
+  Time t{0};
+  const auto step = [&](double degrees) {
+    t += milliseconds(100);
+    tracker.Update(degrees * kDeg, t);
+  };
+  step(0);
+  EXPECT_EQ(tracker.state().motion, DoorMotion::kClosed);
+  for (double a = 10; a <= 80; a += 10)
+    step(a);  // ADA operator opening ~25 deg/s
+  EXPECT_EQ(tracker.state().motion, DoorMotion::kOpening);
+  for (int i = 0; i < 25; ++i)
+    step(80);
+  EXPECT_EQ(tracker.state().motion, DoorMotion::kHeldOpen);
+  for (double a = 70; a >= 30; a -= 10)
+    step(a);
+  EXPECT_EQ(tracker.state().motion, DoorMotion::kClosing);
+  EXPECT_THROW(tracker.Update(std::nan(""), t), InvalidArgument);
+  EXPECT_THROW(tracker.Update(0.0, Time{0}), InvalidArgument);  // time went backwards
+  EXPECT_THROW(DoorStateTracker({"bad", {0, 0}, {0, 0}}), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace egress::perception

@@ -1,0 +1,91 @@
+#include "egress/perception/occupancy_map_3d.h"
+
+#include <cmath>
+#include <numbers>
+
+#include <gtest/gtest.h>
+
+#include "egress/hsr_interface/error.h"
+
+namespace egress::perception {
+namespace {
+
+// A camera at height 1.0 m looking along M's x axis (optical z = M x, optical x = -M y).
+Pose3 ForwardCamera() {
+  return Pose3::FromXyzRpy({0.0, 0.0, 1.0}, {-std::numbers::pi / 2, 0.0, -std::numbers::pi / 2});
+}
+
+// Renders the depth of an axis-aligned box face x = face_x, y in [y0, y1], z in [z0, z1].
+DepthImage RenderFace(const CameraIntrinsics& K, const Pose3& X_MC, double face_x, double y0,
+                      double y1, double z0, double z1) {
+  DepthImage image;
+  image.width = K.width;
+  image.height = K.height;
+  image.depth.assign(std::size_t(K.width * K.height), std::nanf(""));
+  for (int v = 0; v < K.height; ++v) {
+    for (int u = 0; u < K.width; ++u) {
+      const Eigen::Vector3d ray_M = X_MC.rotation() * K.Unproject(u + 0.5, v + 0.5, 1.0);
+      if (ray_M.x() <= 0) continue;
+      const double t = (face_x - X_MC.translation().x()) / ray_M.x();
+      const Eigen::Vector3d p = X_MC.translation() + t * ray_M;
+      if (p.y() >= y0 && p.y() <= y1 && p.z() >= z0 && p.z() <= z1)
+        image.depth[std::size_t(v * K.width + u)] = float(t);
+    }
+  }
+  return image;
+}
+
+// The face lies on a voxel boundary (x = 2.0): accept the voxel on either side.
+bool OccupiedAtFace(const OccupancyMap3D& map, double y, double z) {
+  return map.IsOccupied({1.98, y, z}) || map.IsOccupied({2.02, y, z});
+}
+
+TEST(OccupancyMap3DTest, SyntheticBoxIsOccupiedAndTheSpaceBeforeItFree) {
+  const CameraIntrinsics K = CameraIntrinsics::FromHorizontalFov(80, 60, 1.047);
+  const Pose3 X_MC = ForwardCamera();
+  OccupancyMap3D map;
+  // A table-like face 2 m ahead, 0.4-0.8 m high: above the base laser's scan plane.
+  const std::size_t inserted =
+      map.InsertDepthImage(RenderFace(K, X_MC, 2.0, -0.3, 0.3, 0.4, 0.8), K, X_MC);
+  EXPECT_GT(inserted, 100u);
+  EXPECT_TRUE(OccupiedAtFace(map, 0.0, 0.6));
+  EXPECT_FALSE(map.IsOccupied({0.5, 0.0, 0.9}));  // along the rays, within clearing_range: free
+  const octomap::OcTreeNode* carved = map.tree()->search(0.5, 0.0, 0.9);
+  ASSERT_NE(carved, nullptr);  // observed (carved), not merely unknown
+  EXPECT_FALSE(map.tree()->isNodeOccupied(carved));
+  const auto projected = map.ProjectObstacles();
+  ASSERT_FALSE(projected.empty());
+  for (const auto& p : projected) {
+    EXPECT_GT(p.x(), 1.9);
+    EXPECT_LT(std::abs(p.y()), 0.4);
+  }
+}
+
+TEST(OccupancyMap3DTest, OverheadObstaclesAreNotProjected) {
+  const CameraIntrinsics K = CameraIntrinsics::FromHorizontalFov(80, 60, 1.047);
+  const Pose3 X_MC = ForwardCamera();
+  OccupancyMap3DConfig config;
+  config.max_obstacle_height = 1.5;
+  OccupancyMap3D map(config);
+  map.InsertDepthImage(RenderFace(K, X_MC, 2.0, -0.3, 0.3, 1.6, 1.9), K, X_MC);  // above the robot
+  EXPECT_TRUE(OccupiedAtFace(map, 0.0, 1.7));
+  EXPECT_TRUE(map.ProjectObstacles().empty());
+}
+
+TEST(OccupancyMap3DTest, MalformedInput) {
+  const CameraIntrinsics K = CameraIntrinsics::FromHorizontalFov(80, 60, 1.047);
+  OccupancyMap3D map;
+  DepthImage image;
+  image.width = 40;
+  image.height = 30;
+  image.depth.assign(40 * 30, 1.0f);
+  EXPECT_THROW(map.InsertDepthImage(image, K, ForwardCamera()), InvalidArgument);  // size mismatch
+  image.width = 80;
+  image.height = 60;
+  image.depth.assign(80 * 60, std::nanf(""));  // all invalid: nothing inserted, no crash
+  EXPECT_EQ(map.InsertDepthImage(image, K, ForwardCamera()), 0u);
+  EXPECT_THROW(OccupancyMap3D(OccupancyMap3DConfig{0.0}), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace egress::perception

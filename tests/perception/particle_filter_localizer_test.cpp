@@ -1,0 +1,99 @@
+#include "egress/perception/particle_filter_localizer.h"
+
+#include <cmath>
+#include <numbers>
+
+#include <gtest/gtest.h>
+
+#include "egress/hsr_interface/error.h"
+#include "synthetic.h"
+
+namespace egress::perception {
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// Drives a multi-room route (through the doorway and back) at 0.5 m/s with 2% odometry drift
+// (scale error on translation and rotation) and checks the pose is held within 5 cm / 2 deg.
+TEST(ParticleFilterLocalizerTest, HoldsThePoseOverAMultiRoomRouteWithDriftingOdometry) {
+  const OccupancyGrid map = testing::TwoRoomMap();
+  const Pose2 X_BL{0.1675, 0.0, 0.0};
+  ParticleFilterLocalizer localizer(map, X_BL);
+  const std::vector<Eigen::Vector2d> route = {{1.5, 1.5}, {4.5, 4.0}, {7.5, 4.0}, {10.5, 3.0},
+                                              {8.0, 6.5}, {6.5, 4.0}, {2.0, 4.5}};
+  Pose2 truth{route[0].x(), route[0].y(), 0.6};
+  Pose2 odometry = truth;  // odom frame starts aligned with the map
+  localizer.Initialize({truth.x + 0.1, truth.y - 0.08, truth.yaw + 3 * kDeg},
+                       Eigen::Vector3d(0.01, 0.01, 0.003).asDiagonal());
+  LaserScan scan = testing::MakeScan(181, 8.0);
+  localizer.Update(odometry, scan);
+
+  constexpr double kDt = 0.2, kSpeed = 0.5, kDrift = 1.02;
+  double worst_position = 0.0, worst_yaw = 0.0, travelled = 0.0;
+  int steps = 0;
+  for (std::size_t w = 1; w < route.size(); ++w) {
+    while ((route[w] - truth.translation()).norm() > kSpeed * kDt) {
+      const Eigen::Vector2d to_goal = route[w] - truth.translation();
+      const double heading = std::atan2(to_goal.y(), to_goal.x());
+      // The omnidirectional base translates toward the goal and turns toward its heading.
+      const Pose2 step_B{
+          kSpeed * kDt * std::cos(heading - truth.yaw),
+          kSpeed * kDt * std::sin(heading - truth.yaw),
+          std::clamp(WrapAngle(heading - truth.yaw), -0.3 * kDt * 5, 0.3 * kDt * 5) * 0.2};
+      truth = truth * step_B;
+      odometry = odometry * Pose2{step_B.x * kDrift, step_B.y * kDrift, step_B.yaw * kDrift};
+      travelled += kSpeed * kDt;
+      testing::CastScan(map, truth * X_BL, &scan);
+      localizer.Update(odometry, scan);
+      if (++steps > 10) {  // after the initial convergence
+        const Pose2 estimate = localizer.Estimate();
+        worst_position =
+            std::max(worst_position, std::hypot(estimate.x - truth.x, estimate.y - truth.y));
+        worst_yaw = std::max(worst_yaw, std::abs(WrapAngle(estimate.yaw - truth.yaw)));
+      }
+    }
+  }
+  // Odometry alone drifted by decimetres by now.
+  EXPECT_GT((odometry.translation() - truth.translation()).norm(), 0.1);
+  EXPECT_GT(travelled, 20.0);
+  RecordProperty("worst_position_error_m", std::to_string(worst_position));
+  RecordProperty("worst_yaw_error_deg", std::to_string(worst_yaw / kDeg));
+  EXPECT_LT(worst_position, 0.05) << "worst position error [m]";
+  EXPECT_LT(worst_yaw, 2 * kDeg) << "worst yaw error [rad]";
+  const Eigen::Matrix3d covariance = localizer.Covariance();
+  EXPECT_LT(covariance(0, 0), 0.01);
+  EXPECT_GT(localizer.resample_count(), 0);
+}
+
+TEST(ParticleFilterLocalizerTest, IsDeterministicForASeed) {
+  const OccupancyGrid map = testing::TwoRoomMap();
+  LaserScan scan = testing::MakeScan(121, 8.0);
+  testing::CastScan(map, {2.0, 2.0, 0.3}, &scan);
+  Pose2 a, b;
+  for (Pose2* out : {&a, &b}) {
+    ParticleFilterLocalizer localizer(map, {}, {});
+    localizer.Initialize({2.05, 1.95, 0.32}, Eigen::Vector3d(0.02, 0.02, 0.01).asDiagonal());
+    localizer.Predict({0, 0, 0}, {0.1, 0.0, 0.0});
+    localizer.Correct(scan);
+    *out = localizer.Estimate();
+  }
+  EXPECT_EQ(a.x, b.x);
+  EXPECT_EQ(a.yaw, b.yaw);
+}
+
+TEST(ParticleFilterLocalizerTest, RejectsBadInput) {
+  const OccupancyGrid map = testing::TwoRoomMap();
+  ParticleFilterLocalizer localizer(map, {});
+  EXPECT_THROW(localizer.Estimate(), InvalidArgument);  // not initialized
+  EXPECT_THROW(localizer.Initialize({std::nan(""), 0, 0}, Eigen::Matrix3d::Identity()),
+               InvalidArgument);
+  EXPECT_THROW(localizer.Initialize({1, 1, 0}, -Eigen::Matrix3d::Identity()), InvalidArgument);
+  localizer.Initialize({2, 2, 0}, Eigen::Matrix3d::Identity() * 0.01);
+  LaserScan empty = testing::MakeScan(2);
+  empty.ranges.assign(2, std::numeric_limits<float>::infinity());
+  EXPECT_FALSE(localizer.Correct(empty));  // no usable beam
+  EXPECT_THROW(ParticleFilterLocalizer(map, {}, LocalizerConfig{5}), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace egress::perception

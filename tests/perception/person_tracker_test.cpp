@@ -1,0 +1,87 @@
+#include "egress/perception/person_tracker.h"
+
+#include <cmath>
+#include <numbers>
+
+#include <gtest/gtest.h>
+
+#include "egress/hsr_interface/error.h"
+
+namespace egress::perception {
+namespace {
+
+using std::chrono::milliseconds;
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// The door of the lab: along y = 0 from x = 0 (hinge) to x = 0.9, opening toward +y.
+DoorZone LabZone() {
+  return {{"lab", {0.0, 0.0}, {0.9, 0.0}, 1.0, std::numbers::pi / 2}, 1.0, 0.3};
+}
+
+// Feeds a straight walk at 10 Hz (the detector's ~8 Hz rounded) and returns the tracker.
+PersonTracker Walk(Eigen::Vector2d start, Eigen::Vector2d velocity, int frames) {
+  PersonTracker tracker;
+  for (int i = 0; i < frames; ++i) {
+    tracker.Update({start + velocity * (0.1 * i)}, milliseconds(100 * i));
+  }
+  return tracker;
+}
+
+TEST(PersonTrackerTest, SmoothedVelocityAndForecast) {
+  const PersonTracker tracker = Walk({0.45, -4.0}, {0.0, 1.2}, 25);
+  ASSERT_EQ(tracker.people().size(), 1u);
+  const TrackedPerson& person = tracker.people()[0];
+  EXPECT_NEAR(person.v_MP.y(), 1.2, 0.06);
+  EXPECT_NEAR(person.v_MP.x(), 0.0, 0.02);
+  ASSERT_EQ(person.forecast.size(), 4u);  // 4 x 0.2 s
+  EXPECT_NEAR(person.forecast[3].y() - person.p_MP.y(), 1.2 * 0.8, 0.06);
+}
+
+TEST(PersonTrackerTest, IntentOnScriptedTracks) {
+  const DoorZone zone = LabZone();
+  DoorState closed;
+  // Walking straight at the opening, 1.6 m away: crossing within the horizon.
+  const PersonTracker toward = Walk({0.45, -4.0}, {0.0, 1.2}, 20);
+  EXPECT_EQ(ClassifyIntent(toward.people()[0], zone, closed), PersonIntent::kCrossing);
+  // Parallel to the door 1.5 m in front of it: walking past.
+  const PersonTracker past = Walk({-3.0, -1.5}, {1.2, 0.0}, 20);
+  EXPECT_EQ(ClassifyIntent(past.people()[0], zone, closed), PersonIntent::kWalkingPast);
+  // Toward the door but far away: approaching.
+  const PersonTracker far = Walk({0.45, -9.0}, {0.0, 1.0}, 20);
+  EXPECT_EQ(ClassifyIntent(far.people()[0], zone, closed), PersonIntent::kApproaching);
+  // Standing at the leaf's free edge of a door open at 70 degrees: holding it.
+  DoorState open;
+  open.observed = true;
+  open.angle = 70 * kDeg;
+  open.open_fraction = 70.0 / 90.0;
+  const Eigen::Vector2d tip = zone.door.LeafTip(open.angle);
+  const PersonTracker holder = Walk(tip + Eigen::Vector2d(0.3, 0.2), {0.0, 0.0}, 15);
+  EXPECT_EQ(ClassifyIntent(holder.people()[0], zone, open), PersonIntent::kHoldingDoor);
+  EXPECT_EQ(ClassifyIntent(holder.people()[0], zone, closed), PersonIntent::kStationary);
+}
+
+TEST(PersonTrackerTest, DoorZoneOccupancyForecast) {
+  const DoorZone zone = LabZone();
+  // 1.9 m from the zone's edge... at 1.2 m/s it enters within 0.8 s? Place it closer.
+  const PersonTracker tracker = Walk({0.45, -2.5}, {0.0, 1.2}, 10);  // now at y ~ -1.42
+  const auto occupied = ForecastZoneOccupancy(tracker.people(), zone);
+  ASSERT_EQ(occupied.size(), 5u);
+  EXPECT_FALSE(occupied[0]);  // not yet in the zone (depth 1 m + radius 0.3 m)
+  EXPECT_TRUE(occupied[4]);   // forecast into it within 0.8 s
+  EXPECT_TRUE(ForecastZoneOccupancy({}, zone).size() == 1u);
+}
+
+TEST(PersonTrackerTest, TracksSeveralPeopleAndDropsLostOnes) {
+  PersonTracker tracker;
+  tracker.Update({{0, 0}, {5, 5}}, milliseconds(0));
+  tracker.Update({{0.1, 0}, {5, 5.1}}, milliseconds(100));
+  EXPECT_EQ(tracker.people().size(), 2u);
+  for (int i = 0; i < 5; ++i)
+    tracker.Update({{0.2 + 0.1 * i, 0}}, milliseconds(200 + 100 * i));
+  EXPECT_EQ(tracker.people().size(), 1u);
+  EXPECT_THROW(tracker.Update({{std::nan(""), 0}}, milliseconds(800)), InvalidArgument);
+  EXPECT_THROW(tracker.Update({}, milliseconds(10)), InvalidArgument);  // time went backwards
+}
+
+}  // namespace
+}  // namespace egress::perception
