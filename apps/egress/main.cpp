@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
 
   egress::apps::AddModelCommand(app);
   egress::apps::AddBtCommand(app);
+  egress::apps::AddCostmapCommand(app);
   egress::apps::AddPlannedCommand(app, "sim", "Run one twin scenario end to end",
                                   "the robot-brain issue (twin + executive)");
   egress::apps::AddPlannedCommand(app, "batch",

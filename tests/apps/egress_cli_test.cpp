@@ -169,4 +169,44 @@ TEST(EgressCliTest, BtTraceScriptErrorsNameTheLine) {
   EXPECT_THAT(result.output, HasSubstr("no node is named 'OpenDoor'"));
 }
 
+// ---- egress costmap
+
+TEST(EgressCliTest, CostmapRendersAPng) {
+  const auto dir = std::filesystem::temp_directory_path() / "egress_cli_costmap";
+  std::filesystem::create_directories(dir);
+  {
+    // A 4 m x 2 m room (5 cm cells) with a dividing wall and a 1 m opening.
+    std::ofstream pgm(dir / "map.pgm", std::ios::binary);
+    pgm << "P5\n80 40\n255\n";
+    for (int row = 0; row < 40; ++row) {
+      for (int col = 0; col < 80; ++col) {
+        const bool wall =
+            row < 1 || row > 38 || col < 1 || col > 78 || (col == 40 && (row < 10 || row > 29));
+        pgm.put(static_cast<char>(wall ? 0 : 254));
+      }
+    }
+  }
+  std::ofstream(dir / "map.yaml") << "image: map.pgm\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\n";
+  const std::string out = (dir / "costmap.png").string();
+  std::filesystem::remove(out);
+  const std::string args =
+      "costmap " + (dir / "map.yaml").string() + " --out " + out + " --doorway 2.0 0.5 2.0 1.5";
+  Result result = RunEgress(args);
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("costmap 80x40 cells at 0.050 m"));
+  EXPECT_THAT(result.output, HasSubstr("1 doorways"));
+  EXPECT_GT(std::filesystem::file_size(out), 100u);
+  result = RunEgress(args);  // never overwrite without asking
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_THAT(result.output, HasSubstr("pass --overwrite"));
+  result = RunEgress("costmap " + (dir / "map.yaml").string() + " --out " + out +
+                     " --overwrite --doorway 1 2 3");
+  EXPECT_NE(result.exit_code, 0);
+  std::ofstream(dir / "bad.yaml") << "image: map.pgm\nresolution: fine\norigin: [0, 0, 0]\n";
+  result = RunEgress("costmap " + (dir / "bad.yaml").string() + " --out " + out + " --overwrite");
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_THAT(result.output, HasSubstr("bad.yaml:2: field 'resolution' (fine) must be a number"));
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace

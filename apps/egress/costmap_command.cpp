@@ -1,0 +1,104 @@
+// `egress costmap MAP.yaml --out costmap.png`: loads a map_server map, builds the door-aware
+// costmap egress plans on, and writes it as a PNG (black lethal, dark inscribed, gray decay,
+// white free, blue unknown; doorway thresholds tinted green).
+
+#include <filesystem>
+#include <memory>
+
+#include <fmt/format.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "commands.h"
+#include "egress/perception/costmap.h"
+
+namespace egress::apps {
+namespace {
+
+struct CostmapOptions {
+  std::string map;
+  std::string out{"costmap.png"};
+  double robot_radius{0.215};
+  double inflation_radius{0.55};
+  std::vector<double> doorways;  // x1 y1 x2 y2, repeated
+  bool overwrite{false};
+};
+
+void Run(const CostmapOptions& options) {
+  using namespace perception;
+  if (options.doorways.size() % 4 != 0) {
+    throw CommandFailed("--doorway takes 4 numbers per doorway: hinge x y, latch x y [m]");
+  }
+  if (std::filesystem::exists(options.out) && !options.overwrite) {
+    throw CommandFailed(fmt::format("'{}' exists; pass --overwrite to replace it", options.out));
+  }
+  CostmapConfig config;
+  config.robot_radius = options.robot_radius;
+  config.inflation_radius = options.inflation_radius;
+  Costmap2D costmap(OccupancyGrid::LoadMapServerYaml(options.map), config);
+  for (std::size_t i = 0; i < options.doorways.size(); i += 4) {
+    costmap.AddDoorway({fmt::format("doorway_{}", i / 4),
+                        {options.doorways[i], options.doorways[i + 1]},
+                        {options.doorways[i + 2], options.doorways[i + 3]}});
+  }
+  const cv::Mat costs = costmap.ToImage();
+  cv::Mat image(costs.size(), CV_8UC3);
+  for (int r = 0; r < costs.rows; ++r) {
+    for (int c = 0; c < costs.cols; ++c) {
+      const std::uint8_t cost = costs.at<std::uint8_t>(r, c);
+      cv::Vec3b color;
+      if (cost == kUnknownCost) {
+        color = {160, 90, 40};
+      } else if (cost == kLethalCost) {
+        color = {0, 0, 0};
+      } else if (cost == kInscribedCost) {
+        color = {60, 60, 60};
+      } else {
+        const auto v = static_cast<std::uint8_t>(255 - cost * 150 / 252);
+        color = {v, v, v};
+      }
+      image.at<cv::Vec3b>(r, c) = color;
+    }
+  }
+  const GridGeometry& g = costmap.geometry();
+  for (const auto& [id, doorway] : costmap.doorways()) {
+    const auto to_pixel = [&](const Eigen::Vector2d& p) {
+      return cv::Point(int((p.x() - g.origin.x()) / g.resolution),
+                       g.height - 1 - int((p.y() - g.origin.y()) / g.resolution));
+    };
+    cv::line(image, to_pixel(doorway.p_MHinge), to_pixel(doorway.p_MLatch), cv::Scalar(60, 180, 60),
+             2);
+  }
+  if (!cv::imwrite(options.out, image))
+    throw CommandFailed(fmt::format("cannot write '{}'", options.out));
+  std::size_t lethal = 0, free_cells = 0;
+  for (const auto cost : costmap.costs()) {
+    lethal += cost == kLethalCost;
+    free_cells += cost == kFreeCost;
+  }
+  fmt::print("costmap {}x{} cells at {:.3f} m: {} lethal, {} free, {} doorways -> {}\n", g.width,
+             g.height, g.resolution, lethal, free_cells, costmap.doorways().size(), options.out);
+}
+
+}  // namespace
+
+void AddCostmapCommand(CLI::App& app) {
+  auto options = std::make_shared<CostmapOptions>();
+  auto* command =
+      app.add_subcommand("costmap", "Render the door-aware costmap of a map_server map as a PNG");
+  command->add_option("MAP", options->map, "map_server YAML (image, resolution, origin, ...)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  command->add_option("--out", options->out, "PNG to write")->capture_default_str();
+  command->add_option("--robot-radius", options->robot_radius, "inscribed radius [m]")
+      ->capture_default_str();
+  command->add_option("--inflation-radius", options->inflation_radius, "[m]")
+      ->capture_default_str();
+  command->add_option("--doorway", options->doorways, "hinge x y latch x y [m] (repeatable)")
+      ->expected(4)
+      ->take_all();
+  command->add_flag("--overwrite", options->overwrite, "replace an existing PNG");
+  command->callback([options] { Run(*options); });
+}
+
+}  // namespace egress::apps
