@@ -240,7 +240,8 @@ struct RobotModel::Impl {
     X_wrist_G = pending;
   }
 
-  // Poses of the palm (last entry) and of each arm joint frame J_i (at its moving side) in M.
+  // Poses of the palm and of each arm joint frame J_i (before its motion) in M. Raw rotation
+  // and translation arithmetic: this is the IK's inner loop, so no Pose3 validation here.
   void ForwardKinematics(const WholeBodyVector& q, std::array<Pose3, kNumWholeBodyJoints - 3>* X_MJ,
                          Pose3* X_MG) const {
     for (int i = 0; i < kNumWholeBodyJoints; ++i) {
@@ -248,18 +249,23 @@ struct RobotModel::Impl {
                   "Invalid whole-body configuration: ", kWholeBodyJointNames[i], " (", q[i],
                   ") must be finite.");
     }
-    Pose3 X = Pose3::FromPose2({q[kBaseX], q[kBaseY], q[kBaseYaw]});
+    const double c = std::cos(q[kBaseYaw]), s = std::sin(q[kBaseYaw]);
+    Eigen::Matrix3d R;
+    R << c, -s, 0, s, c, 0, 0, 0, 1;
+    Eigen::Vector3d p(q[kBaseX], q[kBaseY], 0.0);
     for (int i = 0; i < kNumWholeBodyJoints - 3; ++i) {
       const ChainSegment& segment = arm_chain[i];
-      X = X * segment.X_prev_J;
-      if (X_MJ) (*X_MJ)[i] = X;  // Joint frame before its motion: axis and origin live here.
+      p += R * segment.X_prev_J.translation();
+      R = R * segment.X_prev_J.rotation();
+      if (X_MJ) (*X_MJ)[i] = Pose3::FromTrustedParts(R, p);
       const double value = q[kArmLift + i];
-      X = segment.type == JointType::kRevolute
-              ? X * Pose3(Eigen::AngleAxisd(value, segment.axis).toRotationMatrix(),
-                          Eigen::Vector3d::Zero())
-              : X * Pose3(Eigen::Vector3d(segment.axis * value));
+      if (segment.type == JointType::kRevolute) {
+        R = R * Eigen::AngleAxisd(value, segment.axis).toRotationMatrix();
+      } else {
+        p += R * (segment.axis * value);
+      }
     }
-    *X_MG = X * X_wrist_G;
+    *X_MG = Pose3::FromTrustedParts(R * X_wrist_G.rotation(), p + R * X_wrist_G.translation());
   }
 };
 

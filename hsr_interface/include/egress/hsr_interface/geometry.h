@@ -59,6 +59,10 @@ class Pose3 {
   static Pose3 FromXyzRpy(const Eigen::Vector3d& xyz, const Eigen::Vector3d& rpy);
   /// Lifts a planar pose into space at height z = 0.
   static Pose3 FromPose2(const Pose2& X_AB);
+  /// No validation: for hot loops whose rotation is a product of rotations by construction.
+  static Pose3 FromTrustedParts(const Eigen::Matrix3d& R_AB, const Eigen::Vector3d& p_AB) {
+    return Pose3(R_AB, p_AB, Unchecked{});
+  }
 
   const Eigen::Matrix3d& rotation() const { return R_; }
   const Eigen::Vector3d& translation() const { return p_; }

@@ -1,0 +1,108 @@
+#pragma once
+/// @file
+/// BasePlanner: OMPL planning of the omnidirectional base over SE(2).
+///  - Validity (FootprintValidityChecker): the round footprint touches no obstacle of the
+///    costmap (the centre cell's cost is below kInscribedCost, which encodes the robot radius)
+///    and, when an OctoMap is given, an FCL cylinder of the footprint does not collide with it;
+///    when carrying, the arm's swept box is checked too. Motions are checked at the costmap's
+///    cell size.
+///  - Planner by name (RRTConnect default; RRTstar, PRMstar, BITstar, InformedRRTstar use the
+///    time budget to improve), objective path length plus optional costmap cost; shortcutting
+///    and smoothing, then a check that the simplified path is still valid.
+///  - A path through a known door runs on the door's centreline: an approach pose in front of
+///    the door, an exit pose behind it; the result lists the doors crossed.
+///  - Failures are statuses with reasons: start or goal in collision, goal unreachable (no
+///    free connection on the costmap grid, e.g. a closed door), timeout, invalid request.
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <octomap/OcTree.h>
+
+#include "egress/hsr_interface/clock.h"
+#include "egress/hsr_interface/geometry.h"
+#include "egress/perception/costmap.h"
+
+namespace egress::planning {
+
+/// A box the arm sweeps while carrying, in the base frame: centre offset and full size [m].
+struct CarryBox {
+  Eigen::Vector3d p_BBox{0.35, 0.0, 0.8};
+  Eigen::Vector3d size{0.25, 0.2, 0.3};
+};
+
+struct BasePlannerConfig {
+  std::string planner{"RRTConnect"};  ///< RRTConnect, RRTstar, PRMstar, BITstar, InformedRRTstar.
+  double time_budget{1.0};            ///< [s] wall time; optimizing planners use all of it.
+  double simplify_time{0.05};         ///< [s] for shortcutting and smoothing.
+  double footprint_radius{0.215};     ///< FCL cylinder radius [m] (the costmap has its own).
+  double robot_height{1.35};          ///< FCL cylinder height [m].
+  std::optional<CarryBox> carry;      ///< Checked when set.
+  double costmap_cost_weight{0.0};    ///< > 0 adds the costmap cost to the objective.
+  bool allow_unknown{false};          ///< Plan through unknown cells.
+  double door_standoff{0.6};          ///< Approach/exit poses this far from the door line [m].
+  std::uint32_t seed{42};             ///< OMPL's process-wide seed (set once per process).
+  void Validate() const;
+};
+
+enum class PlanStatus {
+  kSuccess,
+  kInvalidRequest,
+  kStartInCollision,
+  kGoalInCollision,
+  kGoalUnreachable,
+  kTimeout
+};
+std::string_view ToString(PlanStatus status);
+
+struct PlanResult {
+  PlanStatus status{PlanStatus::kInvalidRequest};
+  std::string message;                     ///< The reason, for failures.
+  std::vector<Pose2> path;                 ///< X_MB waypoints, start to goal.
+  double length{0.0};                      ///< [m] in the plane.
+  double planning_time{0.0};               ///< [s]
+  std::vector<std::string> doors_crossed;  ///< In order along the path.
+  bool ok() const { return status == PlanStatus::kSuccess; }
+};
+
+/// A door the planner knows: its jambs in M.
+struct PlannerDoor {
+  std::string id;
+  Eigen::Vector2d p_MA{Eigen::Vector2d::Zero()};
+  Eigen::Vector2d p_MB{Eigen::Vector2d::Zero()};
+};
+
+class BasePlanner {
+ public:
+  /// The costmap (and octree) must outlive the planner; they are read at each Plan, so updates
+  /// between calls are seen. `clock` times the planning (a SteadyClock when null).
+  BasePlanner(const perception::Costmap2D& costmap, std::shared_ptr<const octomap::OcTree> octree,
+              BasePlannerConfig config = {}, std::shared_ptr<const Clock> clock = nullptr);
+  ~BasePlanner();
+  BasePlanner(BasePlanner&&) noexcept;
+  BasePlanner& operator=(BasePlanner&&) noexcept;
+  void AddDoor(const PlannerDoor& door);
+
+  PlanResult Plan(const Pose2& X_MB_start, const Pose2& X_MB_goal) const;
+  /// Whether the footprint at X_MB is collision-free (costmap and OctoMap).
+  bool IsValid(const Pose2& X_MB) const;
+  /// Whether every motion of `path` is still valid (for replanning after a costmap update).
+  bool IsPathValid(const std::vector<Pose2>& path) const;
+  /// Planner names accepted by config.planner.
+  static std::vector<std::string> PlannerNames();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Length [m] of the shortest 8-connected grid path between two points over cells below
+/// kInscribedCost (the reference for path quality); nullopt if there is none.
+std::optional<double> GridShortestPathLength(const perception::Costmap2D& costmap,
+                                             const Eigen::Vector2d& start,
+                                             const Eigen::Vector2d& goal,
+                                             bool allow_unknown = false);
+
+}  // namespace egress::planning

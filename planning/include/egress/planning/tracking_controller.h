@@ -1,0 +1,65 @@
+#pragma once
+/// @file
+/// TrackingController: follows a WholeBodyTrajectory at 100 Hz with feedforward + PD on the base
+/// (the paper's Kp = 3.0, Kd = 0.01), with velocity and acceleration limits, and a watchdog that
+/// commands zero velocity when the base is more than 0.5 m or 0.5 rad off the reference and
+/// reports why. A tripped watchdog latches until the next Start (the authors' code killed the
+/// node instead). Arm joints are handed to the robot's joint controller as position + velocity
+/// references.
+
+#include <optional>
+#include <string>
+
+#include "egress/hsr_interface/geometry.h"
+#include "egress/hsr_interface/time.h"
+#include "egress/planning/trajectory.h"
+
+namespace egress::planning {
+
+struct ControllerConfig {
+  double kp{3.0};  ///< [1/s]
+  double kd{0.01};
+  double rate_hz{100.0};
+  double max_linear_speed{0.8};   ///< [m/s]
+  double max_angular_speed{1.2};  ///< [rad/s]
+  double max_linear_accel{1.0};   ///< [m/s²]
+  double max_angular_accel{2.0};  ///< [rad/s²]
+  double watchdog_position{0.5};  ///< [m]
+  double watchdog_yaw{0.5};       ///< [rad]
+  void Validate() const;
+};
+
+struct ControlCommand {
+  Twist2 V_B;                      ///< Base velocity in the base frame.
+  std::array<double, 5> arm_q{};   ///< arm_lift … wrist_roll position references.
+  std::array<double, 5> arm_qd{};  ///< and velocity references.
+  bool active{false};              ///< False when done or stopped.
+  bool finished{false};
+  bool watchdog_tripped{false};
+  std::string watchdog_reason;
+};
+
+class TrackingController {
+ public:
+  explicit TrackingController(ControllerConfig config = {});
+  /// Starts following `trajectory` at time t0.
+  void Start(WholeBodyTrajectory trajectory, Time t0);
+  /// One control step. X_MB is the measured base pose, V_B_measured the measured base velocity
+  /// (base frame). @throws InvalidArgument for non-finite measurements.
+  ControlCommand Update(Time now, const Pose2& X_MB, const Twist2& V_B_measured);
+  /// Stops: zero commands until the next Start.
+  void Stop();
+  bool tripped() const { return tripped_; }
+  const std::string& trip_reason() const { return trip_reason_; }
+
+ private:
+  ControllerConfig config_;
+  std::optional<WholeBodyTrajectory> trajectory_;
+  Time t0_{};
+  bool tripped_{false};
+  std::string trip_reason_;
+  Twist2 last_command_;
+  std::optional<Time> last_time_;
+};
+
+}  // namespace egress::planning

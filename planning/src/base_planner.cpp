@@ -1,0 +1,428 @@
+#include "egress/planning/base_planner.h"
+
+#include <cmath>
+#include <mutex>
+#include <queue>
+
+#include <fcl/geometry/octree/octree.h>
+#include <fcl/narrowphase/collision.h>
+#include <ompl/base/objectives/PathLengthOptimizationObjective.h>
+#include <ompl/base/objectives/StateCostIntegralObjective.h>
+#include <ompl/base/spaces/SE2StateSpace.h>
+#include <ompl/geometric/SimpleSetup.h>
+#include <ompl/geometric/planners/informedtrees/BITstar.h>
+#include <ompl/geometric/planners/prm/PRMstar.h>
+#include <ompl/geometric/planners/rrt/InformedRRTstar.h>
+#include <ompl/geometric/planners/rrt/RRTConnect.h>
+#include <ompl/geometric/planners/rrt/RRTstar.h>
+#include <ompl/util/Console.h>
+#include <ompl/util/RandomNumbers.h>
+
+#include "egress/hsr_interface/error.h"
+
+namespace egress::planning {
+
+namespace ob = ompl::base;
+namespace og = ompl::geometric;
+using perception::kInscribedCost;
+using perception::kLethalCost;
+using perception::kUnknownCost;
+
+void BasePlannerConfig::Validate() const {
+  const auto names = BasePlanner::PlannerNames();
+  ThrowUnless(std::find(names.begin(), names.end(), planner) != names.end(),
+              "Invalid BasePlannerConfig: planner '", planner,
+              "' is not one of RRTConnect, RRTstar, PRMstar, BITstar, InformedRRTstar.");
+  ThrowUnless(time_budget > 0.0 && simplify_time >= 0.0,
+              "Invalid BasePlannerConfig: time_budget must be > 0 and ", "simplify_time >= 0.");
+  ThrowUnless(footprint_radius > 0.0 && robot_height > 0.0,
+              "Invalid BasePlannerConfig: footprint_radius and ", "robot_height must be > 0.");
+  ThrowUnless(costmap_cost_weight >= 0.0 && door_standoff > 0.0,
+              "Invalid BasePlannerConfig: costmap_cost_weight ",
+              "must be >= 0 and door_standoff > 0.");
+}
+
+std::string_view ToString(PlanStatus status) {
+  switch (status) {
+    case PlanStatus::kSuccess:
+      return "success";
+    case PlanStatus::kInvalidRequest:
+      return "invalid_request";
+    case PlanStatus::kStartInCollision:
+      return "start_in_collision";
+    case PlanStatus::kGoalInCollision:
+      return "goal_in_collision";
+    case PlanStatus::kGoalUnreachable:
+      return "goal_unreachable";
+    case PlanStatus::kTimeout:
+      return "timeout";
+  }
+  return "unknown";
+}
+
+std::vector<std::string> BasePlanner::PlannerNames() {
+  return {"RRTConnect", "RRTstar", "PRMstar", "BITstar", "InformedRRTstar"};
+}
+
+namespace {
+
+// Checks a base pose against the costmap and, if present, the OctoMap through FCL.
+class FootprintValidityChecker final : public ob::StateValidityChecker {
+ public:
+  FootprintValidityChecker(const ob::SpaceInformationPtr& si, const perception::Costmap2D& costmap,
+                           const fcl::OcTree<double>* octree, const BasePlannerConfig& config)
+      : ob::StateValidityChecker(si),
+        costmap_(costmap),
+        octree_(octree),
+        config_(config),
+        cylinder_(std::make_shared<fcl::Cylinderd>(config.footprint_radius, config.robot_height)) {
+    if (config.carry) box_ = std::make_shared<fcl::Boxd>(config.carry->size);
+  }
+
+  bool isValid(const ob::State* state) const override {
+    const auto* s = state->as<ob::SE2StateSpace::StateType>();
+    return IsValidPose({s->getX(), s->getY(), s->getYaw()});
+  }
+
+  bool IsValidPose(const Pose2& X_MB) const {
+    const std::uint8_t cost = costmap_.CostAt(X_MB.translation());
+    if (cost == kUnknownCost ? !config_.allow_unknown : cost >= kInscribedCost) return false;
+    if (config_.carry) {
+      // The carried box's footprint must not touch lethal cells.
+      const Eigen::Vector2d half = config_.carry->size.head<2>() / 2;
+      const double step = costmap_.geometry().resolution;
+      for (double x = -half.x(); x <= half.x() + 1e-9; x += step) {
+        for (double y = -half.y(); y <= half.y() + 1e-9; y += step) {
+          const Eigen::Vector2d p =
+              X_MB * (config_.carry->p_BBox.head<2>() + Eigen::Vector2d(x, y));
+          if (costmap_.CostAt(p) == kLethalCost) return false;
+        }
+      }
+    }
+    if (octree_ == nullptr) return true;
+    fcl::Transform3d X_MCyl = fcl::Transform3d::Identity();
+    X_MCyl.translation() = Eigen::Vector3d(X_MB.x, X_MB.y, config_.robot_height / 2);
+    fcl::CollisionObjectd robot(cylinder_, X_MCyl);
+    fcl::CollisionObjectd world(std::shared_ptr<fcl::CollisionGeometryd>(
+        const_cast<fcl::OcTree<double>*>(octree_), [](fcl::CollisionGeometryd*) {}));
+    fcl::CollisionRequestd request;
+    fcl::CollisionResultd result;
+    if (fcl::collide(&robot, &world, request, result) > 0) return false;
+    if (box_) {
+      fcl::Transform3d X_MBox = fcl::Transform3d::Identity();
+      X_MBox.linear() = Eigen::AngleAxisd(X_MB.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+      X_MBox.translation() = Pose3::FromPose2(X_MB) * config_.carry->p_BBox;
+      fcl::CollisionObjectd carried(box_, X_MBox);
+      fcl::CollisionResultd box_result;
+      if (fcl::collide(&carried, &world, request, box_result) > 0) return false;
+    }
+    return true;
+  }
+
+ private:
+  const perception::Costmap2D& costmap_;
+  const fcl::OcTree<double>* octree_;
+  const BasePlannerConfig& config_;
+  std::shared_ptr<fcl::Cylinderd> cylinder_;
+  std::shared_ptr<fcl::Boxd> box_;
+};
+
+// Costmap cost as a state cost, for the optional clearance term of the objective.
+class CostmapObjective final : public ob::StateCostIntegralObjective {
+ public:
+  CostmapObjective(const ob::SpaceInformationPtr& si, const perception::Costmap2D& costmap)
+      : ob::StateCostIntegralObjective(si, true), costmap_(costmap) {}
+  ob::Cost stateCost(const ob::State* state) const override {
+    const auto* s = state->as<ob::SE2StateSpace::StateType>();
+    const std::uint8_t c = costmap_.CostAt({s->getX(), s->getY()});
+    return ob::Cost(c >= kInscribedCost ? 1.0 : double(c) / double(kInscribedCost));
+  }
+
+ private:
+  const perception::Costmap2D& costmap_;
+};
+
+double PathLength(const std::vector<Pose2>& path) {
+  double length = 0.0;
+  for (std::size_t i = 1; i < path.size(); ++i)
+    length += (path[i].translation() - path[i - 1].translation()).norm();
+  return length;
+}
+
+// Segment–segment intersection in the plane.
+bool Crosses(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
+             const Eigen::Vector2d& d) {
+  const auto cross = [](const Eigen::Vector2d& u, const Eigen::Vector2d& v) {
+    return u.x() * v.y() - u.y() * v.x();
+  };
+  const double d1 = cross(d - c, a - c), d2 = cross(d - c, b - c), d3 = cross(b - a, c - a),
+               d4 = cross(b - a, d - a);
+  return ((d1 > 0) != (d2 > 0)) && ((d3 > 0) != (d4 > 0));
+}
+
+}  // namespace
+
+struct BasePlanner::Impl {
+  const perception::Costmap2D& costmap;
+  std::shared_ptr<const octomap::OcTree> octomap;
+  std::unique_ptr<fcl::OcTree<double>> fcl_octree;
+  BasePlannerConfig config;
+  std::shared_ptr<const Clock> clock;
+  std::vector<PlannerDoor> doors;
+  std::shared_ptr<ob::SE2StateSpace> space;
+  ob::SpaceInformationPtr si;
+  std::shared_ptr<FootprintValidityChecker> checker;
+
+  Impl(const perception::Costmap2D& c, std::shared_ptr<const octomap::OcTree> o,
+       BasePlannerConfig cfg, std::shared_ptr<const Clock> clk)
+      : costmap(c), octomap(std::move(o)), config(std::move(cfg)), clock(std::move(clk)) {
+    config.Validate();
+    static std::once_flag seeded;
+    const std::uint32_t seed = config.seed;
+    std::call_once(seeded, [seed] {
+      ompl::msg::setLogLevel(ompl::msg::LOG_WARN);
+      ompl::RNG::setSeed(seed);
+    });
+    if (!clock) clock = std::make_shared<SteadyClock>();
+    if (octomap) fcl_octree = std::make_unique<fcl::OcTree<double>>(octomap);
+    const auto& g = costmap.geometry();
+    space = std::make_shared<ob::SE2StateSpace>();
+    ob::RealVectorBounds bounds(2);
+    bounds.setLow(0, g.origin.x());
+    bounds.setLow(1, g.origin.y());
+    bounds.setHigh(0, g.origin.x() + g.width * g.resolution);
+    bounds.setHigh(1, g.origin.y() + g.height * g.resolution);
+    space->setBounds(bounds);
+    si = std::make_shared<ob::SpaceInformation>(space);
+    checker = std::make_shared<FootprintValidityChecker>(si, costmap, fcl_octree.get(), config);
+    si->setStateValidityChecker(checker);
+    // Check motions at half a costmap cell.
+    si->setStateValidityCheckingResolution(0.5 * g.resolution / space->getMaximumExtent());
+    si->setup();
+  }
+
+  ob::PlannerPtr MakePlanner() const {
+    if (config.planner == "RRTstar") return std::make_shared<og::RRTstar>(si);
+    if (config.planner == "PRMstar") return std::make_shared<og::PRMstar>(si);
+    if (config.planner == "BITstar") return std::make_shared<og::BITstar>(si);
+    if (config.planner == "InformedRRTstar") return std::make_shared<og::InformedRRTstar>(si);
+    return std::make_shared<og::RRTConnect>(si);
+  }
+
+  bool MotionValid(const Pose2& a, const Pose2& b) const {
+    ob::ScopedState<ob::SE2StateSpace> sa(space), sb(space);
+    sa->setXY(a.x, a.y);
+    sa->setYaw(a.yaw);
+    sb->setXY(b.x, b.y);
+    sb->setYaw(b.yaw);
+    return si->checkMotion(sa.get(), sb.get());
+  }
+
+  // One OMPL query between two valid poses.
+  PlanResult PlanSegment(const Pose2& start, const Pose2& goal, double budget) const {
+    PlanResult result;
+    og::SimpleSetup setup(si);
+    ob::ScopedState<ob::SE2StateSpace> s(space), g(space);
+    s->setXY(start.x, start.y);
+    s->setYaw(start.yaw);
+    g->setXY(goal.x, goal.y);
+    g->setYaw(goal.yaw);
+    setup.setStartAndGoalStates(s, g);
+    auto length = std::make_shared<ob::PathLengthOptimizationObjective>(si);
+    if (config.costmap_cost_weight > 0.0) {
+      auto multi = std::make_shared<ob::MultiOptimizationObjective>(si);
+      multi->addObjective(length, 1.0);
+      multi->addObjective(std::make_shared<CostmapObjective>(si, costmap),
+                          config.costmap_cost_weight);
+      setup.setOptimizationObjective(multi);
+    } else {
+      setup.setOptimizationObjective(length);
+    }
+    setup.setPlanner(MakePlanner());
+    const ob::PlannerStatus status = setup.solve(budget);
+    if (status != ob::PlannerStatus::EXACT_SOLUTION) {
+      result.status = PlanStatus::kTimeout;
+      result.message = Cat("no path found within the time budget (", budget, " s, planner ",
+                           config.planner, ")");
+      return result;
+    }
+    og::PathGeometric raw = setup.getSolutionPath();
+    og::PathGeometric path = raw;
+    if (config.simplify_time > 0.0) {
+      og::PathSimplifier simplifier(si);
+      simplifier.simplify(path, config.simplify_time);
+      if (!path.check()) path = raw;  // the simplified path must still be valid
+    }
+    for (std::size_t i = 0; i < path.getStateCount(); ++i) {
+      const auto* st = path.getState(i)->as<ob::SE2StateSpace::StateType>();
+      result.path.push_back({st->getX(), st->getY(), st->getYaw()});
+    }
+    result.status = PlanStatus::kSuccess;
+    return result;
+  }
+
+  static std::string Cat(const auto&... parts) { return StrCat(parts...); }
+};
+
+BasePlanner::BasePlanner(const perception::Costmap2D& costmap,
+                         std::shared_ptr<const octomap::OcTree> octree, BasePlannerConfig config,
+                         std::shared_ptr<const Clock> clock)
+    : impl_(std::make_unique<Impl>(costmap, std::move(octree), std::move(config),
+                                   std::move(clock))) {}
+
+BasePlanner::~BasePlanner() = default;
+BasePlanner::BasePlanner(BasePlanner&&) noexcept = default;
+BasePlanner& BasePlanner::operator=(BasePlanner&&) noexcept = default;
+
+void BasePlanner::AddDoor(const PlannerDoor& door) {
+  ThrowUnless(
+      door.p_MA.allFinite() && door.p_MB.allFinite() && (door.p_MB - door.p_MA).norm() > 0.1,
+      "Invalid door '", door.id, "': jambs must be finite and at least 0.1 m apart.");
+  impl_->doors.push_back(door);
+}
+
+bool BasePlanner::IsValid(const Pose2& X_MB) const {
+  ThrowUnless(X_MB.IsFinite(), "Invalid pose: must be finite.");
+  return impl_->checker->IsValidPose(X_MB);
+}
+
+bool BasePlanner::IsPathValid(const std::vector<Pose2>& path) const {
+  for (std::size_t i = 0; i < path.size(); ++i) {
+    if (!IsValid(path[i])) return false;
+    if (i > 0 && !impl_->MotionValid(path[i - 1], path[i])) return false;
+  }
+  return true;
+}
+
+PlanResult BasePlanner::Plan(const Pose2& start, const Pose2& goal) const {
+  const Duration t0 = impl_->clock->Now();
+  const auto finish = [&](PlanResult result) {
+    result.planning_time = ToSeconds(impl_->clock->Now() - t0);
+    result.length = PathLength(result.path);
+    return result;
+  };
+  PlanResult result;
+  const auto& g = impl_->costmap.geometry();
+  const auto in_map = [&](const Pose2& p) { return g.CellOf(p.translation()).has_value(); };
+  if (!start.IsFinite() || !goal.IsFinite()) {
+    result.message = "start and goal must be finite";
+    return finish(result);
+  }
+  if (!in_map(start) || !in_map(goal)) {
+    result.message =
+        StrCat(!in_map(start) ? "start" : "goal", " (", (!in_map(start) ? start : goal).x, ", ",
+               (!in_map(start) ? start : goal).y, ") is outside the map");
+    return finish(result);
+  }
+  if (!IsValid(start)) {
+    result.status = PlanStatus::kStartInCollision;
+    result.message = StrCat("start (", start.x, ", ", start.y, ") is in collision");
+    return finish(result);
+  }
+  if (!IsValid(goal)) {
+    result.status = PlanStatus::kGoalInCollision;
+    result.message = StrCat("goal (", goal.x, ", ", goal.y, ") is in collision");
+    return finish(result);
+  }
+  if (!GridShortestPathLength(impl_->costmap, start.translation(), goal.translation(),
+                              impl_->config.allow_unknown)) {
+    result.status = PlanStatus::kGoalUnreachable;
+    result.message =
+        "no free connection from start to goal on the costmap (a closed door or a blocked passage)";
+    return finish(result);
+  }
+  // First pass: any path; it tells which doors lie on the way.
+  PlanResult first = impl_->PlanSegment(start, goal, impl_->config.time_budget);
+  if (!first.ok()) return finish(first);
+  struct Crossing {
+    std::size_t segment;
+    const PlannerDoor* door;
+  };
+  std::vector<Crossing> crossings;
+  for (std::size_t i = 1; i < first.path.size(); ++i) {
+    for (const auto& door : impl_->doors) {
+      if (Crosses(first.path[i - 1].translation(), first.path[i].translation(), door.p_MA,
+                  door.p_MB)) {
+        crossings.push_back({i, &door});
+      }
+    }
+  }
+  if (crossings.empty()) return finish(first);
+  // Second pass: through each door on its centreline, approach pose to exit pose.
+  std::vector<Pose2> path;
+  Pose2 from = start;
+  for (const Crossing& crossing : crossings) {
+    const PlannerDoor& door = *crossing.door;
+    const Eigen::Vector2d center = (door.p_MA + door.p_MB) / 2;
+    const Eigen::Vector2d along = (door.p_MB - door.p_MA).normalized();
+    Eigen::Vector2d normal(-along.y(), along.x());
+    if ((first.path[crossing.segment].translation() -
+         first.path[crossing.segment - 1].translation())
+            .dot(normal) < 0) {
+      normal = -normal;  // point in the direction of travel
+    }
+    const double yaw = std::atan2(normal.y(), normal.x());
+    const Eigen::Vector2d a = center - impl_->config.door_standoff * normal;
+    const Eigen::Vector2d b = center + impl_->config.door_standoff * normal;
+    const Pose2 approach{a.x(), a.y(), yaw}, exit{b.x(), b.y(), yaw};
+    if (!IsValid(approach) || !IsValid(exit) || !impl_->MotionValid(approach, exit)) {
+      result.status = PlanStatus::kGoalUnreachable;
+      result.message = StrCat("door '", door.id, "': its centreline is blocked");
+      return finish(result);
+    }
+    PlanResult leg = impl_->PlanSegment(from, approach, impl_->config.time_budget);
+    if (!leg.ok()) return finish(leg);
+    if (!path.empty()) leg.path.erase(leg.path.begin());
+    path.insert(path.end(), leg.path.begin(), leg.path.end());
+    path.push_back(exit);
+    result.doors_crossed.push_back(door.id);
+    from = exit;
+  }
+  PlanResult last = impl_->PlanSegment(from, goal, impl_->config.time_budget);
+  if (!last.ok()) return finish(last);
+  path.insert(path.end(), last.path.begin() + 1, last.path.end());
+  result.path = std::move(path);
+  result.status = PlanStatus::kSuccess;
+  return finish(result);
+}
+
+std::optional<double> GridShortestPathLength(const perception::Costmap2D& costmap,
+                                             const Eigen::Vector2d& start,
+                                             const Eigen::Vector2d& goal, bool allow_unknown) {
+  const auto& g = costmap.geometry();
+  const auto s = g.CellOf(start), t = g.CellOf(goal);
+  if (!s || !t) return std::nullopt;
+  const auto passable = [&](int ix, int iy) {
+    const std::uint8_t c = costmap.costs()[g.Index(ix, iy)];
+    return c == kUnknownCost ? allow_unknown : c < kInscribedCost;
+  };
+  if (!passable(s->x(), s->y()) || !passable(t->x(), t->y())) return std::nullopt;
+  std::vector<double> distance(g.size(), std::numeric_limits<double>::infinity());
+  using Item = std::pair<double, std::size_t>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
+  distance[g.Index(s->x(), s->y())] = 0.0;
+  open.push({0.0, g.Index(s->x(), s->y())});
+  const std::size_t target = g.Index(t->x(), t->y());
+  while (!open.empty()) {
+    const auto [d, index] = open.top();
+    open.pop();
+    if (d > distance[index]) continue;
+    if (index == target) return d * g.resolution;
+    const int ix = int(index % std::size_t(g.width)), iy = int(index / std::size_t(g.width));
+    for (int dx = -1; dx <= 1; ++dx) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        if ((dx == 0 && dy == 0) || !g.Contains(ix + dx, iy + dy) || !passable(ix + dx, iy + dy))
+          continue;
+        const std::size_t next = g.Index(ix + dx, iy + dy);
+        const double nd = d + ((dx != 0 && dy != 0) ? std::sqrt(2.0) : 1.0);
+        if (nd < distance[next]) {
+          distance[next] = nd;
+          open.push({nd, next});
+        }
+      }
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace egress::planning

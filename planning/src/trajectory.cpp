@@ -1,0 +1,117 @@
+#include "egress/planning/trajectory.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "egress/hsr_interface/error.h"
+
+namespace egress::planning {
+
+QuinticPolynomial::QuinticPolynomial(double q0, double v0, double a0, double q1, double v1,
+                                     double a1, double duration)
+    : duration_(duration) {
+  ThrowUnless(std::isfinite(q0) && std::isfinite(v0) && std::isfinite(a0) && std::isfinite(q1) &&
+                  std::isfinite(v1) && std::isfinite(a1),
+              "Invalid quintic: boundary values must be finite.");
+  ThrowUnless(duration > 0.0 && std::isfinite(duration), "Invalid quintic: duration (", duration,
+              ") must be > 0.");
+  const double T = duration, T2 = T * T, T3 = T2 * T, T4 = T3 * T, T5 = T4 * T;
+  const double h = q1 - q0;
+  c_ = {q0,
+        v0,
+        a0 / 2.0,
+        (20 * h - (8 * v1 + 12 * v0) * T - (3 * a0 - a1) * T2) / (2 * T3),
+        (-30 * h + (14 * v1 + 16 * v0) * T + (3 * a0 - 2 * a1) * T2) / (2 * T4),
+        (12 * h - 6 * (v1 + v0) * T + (a1 - a0) * T2) / (2 * T5)};
+}
+
+double QuinticPolynomial::Position(double t) const {
+  t = std::clamp(t, 0.0, duration_);
+  return c_[0] + t * (c_[1] + t * (c_[2] + t * (c_[3] + t * (c_[4] + t * c_[5]))));
+}
+
+double QuinticPolynomial::Velocity(double t) const {
+  t = std::clamp(t, 0.0, duration_);
+  return c_[1] + t * (2 * c_[2] + t * (3 * c_[3] + t * (4 * c_[4] + t * 5 * c_[5])));
+}
+
+double QuinticPolynomial::Acceleration(double t) const {
+  t = std::clamp(t, 0.0, duration_);
+  return 2 * c_[2] + t * (6 * c_[3] + t * (12 * c_[4] + t * 20 * c_[5]));
+}
+
+void TrajectoryConfig::Validate() const {
+  ThrowUnless(nominal_speed > 0.0 && door_speed > 0.0,
+              "Invalid TrajectoryConfig: speeds must be > 0.");
+  ThrowUnless(min_duration > 0.0, "Invalid TrajectoryConfig: min_duration must be > 0.");
+}
+
+double SegmentDuration(double base_distance, bool through_door, const TrajectoryConfig& config) {
+  ThrowUnless(std::isfinite(base_distance) && base_distance >= 0.0,
+              "Invalid segment: base distance (", base_distance, ") must be finite and >= 0.");
+  return std::max(base_distance / (through_door ? config.door_speed : config.nominal_speed),
+                  config.min_duration);
+}
+
+WholeBodyTrajectory WholeBodyTrajectory::Plan(const std::vector<WholeBodyVector>& waypoints,
+                                              const RobotModel& model,
+                                              const TrajectoryConfig& config,
+                                              const std::vector<bool>& through_door) {
+  config.Validate();
+  ThrowUnless(waypoints.size() >= 2, "Invalid trajectory: needs at least 2 waypoints, got ",
+              waypoints.size(), ".");
+  ThrowUnless(through_door.empty() || through_door.size() == waypoints.size() - 1,
+              "Invalid trajectory: through_door ", "has ", through_door.size(), " entries for ",
+              waypoints.size() - 1, " segments.");
+  constexpr double kQuinticPeakFactor =
+      1.875;  // peak speed / average speed of a rest-to-rest quintic
+  WholeBodyTrajectory trajectory;
+  WholeBodyVector previous = waypoints[0];
+  ThrowUnless(previous.allFinite(), "Invalid trajectory: waypoint 0 is not finite.");
+  double time = 0.0;
+  for (std::size_t s = 1; s < waypoints.size(); ++s) {
+    ThrowUnless(waypoints[s].allFinite(), "Invalid trajectory: waypoint ", s, " is not finite.");
+    WholeBodyVector next = waypoints[s];
+    next[kBaseYaw] =
+        previous[kBaseYaw] + WrapAngle(next[kBaseYaw] - previous[kBaseYaw]);  // the short way
+    const double distance =
+        std::hypot(next[kBaseX] - previous[kBaseX], next[kBaseY] - previous[kBaseY]);
+    double T = SegmentDuration(distance, !through_door.empty() && through_door[s - 1], config);
+    for (int j = kArmLift; j < kNumWholeBodyJoints; ++j) {
+      const double limit = model.limits(WholeBodyJoint(j)).velocity;
+      if (limit > 0.0)
+        T = std::max(T, kQuinticPeakFactor * std::abs(next[j] - previous[j]) / limit);
+    }
+    std::vector<QuinticPolynomial> joints;
+    for (int j = 0; j < kNumWholeBodyJoints; ++j)
+      joints.emplace_back(previous[j], 0, 0, next[j], 0, 0, T);
+    trajectory.segments_.push_back(std::move(joints));
+    time += T;
+    trajectory.end_times_.push_back(time);
+    previous = next;
+  }
+  return trajectory;
+}
+
+double WholeBodyTrajectory::segment_duration(std::size_t i) const {
+  ThrowUnless(i < segments_.size(), "Invalid segment index ", i, ".");
+  return segments_[i].front().duration();
+}
+
+TrajectorySample WholeBodyTrajectory::Sample(double t) const {
+  ThrowUnless(std::isfinite(t), "Invalid trajectory time: must be finite.");
+  std::size_t s = std::lower_bound(end_times_.begin(), end_times_.end(), t) - end_times_.begin();
+  if (s >= segments_.size()) s = segments_.size() - 1;
+  const double start = s == 0 ? 0.0 : end_times_[s - 1];
+  TrajectorySample sample;
+  for (int j = 0; j < kNumWholeBodyJoints; ++j) {
+    const auto& poly = segments_[s][std::size_t(j)];
+    sample.q[j] = poly.Position(t - start);
+    sample.qd[j] = poly.Velocity(t - start);
+    sample.qdd[j] = poly.Acceleration(t - start);
+  }
+  sample.q[kBaseYaw] = WrapAngle(sample.q[kBaseYaw]);
+  return sample;
+}
+
+}  // namespace egress::planning

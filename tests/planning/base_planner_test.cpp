@@ -1,0 +1,150 @@
+#include "egress/planning/base_planner.h"
+
+#include <cmath>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "egress/hsr_interface/error.h"
+
+namespace egress::planning {
+namespace {
+
+using perception::Box2;
+using perception::Costmap2D;
+using perception::OccupancyGrid;
+using ::testing::ElementsAre;
+using ::testing::HasSubstr;
+
+// The office: 14 m x 6 m, three rooms; door A (x = 5, y 2.5..3.5), door B (x = 9, y 1..2).
+OccupancyGrid Office() {
+  const std::vector<Box2> walls = {{{7.0, 0.05, 0.0}, {14.0, 0.1}}, {{7.0, 5.95, 0.0}, {14.0, 0.1}},
+                                   {{0.05, 3.0, 0.0}, {0.1, 6.0}},  {{13.95, 3.0, 0.0}, {0.1, 6.0}},
+                                   {{5.0, 1.25, 0.0}, {0.1, 2.5}},  {{5.0, 4.75, 0.0}, {0.1, 2.5}},
+                                   {{9.0, 0.5, 0.0}, {0.1, 1.0}},   {{9.0, 4.0, 0.0}, {0.1, 4.0}},
+                                   {{2.5, 1.2, 0.0}, {1.2, 0.6}}};
+  return OccupancyGrid::FromBoxes(walls, {0, 0}, {14, 6}, 0.05);
+}
+
+class BasePlannerTest : public ::testing::Test {
+ protected:
+  BasePlannerTest() : costmap_(Office()) {
+    costmap_.AddDoorway({"A", {5.0, 2.5}, {5.0, 3.5}});
+    costmap_.AddDoorway({"B", {9.0, 1.0}, {9.0, 2.0}});
+  }
+  BasePlanner MakePlanner(std::shared_ptr<const octomap::OcTree> octree = nullptr,
+                          BasePlannerConfig config = {}) {
+    BasePlanner planner(costmap_, std::move(octree), config);
+    planner.AddDoor({"A", {5.0, 2.5}, {5.0, 3.5}});
+    planner.AddDoor({"B", {9.0, 1.0}, {9.0, 2.0}});
+    return planner;
+  }
+  // Every point along the path, at 2 cm, keeps the footprint off inflated obstacles.
+  void ExpectCollisionFree(const BasePlanner& planner, const std::vector<Pose2>& path) {
+    for (std::size_t i = 1; i < path.size(); ++i) {
+      const Eigen::Vector2d a = path[i - 1].translation(), b = path[i].translation();
+      const int steps = std::max(1, int((b - a).norm() / 0.02));
+      for (int k = 0; k <= steps; ++k) {
+        const Eigen::Vector2d p = a + (b - a) * (double(k) / steps);
+        ASSERT_LT(costmap_.CostAt(p), perception::kInscribedCost) << p.transpose();
+        ASSERT_TRUE(planner.IsValid({p.x(), p.y(), 0.0}));
+      }
+    }
+  }
+  Costmap2D costmap_;
+};
+
+TEST_F(BasePlannerTest, ThroughOpenDoorwaysOnTheirCentrelines) {
+  const BasePlanner planner = MakePlanner();
+  const PlanResult result = planner.Plan({1.5, 4.5, 0.0}, {12.5, 1.5, 0.0});
+  ASSERT_TRUE(result.ok()) << result.message;
+  EXPECT_THAT(result.doors_crossed, ElementsAre("A", "B"));
+  ExpectCollisionFree(planner, result.path);
+  EXPECT_NEAR(result.path.front().x, 1.5, 1e-9);
+  EXPECT_NEAR(result.path.back().y, 1.5, 1e-9);
+  // The crossing of door A is the straight segment from its approach to its exit pose.
+  bool found = false;
+  for (std::size_t i = 1; i < result.path.size(); ++i) {
+    if (std::abs(result.path[i - 1].x - 4.4) < 1e-9 && std::abs(result.path[i].x - 5.6) < 1e-9) {
+      EXPECT_NEAR(result.path[i - 1].y, 3.0, 1e-9);
+      EXPECT_NEAR(result.path[i].y, 3.0, 1e-9);
+      found = true;
+    }
+  }
+  EXPECT_TRUE(found);
+  const auto grid = GridShortestPathLength(costmap_, {1.5, 4.5}, {12.5, 1.5});
+  ASSERT_TRUE(grid.has_value());
+  EXPECT_LT(result.length, *grid * 1.15);
+  EXPECT_GT(result.planning_time, 0.0);
+}
+
+TEST_F(BasePlannerTest, ClosedDoorMeansNoPath) {
+  costmap_.SetDoorLeafAngle("A", 0.0);
+  const PlanResult result = MakePlanner().Plan({1.5, 4.5, 0.0}, {12.5, 1.5, 0.0});
+  EXPECT_EQ(result.status, PlanStatus::kGoalUnreachable);
+  EXPECT_THAT(result.message, HasSubstr("closed door"));
+  EXPECT_TRUE(result.path.empty());
+}
+
+TEST_F(BasePlannerTest, BadRequestsGetClearStatuses) {
+  const BasePlanner planner = MakePlanner();
+  PlanResult result = planner.Plan({std::nan(""), 1.0, 0.0}, {12.5, 1.5, 0.0});
+  EXPECT_EQ(result.status, PlanStatus::kInvalidRequest);
+  result = planner.Plan({1.5, 4.5, 0.0}, {20.0, 1.5, 0.0});
+  EXPECT_EQ(result.status, PlanStatus::kInvalidRequest);
+  EXPECT_THAT(result.message, HasSubstr("goal (20, 1.5) is outside the map"));
+  result = planner.Plan({5.0, 1.0, 0.0}, {12.5, 1.5, 0.0});  // inside the wall
+  EXPECT_EQ(result.status, PlanStatus::kStartInCollision);
+  result = planner.Plan({1.5, 4.5, 0.0}, {2.5, 1.2, 0.0});  // on the table
+  EXPECT_EQ(result.status, PlanStatus::kGoalInCollision);
+  BasePlannerConfig config;
+  config.planner = "AStar";
+  EXPECT_THROW(BasePlanner(costmap_, nullptr, config), InvalidArgument);
+}
+
+TEST_F(BasePlannerTest, OctomapObstaclesTheLaserMissesAreAvoided) {
+  // A table top at 0.7 m in the first room, invisible to the costmap.
+  auto octree = std::make_shared<octomap::OcTree>(0.05);
+  for (double x = 2.8; x <= 3.8; x += 0.05) {
+    for (double y = 2.2; y <= 4.2; y += 0.05)
+      octree->updateNode(x, y, 0.7, true);
+  }
+  octree->updateInnerOccupancy();
+  const BasePlanner planner = MakePlanner(octree);
+  EXPECT_TRUE(costmap_.IsFree({3.3, 3.2}));
+  EXPECT_FALSE(planner.IsValid({3.3, 3.2, 0.0}));
+  const PlanResult result = planner.Plan({1.5, 3.0, 0.0}, {12.5, 1.5, 0.0});
+  ASSERT_TRUE(result.ok()) << result.message;
+  for (std::size_t i = 1; i < result.path.size(); ++i) {
+    const Eigen::Vector2d a = result.path[i - 1].translation(), b = result.path[i].translation();
+    for (int k = 0; k <= 50; ++k)
+      EXPECT_TRUE(planner.IsValid({(a + (b - a) * k / 50.0).x(), (a + (b - a) * k / 50.0).y(), 0}));
+  }
+}
+
+TEST_F(BasePlannerTest, AnUpdatedCostmapInvalidatesThePathForReplanning) {
+  const BasePlanner planner = MakePlanner();
+  const PlanResult result = planner.Plan({6.0, 4.0, 0.0}, {8.0, 4.0, 0.0});
+  ASSERT_TRUE(result.ok()) << result.message;
+  EXPECT_TRUE(planner.IsPathValid(result.path));
+  costmap_.SetProjectedObstacles({{7.0, 4.0}, {7.0, 4.05}, {7.0, 3.95}, {7.0, 4.1}, {7.0, 3.9}});
+  EXPECT_FALSE(planner.IsPathValid(result.path));
+  const PlanResult again = planner.Plan({6.0, 4.0, 0.0}, {8.0, 4.0, 0.0});
+  ASSERT_TRUE(again.ok()) << again.message;
+  EXPECT_TRUE(planner.IsPathValid(again.path));
+}
+
+TEST_F(BasePlannerTest, OptimizingPlannersByName) {
+  for (const char* name : {"RRTstar", "InformedRRTstar", "PRMstar", "BITstar"}) {
+    BasePlannerConfig config;
+    config.planner = name;
+    config.time_budget = 0.2;
+    config.costmap_cost_weight = std::string(name) == "RRTstar" ? 0.5 : 0.0;
+    const PlanResult result = MakePlanner(nullptr, config).Plan({6.0, 4.5, 0.0}, {8.0, 2.0, 0.0});
+    ASSERT_TRUE(result.ok()) << name << ": " << result.message;
+    EXPECT_LT(result.length, 4.0) << name;
+  }
+}
+
+}  // namespace
+}  // namespace egress::planning
