@@ -446,13 +446,22 @@ WholeBodyJacobian RobotModel::CalcFingertipJacobian(const WholeBodyVector& q) co
 
 WholeBodyJacobian RobotModel::CalcJacobianOfPalmPoint(const WholeBodyVector& q,
                                                       const Eigen::Vector3d& p_GQ) const {
+  Pose3 X_MG;
+  WholeBodyJacobian J;
+  CalcPalmPoseAndJacobian(q, p_GQ, &X_MG, &J);
+  return J;
+}
+
+void RobotModel::CalcPalmPoseAndJacobian(const WholeBodyVector& q, const Eigen::Vector3d& p_GQ,
+                                         Pose3* X_MG_out, WholeBodyJacobian* J_out) const {
   ThrowUnless(p_GQ.allFinite(), "Invalid palm point: p_GQ must be finite.");
   std::array<Pose3, kNumWholeBodyJoints - 3> X_MJ;
   Pose3 X_MG;
   impl_->ForwardKinematics(q, &X_MJ, &X_MG);
   const Eigen::Vector3d p_MQ = X_MG * p_GQ;
 
-  WholeBodyJacobian J = WholeBodyJacobian::Zero();
+  WholeBodyJacobian& J = *J_out;
+  J.setZero();
   J.block<3, 1>(0, kBaseX) = Eigen::Vector3d::UnitX();
   J.block<3, 1>(0, kBaseY) = Eigen::Vector3d::UnitY();
   const Eigen::Vector3d p_MB(q[kBaseX], q[kBaseY], 0.0);
@@ -467,7 +476,7 @@ WholeBodyJacobian RobotModel::CalcJacobianOfPalmPoint(const WholeBodyVector& q,
       J.block<3, 1>(3, kArmLift + i) = axis_M;
     }
   }
-  return J;
+  *X_MG_out = X_MG;
 }
 
 Pose3 RobotModel::CalcHeadCameraPose(double arm_lift, const HeadConfiguration& head) const {

@@ -324,30 +324,28 @@ PlanResult BasePlanner::Plan(const Pose2& start, const Pose2& goal) const {
     result.message = StrCat("goal (", goal.x, ", ", goal.y, ") is in collision");
     return finish(result);
   }
-  if (!GridShortestPathLength(impl_->costmap, start.translation(), goal.translation(),
-                              impl_->config.allow_unknown)) {
+  // The grid's shortest path decides reachability and which doors lie on the way (in order).
+  const auto grid_path = GridShortestPath(impl_->costmap, start.translation(), goal.translation(),
+                                          impl_->config.allow_unknown);
+  if (!grid_path) {
     result.status = PlanStatus::kGoalUnreachable;
     result.message =
         "no free connection from start to goal on the costmap (a closed door or a blocked passage)";
     return finish(result);
   }
-  // First pass: any path; it tells which doors lie on the way.
-  PlanResult first = impl_->PlanSegment(start, goal, impl_->config.time_budget);
-  if (!first.ok()) return finish(first);
   struct Crossing {
-    std::size_t segment;
+    Eigen::Vector2d direction;  // of travel through the door
     const PlannerDoor* door;
   };
   std::vector<Crossing> crossings;
-  for (std::size_t i = 1; i < first.path.size(); ++i) {
+  for (std::size_t i = 1; i < grid_path->size(); ++i) {
     for (const auto& door : impl_->doors) {
-      if (Crosses(first.path[i - 1].translation(), first.path[i].translation(), door.p_MA,
-                  door.p_MB)) {
-        crossings.push_back({i, &door});
+      if (Crosses((*grid_path)[i - 1], (*grid_path)[i], door.p_MA, door.p_MB)) {
+        crossings.push_back({(*grid_path)[i] - (*grid_path)[i - 1], &door});
       }
     }
   }
-  if (crossings.empty()) return finish(first);
+  if (crossings.empty()) return finish(impl_->PlanSegment(start, goal, impl_->config.time_budget));
   // Second pass: through each door on its centreline, approach pose to exit pose.
   std::vector<Pose2> path;
   Pose2 from = start;
@@ -356,11 +354,7 @@ PlanResult BasePlanner::Plan(const Pose2& start, const Pose2& goal) const {
     const Eigen::Vector2d center = (door.p_MA + door.p_MB) / 2;
     const Eigen::Vector2d along = (door.p_MB - door.p_MA).normalized();
     Eigen::Vector2d normal(-along.y(), along.x());
-    if ((first.path[crossing.segment].translation() -
-         first.path[crossing.segment - 1].translation())
-            .dot(normal) < 0) {
-      normal = -normal;  // point in the direction of travel
-    }
+    if (crossing.direction.dot(normal) < 0) normal = -normal;  // point in the direction of travel
     const double yaw = std::atan2(normal.y(), normal.x());
     const Eigen::Vector2d a = center - impl_->config.door_standoff * normal;
     const Eigen::Vector2d b = center + impl_->config.door_standoff * normal;
@@ -389,40 +383,62 @@ PlanResult BasePlanner::Plan(const Pose2& start, const Pose2& goal) const {
 std::optional<double> GridShortestPathLength(const perception::Costmap2D& costmap,
                                              const Eigen::Vector2d& start,
                                              const Eigen::Vector2d& goal, bool allow_unknown) {
+  const auto path = GridShortestPath(costmap, start, goal, allow_unknown);
+  if (!path) return std::nullopt;
+  double length = 0.0;
+  for (std::size_t i = 1; i < path->size(); ++i)
+    length += ((*path)[i] - (*path)[i - 1]).norm();
+  return length;
+}
+
+std::optional<std::vector<Eigen::Vector2d>> GridShortestPath(const perception::Costmap2D& costmap,
+                                                             const Eigen::Vector2d& start,
+                                                             const Eigen::Vector2d& goal,
+                                                             bool allow_unknown) {
   const auto& g = costmap.geometry();
   const auto s = g.CellOf(start), t = g.CellOf(goal);
   if (!s || !t) return std::nullopt;
-  const auto passable = [&](int ix, int iy) {
-    const std::uint8_t c = costmap.costs()[g.Index(ix, iy)];
+  const auto passable = [&](std::size_t i) {
+    const std::uint8_t c = costmap.costs()[i];
     return c == kUnknownCost ? allow_unknown : c < kInscribedCost;
   };
-  if (!passable(s->x(), s->y()) || !passable(t->x(), t->y())) return std::nullopt;
-  std::vector<double> distance(g.size(), std::numeric_limits<double>::infinity());
-  using Item = std::pair<double, std::size_t>;
+  const std::size_t source = g.Index(s->x(), s->y()), target = g.Index(t->x(), t->y());
+  if (!passable(source) || !passable(target)) return std::nullopt;
+  std::vector<float> distance(g.size(), std::numeric_limits<float>::infinity());
+  std::vector<std::uint32_t> parent(g.size(), std::numeric_limits<std::uint32_t>::max());
+  using Item = std::pair<float, std::uint32_t>;
   std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
-  distance[g.Index(s->x(), s->y())] = 0.0;
-  open.push({0.0, g.Index(s->x(), s->y())});
-  const std::size_t target = g.Index(t->x(), t->y());
+  distance[source] = 0.0f;
+  open.push({0.0f, std::uint32_t(source)});
+  constexpr float kDiagonal = 1.41421356f;
   while (!open.empty()) {
     const auto [d, index] = open.top();
     open.pop();
     if (d > distance[index]) continue;
-    if (index == target) return d * g.resolution;
-    const int ix = int(index % std::size_t(g.width)), iy = int(index / std::size_t(g.width));
-    for (int dx = -1; dx <= 1; ++dx) {
-      for (int dy = -1; dy <= 1; ++dy) {
-        if ((dx == 0 && dy == 0) || !g.Contains(ix + dx, iy + dy) || !passable(ix + dx, iy + dy))
-          continue;
+    if (index == target) break;
+    const int ix = int(index % std::uint32_t(g.width)), iy = int(index / std::uint32_t(g.width));
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        if ((dx == 0 && dy == 0) || !g.Contains(ix + dx, iy + dy)) continue;
         const std::size_t next = g.Index(ix + dx, iy + dy);
-        const double nd = d + ((dx != 0 && dy != 0) ? std::sqrt(2.0) : 1.0);
+        if (!passable(next)) continue;
+        const float nd = d + ((dx != 0 && dy != 0) ? kDiagonal : 1.0f);
         if (nd < distance[next]) {
           distance[next] = nd;
-          open.push({nd, next});
+          parent[next] = index;
+          open.push({nd, std::uint32_t(next)});
         }
       }
     }
   }
-  return std::nullopt;
+  if (!std::isfinite(distance[target])) return std::nullopt;
+  std::vector<Eigen::Vector2d> path;
+  for (std::size_t i = target;; i = parent[i]) {
+    path.push_back(g.CellCenter(int(i % std::size_t(g.width)), int(i / std::size_t(g.width))));
+    if (i == source) break;
+  }
+  std::reverse(path.begin(), path.end());
+  return path;
 }
 
 }  // namespace egress::planning

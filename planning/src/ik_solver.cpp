@@ -67,8 +67,10 @@ IkResult DlsIkSolver::Solve(const IkTarget& target, const WholeBodyVector& q_sta
   if (config_.wrist_leveling) Level(result.q);
   Eigen::Matrix<double, 6, kNumWholeBodyJoints> J;
   Eigen::Matrix<double, 6, 1> e;
+  WholeBodyJacobian full;
+  Pose3 X_MG;
   for (;;) {
-    const Pose3 X_MG = model_.CalcPalmPose(result.q);
+    model_.CalcPalmPoseAndJacobian(result.q, p_GQ, &X_MG, &full);
     const Eigen::Vector3d p_MQ = X_MG * p_GQ;
     e.head<3>() = target.p_MT - p_MQ;
     result.position_error = e.head<3>().norm();
@@ -88,7 +90,6 @@ IkResult DlsIkSolver::Solve(const IkTarget& target, const WholeBodyVector& q_sta
     if (result.iterations >= config_.max_iterations) return result;
     ++result.iterations;
 
-    const WholeBodyJacobian full = model_.CalcJacobianOfPalmPoint(result.q, p_GQ);
     for (int k = 0; k < n; ++k) {
       const int j = active[k];
       J.col(k).head<3>() = full.col(j).head<3>();
@@ -105,13 +106,29 @@ IkResult DlsIkSolver::Solve(const IkTarget& target, const WholeBodyVector& q_sta
         }
       }
     }
-    // Fixed maximum sizes: no heap allocation in the loop.
+    // Clamping loop: a joint at a limit whose step points outward is taken out (its column
+    // zeroed) and the step recomputed, so the other joints carry the task instead of the
+    // clamped share being lost every iteration.
     using SmallMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
     using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kNumWholeBodyJoints, 1>;
-    const auto Jn = J.topLeftCorner(rows, n);
-    SmallMatrix A = Jn * Jn.transpose();
-    A.diagonal().array() += config_.damping * config_.damping;
-    const SmallVector dq = config_.step * (Jn.transpose() * A.ldlt().solve(e.head(rows)));
+    SmallVector dq;
+    for (int pass = 0; pass <= n; ++pass) {
+      const auto Jn = J.topLeftCorner(rows, n);
+      SmallMatrix A = Jn * Jn.transpose();
+      A.diagonal().array() += config_.damping * config_.damping;
+      dq = config_.step * (Jn.transpose() * A.ldlt().solve(e.head(rows)));
+      bool removed = false;
+      for (int k = 0; k < n; ++k) {
+        const int j = active[k];
+        const bool at_lower = result.q[j] <= lower[j] && dq[k] < 0.0;
+        const bool at_upper = result.q[j] >= upper[j] && dq[k] > 0.0;
+        if ((at_lower || at_upper) && !J.col(k).isZero()) {
+          J.col(k).setZero();
+          removed = true;
+        }
+      }
+      if (!removed) break;
+    }
     if (!dq.allFinite()) return result;
     for (int k = 0; k < n; ++k) {
       const int j = active[k];

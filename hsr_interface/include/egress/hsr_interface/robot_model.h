@@ -116,6 +116,9 @@ class RobotModel {
   WholeBodyJacobian CalcPalmJacobian(const WholeBodyVector& q) const;
   /// Geometric Jacobian of the fingertip point (linear rows) and palm rotation (angular rows).
   WholeBodyJacobian CalcFingertipJacobian(const WholeBodyVector& q) const;
+  /// The palm pose and the Jacobian of the palm point p_GQ in one pass (the IK's inner loop).
+  void CalcPalmPoseAndJacobian(const WholeBodyVector& q, const Eigen::Vector3d& p_GQ, Pose3* X_MG,
+                               WholeBodyJacobian* J) const;
   /// Jacobian of an arbitrary point p_GQ fixed in the palm frame.
   WholeBodyJacobian CalcJacobianOfPalmPoint(const WholeBodyVector& q,
                                             const Eigen::Vector3d& p_GQ) const;

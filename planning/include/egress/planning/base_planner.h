@@ -98,6 +98,12 @@ class BasePlanner {
   std::unique_ptr<Impl> impl_;
 };
 
+/// The shortest 8-connected grid path (cell centres) between two points over cells below
+/// kInscribedCost; nullopt if there is none.
+std::optional<std::vector<Eigen::Vector2d>> GridShortestPath(const perception::Costmap2D& costmap,
+                                                             const Eigen::Vector2d& start,
+                                                             const Eigen::Vector2d& goal,
+                                                             bool allow_unknown = false);
 /// Length [m] of the shortest 8-connected grid path between two points over cells below
 /// kInscribedCost (the reference for path quality); nullopt if there is none.
 std::optional<double> GridShortestPathLength(const perception::Costmap2D& costmap,
