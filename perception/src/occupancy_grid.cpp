@@ -180,20 +180,34 @@ OccupancyGrid OccupancyGrid::LoadMapServerYaml(const std::filesystem::path& yaml
     throw LoadError(
         StrCat(file, ":", image_field.line, ": image '", image_path.string(), "' cannot be read."));
   }
+  return FromImage(image, resolution, {origin[0], origin[1]}, negate, occupied_thresh, free_thresh);
+}
+
+OccupancyGrid OccupancyGrid::FromImage(const cv::Mat& gray, double resolution,
+                                       const Eigen::Vector2d& origin, bool negate,
+                                       double occupied_thresh, double free_thresh) {
+  ThrowUnless(!gray.empty() && gray.type() == CV_8UC1,
+              "Invalid map image: it must be a non-empty 8-bit gray image.");
+  ThrowUnless(std::isfinite(resolution) && resolution > 0.0, "Invalid map: resolution (",
+              resolution, ") must be > 0.");
+  ThrowUnless(origin.allFinite(), "Invalid map: origin must be finite.");
+  ThrowUnless(free_thresh >= 0.0 && occupied_thresh <= 1.0 && free_thresh < occupied_thresh,
+              "Invalid map: thresholds must satisfy 0 <= free_thresh (", free_thresh,
+              ") < occupied_thresh (", occupied_thresh, ") <= 1.");
   GridGeometry geometry;
   geometry.resolution = resolution;
-  geometry.origin = {origin[0], origin[1]};
-  geometry.width = image.cols;
-  geometry.height = image.rows;
+  geometry.origin = origin;
+  geometry.width = gray.cols;
+  geometry.height = gray.rows;
   OccupancyGrid grid(geometry, kUnknownCost);
-  for (int row = 0; row < image.rows; ++row) {
-    for (int col = 0; col < image.cols; ++col) {
-      const double value = image.at<std::uint8_t>(row, col) / 255.0;
+  for (int row = 0; row < gray.rows; ++row) {
+    for (int col = 0; col < gray.cols; ++col) {
+      const double value = gray.at<std::uint8_t>(row, col) / 255.0;
       const double occupancy = negate ? value : 1.0 - value;  // dark = occupied
       std::uint8_t cost = kUnknownCost;
       if (occupancy > occupied_thresh) cost = kLethalCost;
       if (occupancy < free_thresh) cost = kFreeCost;
-      grid.at(col, image.rows - 1 - row) = cost;  // image row 0 is the top (max y)
+      grid.at(col, gray.rows - 1 - row) = cost;  // image row 0 is the top (max y)
     }
   }
   return grid;

@@ -11,7 +11,9 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+
 #include <nlohmann/json.hpp>
+#include "test_paths.h"
 
 namespace {
 
@@ -83,7 +85,7 @@ TEST(EgressCliTest, ClearErrors) {
 // ---- egress bt
 
 std::string WriteTemp(const std::string& name, const std::string& text) {
-  const auto path = std::filesystem::temp_directory_path() / ("egress_cli_test_" + name);
+  const auto path = egress::testing::TestTempPath(name);
   std::ofstream(path) << text;
   return path.string();
 }
@@ -172,7 +174,7 @@ TEST(EgressCliTest, BtTraceScriptErrorsNameTheLine) {
 // ---- egress costmap
 
 TEST(EgressCliTest, CostmapRendersAPng) {
-  const auto dir = std::filesystem::temp_directory_path() / "egress_cli_costmap";
+  const auto dir = egress::testing::TestTempPath("costmap");
   std::filesystem::create_directories(dir);
   {
     // A 4 m x 2 m room (5 cm cells) with a dividing wall and a 1 m opening.

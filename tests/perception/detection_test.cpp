@@ -6,6 +6,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "test_paths.h"
+
 #include "egress/hsr_interface/error.h"
 
 namespace egress::perception {
@@ -18,7 +20,7 @@ namespace fs = std::filesystem;
 class YoloDetectorTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    model_ = fs::temp_directory_path() / "egress_tiny_yolo.onnx";
+    model_ = egress::testing::TestTempPath("tiny_yolo.onnx");
     const std::string command =
         std::string("/usr/bin/python3 ") + EGRESS_TINY_YOLO_SCRIPT + " " + model_.string() +
         " 64 3 8"

@@ -5,7 +5,9 @@
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
+
 #include <opencv2/imgcodecs.hpp>
+#include "test_paths.h"
 
 #include "egress/hsr_interface/error.h"
 
@@ -18,7 +20,7 @@ namespace fs = std::filesystem;
 class MapServerTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() / "egress_map_server_test";
+    dir_ = egress::testing::TestTempPath("map");
     fs::create_directories(dir_);
     // 4 x 3 image: top-left black (occupied), bottom-right white (free), one gray (unknown).
     cv::Mat image(3, 4, CV_8UC1, cv::Scalar(254));

@@ -9,6 +9,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "test_paths.h"
+
 #include "test_nodes.h"
 
 namespace egress::bt {
@@ -277,7 +279,7 @@ TEST_F(FactoryTest, StandInsForUnknownNodes) {
 }
 
 TEST_F(FactoryTest, IncludesResolveRelativeToTheIncludingFile) {
-  const auto dir = std::filesystem::temp_directory_path() / "egress_bt_include_test";
+  const auto dir = egress::testing::TestTempPath("include");
   std::filesystem::create_directories(dir / "sub");
   std::ofstream(dir / "main.xml")
       << "<root BTCPP_format='4'><include path='sub/child.xml'/>"

@@ -7,6 +7,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "test_paths.h"
+
 #include "egress/bt/factory.h"
 
 namespace egress::bt {
@@ -59,7 +61,7 @@ TEST(LoggersTest, FileLogger2WritesTheDocumentedLayout) {
   Tree tree = factory.CreateTreeFromText(kTree, "Main");
   auto clock = std::make_shared<ManualClock>();
   tree.SetClock(clock);
-  const auto path = std::filesystem::temp_directory_path() / "egress_loggers_test.btlog";
+  const auto path = egress::testing::TestTempPath("run.btlog");
   {
     FileLogger2 logger(tree, factory, path, 1'700'000'000'000'000);
     tree.TickOnce();

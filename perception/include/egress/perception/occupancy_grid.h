@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <opencv2/core.hpp>
 
 #include "egress/hsr_interface/geometry.h"
 
@@ -59,6 +60,12 @@ class OccupancyGrid {
   /// free_thresh; mode trinary). The image path is relative to the YAML file. Origin yaw must be
   /// 0. @throws LoadError naming the file, line and field.
   static OccupancyGrid LoadMapServerYaml(const std::filesystem::path& yaml_path);
+  /// A map_server image (8-bit gray, row 0 at the top) with its YAML parameters: dark cells
+  /// (occupancy > occupied_thresh) are occupied, light ones (< free_thresh) free, the rest
+  /// unknown. @throws InvalidArgument for an empty image or bad parameters.
+  static OccupancyGrid FromImage(const cv::Mat& gray, double resolution,
+                                 const Eigen::Vector2d& origin, bool negate = false,
+                                 double occupied_thresh = 0.65, double free_thresh = 0.196);
   /// A free grid covering `bounds_min`..`bounds_max` with every box rasterized as occupied.
   static OccupancyGrid FromBoxes(const std::vector<Box2>& boxes, const Eigen::Vector2d& bounds_min,
                                  const Eigen::Vector2d& bounds_max, double resolution);

@@ -1,0 +1,302 @@
+// The navigation service, started for real on a loopback port and called with the generated
+// gRPC client.
+
+#include "navigation_server.h"
+
+#include <grpcpp/grpcpp.h>
+
+#include <cmath>
+#include <future>
+#include <limits>
+#include <thread>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "egress/nav/v1/navigation.grpc.pb.h"
+#include "egress/perception/occupancy_grid.h"
+
+namespace egress::navd {
+namespace {
+
+namespace v1 = egress::nav::v1;
+using perception::Box2;
+using ::testing::HasSubstr;
+
+// The office (three rooms, doors A and B) as a PNG map_server image at 5 cm.
+std::string OfficePng() {
+  const auto grid = perception::OccupancyGrid::FromBoxes({{{7.0, 0.05, 0.0}, {14.0, 0.1}},
+                                                          {{7.0, 5.95, 0.0}, {14.0, 0.1}},
+                                                          {{0.05, 3.0, 0.0}, {0.1, 6.0}},
+                                                          {{13.95, 3.0, 0.0}, {0.1, 6.0}},
+                                                          {{5.0, 1.25, 0.0}, {0.1, 2.5}},
+                                                          {{5.0, 4.75, 0.0}, {0.1, 2.5}},
+                                                          {{9.0, 0.5, 0.0}, {0.1, 1.0}},
+                                                          {{9.0, 4.0, 0.0}, {0.1, 4.0}}},
+                                                         {0, 0}, {14, 6}, 0.05);
+  const auto& g = grid.geometry();
+  cv::Mat image(g.height, g.width, CV_8UC1);
+  for (int iy = 0; iy < g.height; ++iy) {
+    for (int ix = 0; ix < g.width; ++ix)
+      image.at<std::uint8_t>(g.height - 1 - iy, ix) = grid.at(ix, iy) ? 0 : 254;
+  }
+  std::vector<std::uint8_t> png;
+  cv::imencode(".png", image, png);
+  return {png.begin(), png.end()};
+}
+
+v1::Pose2 Pose(double x, double y, double yaw = 0.0) {
+  v1::Pose2 p;
+  p.set_x(x);
+  p.set_y(y);
+  p.set_yaw(yaw);
+  return p;
+}
+
+class NavigationServerTest : public ::testing::Test {
+ protected:
+  void Start(NavigationServerConfig config = {}) {
+    config.listen = "127.0.0.1:0";
+    server_ = std::make_unique<NavigationServer>(config);
+    channel_ = grpc::CreateChannel("127.0.0.1:" + std::to_string(server_->port()),
+                                   grpc::InsecureChannelCredentials());
+    stub_ = v1::Navigation::NewStub(channel_);
+  }
+  void SetUp() override { Start(); }
+
+  std::string LoadOffice(const std::string& token = "") {
+    v1::LoadWorldRequest request;
+    request.mutable_map()->set_image(OfficePng());
+    request.mutable_map()->set_resolution(0.05);
+    for (auto [id, hx, hy, lx, ly] :
+         {std::tuple{"A", 5.0, 2.5, 5.0, 3.5}, std::tuple{"B", 9.0, 1.0, 9.0, 2.0}}) {
+      auto* door = request.add_doors();
+      door->set_id(id);
+      door->mutable_hinge()->set_x(hx);
+      door->mutable_hinge()->set_y(hy);
+      door->mutable_latch()->set_x(lx);
+      door->mutable_latch()->set_y(ly);
+    }
+    grpc::ClientContext context;
+    if (!token.empty()) context.AddMetadata("authorization", "Bearer " + token);
+    v1::LoadWorldResponse response;
+    const grpc::Status status = stub_->LoadWorld(&context, request, &response);
+    EXPECT_TRUE(status.ok()) << status.error_message();
+    return response.world_id();
+  }
+
+  grpc::Status Plan(const std::string& world, v1::Pose2 start, v1::Pose2 goal,
+                    v1::PlanPathResponse* response, const std::string& planner = "",
+                    double budget = 0.0,
+                    std::chrono::milliseconds deadline = std::chrono::seconds(30)) {
+    v1::PlanPathRequest request;
+    request.set_world_id(world);
+    *request.mutable_start() = start;
+    *request.mutable_goal() = goal;
+    request.set_planner(planner);
+    request.set_time_budget(budget);
+    grpc::ClientContext context;
+    context.set_deadline(std::chrono::system_clock::now() + deadline);
+    return stub_->PlanPath(&context, request, response);
+  }
+
+  std::unique_ptr<NavigationServer> server_;
+  std::shared_ptr<grpc::Channel> channel_;
+  std::unique_ptr<v1::Navigation::Stub> stub_;
+};
+
+TEST_F(NavigationServerTest, PlansThroughAnOpenDoorAndNotThroughAClosedOne) {
+  const std::string world = LoadOffice();
+  v1::PlanPathResponse response;
+  ASSERT_TRUE(Plan(world, Pose(1.5, 4.5), Pose(7.0, 4.5), &response).ok());
+  EXPECT_EQ(response.status(), v1::PLAN_STATUS_SUCCESS) << response.message();
+  EXPECT_THAT(
+      std::vector<std::string>(response.doors_crossed().begin(), response.doors_crossed().end()),
+      ::testing::ElementsAre("A"));
+  EXPECT_GT(response.length(), 5.0);
+  EXPECT_GE(response.path_size(), 2);
+
+  v1::SetDoorStateRequest close;
+  close.set_world_id(world);
+  close.set_door_id("A");
+  close.set_angle(0.0);
+  grpc::ClientContext context;
+  v1::SetDoorStateResponse ignored;
+  ASSERT_TRUE(stub_->SetDoorState(&context, close, &ignored).ok());
+  v1::PlanPathResponse blocked;
+  ASSERT_TRUE(Plan(world, Pose(1.5, 4.5), Pose(7.0, 4.5), &blocked).ok());
+  EXPECT_EQ(blocked.status(), v1::PLAN_STATUS_GOAL_UNREACHABLE);
+  EXPECT_THAT(blocked.message(), HasSubstr("closed door"));
+  EXPECT_EQ(blocked.path_size(), 0);
+}
+
+TEST_F(NavigationServerTest, BadInputsGetClearStatuses) {
+  const std::string world = LoadOffice();
+  v1::PlanPathResponse response;
+  grpc::Status status = Plan(world, Pose(std::nan(""), 1.0), Pose(7.0, 4.5), &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("start"));
+  status = Plan(world, Pose(1.5, 4.5), Pose(40.0, 4.5), &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("outside the map"));
+  status = Plan("world-999", Pose(1.5, 4.5), Pose(7.0, 4.5), &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::NOT_FOUND);
+  status = Plan(world, Pose(5.0, 1.0), Pose(7.0, 4.5), &response);  // inside a wall
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::FAILED_PRECONDITION);
+  status = Plan(world, Pose(1.5, 4.5), Pose(7.0, 4.5), &response, "AStar");
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("planner"));
+
+  v1::LoadWorldRequest empty;
+  empty.mutable_map()->set_resolution(0.05);
+  grpc::ClientContext c1;
+  v1::LoadWorldResponse loaded;
+  status = stub_->LoadWorld(&c1, empty, &loaded);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("map.image is empty"));
+  v1::LoadWorldRequest no_source;
+  grpc::ClientContext c2;
+  EXPECT_EQ(stub_->LoadWorld(&c2, no_source, &loaded).error_code(),
+            grpc::StatusCode::INVALID_ARGUMENT);
+  v1::SetDoorStateRequest unknown_door;
+  unknown_door.set_world_id(world);
+  unknown_door.set_door_id("Z");
+  grpc::ClientContext c3;
+  v1::SetDoorStateResponse ignored;
+  EXPECT_EQ(stub_->SetDoorState(&c3, unknown_door, &ignored).error_code(),
+            grpc::StatusCode::NOT_FOUND);
+  v1::UpdateCostmapRequest bad_scan;
+  bad_scan.set_world_id(world);
+  bad_scan.mutable_scan()->set_angle_increment(0.0);
+  bad_scan.mutable_scan()->set_range_max(5.0);
+  bad_scan.mutable_scan()->add_ranges(1.0f);
+  grpc::ClientContext c4;
+  v1::UpdateCostmapResponse updated;
+  status = stub_->UpdateCostmap(&c4, bad_scan, &updated);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("angle_increment"));
+}
+
+TEST_F(NavigationServerTest, RefusesMapsBeyondTheCellLimit) {
+  server_.reset();
+  NavigationServerConfig config;
+  config.max_map_cells = 10'000;  // the office is 280 x 120 = 33,600 cells
+  Start(config);
+  v1::LoadWorldRequest request;
+  request.mutable_map()->set_image(OfficePng());
+  request.mutable_map()->set_resolution(0.05);
+  grpc::ClientContext context;
+  v1::LoadWorldResponse response;
+  const grpc::Status status = stub_->LoadWorld(&context, request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("limit of 10000"));
+}
+
+TEST_F(NavigationServerTest, AnswersThirtyTwoConcurrentRequests) {
+  const std::string world = LoadOffice();
+  std::vector<std::future<grpc::Status>> calls;
+  for (int i = 0; i < 32; ++i) {
+    calls.push_back(std::async(std::launch::async, [&, i] {
+      v1::PlanPathResponse response;
+      return Plan(world, Pose(1.0 + 0.05 * (i % 8), 4.5), Pose(12.5, 1.5), &response);
+    }));
+  }
+  int ok = 0, exhausted = 0;
+  for (auto& call : calls) {
+    const grpc::Status status = call.get();  // every request gets an answer
+    if (status.ok()) ++ok;
+    if (status.error_code() == grpc::StatusCode::RESOURCE_EXHAUSTED) ++exhausted;
+  }
+  EXPECT_EQ(ok + exhausted, 32);
+  EXPECT_GT(ok, 0);
+  grpc::ClientContext context;
+  v1::HealthResponse health;
+  ASSERT_TRUE(stub_->Health(&context, {}, &health).ok());
+  EXPECT_EQ(health.busy_workers(), 0);
+  EXPECT_EQ(health.max_workers(), 4);
+  EXPECT_EQ(health.worlds(), 1);
+}
+
+TEST_F(NavigationServerTest, HonoursDeadlines) {
+  const std::string world = LoadOffice();
+  // An optimizing planner asked for 10 s inside a 300 ms deadline plans within the deadline.
+  v1::PlanPathResponse response;
+  const grpc::Status status = Plan(world, Pose(1.5, 4.5), Pose(7.0, 4.5), &response, "RRTstar",
+                                   10.0, std::chrono::milliseconds(300));
+  ASSERT_TRUE(status.ok() || status.error_code() == grpc::StatusCode::DEADLINE_EXCEEDED)
+      << status.error_message();
+  if (status.ok()) {
+    EXPECT_LT(response.planning_time(), 0.3);  // the budget was capped by the deadline
+  }
+  // A deadline that has already passed is reported as such.
+  v1::PlanPathRequest request;
+  request.set_world_id(world);
+  *request.mutable_start() = Pose(1.5, 4.5);
+  *request.mutable_goal() = Pose(7.0, 4.5);
+  grpc::ClientContext context;
+  context.set_deadline(std::chrono::system_clock::now() - std::chrono::seconds(1));
+  EXPECT_EQ(stub_->PlanPath(&context, request, &response).error_code(),
+            grpc::StatusCode::DEADLINE_EXCEEDED);
+}
+
+TEST_F(NavigationServerTest, ShutdownLosesNothingAlreadyRunning) {
+  const std::string world = LoadOffice();
+  std::vector<std::future<grpc::Status>> calls;
+  for (int i = 0; i < 3; ++i) {
+    calls.push_back(std::async(std::launch::async, [&] {
+      v1::PlanPathResponse response;
+      return Plan(world, Pose(1.5, 4.5), Pose(12.5, 1.5), &response, "RRTstar", 0.5);
+    }));
+  }
+  // Wait until the three are running, then shut down: they still complete.
+  for (int i = 0; i < 200; ++i) {
+    grpc::ClientContext context;
+    v1::HealthResponse health;
+    if (stub_->Health(&context, {}, &health).ok() && health.busy_workers() >= 3) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  server_->Shutdown(std::chrono::seconds(10));
+  for (auto& call : calls)
+    EXPECT_TRUE(call.get().ok());
+}
+
+TEST_F(NavigationServerTest, TokensAndListenAddresses) {
+  server_.reset();
+  NavigationServerConfig config;
+  config.allow_remote = true;
+  config.token = "s3cret";
+  Start(config);
+  v1::LoadWorldRequest request;
+  request.mutable_map()->set_image(OfficePng());
+  request.mutable_map()->set_resolution(0.05);
+  grpc::ClientContext context;
+  v1::LoadWorldResponse response;
+  EXPECT_EQ(stub_->LoadWorld(&context, request, &response).error_code(),
+            grpc::StatusCode::UNAUTHENTICATED);
+  EXPECT_FALSE(LoadOffice("s3cret").empty());
+
+  NavigationServerConfig remote;
+  remote.listen = "0.0.0.0:50051";
+  EXPECT_THROW(ValidateListenAddress(remote), std::invalid_argument);
+  remote.allow_remote = true;
+  EXPECT_THROW(ValidateListenAddress(remote), std::invalid_argument);  // no token
+  remote.token = "t";
+  EXPECT_NO_THROW(ValidateListenAddress(remote));
+}
+
+TEST_F(NavigationServerTest, ListsPlannersAndRefusesSdfForNow) {
+  grpc::ClientContext context;
+  v1::ListPlannersResponse planners;
+  ASSERT_TRUE(stub_->ListPlanners(&context, {}, &planners).ok());
+  EXPECT_EQ(planners.planners(0), "RRTConnect");
+  EXPECT_EQ(planners.planners_size(), 5);
+  v1::LoadWorldRequest sdf;
+  sdf.set_sdf_path("/tmp/office.world");
+  grpc::ClientContext c2;
+  v1::LoadWorldResponse response;
+  EXPECT_EQ(stub_->LoadWorld(&c2, sdf, &response).error_code(), grpc::StatusCode::UNIMPLEMENTED);
+}
+
+}  // namespace
+}  // namespace egress::navd
