@@ -7,10 +7,10 @@
 
 #include <fmt/format.h>
 #include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "commands.h"
 #include "egress/perception/costmap.h"
+#include "render.h"
 
 namespace egress::apps {
 namespace {
@@ -41,34 +41,7 @@ void Run(const CostmapOptions& options) {
                         {options.doorways[i], options.doorways[i + 1]},
                         {options.doorways[i + 2], options.doorways[i + 3]}});
   }
-  const cv::Mat costs = costmap.ToImage();
-  cv::Mat image(costs.size(), CV_8UC3);
-  for (int r = 0; r < costs.rows; ++r) {
-    for (int c = 0; c < costs.cols; ++c) {
-      const std::uint8_t cost = costs.at<std::uint8_t>(r, c);
-      cv::Vec3b color;
-      if (cost == kUnknownCost) {
-        color = {160, 90, 40};
-      } else if (cost == kLethalCost) {
-        color = {0, 0, 0};
-      } else if (cost == kInscribedCost) {
-        color = {60, 60, 60};
-      } else {
-        const auto v = static_cast<std::uint8_t>(255 - cost * 150 / 252);
-        color = {v, v, v};
-      }
-      image.at<cv::Vec3b>(r, c) = color;
-    }
-  }
-  const GridGeometry& g = costmap.geometry();
-  for (const auto& [id, doorway] : costmap.doorways()) {
-    const auto to_pixel = [&](const Eigen::Vector2d& p) {
-      return cv::Point(int((p.x() - g.origin.x()) / g.resolution),
-                       g.height - 1 - int((p.y() - g.origin.y()) / g.resolution));
-    };
-    cv::line(image, to_pixel(doorway.p_MHinge), to_pixel(doorway.p_MLatch), cv::Scalar(60, 180, 60),
-             2);
-  }
+  const cv::Mat image = RenderCostmap(costmap);
   if (!cv::imwrite(options.out, image))
     throw CommandFailed(fmt::format("cannot write '{}'", options.out));
   std::size_t lethal = 0, free_cells = 0;
@@ -76,6 +49,7 @@ void Run(const CostmapOptions& options) {
     lethal += cost == kLethalCost;
     free_cells += cost == kFreeCost;
   }
+  const GridGeometry& g = costmap.geometry();
   fmt::print("costmap {}x{} cells at {:.3f} m: {} lethal, {} free, {} doorways -> {}\n", g.width,
              g.height, g.resolution, lethal, free_cells, costmap.doorways().size(), options.out);
 }

@@ -13,6 +13,8 @@
 #include <gtest/gtest.h>
 
 #include <nlohmann/json.hpp>
+
+#include "navigation_server.h"
 #include "test_paths.h"
 
 namespace {
@@ -208,6 +210,64 @@ TEST(EgressCliTest, CostmapRendersAPng) {
   result = RunEgress("costmap " + (dir / "bad.yaml").string() + " --out " + out + " --overwrite");
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_THAT(result.output, HasSubstr("bad.yaml:2: field 'resolution' (fine) must be a number"));
+  std::filesystem::remove_all(dir);
+}
+
+// ---- egress plan
+
+// A 4 m x 2 m room split by a wall with a 1 m door at y in [0.5, 1.5] (x = 2).
+std::filesystem::path WriteRoomMap() {
+  const auto dir = egress::testing::TestTempPath("room");
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream pgm(dir / "map.pgm", std::ios::binary);
+    pgm << "P5\n80 40\n255\n";
+    for (int row = 0; row < 40; ++row) {
+      for (int col = 0; col < 80; ++col) {
+        const bool wall =
+            row < 1 || row > 38 || col < 1 || col > 78 || (col == 40 && (row < 10 || row > 29));
+        pgm.put(static_cast<char>(wall ? 0 : 254));
+      }
+    }
+  }
+  std::ofstream(dir / "map.yaml") << "image: map.pgm\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\n";
+  return dir;
+}
+
+TEST(EgressCliTest, PlanLocallyAndThroughTheService) {
+  const auto dir = WriteRoomMap();
+  const std::string common = "plan --map " + (dir / "map.yaml").string() +
+                             " --start 0.6 1.0 0 --goal 3.4 1.0 0 --door D:2.0,0.5,2.0,1.5";
+  Result local = RunEgress(common + " --local --json");
+  ASSERT_EQ(local.exit_code, 0) << local.output;
+  auto json = nlohmann::json::parse(local.output);
+  EXPECT_EQ(json.at("status"), "success");
+  EXPECT_EQ(json.at("doors_crossed")[0], "D");
+  EXPECT_GT(json.at("length").get<double>(), 2.7);
+
+  Result closed = RunEgress(common + " --local --closed D");
+  EXPECT_EQ(closed.exit_code, 1);
+  EXPECT_THAT(closed.output, HasSubstr("goal_unreachable"));
+
+  egress::navd::NavigationServerConfig config;
+  config.listen = "127.0.0.1:0";
+  egress::navd::NavigationServer server(config);
+  const std::string png = (dir / "path.png").string();
+  Result remote =
+      RunEgress(common + " --server 127.0.0.1:" + std::to_string(server.port()) + " --png " + png);
+  ASSERT_EQ(remote.exit_code, 0) << remote.output;
+  EXPECT_THAT(remote.output, HasSubstr("status         success"));
+  EXPECT_THAT(remote.output, HasSubstr("doors crossed  D"));
+  EXPECT_GT(std::filesystem::file_size(png), 100u);
+
+  Result in_wall = RunEgress(
+      "plan --map " + (dir / "map.yaml").string() +
+      " --start 2.0 0.1 0 --goal 3.4 1.0 0 --server 127.0.0.1:" + std::to_string(server.port()));
+  EXPECT_EQ(in_wall.exit_code, 1);
+  EXPECT_THAT(in_wall.output, HasSubstr("in collision"));
+  Result no_server = RunEgress(common + " --server 127.0.0.1:1");
+  EXPECT_EQ(no_server.exit_code, 1);
+  EXPECT_THAT(no_server.output, HasSubstr("127.0.0.1:1"));
   std::filesystem::remove_all(dir);
 }
 
