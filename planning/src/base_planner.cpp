@@ -196,8 +196,9 @@ struct BasePlanner::Impl {
     si = std::make_shared<ob::SpaceInformation>(space);
     checker = std::make_shared<FootprintValidityChecker>(si, costmap, fcl_octree.get(), config);
     si->setStateValidityChecker(checker);
-    // Check motions at half a costmap cell.
-    si->setStateValidityCheckingResolution(0.5 * g.resolution / space->getMaximumExtent());
+    // Check motions at a quarter cell: fine enough that a straight motion cannot slip between
+    // two diagonally touching occupied cells.
+    si->setStateValidityCheckingResolution(0.25 * g.resolution / space->getMaximumExtent());
     si->setup();
   }
 
@@ -216,6 +217,54 @@ struct BasePlanner::Impl {
     sb->setXY(b.x, b.y);
     sb->setYaw(b.yaw);
     return si->checkMotion(sa.get(), sb.get());
+  }
+
+  // Greedy line-of-sight shortcutting of a dense path (a grid seed): from each kept state, jump
+  // to the farthest later state reachable by a valid straight motion (exponential then binary
+  // search). OMPL's simplifier is far slower on thousands of states.
+  og::PathGeometric StringPull(const og::PathGeometric& dense) const {
+    og::PathGeometric pulled(si);
+    const std::size_t n = dense.getStateCount();
+    std::size_t anchor = 0;
+    pulled.append(dense.getState(0));
+    while (anchor + 1 < n) {
+      std::size_t good = anchor + 1, step = 2;
+      while (anchor + step < n &&
+             si->checkMotion(dense.getState(anchor), dense.getState(anchor + step))) {
+        good = anchor + step;
+        step *= 2;
+      }
+      std::size_t lo = good, hi = std::min(anchor + step, n - 1);
+      while (hi > lo + 1) {
+        const std::size_t mid = (lo + hi) / 2;
+        if (si->checkMotion(dense.getState(anchor), dense.getState(mid))) {
+          lo = mid;
+        } else {
+          hi = mid;
+        }
+      }
+      anchor = lo;
+      pulled.append(dense.getState(anchor));
+    }
+    return pulled;
+  }
+
+  // The grid's shortest path from start to goal, string-pulled; nullopt without one.
+  std::optional<og::PathGeometric> GridSeed(const Pose2& start, const Pose2& goal,
+                                            const ob::State* s, const ob::State* g) const {
+    const auto cells =
+        GridShortestPath(costmap, start.translation(), goal.translation(), config.allow_unknown);
+    if (!cells) return std::nullopt;
+    og::PathGeometric dense(si);
+    ob::ScopedState<ob::SE2StateSpace> state(space);
+    dense.append(s);
+    for (std::size_t i = 1; i + 1 < cells->size(); ++i) {
+      state->setXY((*cells)[i].x(), (*cells)[i].y());
+      state->setYaw(0.0);
+      dense.append(state.get());
+    }
+    dense.append(g);
+    return StringPull(dense);
   }
 
   // One OMPL query between two valid poses.
@@ -239,19 +288,38 @@ struct BasePlanner::Impl {
       setup.setOptimizationObjective(length);
     }
     setup.setPlanner(MakePlanner());
-    const ob::PlannerStatus status = setup.solve(budget);
-    if (status != ob::PlannerStatus::EXACT_SOLUTION) {
+    const double sampling =
+        config.grid_seed_after > 0.0 ? std::min(budget, config.grid_seed_after) : budget;
+    const ob::PlannerStatus status = setup.solve(sampling);
+    og::PathGeometric raw(si);
+    bool seeded = false;
+    if (status == ob::PlannerStatus::EXACT_SOLUTION) {
+      raw = setup.getSolutionPath();
+    } else if (config.grid_seed_after > 0.0) {
+      if (auto seed = GridSeed(start, goal, s.get(), g.get())) {
+        raw = std::move(*seed);
+        seeded = true;
+      }
+    }
+    if (raw.getStateCount() < 2 || !raw.check()) {
       result.status = PlanStatus::kTimeout;
       result.message = Cat("no path found within the time budget (", budget, " s, planner ",
                            config.planner, ")");
       return result;
     }
-    og::PathGeometric raw = setup.getSolutionPath();
     og::PathGeometric path = raw;
-    if (config.simplify_time > 0.0) {
+    if (config.simplify_time > 0.0 && !seeded) {
       og::PathSimplifier simplifier(si);
       simplifier.simplify(path, config.simplify_time);
       if (!path.check()) path = raw;  // the simplified path must still be valid
+    }
+    // For the pure length objective, a sampled path that took a long way round (another
+    // homotopy class) loses to the string-pulled grid path.
+    if (!seeded && config.grid_seed_after > 0.0 && config.costmap_cost_weight == 0.0) {
+      if (auto seed = GridSeed(start, goal, s.get(), g.get());
+          seed && seed->length() < path.length() && seed->check()) {
+        path = std::move(*seed);
+      }
     }
     for (std::size_t i = 0; i < path.getStateCount(); ++i) {
       const auto* st = path.getState(i)->as<ob::SE2StateSpace::StateType>();
@@ -422,6 +490,10 @@ std::optional<std::vector<Eigen::Vector2d>> GridShortestPath(const perception::C
         if ((dx == 0 && dy == 0) || !g.Contains(ix + dx, iy + dy)) continue;
         const std::size_t next = g.Index(ix + dx, iy + dy);
         if (!passable(next)) continue;
+        // No corner cutting: a diagonal step needs both cells beside it free.
+        if (dx != 0 && dy != 0 &&
+            (!passable(g.Index(ix + dx, iy)) || !passable(g.Index(ix, iy + dy))))
+          continue;
         const float nd = d + ((dx != 0 && dy != 0) ? kDiagonal : 1.0f);
         if (nd < distance[next]) {
           distance[next] = nd;

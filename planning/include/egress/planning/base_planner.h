@@ -11,6 +11,8 @@
 ///    and smoothing, then a check that the simplified path is still valid.
 ///  - A path through a known door runs on the door's centreline: an approach pose in front of
 ///    the door, an exit pose behind it; the result lists the doors crossed.
+///  - Narrow passages: when sampling finds nothing within grid_seed_after, the grid shortest
+///    path, shortcut by OMPL's simplifier, is the answer.
 ///  - Failures are statuses with reasons: start or goal in collision, goal unreachable (no
 ///    free connection on the costmap grid, e.g. a closed door), timeout, invalid request.
 
@@ -43,7 +45,11 @@ struct BasePlannerConfig {
   double costmap_cost_weight{0.0};    ///< > 0 adds the costmap cost to the objective.
   bool allow_unknown{false};          ///< Plan through unknown cells.
   double door_standoff{0.6};          ///< Approach/exit poses this far from the door line [m].
-  std::uint32_t seed{42};             ///< OMPL's process-wide seed (set once per process).
+  /// Narrow passages (1-cell doors, maze corridors) defeat sampling: when the planner finds
+  /// nothing within this time, the grid's shortest path seeds the answer and OMPL's simplifier
+  /// shortcuts it (the result is re-checked). 0 disables the fallback (pure sampling).
+  double grid_seed_after{0.25};  ///< [s]
+  std::uint32_t seed{42};        ///< OMPL's process-wide seed (set once per process).
   void Validate() const;
 };
 
@@ -98,8 +104,8 @@ class BasePlanner {
   std::unique_ptr<Impl> impl_;
 };
 
-/// The shortest 8-connected grid path (cell centres) between two points over cells below
-/// kInscribedCost; nullopt if there is none.
+/// The shortest 8-connected grid path (cell centres, no corner cutting) between two points over
+/// cells below kInscribedCost; nullopt if there is none.
 std::optional<std::vector<Eigen::Vector2d>> GridShortestPath(const perception::Costmap2D& costmap,
                                                              const Eigen::Vector2d& start,
                                                              const Eigen::Vector2d& goal,
