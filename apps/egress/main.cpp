@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   egress::apps::AddBtCommand(app);
   egress::apps::AddCostmapCommand(app);
   egress::apps::AddPlanCommand(app);
+  egress::apps::AddBenchCommand(app);
   egress::apps::AddPlannedCommand(app, "sim", "Run one twin scenario end to end",
                                   "the robot-brain issue (twin + executive)");
   egress::apps::AddPlannedCommand(app, "batch",
@@ -28,8 +29,6 @@ int main(int argc, char** argv) {
                                   "the robot-brain issue");
   egress::apps::AddPlannedCommand(app, "render", "Render a recorded run to PNG/MP4",
                                   "the digital-twin issue");
-  egress::apps::AddPlannedCommand(app, "bench", "Benchmark planners over the regression suite",
-                                  "the navigation-service issue");
 
   try {
     app.parse(argc, argv);

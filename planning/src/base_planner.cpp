@@ -15,6 +15,7 @@
 #include <ompl/geometric/planners/rrt/InformedRRTstar.h>
 #include <ompl/geometric/planners/rrt/RRTConnect.h>
 #include <ompl/geometric/planners/rrt/RRTstar.h>
+#include <ompl/tools/benchmark/Benchmark.h>
 #include <ompl/util/Console.h>
 #include <ompl/util/RandomNumbers.h>
 
@@ -202,11 +203,12 @@ struct BasePlanner::Impl {
     si->setup();
   }
 
-  ob::PlannerPtr MakePlanner() const {
-    if (config.planner == "RRTstar") return std::make_shared<og::RRTstar>(si);
-    if (config.planner == "PRMstar") return std::make_shared<og::PRMstar>(si);
-    if (config.planner == "BITstar") return std::make_shared<og::BITstar>(si);
-    if (config.planner == "InformedRRTstar") return std::make_shared<og::InformedRRTstar>(si);
+  ob::PlannerPtr MakePlanner() const { return MakePlanner(config.planner); }
+  ob::PlannerPtr MakePlanner(const std::string& name) const {
+    if (name == "RRTstar") return std::make_shared<og::RRTstar>(si);
+    if (name == "PRMstar") return std::make_shared<og::PRMstar>(si);
+    if (name == "BITstar") return std::make_shared<og::BITstar>(si);
+    if (name == "InformedRRTstar") return std::make_shared<og::InformedRRTstar>(si);
     return std::make_shared<og::RRTConnect>(si);
   }
 
@@ -446,6 +448,67 @@ PlanResult BasePlanner::Plan(const Pose2& start, const Pose2& goal) const {
   result.path = std::move(path);
   result.status = PlanStatus::kSuccess;
   return finish(result);
+}
+
+std::vector<BasePlanner::BenchmarkSummary> BasePlanner::RunOmplBenchmark(
+    const Pose2& start, const Pose2& goal, const std::vector<std::string>& planners, int runs,
+    double time_limit, const std::string& experiment, const std::filesystem::path& log_path) const {
+  const auto names = PlannerNames();
+  for (const auto& name : planners) {
+    ThrowUnless(std::find(names.begin(), names.end(), name) != names.end(), "Unknown planner '",
+                name, "'.");
+  }
+  ThrowUnless(runs >= 1 && time_limit > 0.0,
+              "Invalid benchmark: runs must be >= 1 and time_limit > 0.");
+  ThrowUnless(IsValid(start) && IsValid(goal),
+              "Invalid benchmark problem: start and goal must be collision-free.");
+  og::SimpleSetup setup(impl_->si);
+  ob::ScopedState<ob::SE2StateSpace> s(impl_->space), g(impl_->space);
+  s->setXY(start.x, start.y);
+  s->setYaw(start.yaw);
+  g->setXY(goal.x, goal.y);
+  g->setYaw(goal.yaw);
+  setup.setStartAndGoalStates(s, g);
+  setup.setOptimizationObjective(std::make_shared<ob::PathLengthOptimizationObjective>(impl_->si));
+  ompl::tools::Benchmark benchmark(setup, experiment);
+  for (const auto& name : planners)
+    benchmark.addPlanner(impl_->MakePlanner(name));
+  ompl::tools::Benchmark::Request request(time_limit, 4096.0, static_cast<unsigned>(runs));
+  request.displayProgress = false;
+  request.simplify = true;
+  benchmark.benchmark(request);
+  if (!benchmark.saveResultsToFile(log_path.string().c_str())) {
+    throw LoadError(StrCat("Cannot write the benchmark log '", log_path.string(), "'."));
+  }
+  std::vector<BenchmarkSummary> rows;
+  for (const auto& planner : benchmark.getRecordedExperimentData().planners) {
+    BenchmarkSummary row;
+    row.planner = planner.name;
+    std::vector<double> times, lengths;
+    for (const auto& run : planner.runs) {
+      ++row.runs;
+      const auto get = [&](const char* key) -> std::optional<double> {
+        auto it = run.find(key);
+        if (it == run.end() || it->second.empty()) return std::nullopt;
+        return std::stod(it->second);
+      };
+      if (auto t = get("time REAL")) times.push_back(*t);
+      if (get("solved BOOLEAN").value_or(0.0) != 0.0 &&
+          get("approximate solution BOOLEAN").value_or(0.0) == 0.0) {
+        ++row.solved;
+        if (auto l = get("simplified solution length REAL")) lengths.push_back(*l);
+      }
+    }
+    const auto median = [](std::vector<double> v) {
+      if (v.empty()) return 0.0;
+      std::sort(v.begin(), v.end());
+      return v[v.size() / 2];
+    };
+    row.median_time = median(times);
+    row.median_length = median(lengths);
+    rows.push_back(row);
+  }
+  return rows;
 }
 
 std::optional<double> GridShortestPathLength(const perception::Costmap2D& costmap,

@@ -271,4 +271,29 @@ TEST(EgressCliTest, PlanLocallyAndThroughTheService) {
   std::filesystem::remove_all(dir);
 }
 
+// ---- egress bench plan
+
+TEST(EgressCliTest, BenchPlanWritesOmplLogsAndACsv) {
+  const auto out = egress::testing::TestTempPath("bench");
+  const Result result = RunEgress(
+      "bench plan --out " + out.string() +
+      " --planner RRTConnect --runs 2 --time 0.2 --movingai-problems 0 --reference /nonexistent");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("office_two_doors"));
+  std::ifstream log(out / "office_two_doors.log");
+  const std::string text((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+  EXPECT_THAT(text, HasSubstr("Experiment office_two_doors"));  // OMPL's benchmark log format
+  EXPECT_THAT(text, HasSubstr("geometric_RRTConnect"));
+  std::ifstream csv(out / "summary.csv");
+  std::string header, row;
+  std::getline(csv, header);
+  std::getline(csv, row);
+  EXPECT_EQ(
+      header,
+      "problem,planner,runs,solved,median_time_s,median_length_m,reference_length_m,length_ratio");
+  EXPECT_THAT(row, ::testing::StartsWith("office_two_doors,geometric_RRTConnect,2,2,"));
+  EXPECT_NE(RunEgress("bench plan --runs 0").exit_code, 0);
+  std::filesystem::remove_all(out);
+}
+
 }  // namespace

@@ -16,6 +16,7 @@
 ///  - Failures are statuses with reasons: start or goal in collision, goal unreachable (no
 ///    free connection on the costmap grid, e.g. a closed door), timeout, invalid request.
 
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <string>
@@ -96,6 +97,22 @@ class BasePlanner {
   bool IsValid(const Pose2& X_MB) const;
   /// Whether every motion of `path` is still valid (for replanning after a costmap update).
   bool IsPathValid(const std::vector<Pose2>& path) const;
+  /// One row of RunOmplBenchmark's summary.
+  struct BenchmarkSummary {
+    std::string planner;
+    int runs{0};
+    int solved{0};
+    double median_time{0.0};    ///< [s]
+    double median_length{0.0};  ///< [m] over solved runs
+  };
+  /// Runs OMPL's own benchmark (ompl::tools::Benchmark) of `planners` on start -> goal with this
+  /// planner's validity checking, `runs` times each with `time_limit` seconds, and writes OMPL's
+  /// log format (Planner Arena reads it) to `log_path`. Door centrelines are not applied: this
+  /// measures the sampling planners themselves.
+  std::vector<BenchmarkSummary> RunOmplBenchmark(const Pose2& start, const Pose2& goal,
+                                                 const std::vector<std::string>& planners, int runs,
+                                                 double time_limit, const std::string& experiment,
+                                                 const std::filesystem::path& log_path) const;
   /// Planner names accepted by config.planner.
   static std::vector<std::string> PlannerNames();
 
