@@ -83,6 +83,14 @@ case "$command" in
     echo
     say "forward kinematics, arm horizontal (arm_flex = -pi/2): palm reach"
     "$build_dir/apps/egress" model fk --arm 0 -1.5707963267948966
+    echo
+    say "a base path across the office (worlds/office), through doors A and B, drawn to $build_dir/demo_path.png"
+    "$build_dir/apps/egress" plan --local --map worlds/office/office.yaml --start 1.5 4.5 0 --goal 12.5 1.5 0 \
+      --door A:5,2.5,5,3.5 --door B:9,1,9,2 --png "$build_dir/demo_path.png" --overwrite
+    echo
+    say "the same with door A closed: no path, and the planner says why"
+    "$build_dir/apps/egress" plan --local --map worlds/office/office.yaml --start 1.5 4.5 0 --goal 12.5 1.5 0 \
+      --door A:5,2.5,5,3.5 --door B:9,1,9,2 --closed A || true
     ;;
   test)
     install_deps
