@@ -475,6 +475,7 @@ std::vector<BasePlanner::BenchmarkSummary> BasePlanner::RunOmplBenchmark(
     benchmark.addPlanner(impl_->MakePlanner(name));
   ompl::tools::Benchmark::Request request(time_limit, 4096.0, static_cast<unsigned>(runs));
   request.displayProgress = false;
+  request.saveConsoleOutput = false;  // OMPL would write ompl_<host>_<date>.console into the cwd
   request.simplify = true;
   benchmark.benchmark(request);
   if (!benchmark.saveResultsToFile(log_path.string().c_str())) {
