@@ -9,42 +9,26 @@
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <future>
 
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include "egress/nav/v1/navigation.grpc.pb.h"
-#include "egress/perception/occupancy_grid.h"
 #include "navigation_server.h"
 
 namespace {
 
 namespace v1 = egress::nav::v1;
-using egress::perception::Box2;
 
 v1::LoadWorldRequest OfficeRequest() {
-  const auto grid = egress::perception::OccupancyGrid::FromBoxes({{{7.0, 0.05, 0.0}, {14.0, 0.1}},
-                                                                  {{7.0, 5.95, 0.0}, {14.0, 0.1}},
-                                                                  {{0.05, 3.0, 0.0}, {0.1, 6.0}},
-                                                                  {{13.95, 3.0, 0.0}, {0.1, 6.0}},
-                                                                  {{5.0, 1.25, 0.0}, {0.1, 2.5}},
-                                                                  {{5.0, 4.75, 0.0}, {0.1, 2.5}},
-                                                                  {{9.0, 0.5, 0.0}, {0.1, 1.0}},
-                                                                  {{9.0, 4.0, 0.0}, {0.1, 4.0}},
-                                                                  {{2.5, 1.2, 0.0}, {1.2, 0.6}}},
-                                                                 {0, 0}, {14, 6}, 0.05);
-  const auto& g = grid.geometry();
-  cv::Mat image(g.height, g.width, CV_8UC1);
-  for (int iy = 0; iy < g.height; ++iy) {
-    for (int ix = 0; ix < g.width; ++ix)
-      image.at<std::uint8_t>(g.height - 1 - iy, ix) = grid.at(ix, iy) ? 0 : 254;
-  }
-  std::vector<std::uint8_t> png;
-  cv::imencode(".png", image, png);
+  // The office map (worlds/office): the bytes of its PGM image.
+  std::ifstream in(std::filesystem::path(EGRESS_OFFICE_MAP).parent_path() / "office.pgm",
+                   std::ios::binary);
+  const std::string pgm{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
   v1::LoadWorldRequest request;
-  request.mutable_map()->set_image(std::string(png.begin(), png.end()));
+  request.mutable_map()->set_image(pgm);
   request.mutable_map()->set_resolution(0.05);
   for (auto [id, hx, hy, lx, ly] :
        {std::tuple{"A", 5.0, 2.5, 5.0, 3.5}, std::tuple{"B", 9.0, 1.0, 9.0, 2.0}}) {

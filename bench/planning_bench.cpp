@@ -18,12 +18,7 @@ using namespace egress;
 using perception::Box2;
 
 perception::OccupancyGrid Office() {
-  const std::vector<Box2> walls = {{{7.0, 0.05, 0.0}, {14.0, 0.1}}, {{7.0, 5.95, 0.0}, {14.0, 0.1}},
-                                   {{0.05, 3.0, 0.0}, {0.1, 6.0}},  {{13.95, 3.0, 0.0}, {0.1, 6.0}},
-                                   {{5.0, 1.25, 0.0}, {0.1, 2.5}},  {{5.0, 4.75, 0.0}, {0.1, 2.5}},
-                                   {{9.0, 0.5, 0.0}, {0.1, 1.0}},   {{9.0, 4.0, 0.0}, {0.1, 4.0}},
-                                   {{2.5, 1.2, 0.0}, {1.2, 0.6}},   {{11.5, 4.5, 0.0}, {1.0, 1.5}}};
-  return perception::OccupancyGrid::FromBoxes(walls, {0, 0}, {14, 6}, 0.05);
+  return perception::OccupancyGrid::LoadMapServerYaml(EGRESS_OFFICE_MAP);
 }
 
 double Median(std::vector<double> v) {

@@ -26,6 +26,7 @@ function(egress_add_test name)
   target_link_libraries(${name} PRIVATE ${_t_DEPS} GTest::gtest GTest::gmock GTest::gtest_main
                         egress_warnings)
   target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR}/tests)
+  target_compile_definitions(${name} PRIVATE EGRESS_OFFICE_MAP="${EGRESS_OFFICE_MAP}")
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60
     PROPERTIES ENVIRONMENT "EGRESS_REFERENCE_DIR=${EGRESS_REFERENCE_DIR}")
 endfunction()

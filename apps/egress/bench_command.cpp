@@ -27,16 +27,7 @@ struct BenchOptions {
 };
 
 perception::OccupancyGrid Office() {
-  return perception::OccupancyGrid::FromBoxes({{{7.0, 0.05, 0.0}, {14.0, 0.1}},
-                                               {{7.0, 5.95, 0.0}, {14.0, 0.1}},
-                                               {{0.05, 3.0, 0.0}, {0.1, 6.0}},
-                                               {{13.95, 3.0, 0.0}, {0.1, 6.0}},
-                                               {{5.0, 1.25, 0.0}, {0.1, 2.5}},
-                                               {{5.0, 4.75, 0.0}, {0.1, 2.5}},
-                                               {{9.0, 0.5, 0.0}, {0.1, 1.0}},
-                                               {{9.0, 4.0, 0.0}, {0.1, 4.0}},
-                                               {{2.5, 1.2, 0.0}, {1.2, 0.6}}},
-                                              {0, 0}, {14, 6}, 0.05);
+  return perception::OccupancyGrid::LoadMapServerYaml(EGRESS_OFFICE_MAP);
 }
 
 struct Problem {

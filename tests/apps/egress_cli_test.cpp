@@ -175,11 +175,11 @@ TEST(EgressCliTest, BtTraceScriptErrorsNameTheLine) {
 
 // ---- egress costmap
 
-TEST(EgressCliTest, CostmapRendersAPng) {
-  const auto dir = egress::testing::TestTempPath("costmap");
+// A 4 m x 2 m room split by a wall with a 1 m door at y in [0.5, 1.5] (x = 2).
+std::filesystem::path WriteRoomMap() {
+  const auto dir = egress::testing::TestTempPath("room");
   std::filesystem::create_directories(dir);
   {
-    // A 4 m x 2 m room (5 cm cells) with a dividing wall and a 1 m opening.
     std::ofstream pgm(dir / "map.pgm", std::ios::binary);
     pgm << "P5\n80 40\n255\n";
     for (int row = 0; row < 40; ++row) {
@@ -191,6 +191,11 @@ TEST(EgressCliTest, CostmapRendersAPng) {
     }
   }
   std::ofstream(dir / "map.yaml") << "image: map.pgm\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\n";
+  return dir;
+}
+
+TEST(EgressCliTest, CostmapRendersAPng) {
+  const auto dir = WriteRoomMap();
   const std::string out = (dir / "costmap.png").string();
   std::filesystem::remove(out);
   const std::string args =
@@ -214,25 +219,6 @@ TEST(EgressCliTest, CostmapRendersAPng) {
 }
 
 // ---- egress plan
-
-// A 4 m x 2 m room split by a wall with a 1 m door at y in [0.5, 1.5] (x = 2).
-std::filesystem::path WriteRoomMap() {
-  const auto dir = egress::testing::TestTempPath("room");
-  std::filesystem::create_directories(dir);
-  {
-    std::ofstream pgm(dir / "map.pgm", std::ios::binary);
-    pgm << "P5\n80 40\n255\n";
-    for (int row = 0; row < 40; ++row) {
-      for (int col = 0; col < 80; ++col) {
-        const bool wall =
-            row < 1 || row > 38 || col < 1 || col > 78 || (col == 40 && (row < 10 || row > 29));
-        pgm.put(static_cast<char>(wall ? 0 : 254));
-      }
-    }
-  }
-  std::ofstream(dir / "map.yaml") << "image: map.pgm\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\n";
-  return dir;
-}
 
 TEST(EgressCliTest, PlanLocallyAndThroughTheService) {
   const auto dir = WriteRoomMap();

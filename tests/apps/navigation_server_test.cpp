@@ -6,44 +6,28 @@
 #include <grpcpp/grpcpp.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <future>
 #include <limits>
 #include <thread>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "egress/nav/v1/navigation.grpc.pb.h"
-#include "egress/perception/occupancy_grid.h"
 
 namespace egress::navd {
 namespace {
 
 namespace v1 = egress::nav::v1;
-using perception::Box2;
 using ::testing::HasSubstr;
 
-// The office (three rooms, doors A and B) as a PNG map_server image at 5 cm.
+// The office map (worlds/office) as the bytes of its PGM image.
 std::string OfficePng() {
-  const auto grid = perception::OccupancyGrid::FromBoxes({{{7.0, 0.05, 0.0}, {14.0, 0.1}},
-                                                          {{7.0, 5.95, 0.0}, {14.0, 0.1}},
-                                                          {{0.05, 3.0, 0.0}, {0.1, 6.0}},
-                                                          {{13.95, 3.0, 0.0}, {0.1, 6.0}},
-                                                          {{5.0, 1.25, 0.0}, {0.1, 2.5}},
-                                                          {{5.0, 4.75, 0.0}, {0.1, 2.5}},
-                                                          {{9.0, 0.5, 0.0}, {0.1, 1.0}},
-                                                          {{9.0, 4.0, 0.0}, {0.1, 4.0}}},
-                                                         {0, 0}, {14, 6}, 0.05);
-  const auto& g = grid.geometry();
-  cv::Mat image(g.height, g.width, CV_8UC1);
-  for (int iy = 0; iy < g.height; ++iy) {
-    for (int ix = 0; ix < g.width; ++ix)
-      image.at<std::uint8_t>(g.height - 1 - iy, ix) = grid.at(ix, iy) ? 0 : 254;
-  }
-  std::vector<std::uint8_t> png;
-  cv::imencode(".png", image, png);
-  return {png.begin(), png.end()};
+  std::ifstream in(std::filesystem::path(EGRESS_OFFICE_MAP).parent_path() / "office.pgm",
+                   std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 v1::Pose2 Pose(double x, double y, double yaw = 0.0) {

@@ -16,14 +16,10 @@ using perception::OccupancyGrid;
 using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 
-// The office: 14 m x 6 m, three rooms; door A (x = 5, y 2.5..3.5), door B (x = 9, y 1..2).
+// The office (worlds/office): 14 m x 6 m, three rooms; door A (x = 5, y 2.5..3.5), door B
+// (x = 9, y 1..2), a table in room 1.
 OccupancyGrid Office() {
-  const std::vector<Box2> walls = {{{7.0, 0.05, 0.0}, {14.0, 0.1}}, {{7.0, 5.95, 0.0}, {14.0, 0.1}},
-                                   {{0.05, 3.0, 0.0}, {0.1, 6.0}},  {{13.95, 3.0, 0.0}, {0.1, 6.0}},
-                                   {{5.0, 1.25, 0.0}, {0.1, 2.5}},  {{5.0, 4.75, 0.0}, {0.1, 2.5}},
-                                   {{9.0, 0.5, 0.0}, {0.1, 1.0}},   {{9.0, 4.0, 0.0}, {0.1, 4.0}},
-                                   {{2.5, 1.2, 0.0}, {1.2, 0.6}}};
-  return OccupancyGrid::FromBoxes(walls, {0, 0}, {14, 6}, 0.05);
+  return OccupancyGrid::LoadMapServerYaml(EGRESS_OFFICE_MAP);
 }
 
 class BasePlannerTest : public ::testing::Test {

@@ -22,21 +22,13 @@ namespace {
 
 using perception::Box2;
 
-// The office (three rooms, doors A and B) and a corridor 0.55 m wide (robot 0.43 m).
+// The office (worlds/office), plus a corridor 0.55 m wide (robot 0.43 m) between two cabinets
+// in room 3.
 perception::OccupancyGrid Office() {
-  return perception::OccupancyGrid::FromBoxes({{{7.0, 0.05, 0.0}, {14.0, 0.1}},
-                                               {{7.0, 5.95, 0.0}, {14.0, 0.1}},
-                                               {{0.05, 3.0, 0.0}, {0.1, 6.0}},
-                                               {{13.95, 3.0, 0.0}, {0.1, 6.0}},
-                                               {{5.0, 1.25, 0.0}, {0.1, 2.5}},
-                                               {{5.0, 4.75, 0.0}, {0.1, 2.5}},
-                                               {{9.0, 0.5, 0.0}, {0.1, 1.0}},
-                                               {{9.0, 4.0, 0.0}, {0.1, 4.0}},
-                                               {{2.5, 1.2, 0.0}, {1.2, 0.6}},
-                                               // room 3: a narrow corridor between two cabinets
-                                               {{11.0, 4.1, 0.0}, {1.5, 1.4}},
-                                               {{11.0, 2.475, 0.0}, {1.5, 0.75}}},
-                                              {0, 0}, {14, 6}, 0.05);
+  perception::OccupancyGrid grid = perception::OccupancyGrid::LoadMapServerYaml(EGRESS_OFFICE_MAP);
+  grid.AddBox({{11.0, 4.1, 0.0}, {1.5, 1.4}});
+  grid.AddBox({{11.0, 2.475, 0.0}, {1.5, 0.75}});
+  return grid;
 }
 
 struct Problem {
