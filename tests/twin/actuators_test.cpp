@@ -1,0 +1,59 @@
+#include "egress/twin/actuators.h"
+
+#include <gtest/gtest.h>
+
+namespace egress::twin {
+namespace {
+
+// A 0.1 x 0.02 x 0.1 m button on a wall along x whose face looks towards −y, at y = 2.93.
+ActuatorBox WallButton() {
+  return {Pose3(Eigen::Vector3d(1.0, 2.94, 1.0)), {0.1, 0.02, 0.1}};
+}
+
+// Moves the fingertip from 5 cm in front of the face to `depth` behind it in `steps` steps.
+PushButton::Result Poke(PushButton* b, double x, double z, double depth, int steps) {
+  PushButton::Result result = PushButton::Result::kNone;
+  const double y0 = 2.93 - 0.05, y1 = 2.93 + depth;
+  for (int i = 0; i <= steps; ++i) {
+    const auto r = b->Update({x, y0 + (y1 - y0) * i / steps, z});
+    if (r != PushButton::Result::kNone) result = r;
+  }
+  return result;
+}
+
+TEST(PushButtonTest, PressCountsAfterTheStrokeWithSmallForce) {
+  PushButton b(WallButton(), 0.004, 5.0, 22.0);
+  EXPECT_EQ(Poke(&b, 1.0, 1.0, 0.005, 200), PushButton::Result::kPressed);
+  EXPECT_LT(b.force(), 22.0);
+  // Held in: no second press until released.
+  EXPECT_EQ(b.Update({1.0, 2.935, 1.0}), PushButton::Result::kNone);
+  b.Update({1.0, 2.85, 1.0});
+  EXPECT_EQ(Poke(&b, 1.02, 0.98, 0.005, 200), PushButton::Result::kPressed);
+}
+
+TEST(PushButtonTest, NearMissesDoNotPress) {
+  PushButton b(WallButton(), 0.004, 5.0, 22.0);
+  EXPECT_EQ(Poke(&b, 1.0, 1.0, 0.002, 200), PushButton::Result::kNone);   // too shallow
+  EXPECT_EQ(Poke(&b, 1.07, 1.0, 0.005, 200), PushButton::Result::kNone);  // beside the cap
+  EXPECT_EQ(Poke(&b, 1.0, 1.06, 0.005, 200), PushButton::Result::kNone);  // above it
+}
+
+TEST(PushButtonTest, AJabPastTheBottomIsRefusedAsOverForce) {
+  PushButton b(WallButton(), 0.004, 5.0, 22.0);
+  // 5 cm approach + 8 mm in two steps: the first sample inside is already past the bottom.
+  EXPECT_EQ(Poke(&b, 1.0, 1.0, 0.008, 2), PushButton::Result::kOverForce);
+  EXPECT_GT(b.force(), 22.0);
+}
+
+TEST(ProximityPlateTest, TriggersWithinRangeOnceUntilTheHandLeaves) {
+  ProximityPlate plate(WallButton(), 0.3);
+  EXPECT_FALSE(plate.Update({{1.0, 2.93 - 0.35, 1.0}}));
+  EXPECT_TRUE(plate.Update({{1.0, 2.93 - 0.25, 1.0}}));
+  EXPECT_FALSE(plate.Update({{1.0, 2.93 - 0.1, 1.0}}));  // still there: one trigger
+  EXPECT_FALSE(plate.Update({{1.0, 2.93 - 0.5, 1.0}}));  // leaves beyond 1.5 x range: re-armed
+  EXPECT_TRUE(plate.Update({{1.0, 2.93 - 0.2, 1.0}}));
+  EXPECT_NEAR(plate.DistanceTo({1.0, 2.83, 1.0}), 0.1, 1e-9);
+}
+
+}  // namespace
+}  // namespace egress::twin

@@ -1,0 +1,81 @@
+#include "egress/twin/scenario_judge.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "twin_test_util.h"
+
+namespace egress::twin {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::Hsr;
+using testing::LoadText;
+using testing::WorldsDir;
+
+// Drives the robot north along x = 0 through the lab doorway with a P controller on y.
+Verdict DriveThrough(const std::string& doors, double seconds, const std::string& people = "") {
+  const std::string yaml =
+      "world: lab.sdf\nrobot:\n  start: {x: 0.0, y: 1.2, yaw_deg: 90}\n  goal: {x: 0.0, y: 5.0}\n" +
+      doors + people +
+      "success: [reach_goal, {cross_door: lab_door}, {door_open_when_crossed: lab_door}, "
+      "{button_not_pressed: lab_door}, no_person_contact]\n";
+  auto loaded = LoadText(yaml, WorldsDir() / "lab");
+  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+  ScenarioJudge judge;
+  while (world.time() < seconds) {
+    const Pose2 X = world.robot_pose();
+    // Wait 5 s (for the door), then go; forward in B is +y in W here.
+    const double vx = world.time() < 5.0 ? 0.0 : std::clamp(5.0 - X.y, 0.0, 0.4);
+    world.SetBaseVelocity({vx, X.x * 1.0, 0.0});
+    world.Step();
+    judge.Observe(world);
+  }
+  return judge.Finish(world);
+}
+
+TEST(ScenarioJudgeTest, ThroughAnOpenDoorEveryPredicatePasses) {
+  const Verdict v = DriveThrough(
+      "doors: [{door: lab_door, operator: push, actuator: lab_button, open_at: [0.5]}]\n", 20.0);
+  EXPECT_TRUE(v.success) << FormatVerdict(v);
+  ASSERT_EQ(v.metrics.crossings.size(), 1u);
+  EXPECT_GT(v.metrics.crossings[0].angle, 75 * M_PI / 180);
+  ASSERT_TRUE(v.metrics.time_to_goal.has_value());
+  EXPECT_GT(*v.metrics.time_to_goal, 5.0 + 3.8 / 0.4 - 1.0);
+  EXPECT_NEAR(v.metrics.path_length, 3.8, 0.1);
+  // It stood 5 s within 2 m of the door before crossing.
+  EXPECT_NEAR(v.metrics.door_wait_time.at("lab_door"), 5.0, 0.3);
+  EXPECT_EQ(v.metrics.button_presses.at("lab_door"), 0);
+  const std::string table = FormatVerdict(v);
+  EXPECT_THAT(table, HasSubstr("SUCCESS"));
+  EXPECT_THAT(table, HasSubstr("PASS  door_open_when_crossed:lab_door"));
+  EXPECT_THAT(VerdictToJson(v), HasSubstr("\"success\":true"));
+}
+
+TEST(ScenarioJudgeTest, AgainstAClosedDoorTheRobotIsStoppedAndFails) {
+  const Verdict v =
+      DriveThrough("doors: [{door: lab_door, operator: push, actuator: lab_button}]\n", 20.0);
+  EXPECT_FALSE(v.success);
+  EXPECT_TRUE(v.metrics.crossings.empty());
+  EXPECT_GE(v.metrics.contacts.at("door"), 1);
+  EXPECT_FALSE(v.metrics.time_to_goal.has_value());
+  const std::string table = FormatVerdict(v);
+  EXPECT_THAT(table, HasSubstr("FAIL  reach_goal"));
+  EXPECT_THAT(table, HasSubstr("FAIL  cross_door:lab_door"));
+  EXPECT_THAT(VerdictToJson(v), HasSubstr("\"success\":false"));
+}
+
+TEST(ScenarioJudgeTest, PersonalSpaceAndPersonContactsAreMeasured) {
+  // A person starts touching the robot (0.4 m apart, radii 0.215 + 0.25) and steps away.
+  const Verdict v = DriveThrough(
+      "doors: [{door: lab_door, operator: push, actuator: lab_button, open_at: [0.5]}]\n", 20.0,
+      "people: [{name: bumped, behavior: approach_and_wait, start: [-0.4, 1.2], goal: [-2.0, 1.2], "
+      "wait_s: 60}]\n");
+  EXPECT_LT(v.metrics.min_person_distance, 0.0);
+  EXPECT_GT(v.metrics.time_in_personal_space, 0.2);
+  EXPECT_GE(v.metrics.contacts.count("person") ? v.metrics.contacts.at("person") : 0, 1);
+  EXPECT_FALSE(v.success);
+}
+
+}  // namespace
+}  // namespace egress::twin

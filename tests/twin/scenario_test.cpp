@@ -1,0 +1,100 @@
+#include "egress/twin/scenario.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "egress/hsr_interface/error.h"
+#include "twin_test_util.h"
+
+namespace egress::twin {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::WorldsDir;
+
+TEST(ScenarioTest, OurScenariosLoadAndFitTheirWorlds) {
+  for (const char* file :
+       {"lab/lab_push_button.yaml", "lab/lab_hold_door.yaml", "office/office_evacuation.yaml"}) {
+    const Scenario s = LoadScenario(WorldsDir() / file);
+    EXPECT_NO_THROW(s.ValidateAgainst(LoadSdfWorld(s.world_file))) << file;
+    EXPECT_FALSE(s.success.empty()) << file;
+  }
+  const Scenario office = LoadScenario(WorldsDir() / "office/office_evacuation.yaml");
+  ASSERT_EQ(office.doors.size(), 2u);
+  EXPECT_EQ(office.doors[0].kind, OperatorKind::kPushButton);
+  EXPECT_EQ(office.doors[1].kind, OperatorKind::kProximityPlate);
+  EXPECT_TRUE(office.doors[1].glass);
+  EXPECT_DOUBLE_EQ(office.doors[0].timing.hold_open_s, 10.0);  // the paper's window by default
+  ASSERT_EQ(office.people.size(), 2u);
+  EXPECT_EQ(office.people[0].trigger.kind, TriggerSpec::Kind::kEvent);
+  EXPECT_EQ(office.people[0].trigger.event, "door_opened:door_a");
+  ASSERT_EQ(office.payloads.size(), 2u);
+  EXPECT_EQ(office.payloads[1].kind, PayloadKind::kFlashlight);
+  EXPECT_DOUBLE_EQ(office.randomize.payload_xy, 0.03);
+}
+
+std::string Minimal(const std::string& extra) {
+  return "world: lab.sdf\nrobot:\n  start: {x: 0, y: 0}\n" + extra;
+}
+
+void ExpectError(const std::string& yaml, const std::string& needle1, const std::string& needle2) {
+  try {
+    LoadScenarioFromString(yaml, "bad.yaml", WorldsDir() / "lab");
+    FAIL() << "accepted:\n" << yaml;
+  } catch (const LoadError& e) {
+    EXPECT_THAT(e.what(), HasSubstr(needle1)) << yaml;
+    EXPECT_THAT(e.what(), HasSubstr(needle2)) << yaml;
+  }
+}
+
+TEST(ScenarioTest, ErrorsNameFileLineAndField) {
+  ExpectError(Minimal("time_limt: 5\n"), "bad.yaml:4", "unknown field");
+  ExpectError(Minimal("doors:\n  - door: lab_door\n    operator: knock\n"), "bad.yaml:6",
+              "doors[0].operator");
+  ExpectError(
+      Minimal("people:\n  - behavior: cross_doorway\n    door: lab_door\n    start: [0, 0]\n"
+              "    goal: [0, 5]\n    speed: [2, 1]\n"),
+      "people[0].speed", "min is larger than max");
+  ExpectError(Minimal("time_limit: .nan\n"), "time_limit", "finite");
+  ExpectError(Minimal("robot_x: 1\n"), "robot_x", "unknown field");
+  ExpectError("world: nowhere.sdf\nrobot: {start: {x: 0, y: 0}}\n", "world", "no such file");
+  ExpectError("world: lab.sdf\n", "robot", "is required");
+  ExpectError(Minimal("success: [reach_goal]\n"), "success[0]", "needs robot.goal");
+  ExpectError(Minimal("people:\n  - behavior: hold_door\n    start: [0, 0]\n"), "people[0].door",
+              "is required");
+  ExpectError(Minimal("people:\n  - behavior: walk_past\n    start: [0, 0]\n    goal: [1, 1]\n"
+                      "    trigger: {event: opened}\n"),
+              "trigger.event", "button_pressed:<door>");
+  ExpectError("world: [lab.sdf\n", "bad.yaml:", "not valid YAML");
+}
+
+TEST(ScenarioTest, ValidationAgainstTheWorldNamesTheField) {
+  const Scenario s = LoadScenarioFromString(
+      Minimal("doors:\n  - {door: front_door, operator: push, actuator: lab_button}\n"), "v.yaml",
+      WorldsDir() / "lab");
+  try {
+    s.ValidateAgainst(LoadSdfWorld(s.world_file));
+    FAIL();
+  } catch (const LoadError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("doors[0].door"));
+    EXPECT_THAT(e.what(), HasSubstr("front_door"));
+  }
+  const Scenario t = LoadScenarioFromString(
+      Minimal("doors:\n  - {door: lab_door, operator: push, actuator: wall_north_button}\n"),
+      "v.yaml", WorldsDir() / "lab");
+  EXPECT_THROW(t.ValidateAgainst(LoadSdfWorld(t.world_file)), LoadError);
+}
+
+TEST(ScenarioTest, RangeSamplesWithinBoundsAndFixedValues) {
+  std::mt19937_64 rng(7);
+  const Range r{1.0, 2.0};
+  for (int i = 0; i < 100; ++i) {
+    const double v = r.Sample(rng);
+    EXPECT_GE(v, 1.0);
+    EXPECT_LE(v, 2.0);
+  }
+  EXPECT_EQ((Range{1.5, 1.5}.Sample(rng)), 1.5);
+}
+
+}  // namespace
+}  // namespace egress::twin

@@ -1,0 +1,180 @@
+#include "egress/twin/sdf_world_loader.h"
+
+#include <fstream>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "egress/hsr_interface/error.h"
+#include "test_paths.h"
+#include "twin_test_util.h"
+
+namespace egress::twin {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::ReferenceDir;
+using testing::WorldsDir;
+
+#define REQUIRE_REFERENCE_WORLDS()                                                             \
+  if (ReferenceDir().empty() || !std::filesystem::exists(ReferenceDir() / "worlds")) {         \
+    GTEST_SKIP() << "the paper's worlds are not here: set EGRESS_REFERENCE_DIR to the folder " \
+                    "holding worlds/door.world (../shared/reference)";                         \
+  }
+
+int CountNotes(const WorldDescription& w, const std::string& needle) {
+  int n = 0;
+  for (const auto& note : w.notes)
+    n += note.find(needle) != std::string::npos ? 1 : 0;
+  return n;
+}
+
+TEST(SdfWorldLoaderTest, PaperDoorWorldHasItsWallsDoorAndButton) {
+  REQUIRE_REFERENCE_WORLDS();
+  const WorldDescription w = LoadSdfWorld(ReferenceDir() / "worlds/door.world");
+  // Ground plane, two hallway walls, the button (the door frame link has no collision).
+  ASSERT_EQ(w.shapes.size(), 4u);
+  const auto left = w.ShapesOfModel("hallway_wall_left");
+  ASSERT_EQ(left.size(), 1u);
+  EXPECT_NEAR(left[0]->X_WS.translation().x(), -2.6, 1e-9);
+  EXPECT_NEAR(left[0]->box_size.x(), 3.1, 1e-9);
+  ASSERT_EQ(w.doors.size(), 1u);
+  const DoorDescription& door = w.doors[0];
+  EXPECT_EQ(door.name, "handicap_door");
+  EXPECT_EQ(door.joint, "door_hinge");
+  // Hinge on the right of the opening at x = 0, leaf covering x −1..0, opening to +y (q < 0).
+  EXPECT_TRUE(door.p_WH.isApprox(Eigen::Vector3d(0.0, 4.5, 1.0), 1e-9));
+  EXPECT_NEAR(door.X_WL.translation().x(), -0.5, 1e-9);
+  EXPECT_NEAR(door.LeafReach(), 1.0, 1e-9);
+  EXPECT_EQ(door.open_sign, -1.0);
+  EXPECT_NEAR(door.max_open_angle, 1.57, 1e-9);
+  EXPECT_NEAR(door.max_velocity, 0.6, 1e-9);
+  EXPECT_NEAR(door.damping, 5.0, 1e-9);
+  EXPECT_GT(door.CalcFreeEdge(M_PI / 2).y(), 5.4);  // swings away from the robot (+y)
+  const auto button = w.ShapesOfModel("ada_button");
+  ASSERT_EQ(button.size(), 1u);
+  EXPECT_TRUE(button[0]->box_size.isApprox(Eigen::Vector3d(0.15, 0.02, 0.15)));
+  EXPECT_NEAR(button[0]->X_WS.translation().y(), 4.44, 1e-9);
+  // Five world plugins, two on the door, one on the button: one note each; and the sensor.
+  EXPECT_EQ(CountNotes(w, "ignoring plugin"), 8);
+  EXPECT_EQ(CountNotes(w, "TouchPlugin"), 1);
+  EXPECT_EQ(CountNotes(w, "ignoring sensor 'button_contact_sensor'"), 1);
+}
+
+TEST(SdfWorldLoaderTest, PaperDoubleDoorWorldHasTwoDoorsOpeningAway) {
+  REQUIRE_REFERENCE_WORLDS();
+  const WorldDescription w = LoadSdfWorld(ReferenceDir() / "worlds/double_door.world");
+  ASSERT_EQ(w.doors.size(), 2u);
+  const DoorDescription* left = w.FindDoor("handicap_door_left");
+  const DoorDescription* right = w.FindDoor("handicap_door_right");
+  ASSERT_NE(left, nullptr);
+  ASSERT_NE(right, nullptr);
+  EXPECT_EQ(left->open_sign, 1.0);
+  EXPECT_EQ(right->open_sign, -1.0);
+  EXPECT_NEAR(left->p_WH.x(), -1.0, 1e-9);
+  EXPECT_NEAR(right->p_WH.x(), 1.0, 1e-9);
+  for (const DoorDescription* d : {left, right}) {
+    EXPECT_GT(d->CalcFreeEdge(1.2).y(), 4.5 + 0.5) << d->name;  // both open away (+y)
+  }
+  EXPECT_EQ(w.ShapesOfModel("ada_button").size(), 1u);
+  EXPECT_NEAR(w.ShapesOfModel("ada_button")[0]->X_WS.translation().x(), -1.7, 1e-9);
+}
+
+TEST(SdfWorldLoaderTest, OurWorldsLoad) {
+  const WorldDescription lab = LoadSdfWorld(WorldsDir() / "lab/lab.sdf");
+  ASSERT_EQ(lab.doors.size(), 1u);
+  EXPECT_EQ(lab.doors[0].open_sign, -1.0);
+  EXPECT_NEAR(lab.doors[0].LeafReach(), 0.95, 1e-9);
+  const WorldDescription office = LoadSdfWorld(WorldsDir() / "office/office.sdf");
+  ASSERT_EQ(office.doors.size(), 2u);
+  // Both office doors open into the room with larger x.
+  for (const auto& d : office.doors)
+    EXPECT_GT(d.CalcFreeEdge(1.2).x(), d.p_WH.x() + 0.5) << d.name;
+  EXPECT_EQ(office.ShapesOfModel("table").size(), 1u);
+}
+
+std::string DoorSdf(const std::string& leaf_geometry) {
+  return R"(<?xml version="1.0"?>
+<sdf version="1.6"><world name="w">
+  <model name="d"><pose>0 0 1 0 0 0</pose>
+    <link name="frame"/>
+    <link name="leaf"><collision name="c"><pose>-0.5 0 0 0 0 0</pose><geometry>)" +
+         leaf_geometry + R"(</geometry></collision></link>
+    <joint name="hinge" type="revolute"><parent>frame</parent><child>leaf</child>
+      <axis><xyz>0 0 1</xyz><limit><lower>0</lower><upper>1.5</upper></limit></axis></joint>
+  </model>
+</world></sdf>)";
+}
+
+TEST(SdfWorldLoaderTest, DoorFromStringAndNonBoxLeafIsRefused) {
+  const WorldDescription w =
+      LoadSdfWorldFromString(DoorSdf("<box><size>1 0.05 2</size></box>"), "door.sdf");
+  ASSERT_EQ(w.doors.size(), 1u);
+  EXPECT_EQ(w.doors[0].open_sign, 1.0);
+  try {
+    LoadSdfWorldFromString(DoorSdf("<sphere><radius>0.3</radius></sphere>"), "ball_door.sdf");
+    FAIL() << "a spherical leaf was accepted";
+  } catch (const LoadError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("ball_door.sdf"));
+    EXPECT_THAT(e.what(), HasSubstr("not a box"));
+  }
+}
+
+TEST(SdfWorldLoaderTest, MalformedSdfNamesFileAndLine) {
+  const auto path = egress::testing::TestTempPath("broken.world");
+  {
+    std::ofstream out(path);
+    out << "<?xml version=\"1.0\"?>\n<sdf version=\"1.6\">\n<world name=\"w\">\n"
+           "<model name=\"m\"><static>true</static>\n<link name=\"l\"><collision name=\"c\">"
+           "<geometry><box><size>1 1</size></box></geometry></collision></link></model>\n"
+           "</world></sdf>\n";
+  }
+  try {
+    LoadSdfWorld(path);
+    FAIL() << "a two-component box size was accepted";
+  } catch (const LoadError& e) {
+    EXPECT_THAT(e.what(), HasSubstr(path.string()));
+  }
+  std::filesystem::remove(path);
+  EXPECT_THROW(LoadSdfWorldFromString("<sdf version='1.6'><world name='w'>", "cut.sdf"), LoadError);
+  try {
+    LoadSdfWorld("/nonexistent/nowhere.world");
+    FAIL();
+  } catch (const LoadError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("/nonexistent/nowhere.world: no such world file"));
+  }
+}
+
+TEST(SdfWorldLoaderTest, MeshCollisionFromObjRelativeToTheWorldFile) {
+  const auto dir = egress::testing::TestTempPath("mesh_world");
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream obj(dir / "wedge.obj");
+    obj << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    std::ofstream sdf(dir / "w.sdf");
+    sdf << R"(<?xml version="1.0"?><sdf version="1.6"><world name="w"><model name="rock">
+      <static>true</static><pose>2 0 0 0 0 0</pose><link name="l"><collision name="c">
+      <geometry><mesh><uri>wedge.obj</uri><scale>2 2 2</scale></mesh></geometry></collision>
+      </link></model></world></sdf>)";
+  }
+  const WorldDescription w = LoadSdfWorld(dir / "w.sdf");
+  ASSERT_EQ(w.shapes.size(), 1u);
+  ASSERT_EQ(w.shapes[0].kind, ShapeKind::kMesh);
+  EXPECT_EQ(w.shapes[0].mesh->triangles.size(), 4u);
+  Eigen::Vector3d lo, hi;
+  w.shapes[0].CalcWorldBounds(&lo, &hi);
+  EXPECT_TRUE(lo.isApprox(Eigen::Vector3d(2, 0, 0)));
+  EXPECT_TRUE(hi.isApprox(Eigen::Vector3d(4, 2, 2)));
+  std::filesystem::remove(dir / "wedge.obj");
+  try {
+    LoadSdfWorld(dir / "w.sdf");
+    FAIL() << "a missing mesh was accepted";
+  } catch (const LoadError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("wedge.obj"));
+    EXPECT_THAT(e.what(), HasSubstr("rock"));
+  }
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace egress::twin

@@ -1,0 +1,216 @@
+#include "egress/twin/sensors.h"
+
+#include <gtest/gtest.h>
+
+#include "egress/twin/twin_robot.h"
+#include "twin_test_util.h"
+
+namespace egress::twin {
+namespace {
+
+using testing::Hsr;
+using testing::LoadText;
+using testing::WorldsDir;
+
+constexpr double kDeg = M_PI / 180.0;
+const char* const kQuiet =
+    "sensors:\n  laser: {noise: 0}\n  depth: {noise_coeff: 0}\n  detector: {miss_rate: 0, "
+    "false_positive_rate: 0}\n";
+
+std::string At(const char* world, double x, double y, double yaw, const std::string& extra = "") {
+  return std::string("world: ") + world + "\nrobot: {start: {x: " + std::to_string(x) +
+         ", y: " + std::to_string(y) + ", yaw: " + std::to_string(yaw) + "}}\n" + kQuiet + extra;
+}
+
+std::size_t BeamAt(const LaserScan& scan, double angle) {
+  return std::size_t(std::lround((angle - scan.angle_min) / scan.angle_increment));
+}
+
+TEST(LaserSimulatorTest, RangesEqualTheAnalyticDistancesToTheLabWalls) {
+  auto loaded = LoadText(At("lab.sdf", -1.5, 0.0, 0.0), WorldsDir() / "lab");
+  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+  const LaserSimulator laser(loaded.scenario.sensors);
+  std::mt19937_64 rng(1);
+  const LaserScan scan = laser.Capture(world, rng);
+  ASSERT_NO_THROW(scan.Validate());
+  ASSERT_EQ(scan.ranges.size(), 1081u);  // 270° in 0.25° steps
+  const Eigen::Vector3d p_WL =
+      (Pose3::FromPose2(world.robot_pose()) * Hsr()->laser_pose()).translation();
+  EXPECT_NEAR(scan.ranges[BeamAt(scan, 0.0)], 3.0 - p_WL.x(), 1e-3);  // east wall face x = 3
+  EXPECT_NEAR(scan.ranges[BeamAt(scan, M_PI / 2)], 2.95 - p_WL.y(),
+              1e-3);  // door wall face y = 2.95
+  EXPECT_NEAR(scan.ranges[BeamAt(scan, -M_PI / 2)], p_WL.y() + 1.0,
+              1e-3);  // south wall face y = −1
+  // An oblique beam at 20° hits the east wall at (3 − x) / cos 20°; at −30° the south wall.
+  EXPECT_NEAR(scan.ranges[BeamAt(scan, 20 * kDeg)], (3.0 - p_WL.x()) / std::cos(20 * kDeg), 2e-3);
+  EXPECT_NEAR(scan.ranges[BeamAt(scan, -30 * kDeg)], (p_WL.y() + 1.0) / std::sin(30 * kDeg), 2e-3);
+}
+
+TEST(LaserSimulatorTest, NoiseHasTheConfiguredSpread) {
+  auto loaded = LoadText(At("lab.sdf", -1.5, 0.0, 0.0), WorldsDir() / "lab");
+  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+  SensorConfig config = loaded.scenario.sensors;
+  config.laser_noise = 0.02;
+  const LaserSimulator noisy(config), exact(loaded.scenario.sensors);
+  std::mt19937_64 rng(1);
+  const LaserScan a = noisy.Capture(world, rng), b = exact.Capture(world, rng);
+  double sum2 = 0;
+  int n = 0;
+  for (std::size_t i = 0; i < a.ranges.size(); ++i) {
+    if (std::isfinite(a.ranges[i]) && std::isfinite(b.ranges[i])) {
+      sum2 += std::pow(a.ranges[i] - b.ranges[i], 2);
+      ++n;
+    }
+  }
+  EXPECT_NEAR(std::sqrt(sum2 / n), 0.02, 0.003);
+}
+
+TEST(LaserSimulatorTest, GlassReturnsOnlyNearNormalIncidence) {
+  const std::string doors_glass =
+      "doors: [{door: door_b, operator: proximity, actuator: door_b_plate, glass: true}]\n";
+  const std::string doors_solid =
+      "doors: [{door: door_b, operator: proximity, actuator: door_b_plate}]\n";
+  auto glass = LoadText(At("office.sdf", 7.5, 1.3, 0.0, doors_glass), WorldsDir() / "office");
+  auto solid = LoadText(At("office.sdf", 7.5, 1.3, 0.0, doors_solid), WorldsDir() / "office");
+  TwinWorld glass_world(glass.scenario, glass.world, 1, Hsr());
+  TwinWorld solid_world(solid.scenario, solid.world, 1, Hsr());
+  const LaserSimulator laser(glass.scenario.sensors);
+  std::mt19937_64 rng(1);
+  const LaserScan g = laser.Capture(glass_world, rng), s = laser.Capture(solid_world, rng);
+  const double p_x =
+      (Pose3::FromPose2(glass_world.robot_pose()) * Hsr()->laser_pose()).translation().x();
+  // Straight at the leaf (x = 8.99): both return.
+  EXPECT_NEAR(g.ranges[BeamAt(g, 0.0)], 8.99 - p_x, 2e-3);
+  EXPECT_NEAR(s.ranges[BeamAt(s, 0.0)], 8.99 - p_x, 2e-3);
+  // 25° off the normal: the solid leaf returns, the glass lets the beam through to room 3.
+  const std::size_t oblique = BeamAt(g, 25 * kDeg);
+  EXPECT_NEAR(s.ranges[oblique], (8.99 - p_x) / std::cos(25 * kDeg), 5e-3);
+  EXPECT_GT(g.ranges[oblique], 3.0);
+}
+
+TEST(DepthCameraSimulatorTest, DepthEqualsTheAnalyticDistanceAndGlassIsInvalid) {
+  auto loaded = LoadText(At("lab.sdf", -1.5, 0.0, 0.0), WorldsDir() / "lab");
+  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+  const DepthCameraSimulator camera(loaded.scenario.sensors);
+  std::mt19937_64 rng(1);
+  const DepthImage image = camera.Capture(world, rng);
+  ASSERT_NO_THROW(image.Validate());
+  ASSERT_EQ(image.width, 80);
+  ASSERT_EQ(image.height, 60);
+  const Pose3 X_WC = world.head_camera_pose();
+  int checked = 0;
+  for (int v = 5; v < 60; v += 10) {
+    for (int u = 5; u < 80; u += 10) {
+      const Eigen::Vector3d d_W =
+          X_WC.rotation() * camera.intrinsics().Unproject(u + 0.5, v + 0.5, 1.0);
+      // The ray to the east wall face (x = 3) or the floor (z = 0), whichever is first.
+      const double s_wall = (3.0 - X_WC.translation().x()) / d_W.x();
+      const double s_floor = d_W.z() < 0 ? -X_WC.translation().z() / d_W.z() : 1e9;
+      const double s = std::min(s_wall, s_floor);  // depth along the optical axis (d_C.z = 1)
+      const Eigen::Vector3d hit = X_WC.translation() + s * d_W;
+      if (hit.y() < -0.95 || hit.y() > 2.9 || hit.z() > 1.95) continue;  // the plain wall and floor
+      EXPECT_NEAR(image.At(u, v), s, 2e-3) << u << "," << v;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 20);
+  // Facing the glass leaf of door_b straight on: the centre pixels have no valid depth.
+  auto office = LoadText(
+      At("office.sdf", 7.8, 1.5, 0.0,
+         "doors: [{door: door_b, operator: proximity, actuator: door_b_plate, glass: true}]\n"),
+      WorldsDir() / "office");
+  TwinWorld glass_world(office.scenario, office.world, 1, Hsr());
+  const DepthImage g = camera.Capture(glass_world, rng);
+  EXPECT_FALSE(g.IsValidAt(40, 30));
+}
+
+TEST(DetectorSimulatorTest, BoxesMatchTheProjectionAndOccludedObjectsAreDropped) {
+  // In front of the lab button, 1.4 m back, looking at it.
+  const std::string base = At("lab.sdf", 1.075, 1.5, M_PI / 2,
+                              "doors: [{door: lab_door, operator: push, actuator: lab_button}]\n");
+  auto loaded = LoadText(base, WorldsDir() / "lab");
+  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+  const DepthCameraSimulator camera(loaded.scenario.sensors);
+  const DetectorSimulator detector(loaded.scenario.sensors, camera.intrinsics());
+  std::mt19937_64 rng(3);
+  const auto detections = detector.Detect(world, rng);
+  const DetectableObject* button = nullptr;
+  const auto objects = world.DetectableObjects();
+  for (const auto& o : objects) {
+    if (o.label == "push_button") button = &o;
+  }
+  ASSERT_NE(button, nullptr);
+  const auto expected = detector.Project(*button, world.head_camera_pose());
+  ASSERT_TRUE(expected.has_value());
+  const Detection2D* found = nullptr;
+  for (const auto& d : detections) {
+    EXPECT_NO_THROW(d.Validate());
+    if (d.label == "push_button") found = &d;
+  }
+  ASSERT_NE(found, nullptr);
+  EXPECT_NEAR(found->box.center().x(), expected->center().x(), 1.0);
+  EXPECT_NEAR(found->box.center().y(), expected->center().y(), 1.0);
+  EXPECT_NEAR(found->box.width(), expected->width(), 0.5 + 0.1 * expected->width());
+  EXPECT_GT(found->confidence, 0.5);
+  // The door leaf, partly in view at the image's left edge, is detected too (truncated box).
+  bool door_seen = false;
+  for (const auto& d : detections)
+    door_seen = door_seen || (d.label == "door" && d.box.u_min < 1.0);
+  EXPECT_TRUE(door_seen);
+  // A cabinet between the camera and the button hides it.
+  auto occluded =
+      LoadText(base + "obstacles: [{name: cabinet, box: [0.5, 0.2, 1.5], x: 1.075, y: 2.3}]\n",
+               WorldsDir() / "lab");
+  TwinWorld hidden(occluded.scenario, occluded.world, 1, Hsr());
+  for (const auto& d : detector.Detect(hidden, rng))
+    EXPECT_NE(d.label, "push_button");
+}
+
+TEST(TwinRobotTest, SensorsArriveAtTheirRatesAfterTheirLatency) {
+  auto loaded = LoadText(At("lab.sdf", 1.075, 1.5, M_PI / 2,
+                            "doors: [{door: lab_door, operator: push, actuator: lab_button}]\n"),
+                         WorldsDir() / "lab");
+  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+  TwinRobot robot(&world);
+  int scans = 0, images = 0, detections = 0;
+  for (int i = 0; i < 20; ++i) {  // 2 s at the executive's 10 Hz
+    robot.Advance(0.1);
+    const SensorSnapshot s = robot.Sense();  // validated by RobotPort
+    scans += s.scan ? 1 : 0;
+    images += s.depth ? 1 : 0;
+    for (const auto& d : s.detections) {
+      ++detections;
+      const double age = ToSeconds(s.stamp - d.stamp);
+      EXPECT_GE(age, 0.125 - 1e-6);
+      EXPECT_LE(age, 0.2 + 0.1 + 1e-6);
+    }
+    EXPECT_EQ(s.stamp, robot.clock().Now());
+  }
+  EXPECT_NEAR(scans, 20, 1);   // 10 Hz laser
+  EXPECT_NEAR(images, 10, 1);  // 5 Hz depth
+  EXPECT_GE(detections, 14);   // 8 Hz, button + door visible in most frames
+}
+
+TEST(OdometrySimulatorTest, ExactWithoutNoiseAndDriftsWithIt) {
+  SensorConfig exact;
+  exact.odometry_noise = 0.0;
+  exact.odometry_yaw_drift = 0.0;
+  std::mt19937_64 rng(1);
+  OdometrySimulator odom(exact, {}, rng);
+  for (int i = 0; i < 100; ++i)
+    odom.Integrate({0.5, 0.0, 0.1}, 0.01);
+  const Odometry o = odom.Read(Time{0});
+  const double yaw = 0.1;
+  EXPECT_NEAR(o.X_OB.yaw, yaw, 1e-9);
+  EXPECT_NEAR(o.X_OB.x, 0.5 * std::sin(yaw) / 0.1, 1e-3);
+  SensorConfig drifting;
+  drifting.odometry_yaw_drift = 0.01;
+  OdometrySimulator drift(drifting, {}, rng);
+  for (int i = 0; i < 1000; ++i)
+    drift.Integrate({0.5, 0.0, 0.0}, 0.01);
+  EXPECT_GT(std::abs(drift.Read(Time{0}).X_OB.yaw), 0.09);
+  EXPECT_NO_THROW(drift.Read(Time{0}).Validate());
+}
+
+}  // namespace
+}  // namespace egress::twin

@@ -1,0 +1,87 @@
+#include "egress/twin/social_force.h"
+
+#include <gtest/gtest.h>
+
+namespace egress::twin {
+namespace {
+
+double MinGap(const std::vector<Walker>& w) {
+  double gap = 1e9;
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    for (std::size_t j = i + 1; j < w.size(); ++j) {
+      gap = std::min(gap, (w[i].position - w[j].position).norm() - w[i].radius - w[j].radius);
+    }
+  }
+  return gap;
+}
+
+// A 2.4 m wide corridor along x.
+std::vector<WallSegment> Corridor() {
+  return {{{-10, -1.2}, {10, -1.2}}, {{-10, 1.2}, {10, 1.2}}};
+}
+
+TEST(SocialForceModelTest, TwoPeoplePassHeadOnWithoutOverlap) {
+  SocialForceModel sfm;
+  std::vector<Walker> w(2);
+  w[0].position = {-5, 0.0};
+  w[0].target = {5, 0};
+  w[1].position = {5, 0.0};
+  w[1].target = {-5, 0};
+  w[0].desired_speed = w[1].desired_speed = 1.3;
+  double min_gap = 1e9;
+  for (int i = 0; i < 1500; ++i) {
+    sfm.Step(&w, {}, Corridor(), 0.01);
+    min_gap = std::min(min_gap, MinGap(w));
+  }
+  EXPECT_GT(min_gap, 0.0) << "bodies overlapped";
+  EXPECT_NEAR(w[0].position.x(), 5.0, 0.5);
+  EXPECT_NEAR(w[1].position.x(), -5.0, 0.5);
+  for (const auto& x : w)
+    EXPECT_LT(std::abs(x.position.y()), 1.2 - x.radius + 0.02);
+}
+
+TEST(SocialForceModelTest, AWalkerGoesThroughAOneMetreDoorwayWithoutTouchingTheJambs) {
+  SocialForceModel sfm;
+  // A wall at x = 0 with a 1 m gap at y −0.5..0.5 (jambs as short segments, 0.1 m thick).
+  const std::vector<WallSegment> walls = {
+      {{-0.05, -5}, {-0.05, -0.5}, 0},  {{0.05, -5}, {0.05, -0.5}, 0},
+      {{-0.05, -0.5}, {0.05, -0.5}, 0}, {{-0.05, 0.5}, {-0.05, 5}, 1},
+      {{0.05, 0.5}, {0.05, 5}, 1},      {{-0.05, 0.5}, {0.05, 0.5}, 1}};
+  std::vector<Walker> w(1);
+  w[0].position = {-3, 0.3};
+  w[0].desired_speed = 1.3;
+  double min_clearance = 1e9;
+  const std::vector<Eigen::Vector2d> route = {{-1.0, 0.0}, {0.0, 0.0}, {1.0, 0.0}, {3.0, 0.5}};
+  std::size_t next = 0;
+  for (int i = 0; i < 1500 && next < route.size(); ++i) {
+    w[0].target = route[next];
+    if ((w[0].position - route[next]).norm() < 0.25) ++next;
+    sfm.Step(&w, {}, walls, 0.01);
+    for (const auto& s : walls) {
+      min_clearance =
+          std::min(min_clearance,
+                   (w[0].position - ClosestPointOnSegment(w[0].position, s)).norm() - w[0].radius);
+    }
+  }
+  EXPECT_EQ(next, route.size()) << "stuck at " << w[0].position.transpose();
+  EXPECT_GT(min_clearance, 0.0);
+}
+
+TEST(SocialForceModelTest, ARobotDiscIsAvoided) {
+  SocialForceModel sfm;
+  std::vector<Walker> w(1);
+  w[0].position = {-4, 0.05};
+  w[0].target = {4, 0};
+  w[0].desired_speed = 1.2;
+  const std::vector<DiscObstacle> robot = {{{0, 0}, {0, 0}, 0.215}};
+  double min_gap = 1e9;
+  for (int i = 0; i < 1000; ++i) {
+    sfm.Step(&w, robot, {}, 0.01);
+    min_gap = std::min(min_gap, (w[0].position - robot[0].position).norm() - 0.215 - w[0].radius);
+  }
+  EXPECT_GT(min_gap, 0.05);
+  EXPECT_GT(w[0].position.x(), 3.0);
+}
+
+}  // namespace
+}  // namespace egress::twin

@@ -1,0 +1,288 @@
+#include "egress/twin/twin_world.h"
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "egress/hsr_interface/error.h"
+#include "egress/planning/ik_solver.h"
+#include "egress/twin/trace.h"
+#include "twin_test_util.h"
+
+namespace egress::twin {
+namespace {
+
+using testing::Hsr;
+using testing::LoadText;
+using testing::WorldsDir;
+
+constexpr double kDeg = M_PI / 180.0;
+
+int CountEvents(const TwinWorld& w, const std::string& kind, const std::string& subject = "") {
+  int n = 0;
+  for (const auto& e : w.events())
+    n += e.kind == kind && (subject.empty() || e.subject == subject) ? 1 : 0;
+  return n;
+}
+
+std::optional<double> FirstEvent(const TwinWorld& w, const std::string& kind) {
+  for (const auto& e : w.events()) {
+    if (e.kind == kind) return e.t;
+  }
+  return std::nullopt;
+}
+
+// An arm trajectory through the given whole-body configurations (arm joints only).
+JointTrajectory ArmThrough(const std::vector<std::pair<double, WholeBodyVector>>& knots) {
+  JointTrajectory traj;
+  traj.joint_names = {"arm_lift_joint", "arm_flex_joint", "arm_roll_joint", "wrist_flex_joint",
+                      "wrist_roll_joint"};
+  for (const auto& [t, q] : knots) {
+    JointTrajectoryPoint p;
+    p.positions = {q[kArmLift], q[kArmFlex], q[kArmRoll], q[kWristFlex], q[kWristRoll]};
+    p.time_from_start = SecondsToDuration(t);
+    traj.points.push_back(p);
+  }
+  return traj;
+}
+
+std::string LabScenario(const Pose2& start, const std::string& extra = "") {
+  return "world: lab.sdf\nrobot:\n  start: {x: " + std::to_string(start.x) +
+         ", y: " + std::to_string(start.y) + ", yaw: " + std::to_string(start.yaw) + "}\n" + extra;
+}
+
+TEST(TwinWorldTest, ThePressedButtonOpensTheDoorWithAdaTiming) {
+  // Stand off the lab button (face at y = 2.93, 1.0 m high), press it with the fingertip.
+  const Eigen::Vector3d p_button(1.075, 2.93, 1.0);
+  const auto targets =
+      planning::MakeButtonTargets(p_button, {0, -1, 0}, planning::ButtonType::kPushButton);
+  // Whole-body IK for the pre-press pose from the tucked arm at the standoff; the robot starts
+  // at the base pose it found; the press itself moves the arm only.
+  planning::IkConfig ik;
+  ik.fingertip = true;
+  WholeBodyVector q0;
+  q0 << targets.X_MB_standoff.x, targets.X_MB_standoff.y, targets.X_MB_standoff.yaw, 0.0, 0.0,
+      -M_PI / 2, -M_PI / 2, 0.0;
+  const auto approach = planning::DlsIkSolver(*Hsr(), ik).Solve(targets.approach, q0);
+  ASSERT_TRUE(approach.converged);
+  ik.use_base = false;
+  planning::IkTarget press_target = targets.press;
+  press_target.approach_M.reset();  // the arm alone cannot also hold the approach axis exactly
+  const auto press = planning::DlsIkSolver(*Hsr(), ik).Solve(press_target, approach.q);
+  ASSERT_TRUE(press.converged) << press.position_error << " " << press.orientation_error << " "
+                               << press.iterations;
+  const Pose2 start{approach.q[kBaseX], approach.q[kBaseY], approach.q[kBaseYaw]};
+  auto loaded = LoadText(
+      LabScenario(start, "doors:\n  - {door: lab_door, operator: push, actuator: lab_button}\n"),
+      WorldsDir() / "lab");
+  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+  world.SetArmTrajectory(ArmThrough({{2.0, approach.q}, {3.0, press.q}, {4.0, approach.q}}));
+  world.StepFor(5.0);
+  ASSERT_EQ(CountEvents(world, "button_pressed", "lab_door"), 1);
+  EXPECT_EQ(world.button_presses(0), 1);
+  const double pressed_at = *FirstEvent(world, "button_pressed");
+  EXPECT_GT(pressed_at, 2.0);
+  EXPECT_LT(pressed_at, 3.1);
+  // Opening to 80° takes about 3.5 s through the hinge motor.
+  world.StepFor(pressed_at + 2.0 - world.time());
+  EXPECT_LT(world.door_angle(0), 70 * kDeg);
+  EXPECT_GT(world.door_angle(0), 20 * kDeg);
+  world.StepFor(pressed_at + 5.0 - world.time());
+  EXPECT_NEAR(world.door_angle(0), 80 * kDeg, 4 * kDeg);
+  EXPECT_EQ(world.door_phase(0), DoorPhase::kHeldOpen);
+  // Held for the 10 s window, then closed again within ~5 s.
+  world.StepFor(pressed_at + 12.0 - world.time());
+  EXPECT_EQ(world.door_phase(0), DoorPhase::kHeldOpen);
+  world.StepFor(pressed_at + 20.0 - world.time());
+  EXPECT_LT(world.door_angle(0), 2 * kDeg);
+  EXPECT_EQ(world.door_phase(0), DoorPhase::kClosed);
+  EXPECT_EQ(CountEvents(world, "contact"), 0);
+}
+
+TEST(TwinWorldTest, ABlockedLeafStopsAgainstTheRobot) {
+  // The robot stands in the leaf's sweep on the far side; the door is operated at t = 0.5 s.
+  auto loaded = LoadText(
+      LabScenario(
+          {0.0, 3.55, 0.0},
+          "doors:\n  - {door: lab_door, operator: push, actuator: lab_button, open_at: [0.5]}\n"),
+      WorldsDir() / "lab");
+  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+  world.StepFor(6.0);
+  EXPECT_GT(world.door_angle(0), 5 * kDeg);
+  EXPECT_LT(world.door_angle(0), 60 * kDeg);
+  EXPECT_GE(CountEvents(world, "contact", "lab_door"), 1);
+  EXPECT_LT((world.robot_pose().translation() - Eigen::Vector2d(0.0, 3.55)).norm(), 0.1);
+}
+
+TEST(TwinWorldTest, APersonHoldsTheDoorOpenThenItCloses) {
+  const Scenario s = LoadScenario(WorldsDir() / "lab/lab_hold_door.yaml");
+  TwinWorld world(s, LoadSdfWorld(s.world_file), 1, Hsr());
+  world.StepFor(9.0);
+  ASSERT_EQ(CountEvents(world, "person_holding_door"), 1);
+  EXPECT_NEAR(world.door_angle(0), 75 * kDeg, 8 * kDeg);
+  EXPECT_EQ(world.button_presses(0), 0);
+  const double released = *FirstEvent(world, "person_holding_door") + 12.0;
+  world.StepFor(released + 8.0 - world.time());
+  EXPECT_EQ(CountEvents(world, "person_released_door"), 1);
+  EXPECT_LT(world.door_angle(0), 5 * kDeg);
+}
+
+TEST(TwinWorldTest, PeopleCrossAnOpenDoorBothWaysWithoutOverlap) {
+  const std::string yaml = R"(world: office.sdf
+robot: {start: {x: 1.0, y: 5.0}}
+doors: [{door: door_a, operator: push, actuator: door_a_button, open_at: [0.0], hold_open_s: 30}]
+people:
+  - {name: east, behavior: cross_doorway, door: door_a, start: [3.0, 3.2], goal: [7.5, 2.5], speed: 1.3, trigger: {event: "door_opened:door_a"}}
+  - {name: west, behavior: cross_doorway, door: door_a, start: [7.0, 2.8], goal: [3.0, 3.5], speed: 1.2, trigger: {event: "door_opened:door_a"}}
+)";
+  auto loaded = LoadText(yaml, WorldsDir() / "office");
+  TwinWorld world(loaded.scenario, loaded.world, 3, Hsr());
+  double min_gap = 1e9;
+  while (world.time() < 20.0) {
+    world.Step();
+    const auto& p = world.people();
+    min_gap = std::min(min_gap, (p[0].position - p[1].position).norm() - p[0].radius - p[1].radius);
+  }
+  EXPECT_GT(min_gap, 0.0);
+  EXPECT_LT((world.people()[0].position - Eigen::Vector2d(7.5, 2.5)).norm(), 0.5);
+  EXPECT_LT((world.people()[1].position - Eigen::Vector2d(3.0, 3.5)).norm(), 0.5);
+  EXPECT_EQ(world.people()[0].phase, "done");
+}
+
+TEST(TwinWorldTest, PeopleWaitAtAClosedDoor) {
+  const std::string yaml = R"(world: office.sdf
+robot: {start: {x: 1.0, y: 5.0}}
+doors: [{door: door_a, operator: push, actuator: door_a_button, open_at: [6.0]}]
+people:
+  - {name: p, behavior: cross_doorway, door: door_a, start: [3.0, 3.0], goal: [7.5, 3.0], speed: 1.3}
+)";
+  auto loaded = LoadText(yaml, WorldsDir() / "office");
+  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+  world.StepFor(5.0);
+  EXPECT_EQ(world.people()[0].phase, "waiting_for_door");
+  EXPECT_LT(world.people()[0].position.x(), 4.95 - 0.25);
+  world.StepFor(10.0);
+  EXPECT_GT(world.people()[0].position.x(), 7.0);
+}
+
+class GraspTest : public ::testing::Test {
+ protected:
+  // A bottle on the office table; the robot reaches it from the table's north side.
+  std::unique_ptr<TwinWorld> MakeWorld(double reach_offset) {
+    const Eigen::Vector3d p_bottle(2.3, 1.35, 0.856);
+    planning::IkConfig ik;
+    ik.use_base = true;
+    const planning::DlsIkSolver solver(*Hsr(), ik);
+    WholeBodyVector q0 = WholeBodyVector::Zero();
+    q0 << 2.3, 2.05, -M_PI / 2, 0.2, -1.0, 0.0, -0.5, 0.0;
+    // Palm approach axis horizontal towards −y; the grasp centre is 7 cm ahead of the palm.
+    const Eigen::Vector3d approach(0, -1, 0);
+    const Eigen::Vector3d grasp_centre = p_bottle - approach * reach_offset;  // > 0: short of it
+    planning::IkTarget target{grasp_centre - approach * 0.07, approach};
+    const auto solution = solver.Solve(target, q0);
+    EXPECT_TRUE(solution.converged);
+    planning::IkTarget pre{target.p_MT - approach * 0.12, approach};
+    planning::IkConfig arm_only = ik;
+    arm_only.use_base = false;
+    const planning::DlsIkSolver arm_solver(*Hsr(), arm_only);
+    pre_ = arm_solver.Solve(pre, solution.q).q;
+    grasp_ = solution.q;
+    const std::string yaml =
+        "world: office.sdf\nrobot: {start: {x: " + std::to_string(solution.q[kBaseX]) +
+        ", y: " + std::to_string(solution.q[kBaseY]) +
+        ", yaw: " + std::to_string(solution.q[kBaseYaw]) +
+        "}}\npayloads: [{name: bottle, kind: water_bottle, x: 2.3, y: 1.35, z: 0.856}]\n";
+    auto loaded = LoadText(yaml, WorldsDir() / "office");
+    return std::make_unique<TwinWorld>(loaded.scenario, loaded.world, 1, Hsr());
+  }
+  void ReachAndClose(TwinWorld* world) {
+    world->SetArmTrajectory(ArmThrough({{2.0, pre_}, {3.5, grasp_}}));
+    world->StepFor(4.0);
+    GripperCommand close;
+    close.mode = GripperCommand::Mode::kGrasp;
+    close.effort = 10.0;
+    world->SetGripperCommand(close);
+    world->StepFor(2.0);
+  }
+  WholeBodyVector pre_, grasp_;
+};
+
+TEST_F(GraspTest, InsideToleranceTheBottleIsHeldAndLiftedAndReleasedOntoTheTable) {
+  auto world = MakeWorld(0.0);
+  ReachAndClose(world.get());
+  ASSERT_EQ(world->held_payload(), "bottle");
+  EXPECT_EQ(CountEvents(*world, "grasp", "bottle"), 1);
+  // Lift 10 cm: the bottle follows.
+  WholeBodyVector up = grasp_;
+  up[kArmLift] += 0.1;
+  world->SetArmTrajectory(ArmThrough({{1.0, up}}));
+  world->StepFor(1.5);
+  EXPECT_NEAR(world->payload_pose("bottle").translation().z(), 0.856 + 0.1, 0.02);
+  // Lower and open: released, it stays on the table.
+  world->SetArmTrajectory(ArmThrough({{1.0, grasp_}}));
+  world->StepFor(1.5);
+  GripperCommand open;
+  world->SetGripperCommand(open);
+  world->StepFor(2.0);
+  EXPECT_FALSE(world->held_payload().has_value());
+  EXPECT_EQ(CountEvents(*world, "release", "bottle"), 1);
+  EXPECT_NEAR(world->payload_pose("bottle").translation().z(), 0.856, 0.02);
+}
+
+TEST_F(GraspTest, OutsideToleranceTheGraspFails) {
+  auto world = MakeWorld(0.07);  // the fingers close 7 cm short of the bottle
+  ReachAndClose(world.get());
+  EXPECT_FALSE(world->held_payload().has_value());
+  EXPECT_EQ(CountEvents(*world, "grasp"), 0);
+  EXPECT_EQ(CountEvents(*world, "grasp_failed", "bottle"), 1);
+}
+
+TEST(TwinWorldTest, BaseFollowsVelocityWithAccelerationLimitAndStopsAfterTimeout) {
+  auto loaded = LoadText(LabScenario({0.0, 0.0, 0.0}), WorldsDir() / "lab");
+  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+  world.SetBaseVelocity({0.5, 0.0, 0.0});
+  world.StepFor(0.25);
+  EXPECT_NEAR(world.robot_velocity().vx, 0.25, 0.01);  // 1 m/s² limit
+  for (int i = 0; i < 10; ++i) {
+    world.SetBaseVelocity({0.5, 0.0, 0.0});
+    world.StepFor(0.2);
+  }
+  EXPECT_NEAR(world.robot_velocity().vx, 0.5, 1e-6);
+  const double x = world.robot_pose().x;
+  world.StepFor(2.0);  // no new command: stops after the 0.5 s timeout
+  EXPECT_NEAR(world.robot_velocity().vx, 0.0, 1e-9);
+  EXPECT_LT(world.robot_pose().x - x, 0.5 * 0.5 + 0.5 * 0.5 * 0.5 + 0.02);
+  // The base cannot drive through a wall: 3 m to the east wall.
+  for (int i = 0; i < 80; ++i) {
+    world.SetBaseVelocity({0.8, 0.0, 0.0});
+    world.StepFor(0.1);
+  }
+  EXPECT_LT(world.robot_pose().x, 3.0 - 0.2);
+  EXPECT_GE(CountEvents(world, "contact", "wall_east"), 1);
+  EXPECT_THROW(world.SetBaseVelocity({std::nan(""), 0, 0}), InvalidArgument);
+  JointTrajectory bad;
+  bad.joint_names = {"base_x"};
+  bad.points.push_back({{1.0}, {}, {}, SecondsToDuration(1.0)});
+  EXPECT_THROW(world.SetArmTrajectory(bad), InvalidArgument);
+}
+
+TEST(TwinWorldTest, SameSeedSameTraceOtherSeedOtherTrace) {
+  const Scenario s = LoadScenario(WorldsDir() / "office/office_evacuation.yaml");
+  const WorldDescription w = LoadSdfWorld(s.world_file);
+  auto run = [&](std::uint64_t seed) {
+    TwinWorld world(s, w, seed, Hsr());
+    TraceRecorder trace;
+    while (world.time() < 12.0) {
+      world.SetBaseVelocity({0.3, 0.0, 0.1});
+      world.Step();
+      trace.Observe(world);
+    }
+    return std::make_pair(trace.Hash(), trace.sample_count());
+  };
+  const auto a = run(5), b = run(5), c = run(6);
+  EXPECT_EQ(a.first, b.first);
+  EXPECT_EQ(a.second, 12u * 20u + 1u);
+  EXPECT_NE(a.first, c.first);
+}
+
+}  // namespace
+}  // namespace egress::twin

@@ -1,0 +1,186 @@
+#pragma once
+/// @file
+/// A twin scenario: which world, where the robot starts and should go, which door operators,
+/// people, payloads and extra obstacles, what is randomized, the time limit and the success
+/// predicates. Read from YAML (schema in worlds/README.md); every error names the file, line
+/// and field. A scenario plus a seed fully determines a twin run.
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <random>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "egress/hsr_interface/geometry.h"
+#include "egress/twin/world_description.h"
+
+namespace egress::twin {
+
+/// A closed interval to draw from uniformly; min == max is a fixed value.
+struct Range {
+  double min{0.0};
+  double max{0.0};
+  double Sample(std::mt19937_64& rng) const;
+};
+
+/// ADA low-energy operator timing (ANSI/BHMA A156.19; social_sim_notes §4.4) and limits.
+struct DoorTiming {
+  double open_angle_deg{80.0};  ///< Angle the operator opens to (back-check) [deg].
+  double open_time_s{3.5};      ///< 0 → open_angle [s].
+  double hold_open_s{10.0};     ///< Held open after reaching open_angle [s] (paper's window).
+  double close_time_s{3.5};     ///< 90° → 10° [s] (slower is allowed, faster is not).
+  double latch_time_s{1.5};     ///< 10° → 0° [s].
+  double stall_force{67.0};     ///< Force to stop the moving leaf at its latch edge [N].
+};
+
+/// How an actuator opens its door.
+enum class OperatorKind {
+  kPushButton,      ///< Press a button: fingertip travels the stroke with force < the limit.
+  kProximityPlate,  ///< Wave: a hand within the sensing range of the plate.
+  kManual,          ///< No operator: the door moves only when pushed or pulled.
+};
+
+/// One door and its operator.
+struct DoorOperatorSpec {
+  std::string door;      ///< SDF model name of the hinged door.
+  std::string actuator;  ///< SDF model name of the button or plate (empty for kManual).
+  OperatorKind kind{OperatorKind::kPushButton};
+  bool glass{false};  ///< Glass leaf: the laser sees it only near normal incidence.
+  DoorTiming timing;
+  double button_stroke{0.004};      ///< Push-button travel that counts as a press [m].
+  double button_max_force{22.0};    ///< Force above which a press is refused [N].
+  double button_spring_force{5.0};  ///< Spring force at full stroke [N].
+  double proximity_range{0.3};      ///< Proximity-plate sensing range [m].
+  /// Times [s] at which someone else (out of the scene) operates the door: fault injection and
+  /// staged scenarios. These are not the robot's presses.
+  std::vector<double> open_at;
+};
+
+enum class PersonBehavior { kCrossDoorway, kHoldDoor, kWalkPast, kApproachAndWait, kEvacuate };
+std::string_view ToString(PersonBehavior behavior);
+
+/// When a person starts its behavior.
+struct TriggerSpec {
+  enum class Kind { kImmediately, kAtTime, kRobotWithin, kEvent };
+  Kind kind{Kind::kImmediately};
+  double value{0.0};  ///< Time [s] or distance [m].
+  std::string event;  ///< Event name, e.g. "button_pressed:door_a" or "door_opened:door_a".
+};
+
+/// A person (or, for kEvacuate, a group of `count` people around `start`).
+struct PersonSpec {
+  std::string name;
+  PersonBehavior behavior{PersonBehavior::kCrossDoorway};
+  Eigen::Vector2d start{Eigen::Vector2d::Zero()};  ///< In W [m].
+  Eigen::Vector2d goal{Eigen::Vector2d::Zero()};   ///< Final goal in W [m].
+  std::vector<Eigen::Vector2d> via;  ///< Extra waypoints before the goal (walk_past, ...).
+  std::string door;                  ///< Door the behavior is about (cross/hold/evacuate).
+  Range speed{1.2, 1.4};             ///< Desired walking speed [m/s].
+  TriggerSpec trigger;
+  double hold_angle_deg{80.0};  ///< hold_door: opening angle to hold the leaf at [deg].
+  double hold_duration{8.0};    ///< hold_door: time to hold it [s]; approach_and_wait: wait.
+  int count{1};                 ///< evacuate: group size.
+  double radius{0.25};          ///< Body radius [m].
+};
+
+enum class PayloadKind { kWaterBottle, kFlashlight };
+std::string_view ToString(PayloadKind kind);
+
+struct PayloadSpec {
+  std::string name;
+  PayloadKind kind{PayloadKind::kWaterBottle};
+  Pose3 X_WP;  ///< Pose of the payload's centre (bottle upright, flashlight along x).
+};
+
+/// Sensor and detector settings (defaults in the comments; all overridable per scenario).
+struct SensorConfig {
+  double laser_rate_hz{10.0};
+  double laser_fov_deg{270.0};
+  double laser_step_deg{0.25};
+  double laser_range_min{0.05};
+  double laser_range_max{20.0};
+  double laser_noise{0.01};                    ///< Range noise s.d. [m].
+  double laser_glass_max_incidence_deg{15.0};  ///< Glass returns only closer to normal.
+  double laser_latency_s{0.0};
+  double depth_rate_hz{5.0};
+  int depth_width{80};
+  int depth_height{60};
+  double depth_hfov_deg{58.0};
+  double depth_range_max{10.0};
+  double depth_noise_coeff{0.001};  ///< Depth noise s.d. = coeff * z² [m].
+  double depth_latency_s{0.0};
+  double odometry_rate_hz{50.0};
+  double odometry_noise{0.01};       ///< Relative speed noise (s.d. of a multiplicative factor).
+  double odometry_yaw_drift{0.002};  ///< Constant yaw-rate bias [rad/s].
+  double detector_rate_hz{8.0};
+  Range detector_latency_s{0.125, 0.2};
+  double detector_miss_rate{0.02};
+  double detector_false_positive_rate{0.02};  ///< Per frame.
+  double detector_min_visible{0.35};          ///< Drop objects less visible than this fraction.
+  double detector_lighting{1.0};              ///< Scene lighting factor in (0, 1].
+  int detector_visibility_samples{12};        ///< Ray-cast samples per object.
+};
+
+/// A success predicate the judge evaluates at the end of a run.
+struct PredicateSpec {
+  enum class Kind {
+    kReachGoal,            ///< Robot within goal tolerance at the end (or ever, see judge).
+    kCrossDoor,            ///< Robot's centre crossed `door`'s plane.
+    kDoorOpenWhenCrossed,  ///< At each crossing the leaf was open >= 60°.
+    kButtonPressed,        ///< `door`'s actuator was pressed at least once.
+    kButtonNotPressed,     ///< ... never.
+    kPayloadHeld,          ///< `payload` in the gripper at the end.
+    kPayloadDelivered,     ///< `payload` within `radius` of `target` (xy) at the end, released.
+    kNoPersonContact,      ///< No robot–person contact.
+    kWithinTimeLimit,      ///< Finished before the time limit (always checked).
+  };
+  Kind kind{Kind::kReachGoal};
+  std::string door;
+  std::string payload;
+  Eigen::Vector2d target{Eigen::Vector2d::Zero()};
+  double radius{0.3};
+};
+std::string ToString(const PredicateSpec& predicate);
+
+/// Randomization applied per seed (zero ranges = no randomization).
+struct RandomizeSpec {
+  Range robot_dx, robot_dy, robot_dyaw;  ///< Offsets added to the robot's start [m, rad].
+  double payload_xy{0.0};                ///< Payload xy jitter half-width [m].
+  Range hold_open_s;                     ///< Overrides doors' hold time when non-zero.
+  Range person_delay_s;                  ///< Added to each person's trigger.
+  Range person_speed_scale{1.0, 1.0};    ///< Multiplies sampled speeds.
+};
+
+struct Scenario {
+  std::string name;
+  std::filesystem::path source;      ///< The YAML file.
+  std::filesystem::path world_file;  ///< Resolved path of the SDF world.
+  std::uint64_t seed{1};
+  double time_limit{120.0};  ///< [s]
+  Pose2 robot_start;
+  std::optional<Pose2> goal;
+  double goal_tolerance{0.3};  ///< [m]
+  std::vector<DoorOperatorSpec> doors;
+  std::vector<PersonSpec> people;
+  std::vector<PayloadSpec> payloads;
+  std::vector<ShapeDescription> obstacles;  ///< Extra static boxes/cylinders.
+  RandomizeSpec randomize;
+  std::vector<PredicateSpec> success;
+  SensorConfig sensors;
+
+  /// Checks the scenario against its world: doors and actuators exist, poses are free of
+  /// walls. @throws LoadError naming the scenario file and field.
+  void ValidateAgainst(const WorldDescription& world) const;
+};
+
+/// Reads a scenario YAML file. @throws LoadError naming file, line and field.
+Scenario LoadScenario(const std::filesystem::path& path);
+/// The same from text; `base_dir` resolves the relative world path.
+Scenario LoadScenarioFromString(const std::string& yaml, std::string_view source_name,
+                                const std::filesystem::path& base_dir);
+
+}  // namespace egress::twin

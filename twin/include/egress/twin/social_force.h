@@ -1,0 +1,87 @@
+#pragma once
+/// @file
+/// Our Social Force Model for people (Helbing & Molnár 1995 social and wall repulsion, with the
+/// body compression and sliding friction of Helbing, Farkas & Vicsek 2000 when bodies touch;
+/// constants from social_sim_notes §1.1). Planar, in W, independent of physics: the twin moves
+/// kinematic capsules to the positions it integrates.
+
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace egress::twin {
+
+struct SocialForceParams {
+  double relaxation_time{0.5};  ///< τ [s]
+  double drive_factor{2.0};     ///< Gain on the driving term (lightsfm's desired-force
+                                ///< factor): lets walkers through 1 m doorways
+  double social_strength{2.1};  ///< V0 [m²/s²] (HM95)
+  double social_range{0.3};     ///< σ [m]
+  double social_horizon{2.0};   ///< Δt of the step ellipse [s]
+  /// U0 [m²/s²] on the surface gap. HM95 uses 10 on the centre distance, which stops walkers
+  /// at the jambs of a 1 m ADA doorway; 2 lets them pass while still keeping off walls.
+  double wall_strength{2.0};
+  double wall_range{0.2};           ///< R [m]
+  double body_compression{1.2e5};   ///< k [kg/s²] (HFV00)
+  double sliding_friction{2.4e5};   ///< κ [kg/(m·s)]
+  double mass{80.0};                ///< [kg]
+  double behind_weight{0.5};        ///< c: weight of forces from outside the field of view
+  double field_of_view_deg{200.0};  ///< 2φ
+  double max_speed_factor{1.3};     ///< v_max = factor · v0
+  double robot_strength{6.0};       ///< Repulsion from a disc obstacle (the robot) [m²/s²]:
+                                    ///< people keep more room from a robot than HM95's 2.1
+  double robot_range{0.4};          ///< [m]
+  double keep_right{0.3};           ///< Share of the social force turned to the walker's right
+                                    ///< to break head-on symmetry [–]
+  double max_acceleration{20.0};    ///< Clamp [m/s²] (the contact terms are stiff)
+};
+
+/// One walker's state in W.
+struct Walker {
+  Eigen::Vector2d position{Eigen::Vector2d::Zero()};
+  Eigen::Vector2d velocity{Eigen::Vector2d::Zero()};
+  double radius{0.25};
+  double desired_speed{1.3};                        ///< v0 [m/s]; 0 = stand still
+  Eigen::Vector2d target{Eigen::Vector2d::Zero()};  ///< Current waypoint
+  bool final_target{true};  ///< Slow down to stop at the target (false: a via point)
+};
+
+/// A disc that walkers avoid but the model does not move (the robot).
+struct DiscObstacle {
+  Eigen::Vector2d position{Eigen::Vector2d::Zero()};
+  Eigen::Vector2d velocity{Eigen::Vector2d::Zero()};
+  double radius{0.215};
+};
+
+/// A wall segment in W. Segments with the same `obstacle` id (≥ 0) outline one obstacle, which
+/// repels from its nearest point only (so a corner shared by two segments counts once).
+struct WallSegment {
+  Eigen::Vector2d a{Eigen::Vector2d::Zero()};
+  Eigen::Vector2d b{Eigen::Vector2d::Zero()};
+  int obstacle{-1};
+};
+
+/// Closest point to p on segment ab.
+Eigen::Vector2d ClosestPointOnSegment(const Eigen::Vector2d& p, const WallSegment& s);
+
+class SocialForceModel {
+ public:
+  explicit SocialForceModel(SocialForceParams params = {}) : params_(params) {}
+
+  /// Acceleration of walker i [m/s²] from its goal, the other walkers, discs and walls.
+  Eigen::Vector2d CalcAcceleration(std::size_t i, const std::vector<Walker>& walkers,
+                                   const std::vector<DiscObstacle>& discs,
+                                   const std::vector<WallSegment>& walls) const;
+  /// Advances every walker by dt [s] (semi-implicit Euler, speed clipped to v_max).
+  void Step(std::vector<Walker>* walkers, const std::vector<DiscObstacle>& discs,
+            const std::vector<WallSegment>& walls, double dt) const;
+
+  const SocialForceParams& params() const { return params_; }
+
+ private:
+  Eigen::Vector2d BodyForce(const Walker& w, const Eigen::Vector2d& other_p,
+                            const Eigen::Vector2d& other_v, double other_r) const;
+  SocialForceParams params_;
+};
+
+}  // namespace egress::twin

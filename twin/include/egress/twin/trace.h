@@ -1,0 +1,41 @@
+#pragma once
+/// @file
+/// Run trace: robot pose, people, door angles and phases, the held payload and the events since
+/// the previous sample, at a fixed rate (default 20 Hz) of simulated time. Written as JSON lines
+/// (one header line, then one object per sample) with fixed precision, so two runs of the same
+/// scenario and seed produce byte-identical files; Hash() fingerprints them.
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "egress/twin/twin_world.h"
+
+namespace egress::twin {
+
+class TraceRecorder {
+ public:
+  explicit TraceRecorder(double rate_hz = 20.0);
+  /// Call after every world step; records a sample when one is due.
+  void Observe(const TwinWorld& world);
+  /// The whole trace as JSON lines.
+  std::string ToJsonLines() const;
+  /// Writes ToJsonLines() to `path`. @throws LoadError if it cannot be written.
+  void Write(const std::filesystem::path& path) const;
+  /// 64-bit FNV-1a of ToJsonLines().
+  std::uint64_t Hash() const;
+  std::size_t sample_count() const { return samples_.size(); }
+
+ private:
+  double period_;
+  double next_{0.0};
+  std::string header_;
+  std::vector<std::string> samples_;
+  std::size_t events_seen_{0};
+};
+
+/// Escapes a string for a JSON string literal (without the quotes).
+std::string JsonEscape(const std::string& text);
+
+}  // namespace egress::twin

@@ -1,0 +1,169 @@
+#pragma once
+/// @file
+/// The digital twin's world: Bullet rigid-body dynamics at a fixed step with the static
+/// geometry of an SDF world, hinged door leaves driven by ADA operators, push buttons and
+/// proximity plates, people moved by the Social Force Model as kinematic capsules, payloads as
+/// dynamic bodies, and the HSR body (an omnidirectional base following velocity commands with
+/// acceleration limits, arm links posed by RobotModel FK, a gripper). Ground truth lives here;
+/// only sensors (through ray casts) and the scenario judge read it.
+///
+/// Determinism: a world is a pure function of (scenario, world description, seed). Every random
+/// draw comes from engines seeded from `seed`, Bullet runs single-threaded with a fixed step.
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "egress/hsr_interface/command_types.h"
+#include "egress/hsr_interface/geometry.h"
+#include "egress/hsr_interface/robot_model.h"
+#include "egress/hsr_interface/time.h"
+#include "egress/twin/door_operator.h"
+#include "egress/twin/scenario.h"
+#include "egress/twin/world_description.h"
+
+namespace egress::twin {
+
+/// Physics and robot-body settings.
+struct TwinConfig {
+  double physics_rate_hz{240.0};
+  double base_max_linear_acceleration{1.0};   ///< [m/s²]
+  double base_max_angular_acceleration{2.0};  ///< [rad/s²]
+  double base_max_linear_speed{0.8};          ///< [m/s] (HSR: ~3 km/h)
+  double base_max_angular_speed{1.5};         ///< [rad/s]
+  double base_command_timeout{0.5};           ///< Velocity command held this long [s]
+  double robot_mass{37.0};                    ///< [kg]
+  double base_max_force{100.0};               ///< Drive force limit of the wheels [N]
+  double grasp_tolerance{0.02};               ///< Lateral centring error a grasp accepts [m]
+  double person_hold_force{100.0};            ///< Force a person holds a door with [N]
+  double door_crossed_open_angle_deg{60.0};   ///< "Open when crossed" threshold [deg]
+};
+
+/// What a collision object is, for contacts, rays and the detector.
+enum class EntityKind { kStatic, kFloor, kDoor, kRobotBase, kRobotArm, kPerson, kPayload };
+std::string_view ToString(EntityKind kind);
+
+/// Something that happened, with the simulated time [s].
+struct TwinEvent {
+  double t{0.0};
+  std::string kind;     ///< e.g. "button_pressed", "door_opened", "contact", "grasp"
+  std::string subject;  ///< door, person, payload or actuator name
+  std::string detail;
+};
+
+/// A ray-cast result in W.
+struct RayHit {
+  bool hit{false};
+  double distance{0.0};  ///< [m] from the ray origin
+  Eigen::Vector3d point{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d normal{Eigen::Vector3d::Zero()};
+  int entity{-1};     ///< Index into Entities()
+  bool glass{false};  ///< The surface hit is a glass leaf
+};
+
+/// How a ray treats glass leaves.
+enum class GlassMode {
+  kOpaque,       ///< Glass stops the ray like any surface (RayHit::glass tells it was glass).
+  kLaser,        ///< Glass returns only within `max_incidence` of its normal, else the ray passes.
+  kTransparent,  ///< Glass never stops the ray (a camera looking through it).
+};
+
+/// A labelled box the simulated detector can see.
+struct DetectableObject {
+  std::string label;  ///< "person", "door", "glass_door", "push_button", ... "bottle"
+  std::string name;
+  Pose3 X_WO;                                     ///< Box centre frame.
+  Eigen::Vector3d half{Eigen::Vector3d::Zero()};  ///< Half extents [m].
+  int entity{-1};
+};
+
+/// Ground truth of one person.
+struct PersonState {
+  std::string name;
+  PersonBehavior behavior{PersonBehavior::kCrossDoorway};
+  Eigen::Vector2d position{Eigen::Vector2d::Zero()};
+  Eigen::Vector2d velocity{Eigen::Vector2d::Zero()};
+  double radius{0.25};
+  bool started{false};
+  std::string phase;  ///< waiting, walking, waiting_for_door, holding, standing, done
+};
+
+class TwinWorld {
+ public:
+  /// @throws LoadError if the scenario does not fit the world.
+  TwinWorld(const Scenario& scenario, const WorldDescription& world, std::uint64_t seed,
+            std::shared_ptr<const RobotModel> robot_model, TwinConfig config = {});
+  ~TwinWorld();
+  TwinWorld(const TwinWorld&) = delete;
+  TwinWorld& operator=(const TwinWorld&) = delete;
+
+  /// One fixed physics step.
+  void Step();
+  /// Steps until the simulated time has advanced by at least `seconds`.
+  void StepFor(double seconds);
+
+  double time() const;  ///< Simulated time [s].
+  Time now() const;     ///< Simulated time as a Time.
+  double step_size() const;
+  std::uint64_t step_count() const;
+
+  // --- The robot's actuators (TwinRobot calls these). -------------------------------------
+  /// Base velocity in B; held for the command timeout.
+  void SetBaseVelocity(const Twist2& V_B);
+  /// Replaces the arm/head trajectory. @throws InvalidArgument for an unknown joint name.
+  void SetArmTrajectory(const JointTrajectory& trajectory);
+  void SetGripperCommand(const GripperCommand& command);
+
+  // --- Ground truth (sensors, judge, tests). --------------------------------------------
+  Pose2 robot_pose() const;       ///< X_WB
+  Twist2 robot_velocity() const;  ///< V_B (in B)
+  /// Whole-body configuration (base pose + arm joints).
+  WholeBodyVector robot_configuration() const;
+  double arm_joint(std::string_view name) const;  ///< arm, head and hand joints
+  /// Names and positions of the joints the robot reports.
+  std::vector<std::pair<std::string, double>> joint_positions() const;
+  double hand_motor_position() const;
+  double gripper_effort() const;
+  std::optional<std::string> held_payload() const;
+  Eigen::Vector3d fingertip_position() const;  ///< p_WF
+  Pose3 palm_pose() const;                     ///< X_WG
+  Pose3 head_camera_pose() const;              ///< X_WC
+  const RobotModel& robot_model() const;
+  double robot_radius() const;
+
+  std::size_t door_count() const;
+  const DoorDescription& door(std::size_t i) const;
+  double door_angle(std::size_t i) const;     ///< Opening angle [rad], 0 = closed
+  DoorPhase door_phase(std::size_t i) const;  ///< kClosed for doors without operator
+  bool door_is_glass(std::size_t i) const;
+  int FindDoorIndex(const std::string& name) const;  ///< −1 if unknown
+  int button_presses(std::size_t door_index) const;
+
+  const std::vector<PersonState>& people() const;
+  Pose3 payload_pose(const std::string& name) const;
+  std::vector<std::string> payload_names() const;
+
+  const std::vector<TwinEvent>& events() const;
+  std::vector<DetectableObject> DetectableObjects() const;
+  /// Casts a ray from `from` to `to` in W, ignoring the robot's own body.
+  RayHit CastRay(const Eigen::Vector3d& from, const Eigen::Vector3d& to, GlassMode mode,
+                 double glass_max_incidence = 0.26) const;
+  /// Kind and name of an entity from RayHit::entity.
+  EntityKind entity_kind(int entity) const;
+  const std::string& entity_name(int entity) const;
+
+  const Scenario& scenario() const;
+  const WorldDescription& world() const;
+  const TwinConfig& config() const;
+  std::uint64_t seed() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace egress::twin

@@ -1,0 +1,94 @@
+#include "egress/twin/actuators.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "egress/hsr_interface/error.h"
+
+namespace egress::twin {
+namespace {
+// Stiffness of the bottomed-out cap [N/m]: 1 mm past the bottom adds 20 N.
+constexpr double kBottomStiffness = 2.0e4;
+}  // namespace
+
+int ActuatorBox::PressAxis() const {
+  int axis = 0;
+  size.minCoeff(&axis);
+  return axis;
+}
+
+Eigen::Vector3d ActuatorBox::NormalW() const {
+  return X_WA.rotation().col(PressAxis());
+}
+
+PushButton::PushButton(ActuatorBox box, double stroke, double spring_force, double max_force)
+    : box_(std::move(box)), stroke_(stroke), spring_force_(spring_force), max_force_(max_force) {
+  ThrowUnless(stroke > 0 && spring_force > 0 && max_force > spring_force,
+              "push button: need stroke > 0 and 0 < spring force < max force");
+}
+
+double PushButton::CalcForce(double travel) const {
+  if (travel <= 0.0) return 0.0;
+  const double bottom = bottom_travel();
+  if (travel <= bottom) return spring_force_ * travel / stroke_;
+  return spring_force_ * bottom / stroke_ + kBottomStiffness * (travel - bottom);
+}
+
+PushButton::Result PushButton::Update(const Eigen::Vector3d& p_WF) {
+  const Eigen::Vector3d p_AF = box_.X_WA.rotation().transpose() * (p_WF - box_.X_WA.translation());
+  const int k = box_.PressAxis();
+  const Eigen::Vector3d half = box_.size / 2;
+  bool over_face = true;
+  for (int i = 0; i < 3; ++i) {
+    if (i != k && std::abs(p_AF[i]) > half[i]) over_face = false;
+  }
+  const double depth = half[k] - std::abs(p_AF[k]);  // > 0 once past the face
+  if (depth <= 0.0 || !over_face) {
+    // Outside: remember the side, release the cap.
+    if (depth <= 0.0) side_ = p_AF[k] >= 0 ? 1 : -1;
+    travel_ = 0.0;
+    force_ = 0.0;
+    latched_ = false;
+    return Result::kNone;
+  }
+  if (side_ != 0 && (p_AF[k] >= 0 ? 1 : -1) != side_) {
+    // Came through the far side (e.g. from inside the wall): not a press.
+    return Result::kNone;
+  }
+  travel_ = depth;
+  force_ = CalcForce(depth);
+  if (latched_) {
+    if (travel_ < stroke_ / 2) latched_ = false;
+    return Result::kNone;
+  }
+  if (travel_ >= stroke_) {
+    latched_ = true;
+    return force_ <= max_force_ ? Result::kPressed : Result::kOverForce;
+  }
+  return Result::kNone;
+}
+
+ProximityPlate::ProximityPlate(ActuatorBox box, double range)
+    : box_(std::move(box)), range_(range) {
+  ThrowUnless(range > 0, "proximity plate: range must be positive");
+}
+
+double ProximityPlate::DistanceTo(const Eigen::Vector3d& p_W) const {
+  const Eigen::Vector3d p_A = box_.X_WA.rotation().transpose() * (p_W - box_.X_WA.translation());
+  const Eigen::Vector3d outside = (p_A.cwiseAbs() - box_.size / 2).cwiseMax(0.0);
+  return outside.norm();
+}
+
+bool ProximityPlate::Update(const std::vector<Eigen::Vector3d>& hand_points_W) {
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const auto& p : hand_points_W)
+    nearest = std::min(nearest, DistanceTo(p));
+  if (armed_ && nearest <= range_) {
+    armed_ = false;
+    return true;
+  }
+  if (!armed_ && nearest > 1.5 * range_) armed_ = true;
+  return false;
+}
+
+}  // namespace egress::twin

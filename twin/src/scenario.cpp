@@ -1,0 +1,662 @@
+#include "egress/twin/scenario.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "egress/hsr_interface/error.h"
+
+namespace egress::twin {
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+
+// Reads YAML nodes with errors of the form "file:line: field 'a.b[2].c': what is wrong".
+class FieldReader {
+ public:
+  explicit FieldReader(std::string source) : source_(std::move(source)) {}
+
+  [[noreturn]] void Fail(const YAML::Node& node, const std::string& field,
+                         const std::string& message) const {
+    std::string where = source_;
+    if (node.IsDefined() && node.Mark().line >= 0)
+      where += ":" + std::to_string(node.Mark().line + 1);
+    throw LoadError(StrCat(where, ": field '", field, "': ", message));
+  }
+
+  // Refuses keys outside `allowed`, so a typo never becomes a silent default.
+  void CheckKeys(const YAML::Node& map, const std::string& field,
+                 const std::set<std::string>& allowed) const {
+    if (!map.IsMap()) Fail(map, field, "expected a mapping");
+    for (const auto& kv : map) {
+      const std::string key = kv.first.as<std::string>();
+      if (allowed.count(key) == 0) {
+        std::string list;
+        for (const auto& a : allowed)
+          list += (list.empty() ? "" : ", ") + a;
+        Fail(kv.first, Join(field, key), "unknown field (expected one of: " + list + ")");
+      }
+    }
+  }
+
+  static std::string Join(const std::string& parent, const std::string& key) {
+    return parent.empty() ? key : parent + "." + key;
+  }
+
+  double Number(const YAML::Node& node, const std::string& field) const {
+    if (!node.IsScalar()) Fail(node, field, "expected a number");
+    double value = 0.0;
+    try {
+      value = node.as<double>();
+    } catch (const YAML::Exception&) {
+      Fail(node, field, "'" + node.Scalar() + "' is not a number");
+    }
+    if (!std::isfinite(value)) Fail(node, field, "must be finite");
+    return value;
+  }
+
+  double Positive(const YAML::Node& node, const std::string& field) const {
+    const double v = Number(node, field);
+    if (!(v > 0.0)) Fail(node, field, "must be positive");
+    return v;
+  }
+
+  double NonNegative(const YAML::Node& node, const std::string& field) const {
+    const double v = Number(node, field);
+    if (v < 0.0) Fail(node, field, "must not be negative");
+    return v;
+  }
+
+  double Fraction(const YAML::Node& node, const std::string& field) const {
+    const double v = Number(node, field);
+    if (v < 0.0 || v > 1.0) Fail(node, field, "must be in [0, 1]");
+    return v;
+  }
+
+  std::string String(const YAML::Node& node, const std::string& field) const {
+    if (!node.IsScalar() || node.Scalar().empty()) Fail(node, field, "expected a non-empty string");
+    return node.Scalar();
+  }
+
+  bool Bool(const YAML::Node& node, const std::string& field) const {
+    bool value = false;
+    if (!node.IsScalar() || !YAML::convert<bool>::decode(node, value)) {
+      Fail(node, field, "expected true or false");
+    }
+    return value;
+  }
+
+  // A number (fixed) or a two-element list [min, max].
+  Range ReadRange(const YAML::Node& node, const std::string& field) const {
+    if (node.IsScalar()) {
+      const double v = Number(node, field);
+      return {v, v};
+    }
+    if (!node.IsSequence() || node.size() != 2)
+      Fail(node, field, "expected a number or [min, max]");
+    const Range r{Number(node[0], field + "[0]"), Number(node[1], field + "[1]")};
+    if (r.min > r.max) Fail(node, field, "min is larger than max");
+    return r;
+  }
+
+  Eigen::Vector2d Point(const YAML::Node& node, const std::string& field) const {
+    if (node.IsSequence() && node.size() == 2) {
+      return {Number(node[0], field + "[0]"), Number(node[1], field + "[1]")};
+    }
+    if (!node.IsMap()) Fail(node, field, "expected {x: .., y: ..} or [x, y]");
+    CheckKeys(node, field, {"x", "y"});
+    return {Number(Required(node, field, "x"), field + ".x"),
+            Number(Required(node, field, "y"), field + ".y")};
+  }
+
+  Pose2 ReadPose2(const YAML::Node& node, const std::string& field) const {
+    CheckKeys(node, field, {"x", "y", "yaw", "yaw_deg"});
+    Pose2 pose;
+    pose.x = Number(Required(node, field, "x"), field + ".x");
+    pose.y = Number(Required(node, field, "y"), field + ".y");
+    if (node["yaw"]) pose.yaw = Number(node["yaw"], field + ".yaw");
+    if (node["yaw_deg"]) pose.yaw = Number(node["yaw_deg"], field + ".yaw_deg") * kDegToRad;
+    return pose;
+  }
+
+  YAML::Node Required(const YAML::Node& map, const std::string& field, const char* key) const {
+    YAML::Node child = map[key];
+    if (!child) Fail(map, Join(field, key), "is required");
+    return child;
+  }
+
+  const std::string& source() const { return source_; }
+
+ private:
+  std::string source_;
+};
+
+OperatorKind ParseOperator(const FieldReader& r, const YAML::Node& node, const std::string& field) {
+  const std::string s = r.String(node, field);
+  if (s == "push") return OperatorKind::kPushButton;
+  if (s == "proximity") return OperatorKind::kProximityPlate;
+  if (s == "manual") return OperatorKind::kManual;
+  r.Fail(node, field, "'" + s + "' is not an operator (push, proximity, manual)");
+}
+
+PersonBehavior ParseBehavior(const FieldReader& r, const YAML::Node& node,
+                             const std::string& field) {
+  const std::string s = r.String(node, field);
+  for (auto b :
+       {PersonBehavior::kCrossDoorway, PersonBehavior::kHoldDoor, PersonBehavior::kWalkPast,
+        PersonBehavior::kApproachAndWait, PersonBehavior::kEvacuate}) {
+    if (s == ToString(b)) return b;
+  }
+  r.Fail(node, field,
+         "'" + s +
+             "' is not a behavior (cross_doorway, hold_door, walk_past, approach_and_wait, "
+             "evacuate)");
+}
+
+TriggerSpec ParseTrigger(const FieldReader& r, const YAML::Node& node, const std::string& field) {
+  r.CheckKeys(node, field, {"at", "robot_within", "event"});
+  if (node.size() != 1) r.Fail(node, field, "give exactly one of at, robot_within, event");
+  TriggerSpec t;
+  if (node["at"]) {
+    t.kind = TriggerSpec::Kind::kAtTime;
+    t.value = r.NonNegative(node["at"], field + ".at");
+  } else if (node["robot_within"]) {
+    t.kind = TriggerSpec::Kind::kRobotWithin;
+    t.value = r.Positive(node["robot_within"], field + ".robot_within");
+  } else {
+    t.kind = TriggerSpec::Kind::kEvent;
+    t.event = r.String(node["event"], field + ".event");
+    const auto colon = t.event.find(':');
+    const std::string kind = t.event.substr(0, colon);
+    if (colon == std::string::npos || (kind != "button_pressed" && kind != "door_opened" &&
+                                       kind != "door_closed" && kind != "person_started")) {
+      r.Fail(node["event"], field + ".event",
+             "expected button_pressed:<door>, door_opened:<door>, door_closed:<door> or "
+             "person_started:<name>");
+    }
+  }
+  return t;
+}
+
+ShapeDescription ParseObstacle(const FieldReader& r, const YAML::Node& node,
+                               const std::string& field, int index) {
+  r.CheckKeys(node, field, {"name", "box", "cylinder", "x", "y", "z", "yaw"});
+  ShapeDescription s;
+  s.model =
+      node["name"] ? r.String(node["name"], field + ".name") : "obstacle_" + std::to_string(index);
+  s.link = "link";
+  s.collision = "collision";
+  const double yaw = node["yaw"] ? r.Number(node["yaw"], field + ".yaw") : 0.0;
+  Eigen::Vector3d p(r.Number(r.Required(node, field, "x"), field + ".x"),
+                    r.Number(r.Required(node, field, "y"), field + ".y"), 0.0);
+  if (node["box"]) {
+    const YAML::Node b = node["box"];
+    if (!b.IsSequence() || b.size() != 3)
+      r.Fail(b, field + ".box", "expected [size_x, size_y, size_z]");
+    s.kind = ShapeKind::kBox;
+    for (int i = 0; i < 3; ++i)
+      s.box_size[i] = r.Positive(b[i], field + ".box[" + std::to_string(i) + "]");
+    p.z() = s.box_size.z() / 2;
+  } else if (node["cylinder"]) {
+    const YAML::Node c = node["cylinder"];
+    if (!c.IsSequence() || c.size() != 2)
+      r.Fail(c, field + ".cylinder", "expected [radius, height]");
+    s.kind = ShapeKind::kCylinder;
+    s.radius = r.Positive(c[0], field + ".cylinder[0]");
+    s.length = r.Positive(c[1], field + ".cylinder[1]");
+    p.z() = s.length / 2;
+  } else {
+    r.Fail(node, field, "give box: [sx, sy, sz] or cylinder: [radius, height]");
+  }
+  if (node["z"]) p.z() = r.Number(node["z"], field + ".z");
+  s.X_WS = Pose3::FromPose2({p.x(), p.y(), yaw});
+  s.X_WS = Pose3(s.X_WS.rotation(), p);
+  return s;
+}
+
+PredicateSpec ParsePredicate(const FieldReader& r, const YAML::Node& node,
+                             const std::string& field) {
+  PredicateSpec p;
+  using K = PredicateSpec::Kind;
+  if (node.IsScalar()) {
+    const std::string s = node.Scalar();
+    if (s == "reach_goal")
+      p.kind = K::kReachGoal;
+    else if (s == "no_person_contact")
+      p.kind = K::kNoPersonContact;
+    else if (s == "within_time_limit")
+      p.kind = K::kWithinTimeLimit;
+    else
+      r.Fail(node, field,
+             "'" + s +
+                 "' is not a predicate without arguments (reach_goal, "
+                 "no_person_contact, within_time_limit)");
+    return p;
+  }
+  if (!node.IsMap() || node.size() != 1) r.Fail(node, field, "expected one predicate");
+  const std::string key = node.begin()->first.as<std::string>();
+  const YAML::Node value = node.begin()->second;
+  const std::string sub = field + "." + key;
+  if (key == "cross_door" || key == "door_open_when_crossed" || key == "button_pressed" ||
+      key == "button_not_pressed") {
+    p.kind = key == "cross_door"               ? K::kCrossDoor
+             : key == "door_open_when_crossed" ? K::kDoorOpenWhenCrossed
+             : key == "button_pressed"         ? K::kButtonPressed
+                                               : K::kButtonNotPressed;
+    p.door = r.String(value, sub);
+  } else if (key == "payload_held") {
+    p.kind = K::kPayloadHeld;
+    p.payload = r.String(value, sub);
+  } else if (key == "payload_delivered") {
+    p.kind = K::kPayloadDelivered;
+    r.CheckKeys(value, sub, {"payload", "x", "y", "radius"});
+    p.payload = r.String(r.Required(value, sub, "payload"), sub + ".payload");
+    p.target = {r.Number(r.Required(value, sub, "x"), sub + ".x"),
+                r.Number(r.Required(value, sub, "y"), sub + ".y")};
+    if (value["radius"]) p.radius = r.Positive(value["radius"], sub + ".radius");
+  } else {
+    r.Fail(node, field,
+           "'" + key +
+               "' is not a predicate (reach_goal, cross_door, "
+               "door_open_when_crossed, button_pressed, button_not_pressed, "
+               "payload_held, payload_delivered, no_person_contact, within_time_limit)");
+  }
+  return p;
+}
+
+void ParseSensors(const FieldReader& r, const YAML::Node& node, SensorConfig* c) {
+  r.CheckKeys(node, "sensors", {"laser", "depth", "odometry", "detector"});
+  if (const YAML::Node n = node["laser"]) {
+    const std::string f = "sensors.laser";
+    r.CheckKeys(n, f,
+                {"rate_hz", "fov_deg", "step_deg", "range_min", "range_max", "noise",
+                 "glass_max_incidence_deg", "latency_s"});
+    if (n["rate_hz"]) c->laser_rate_hz = r.Positive(n["rate_hz"], f + ".rate_hz");
+    if (n["fov_deg"]) c->laser_fov_deg = r.Positive(n["fov_deg"], f + ".fov_deg");
+    if (n["step_deg"]) c->laser_step_deg = r.Positive(n["step_deg"], f + ".step_deg");
+    if (n["range_min"]) c->laser_range_min = r.NonNegative(n["range_min"], f + ".range_min");
+    if (n["range_max"]) c->laser_range_max = r.Positive(n["range_max"], f + ".range_max");
+    if (n["noise"]) c->laser_noise = r.NonNegative(n["noise"], f + ".noise");
+    if (n["glass_max_incidence_deg"]) {
+      c->laser_glass_max_incidence_deg =
+          r.NonNegative(n["glass_max_incidence_deg"], f + ".glass_max_incidence_deg");
+    }
+    if (n["latency_s"]) c->laser_latency_s = r.NonNegative(n["latency_s"], f + ".latency_s");
+    if (c->laser_fov_deg > 360.0) r.Fail(n["fov_deg"], f + ".fov_deg", "must be at most 360");
+  }
+  if (const YAML::Node n = node["depth"]) {
+    const std::string f = "sensors.depth";
+    r.CheckKeys(
+        n, f, {"rate_hz", "width", "height", "hfov_deg", "range_max", "noise_coeff", "latency_s"});
+    if (n["rate_hz"]) c->depth_rate_hz = r.Positive(n["rate_hz"], f + ".rate_hz");
+    if (n["width"]) c->depth_width = int(r.Positive(n["width"], f + ".width"));
+    if (n["height"]) c->depth_height = int(r.Positive(n["height"], f + ".height"));
+    if (n["hfov_deg"]) c->depth_hfov_deg = r.Positive(n["hfov_deg"], f + ".hfov_deg");
+    if (n["range_max"]) c->depth_range_max = r.Positive(n["range_max"], f + ".range_max");
+    if (n["noise_coeff"])
+      c->depth_noise_coeff = r.NonNegative(n["noise_coeff"], f + ".noise_coeff");
+    if (n["latency_s"]) c->depth_latency_s = r.NonNegative(n["latency_s"], f + ".latency_s");
+  }
+  if (const YAML::Node n = node["odometry"]) {
+    const std::string f = "sensors.odometry";
+    r.CheckKeys(n, f, {"rate_hz", "noise", "yaw_drift"});
+    if (n["rate_hz"]) c->odometry_rate_hz = r.Positive(n["rate_hz"], f + ".rate_hz");
+    if (n["noise"]) c->odometry_noise = r.NonNegative(n["noise"], f + ".noise");
+    if (n["yaw_drift"]) c->odometry_yaw_drift = r.Number(n["yaw_drift"], f + ".yaw_drift");
+  }
+  if (const YAML::Node n = node["detector"]) {
+    const std::string f = "sensors.detector";
+    r.CheckKeys(n, f,
+                {"rate_hz", "latency_s", "miss_rate", "false_positive_rate", "min_visible",
+                 "lighting", "visibility_samples"});
+    if (n["rate_hz"]) c->detector_rate_hz = r.Positive(n["rate_hz"], f + ".rate_hz");
+    if (n["latency_s"]) c->detector_latency_s = r.ReadRange(n["latency_s"], f + ".latency_s");
+    if (n["miss_rate"]) c->detector_miss_rate = r.Fraction(n["miss_rate"], f + ".miss_rate");
+    if (n["false_positive_rate"]) {
+      c->detector_false_positive_rate =
+          r.Fraction(n["false_positive_rate"], f + ".false_positive_rate");
+    }
+    if (n["min_visible"])
+      c->detector_min_visible = r.Fraction(n["min_visible"], f + ".min_visible");
+    if (n["lighting"]) c->detector_lighting = r.Fraction(n["lighting"], f + ".lighting");
+    if (n["visibility_samples"]) {
+      c->detector_visibility_samples =
+          int(r.Positive(n["visibility_samples"], f + ".visibility_samples"));
+    }
+    if (c->detector_latency_s.min < 0)
+      r.Fail(n["latency_s"], f + ".latency_s", "must not be negative");
+  }
+}
+
+Scenario Parse(const YAML::Node& root, const FieldReader& r,
+               const std::filesystem::path& base_dir) {
+  r.CheckKeys(root, "",
+              {"name", "world", "seed", "time_limit", "robot", "doors", "people", "payloads",
+               "obstacles", "randomize", "success", "sensors"});
+  Scenario s;
+  s.name = root["name"] ? r.String(root["name"], "name") : std::string();
+  const std::string world = r.String(r.Required(root, "", "world"), "world");
+  s.world_file =
+      std::filesystem::path(world).is_absolute() ? std::filesystem::path(world) : base_dir / world;
+  if (!std::filesystem::exists(s.world_file)) {
+    r.Fail(root["world"], "world", "no such file: " + s.world_file.string());
+  }
+  if (root["seed"]) {
+    const double seed = r.NonNegative(root["seed"], "seed");
+    if (seed != std::floor(seed)) r.Fail(root["seed"], "seed", "must be a whole number");
+    s.seed = std::uint64_t(seed);
+  }
+  if (root["time_limit"]) s.time_limit = r.Positive(root["time_limit"], "time_limit");
+
+  const YAML::Node robot = r.Required(root, "", "robot");
+  r.CheckKeys(robot, "robot", {"start", "goal"});
+  s.robot_start = r.ReadPose2(r.Required(robot, "robot", "start"), "robot.start");
+  if (const YAML::Node goal = robot["goal"]) {
+    r.CheckKeys(goal, "robot.goal", {"x", "y", "yaw", "yaw_deg", "tolerance"});
+    Pose2 g;
+    g.x = r.Number(r.Required(goal, "robot.goal", "x"), "robot.goal.x");
+    g.y = r.Number(r.Required(goal, "robot.goal", "y"), "robot.goal.y");
+    if (goal["yaw"]) g.yaw = r.Number(goal["yaw"], "robot.goal.yaw");
+    if (goal["yaw_deg"]) g.yaw = r.Number(goal["yaw_deg"], "robot.goal.yaw_deg") * kDegToRad;
+    s.goal = g;
+    if (goal["tolerance"]) s.goal_tolerance = r.Positive(goal["tolerance"], "robot.goal.tolerance");
+  }
+
+  if (const YAML::Node doors = root["doors"]) {
+    if (!doors.IsSequence()) r.Fail(doors, "doors", "expected a list");
+    for (std::size_t i = 0; i < doors.size(); ++i) {
+      const std::string f = "doors[" + std::to_string(i) + "]";
+      const YAML::Node d = doors[i];
+      r.CheckKeys(d, f,
+                  {"door", "operator", "actuator", "glass", "open_angle_deg", "open_time_s",
+                   "hold_open_s", "close_time_s", "latch_time_s", "stall_force", "button_stroke",
+                   "button_max_force", "proximity_range", "open_at"});
+      DoorOperatorSpec op;
+      op.door = r.String(r.Required(d, f, "door"), f + ".door");
+      op.kind = ParseOperator(r, r.Required(d, f, "operator"), f + ".operator");
+      if (op.kind != OperatorKind::kManual) {
+        op.actuator = r.String(r.Required(d, f, "actuator"), f + ".actuator");
+      }
+      if (d["glass"]) op.glass = r.Bool(d["glass"], f + ".glass");
+      auto& t = op.timing;
+      if (d["open_angle_deg"])
+        t.open_angle_deg = r.Positive(d["open_angle_deg"], f + ".open_angle_deg");
+      if (d["open_time_s"]) t.open_time_s = r.Positive(d["open_time_s"], f + ".open_time_s");
+      if (d["hold_open_s"]) t.hold_open_s = r.NonNegative(d["hold_open_s"], f + ".hold_open_s");
+      if (d["close_time_s"]) t.close_time_s = r.Positive(d["close_time_s"], f + ".close_time_s");
+      if (d["latch_time_s"]) t.latch_time_s = r.Positive(d["latch_time_s"], f + ".latch_time_s");
+      if (d["stall_force"]) t.stall_force = r.Positive(d["stall_force"], f + ".stall_force");
+      if (d["button_stroke"])
+        op.button_stroke = r.Positive(d["button_stroke"], f + ".button_stroke");
+      if (d["button_max_force"])
+        op.button_max_force = r.Positive(d["button_max_force"], f + ".button_max_force");
+      if (d["proximity_range"])
+        op.proximity_range = r.Positive(d["proximity_range"], f + ".proximity_range");
+      if (const YAML::Node at = d["open_at"]) {
+        if (!at.IsSequence()) r.Fail(at, f + ".open_at", "expected a list of times [s]");
+        for (std::size_t k = 0; k < at.size(); ++k) {
+          op.open_at.push_back(r.NonNegative(at[k], f + ".open_at[" + std::to_string(k) + "]"));
+        }
+      }
+      if (t.open_angle_deg > 180.0)
+        r.Fail(d["open_angle_deg"], f + ".open_angle_deg", "must be at most 180");
+      for (const auto& other : s.doors) {
+        if (other.door == op.door)
+          r.Fail(d["door"], f + ".door", "door '" + op.door + "' is listed twice");
+      }
+      s.doors.push_back(std::move(op));
+    }
+  }
+
+  if (const YAML::Node people = root["people"]) {
+    if (!people.IsSequence()) r.Fail(people, "people", "expected a list");
+    for (std::size_t i = 0; i < people.size(); ++i) {
+      const std::string f = "people[" + std::to_string(i) + "]";
+      const YAML::Node n = people[i];
+      r.CheckKeys(n, f,
+                  {"name", "behavior", "start", "goal", "via", "door", "speed", "trigger",
+                   "hold_angle_deg", "hold_duration", "wait_s", "count", "radius"});
+      PersonSpec p;
+      p.name = n["name"] ? r.String(n["name"], f + ".name") : "person_" + std::to_string(i);
+      p.behavior = ParseBehavior(r, r.Required(n, f, "behavior"), f + ".behavior");
+      p.start = r.Point(r.Required(n, f, "start"), f + ".start");
+      p.goal = n["goal"] ? r.Point(n["goal"], f + ".goal") : p.start;
+      if (const YAML::Node via = n["via"]) {
+        if (!via.IsSequence()) r.Fail(via, f + ".via", "expected a list of points");
+        for (std::size_t k = 0; k < via.size(); ++k) {
+          p.via.push_back(r.Point(via[k], f + ".via[" + std::to_string(k) + "]"));
+        }
+      }
+      if (n["door"]) p.door = r.String(n["door"], f + ".door");
+      const bool needs_door = p.behavior == PersonBehavior::kCrossDoorway ||
+                              p.behavior == PersonBehavior::kHoldDoor ||
+                              p.behavior == PersonBehavior::kEvacuate;
+      if (needs_door && p.door.empty())
+        r.Fail(n, f + ".door", "is required for " + std::string(ToString(p.behavior)));
+      if (!n["goal"] && p.behavior != PersonBehavior::kApproachAndWait &&
+          p.behavior != PersonBehavior::kHoldDoor) {
+        r.Fail(n, f + ".goal", "is required for " + std::string(ToString(p.behavior)));
+      }
+      if (n["speed"]) {
+        p.speed = r.ReadRange(n["speed"], f + ".speed");
+        if (!(p.speed.min > 0.0) || p.speed.max > 3.0)
+          r.Fail(n["speed"], f + ".speed", "must be within (0, 3] m/s");
+      }
+      if (n["trigger"]) p.trigger = ParseTrigger(r, n["trigger"], f + ".trigger");
+      if (n["hold_angle_deg"])
+        p.hold_angle_deg = r.Positive(n["hold_angle_deg"], f + ".hold_angle_deg");
+      if (n["hold_duration"])
+        p.hold_duration = r.NonNegative(n["hold_duration"], f + ".hold_duration");
+      if (n["wait_s"]) p.hold_duration = r.NonNegative(n["wait_s"], f + ".wait_s");
+      if (n["count"]) {
+        const double count = r.Positive(n["count"], f + ".count");
+        if (count != std::floor(count) || count > 200)
+          r.Fail(n["count"], f + ".count", "must be a whole number up to 200");
+        p.count = int(count);
+      }
+      if (n["radius"]) p.radius = r.Positive(n["radius"], f + ".radius");
+      s.people.push_back(std::move(p));
+    }
+  }
+
+  if (const YAML::Node payloads = root["payloads"]) {
+    if (!payloads.IsSequence()) r.Fail(payloads, "payloads", "expected a list");
+    for (std::size_t i = 0; i < payloads.size(); ++i) {
+      const std::string f = "payloads[" + std::to_string(i) + "]";
+      const YAML::Node n = payloads[i];
+      r.CheckKeys(n, f, {"name", "kind", "x", "y", "z", "yaw"});
+      PayloadSpec p;
+      p.name = r.String(r.Required(n, f, "name"), f + ".name");
+      const std::string kind = r.String(r.Required(n, f, "kind"), f + ".kind");
+      if (kind == "water_bottle")
+        p.kind = PayloadKind::kWaterBottle;
+      else if (kind == "flashlight")
+        p.kind = PayloadKind::kFlashlight;
+      else
+        r.Fail(n["kind"], f + ".kind",
+               "'" + kind + "' is not a payload (water_bottle, flashlight)");
+      const Eigen::Vector3d xyz(r.Number(r.Required(n, f, "x"), f + ".x"),
+                                r.Number(r.Required(n, f, "y"), f + ".y"),
+                                r.Number(r.Required(n, f, "z"), f + ".z"));
+      const double yaw = n["yaw"] ? r.Number(n["yaw"], f + ".yaw") : 0.0;
+      p.X_WP = Pose3(Pose3::FromPose2({0, 0, yaw}).rotation(), xyz);
+      for (const auto& other : s.payloads) {
+        if (other.name == p.name)
+          r.Fail(n["name"], f + ".name", "payload '" + p.name + "' is listed twice");
+      }
+      s.payloads.push_back(std::move(p));
+    }
+  }
+
+  if (const YAML::Node obstacles = root["obstacles"]) {
+    if (!obstacles.IsSequence()) r.Fail(obstacles, "obstacles", "expected a list");
+    for (std::size_t i = 0; i < obstacles.size(); ++i) {
+      s.obstacles.push_back(
+          ParseObstacle(r, obstacles[i], "obstacles[" + std::to_string(i) + "]", int(i)));
+    }
+  }
+
+  if (const YAML::Node rnd = root["randomize"]) {
+    const std::string f = "randomize";
+    r.CheckKeys(rnd, f,
+                {"robot_dx", "robot_dy", "robot_dyaw", "payload_xy", "hold_open_s",
+                 "person_delay_s", "person_speed_scale"});
+    auto& z = s.randomize;
+    if (rnd["robot_dx"]) z.robot_dx = r.ReadRange(rnd["robot_dx"], f + ".robot_dx");
+    if (rnd["robot_dy"]) z.robot_dy = r.ReadRange(rnd["robot_dy"], f + ".robot_dy");
+    if (rnd["robot_dyaw"]) z.robot_dyaw = r.ReadRange(rnd["robot_dyaw"], f + ".robot_dyaw");
+    if (rnd["payload_xy"]) z.payload_xy = r.NonNegative(rnd["payload_xy"], f + ".payload_xy");
+    if (rnd["hold_open_s"]) z.hold_open_s = r.ReadRange(rnd["hold_open_s"], f + ".hold_open_s");
+    if (rnd["person_delay_s"])
+      z.person_delay_s = r.ReadRange(rnd["person_delay_s"], f + ".person_delay_s");
+    if (rnd["person_speed_scale"]) {
+      z.person_speed_scale = r.ReadRange(rnd["person_speed_scale"], f + ".person_speed_scale");
+      if (!(z.person_speed_scale.min > 0))
+        r.Fail(rnd["person_speed_scale"], f + ".person_speed_scale", "must be positive");
+    }
+    if (z.hold_open_s.min < 0)
+      r.Fail(rnd["hold_open_s"], f + ".hold_open_s", "must not be negative");
+    if (z.person_delay_s.min < 0)
+      r.Fail(rnd["person_delay_s"], f + ".person_delay_s", "must not be negative");
+  }
+
+  if (const YAML::Node success = root["success"]) {
+    if (!success.IsSequence()) r.Fail(success, "success", "expected a list of predicates");
+    for (std::size_t i = 0; i < success.size(); ++i) {
+      s.success.push_back(ParsePredicate(r, success[i], "success[" + std::to_string(i) + "]"));
+      if (s.success.back().kind == PredicateSpec::Kind::kReachGoal && !s.goal) {
+        r.Fail(success[i], "success[" + std::to_string(i) + "]", "reach_goal needs robot.goal");
+      }
+    }
+  }
+  if (const YAML::Node sensors = root["sensors"]) ParseSensors(r, sensors, &s.sensors);
+  return s;
+}
+
+}  // namespace
+
+double Range::Sample(std::mt19937_64& rng) const {
+  if (max <= min) return min;
+  return std::uniform_real_distribution<double>(min, max)(rng);
+}
+
+std::string_view ToString(PersonBehavior behavior) {
+  switch (behavior) {
+    case PersonBehavior::kCrossDoorway:
+      return "cross_doorway";
+    case PersonBehavior::kHoldDoor:
+      return "hold_door";
+    case PersonBehavior::kWalkPast:
+      return "walk_past";
+    case PersonBehavior::kApproachAndWait:
+      return "approach_and_wait";
+    case PersonBehavior::kEvacuate:
+      return "evacuate";
+  }
+  return "unknown";
+}
+
+std::string_view ToString(PayloadKind kind) {
+  return kind == PayloadKind::kWaterBottle ? "water_bottle" : "flashlight";
+}
+
+std::string ToString(const PredicateSpec& p) {
+  using K = PredicateSpec::Kind;
+  switch (p.kind) {
+    case K::kReachGoal:
+      return "reach_goal";
+    case K::kCrossDoor:
+      return "cross_door:" + p.door;
+    case K::kDoorOpenWhenCrossed:
+      return "door_open_when_crossed:" + p.door;
+    case K::kButtonPressed:
+      return "button_pressed:" + p.door;
+    case K::kButtonNotPressed:
+      return "button_not_pressed:" + p.door;
+    case K::kPayloadHeld:
+      return "payload_held:" + p.payload;
+    case K::kPayloadDelivered:
+      return "payload_delivered:" + p.payload;
+    case K::kNoPersonContact:
+      return "no_person_contact";
+    case K::kWithinTimeLimit:
+      return "within_time_limit";
+  }
+  return "unknown";
+}
+
+void Scenario::ValidateAgainst(const WorldDescription& world) const {
+  const std::string where = source.string();
+  for (std::size_t i = 0; i < doors.size(); ++i) {
+    const auto& op = doors[i];
+    const std::string f = StrCat(where, ": field 'doors[", i, "]");
+    if (world.FindDoor(op.door) == nullptr) {
+      throw LoadError(
+          StrCat(f, ".door': world ", world_file.string(), " has no hinged door '", op.door, "'"));
+    }
+    if (!op.actuator.empty()) {
+      const auto shapes = world.ShapesOfModel(op.actuator);
+      if (shapes.size() != 1 || shapes.front()->kind != ShapeKind::kBox) {
+        throw LoadError(StrCat(f, ".actuator': world ", world_file.string(), " has no model '",
+                               op.actuator, "' with exactly one box collision"));
+      }
+    }
+  }
+  auto known_door = [&](const std::string& name) {
+    for (const auto& d : world.doors) {
+      if (d.name == name) return true;
+    }
+    return false;
+  };
+  for (std::size_t i = 0; i < people.size(); ++i) {
+    if (!people[i].door.empty() && !known_door(people[i].door)) {
+      throw LoadError(StrCat(where, ": field 'people[", i, "].door': world has no door '",
+                             people[i].door, "'"));
+    }
+  }
+  for (std::size_t i = 0; i < success.size(); ++i) {
+    const auto& p = success[i];
+    if (!p.door.empty() && !known_door(p.door)) {
+      throw LoadError(
+          StrCat(where, ": field 'success[", i, "]': world has no door '", p.door, "'"));
+    }
+    if (!p.payload.empty()) {
+      bool found = false;
+      for (const auto& pl : payloads)
+        found = found || pl.name == p.payload;
+      if (!found)
+        throw LoadError(StrCat(where, ": field 'success[", i, "]': no payload '", p.payload, "'"));
+    }
+  }
+}
+
+Scenario LoadScenario(const std::filesystem::path& path) {
+  if (!std::filesystem::exists(path))
+    throw LoadError(StrCat(path.string(), ": no such scenario file"));
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  Scenario s = LoadScenarioFromString(text.str(), path.string(), path.parent_path());
+  s.source = path;
+  return s;
+}
+
+Scenario LoadScenarioFromString(const std::string& yaml, std::string_view source_name,
+                                const std::filesystem::path& base_dir) {
+  const FieldReader reader{std::string(source_name)};
+  YAML::Node root;
+  try {
+    root = YAML::Load(yaml);
+  } catch (const YAML::Exception& e) {
+    throw LoadError(StrCat(source_name, ":", e.mark.line + 1, ": not valid YAML: ", e.msg));
+  }
+  if (!root.IsMap()) throw LoadError(StrCat(source_name, ": a scenario is a YAML mapping"));
+  Scenario s = Parse(root, reader, base_dir);
+  s.source = std::string(source_name);
+  return s;
+}
+
+}  // namespace egress::twin

@@ -1,0 +1,131 @@
+#include "egress/twin/social_force.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace egress::twin {
+
+Eigen::Vector2d ClosestPointOnSegment(const Eigen::Vector2d& p, const WallSegment& s) {
+  const Eigen::Vector2d ab = s.b - s.a;
+  const double len2 = ab.squaredNorm();
+  if (len2 < 1e-12) return s.a;
+  const double t = std::clamp((p - s.a).dot(ab) / len2, 0.0, 1.0);
+  return s.a + t * ab;
+}
+
+// HFV00 contact: compression along the normal and sliding friction along the tangent, only
+// while the bodies overlap. Returns a force [N].
+Eigen::Vector2d SocialForceModel::BodyForce(const Walker& w, const Eigen::Vector2d& other_p,
+                                            const Eigen::Vector2d& other_v, double other_r) const {
+  const Eigen::Vector2d d = w.position - other_p;
+  const double dist = d.norm();
+  const double overlap = w.radius + other_r - dist;
+  if (overlap <= 0.0 || dist < 1e-9) return Eigen::Vector2d::Zero();
+  const Eigen::Vector2d n = d / dist;
+  const Eigen::Vector2d t(-n.y(), n.x());
+  const double dv_t = (other_v - w.velocity).dot(t);
+  return params_.body_compression * overlap * n + params_.sliding_friction * overlap * dv_t * t;
+}
+
+Eigen::Vector2d SocialForceModel::CalcAcceleration(std::size_t i,
+                                                   const std::vector<Walker>& walkers,
+                                                   const std::vector<DiscObstacle>& discs,
+                                                   const std::vector<WallSegment>& walls) const {
+  const Walker& w = walkers[i];
+  const auto& P = params_;
+  Eigen::Vector2d desired = Eigen::Vector2d::Zero();
+  const Eigen::Vector2d to_goal = w.target - w.position;
+  if (w.desired_speed > 0.0 && to_goal.norm() > 1e-3) {
+    // Slow down over the last half metre so walkers stop at their goal (not at via points).
+    const double speed =
+        w.final_target ? w.desired_speed * std::min(1.0, to_goal.norm() / 0.5) : w.desired_speed;
+    desired = to_goal.normalized() * speed;
+  }
+  Eigen::Vector2d a = P.drive_factor * (desired - w.velocity) / P.relaxation_time;
+  const Eigen::Vector2d heading =
+      w.velocity.norm() > 0.05 ? Eigen::Vector2d(w.velocity.normalized())
+                               : (to_goal.norm() > 1e-3 ? Eigen::Vector2d(to_goal.normalized())
+                                                        : Eigen::Vector2d::UnitX());
+  const double cos_fov = std::cos(P.field_of_view_deg * M_PI / 360.0);
+  auto weight = [&](const Eigen::Vector2d& force_dir) {
+    // A force pointing along −heading comes from something ahead (in view).
+    return -force_dir.dot(heading) >= cos_fov ? 1.0 : P.behind_weight;
+  };
+  auto social = [&](const Eigen::Vector2d& other_p, const Eigen::Vector2d& other_v, double strength,
+                    double range) {
+    // HM95 elliptical potential: b is the semi-minor axis of the ellipse through i with foci
+    // at the other's position and its position one step (Δt) ahead.
+    const Eigen::Vector2d r = w.position - other_p;
+    const Eigen::Vector2d step = other_v * P.social_horizon;
+    const double r_norm = r.norm();
+    if (r_norm < 1e-6 || r_norm > 6.0) return Eigen::Vector2d(Eigen::Vector2d::Zero());
+    const double s = r_norm + (r - step).norm();
+    const double b = 0.5 * std::sqrt(std::max(s * s - step.squaredNorm(), 1e-12));
+    const Eigen::Vector2d n = r / r_norm;
+    Eigen::Vector2d f = (strength / range) * std::exp(-b / range) * n;
+    // Turn part of it to the walker's right when the other is ahead: people keep right.
+    if (n.dot(heading) < 0.0)
+      f += P.keep_right * f.norm() * Eigen::Vector2d(heading.y(), -heading.x());
+    return Eigen::Vector2d(f * weight(f.normalized()));
+  };
+  for (std::size_t j = 0; j < walkers.size(); ++j) {
+    if (j == i) continue;
+    const Walker& o = walkers[j];
+    // Social terms scale with the drive (their balance is what HM95 tuned); walls do not.
+    a += social(o.position, o.velocity, P.drive_factor * P.social_strength, P.social_range);
+    a += BodyForce(w, o.position, o.velocity, o.radius) / P.mass;
+  }
+  for (const auto& d : discs) {
+    a += social(d.position, d.velocity, P.drive_factor * P.robot_strength, P.robot_range);
+    a += BodyForce(w, d.position, d.velocity, d.radius) / P.mass;
+  }
+  // The nearest point of each obstacle (or of each loose segment) repels.
+  std::vector<std::pair<int, Eigen::Vector2d>> nearest;  // obstacle id, nearest point
+  for (const auto& wall : walls) {
+    const Eigen::Vector2d q = ClosestPointOnSegment(w.position, wall);
+    auto it = wall.obstacle < 0 ? nearest.end()
+                                : std::find_if(nearest.begin(), nearest.end(), [&](const auto& e) {
+                                    return e.first == wall.obstacle;
+                                  });
+    if (it == nearest.end()) {
+      nearest.emplace_back(wall.obstacle, q);
+    } else if ((w.position - q).squaredNorm() < (w.position - it->second).squaredNorm()) {
+      it->second = q;
+    }
+  }
+  for (const auto& [id, q] : nearest) {
+    const Eigen::Vector2d r = w.position - q;
+    const double dist = r.norm();
+    if (dist < 1e-9 || dist > 3.0) continue;
+    const Eigen::Vector2d n = r / dist;
+    const double gap = dist - w.radius;
+    Eigen::Vector2d f = (P.wall_strength / P.wall_range) * std::exp(-gap / P.wall_range) * n;
+    if (gap < 0.0) {
+      const Eigen::Vector2d t(-n.y(), n.x());
+      f += (P.body_compression * -gap * n - P.sliding_friction * -gap * w.velocity.dot(t) * t) /
+           P.mass;
+    }
+    a += f;
+  }
+  const double a_norm = a.norm();
+  if (a_norm > P.max_acceleration) a *= P.max_acceleration / a_norm;
+  return a;
+}
+
+void SocialForceModel::Step(std::vector<Walker>* walkers, const std::vector<DiscObstacle>& discs,
+                            const std::vector<WallSegment>& walls, double dt) const {
+  std::vector<Eigen::Vector2d> accelerations(walkers->size());
+  for (std::size_t i = 0; i < walkers->size(); ++i) {
+    accelerations[i] = CalcAcceleration(i, *walkers, discs, walls);
+  }
+  for (std::size_t i = 0; i < walkers->size(); ++i) {
+    Walker& w = (*walkers)[i];
+    w.velocity += accelerations[i] * dt;
+    const double v_max = params_.max_speed_factor * std::max(w.desired_speed, 0.3);
+    if (w.velocity.norm() > v_max) w.velocity *= v_max / w.velocity.norm();
+    if (w.desired_speed == 0.0 && w.velocity.norm() < 0.02) w.velocity.setZero();
+    w.position += w.velocity * dt;
+  }
+}
+
+}  // namespace egress::twin
