@@ -22,13 +22,10 @@ int main(int argc, char** argv) {
   egress::apps::AddCostmapCommand(app);
   egress::apps::AddPlanCommand(app);
   egress::apps::AddBenchCommand(app);
-  egress::apps::AddPlannedCommand(app, "sim", "Run one twin scenario end to end",
-                                  "the robot-brain issue (twin + executive)");
+  egress::apps::AddSimCommand(app);
   egress::apps::AddPlannedCommand(app, "batch",
                                   "Run many seeded trials with a progress bar and success table",
                                   "the robot-brain issue");
-  egress::apps::AddPlannedCommand(app, "render", "Render a recorded run to PNG/MP4",
-                                  "the digital-twin issue");
 
   try {
     app.parse(argc, argv);

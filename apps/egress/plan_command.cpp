@@ -14,9 +14,12 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "commands.h"
+#include "egress/hsr_interface/error.h"
 #include "egress/nav/v1/navigation.grpc.pb.h"
 #include "egress/planning/base_planner.h"
+#include "egress/twin/sdf_world_loader.h"
 #include "render.h"
+#include "sdf_map.h"
 
 namespace egress::apps {
 namespace {
@@ -34,6 +37,7 @@ struct PlanOptions {
   std::string token_file;
   bool local{false};
   std::string png;
+  double resolution{0.05};
   bool overwrite{false};
   bool json{false};
 };
@@ -151,11 +155,34 @@ void Run(const PlanOptions& options) {
   if (!options.png.empty() && std::filesystem::exists(options.png) && !options.overwrite) {
     throw CommandFailed(fmt::format("'{}' exists; pass --overwrite to replace it", options.png));
   }
-  const auto grid = perception::OccupancyGrid::LoadMapServerYaml(options.map);
-  const auto doors = ParseDoors(options.doors);
+  // A map_server YAML, or an SDF world whose walls are rasterized and whose doors are known.
+  const std::filesystem::path map_path(options.map);
+  const bool sdf = map_path.extension() == ".sdf" || map_path.extension() == ".world";
+  perception::OccupancyGrid grid;
+  auto doors = ParseDoors(options.doors);
+  std::vector<double> swing_signs(doors.size(), 1.0);
+  if (sdf) {
+    SdfMap map;  // from common/sdf_map.h
+    try {
+      map = RasterizeSdfWorld(twin::LoadSdfWorld(map_path), options.resolution,
+                              std::int64_t(1) << 26);
+    } catch (const InvalidArgument& e) {
+      throw CommandFailed(e.what());
+    }
+    grid = map.grid;
+    for (const auto& d : map.doors) {
+      doors.push_back({d.id, d.p_MHinge, d.p_MLatch});
+      swing_signs.push_back(d.swing_sign);
+    }
+  } else {
+    grid = perception::OccupancyGrid::LoadMapServerYaml(map_path);
+  }
   perception::Costmap2D costmap(grid);
-  for (const auto& door : doors)
-    costmap.AddDoorway({door.id, door.hinge, door.latch});
+  for (std::size_t i = 0; i < doors.size(); ++i) {
+    perception::Doorway doorway{doors[i].id, doors[i].hinge, doors[i].latch};
+    doorway.swing_sign = swing_signs[i];
+    costmap.AddDoorway(doorway);
+  }
   for (const auto& id : options.closed) {
     if (!costmap.doorways().contains(id))
       throw CommandFailed(fmt::format("--closed '{}' is not a --door", id));
@@ -218,7 +245,12 @@ void AddPlanCommand(CLI::App& app) {
   auto options = std::make_shared<PlanOptions>();
   auto* plan =
       app.add_subcommand("plan", "Plan a base path on a map (via egress-navd, or --local)");
-  plan->add_option("--map", options->map, "map_server YAML")->required()->check(CLI::ExistingFile);
+  plan->add_option("--map", options->map,
+                   "map_server YAML, or an SDF world (.sdf/.world; its doors are added)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  plan->add_option("--resolution", options->resolution, "cell size for an SDF world [m]")
+      ->capture_default_str();
   plan->add_option("--start", options->start, "x y yaw [m, m, rad] in the map frame")
       ->required()
       ->expected(3);

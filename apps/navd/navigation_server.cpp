@@ -16,6 +16,8 @@
 #include "egress/nav/v1/navigation.grpc.pb.h"
 #include "egress/perception/costmap.h"
 #include "egress/planning/base_planner.h"
+#include "egress/twin/sdf_world_loader.h"
+#include "sdf_map.h"
 
 namespace egress::navd {
 namespace {
@@ -147,6 +149,7 @@ class Service final : public v1::Navigation::Service {
 
   Status DoLoadWorld(const v1::LoadWorldRequest& request, v1::LoadWorldResponse* response) {
     perception::OccupancyGrid grid;
+    std::vector<perception::Doorway> sdf_doors;
     switch (request.source_case()) {
       case v1::LoadWorldRequest::kMapYamlPath:
         try {
@@ -176,10 +179,19 @@ class Service final : public v1::Navigation::Service {
         }
         break;
       }
-      case v1::LoadWorldRequest::kSdfPath:
-        return {StatusCode::UNIMPLEMENTED,
-                "sdf_path: SDF worlds are not read yet (the digital-twin issue brings the "
-                "SDF reader); load the world's map_server map instead"};
+      case v1::LoadWorldRequest::kSdfPath: {
+        try {
+          const apps::SdfMap map = apps::RasterizeSdfWorld(
+              twin::LoadSdfWorld(request.sdf_path()),
+              request.sdf_resolution() != 0 ? request.sdf_resolution() : 0.05,
+              config_.max_map_cells);
+          grid = map.grid;
+          sdf_doors = map.doors;
+        } catch (const std::exception& e) {
+          return Invalid(std::string("sdf_path: ") + e.what());
+        }
+        break;
+      }
       default:
         return Invalid("source: set map_yaml_path or map");
     }
@@ -197,8 +209,17 @@ class Service final : public v1::Navigation::Service {
     planner_config.footprint_radius = costmap_config.robot_radius;
     world->planner =
         std::make_unique<planning::BasePlanner>(*world->costmap, nullptr, planner_config);
+    for (const auto& doorway : sdf_doors) {
+      world->costmap->AddDoorway(doorway);
+      world->planner->AddDoor({doorway.id, doorway.p_MHinge, doorway.p_MLatch});
+      world->doors[doorway.id] = doorway;
+    }
     for (const auto& door : request.doors()) {
       if (door.id().empty()) return Invalid("doors[].id must not be empty");
+      if (world->doors.count(door.id()) > 0) {
+        return Invalid("doors[].id '" + door.id() +
+                       "' is given twice (or is a door of the SDF world)");
+      }
       const perception::Doorway doorway{
           door.id(), {door.hinge().x(), door.hinge().y()}, {door.latch().x(), door.latch().y()}};
       world->costmap->AddDoorway(doorway);

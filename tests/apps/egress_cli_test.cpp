@@ -76,7 +76,7 @@ TEST(EgressCliTest, ClearErrors) {
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_THAT(result.output, HasSubstr("arm_flex_joint"));
 
-  result = RunEgress("sim");
+  result = RunEgress("batch");
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_THAT(result.output, HasSubstr("not available in this build yet"));
 
@@ -254,6 +254,75 @@ TEST(EgressCliTest, PlanLocallyAndThroughTheService) {
   Result no_server = RunEgress(common + " --server 127.0.0.1:1");
   EXPECT_EQ(no_server.exit_code, 1);
   EXPECT_THAT(no_server.output, HasSubstr("127.0.0.1:1"));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(EgressCliTest, PlanOnAnSdfWorldFindsItsDoors) {
+  const std::string office =
+      (std::filesystem::path(EGRESS_OFFICE_MAP).parent_path() / "office.sdf").string();
+  Result local =
+      RunEgress("plan --map " + office + " --start 1.5 4.5 0 --goal 12.5 1.5 0 --local --json");
+  ASSERT_EQ(local.exit_code, 0) << local.output;
+  const auto json = nlohmann::json::parse(local.output);
+  EXPECT_EQ(json.at("doors_crossed"), nlohmann::json::array({"door_a", "door_b"}));
+  Result closed = RunEgress("plan --map " + office +
+                            " --start 1.5 4.5 0 --goal 12.5 1.5 0 --local --closed door_a");
+  EXPECT_EQ(closed.exit_code, 1);
+  EXPECT_THAT(closed.output, HasSubstr("goal_unreachable"));
+}
+
+// ---- egress sim / render
+
+TEST(EgressCliTest, SimRunsAScenarioWritesVerdictTraceAndPictures) {
+  const std::string scenario =
+      (std::filesystem::path(EGRESS_OFFICE_MAP).parent_path().parent_path() /
+       "lab/lab_hold_door.yaml")
+          .string();
+  const auto dir = egress::testing::TestTempPath("sim");
+  std::filesystem::create_directories(dir);
+  const std::string outputs = " --trace " + (dir / "run.jsonl").string() + " --json " +
+                              (dir / "verdict.json").string() + " --png " +
+                              (dir / "run.png").string();
+  // The dead-reckoning baseline passes the held door: the verdict table says so, exit 0.
+  Result run = RunEgress("sim " + scenario + " --driver dead-reckoning --duration 25" + outputs);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("SUCCESS"));
+  EXPECT_THAT(run.output, HasSubstr("PASS  door_open_when_crossed:lab_door"));
+  EXPECT_THAT(run.output, HasSubstr("person_holding_door"));
+  const auto verdict = nlohmann::json::parse(std::ifstream(dir / "verdict.json"));
+  EXPECT_TRUE(verdict.at("success").get<bool>());
+  EXPECT_EQ(verdict.at("metrics").at("crossings").size(), 1u);
+  EXPECT_GT(std::filesystem::file_size(dir / "run.png"), 1000u);
+  // Same seed, same trace; outputs are never overwritten without --overwrite.
+  Result again = RunEgress("sim " + scenario + " --driver dead-reckoning --duration 25" + outputs);
+  EXPECT_EQ(again.exit_code, 1);
+  EXPECT_THAT(again.output, HasSubstr("--overwrite"));
+  const auto trace_text = [&] {
+    std::ifstream in(dir / "run.jsonl");
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  const std::string first = trace_text();
+  Result rerun = RunEgress("sim " + scenario +
+                           " --driver dead-reckoning --duration 25 --overwrite -q" + outputs);
+  ASSERT_EQ(rerun.exit_code, 0) << rerun.output;
+  EXPECT_EQ(trace_text(), first);
+  // Standing still, the robot never reaches the goal: FAIL lines and exit 1.
+  Result idle = RunEgress("sim " + scenario + " --duration 5 -q");
+  EXPECT_EQ(idle.exit_code, 1);
+  EXPECT_THAT(idle.output, HasSubstr("FAIL  reach_goal"));
+  // egress render: the trace to a PNG; a bad trace names its line.
+  Result render = RunEgress("render " + (dir / "run.jsonl").string() + " --out " +
+                            (dir / "again.png").string());
+  ASSERT_EQ(render.exit_code, 0) << render.output;
+  EXPECT_GT(std::filesystem::file_size(dir / "again.png"), 1000u);
+  std::ofstream(dir / "bad.jsonl") << first.substr(0, first.find('\n') + 1) << "{not json\n";
+  Result bad =
+      RunEgress("render " + (dir / "bad.jsonl").string() + " --out " + (dir / "bad.png").string());
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_THAT(bad.output, HasSubstr("bad.jsonl:2"));
+  Result broken = RunEgress("sim " + (dir / "verdict.json").string());
+  EXPECT_EQ(broken.exit_code, 1);
+  EXPECT_THAT(broken.output, HasSubstr("verdict.json"));
   std::filesystem::remove_all(dir);
 }
 

@@ -269,17 +269,52 @@ TEST_F(NavigationServerTest, TokensAndListenAddresses) {
   EXPECT_NO_THROW(ValidateListenAddress(remote));
 }
 
-TEST_F(NavigationServerTest, ListsPlannersAndRefusesSdfForNow) {
+TEST_F(NavigationServerTest, ListsPlanners) {
   grpc::ClientContext context;
   v1::ListPlannersResponse planners;
   ASSERT_TRUE(stub_->ListPlanners(&context, {}, &planners).ok());
   EXPECT_EQ(planners.planners(0), "RRTConnect");
   EXPECT_EQ(planners.planners_size(), 5);
+}
+
+TEST_F(NavigationServerTest, LoadsTheOfficeSdfWorldWithItsDoors) {
   v1::LoadWorldRequest sdf;
-  sdf.set_sdf_path("/tmp/office.world");
+  sdf.set_sdf_path(
+      (std::filesystem::path(EGRESS_OFFICE_MAP).parent_path() / "office.sdf").string());
+  grpc::ClientContext context;
+  v1::LoadWorldResponse loaded;
+  const grpc::Status status = stub_->LoadWorld(&context, sdf, &loaded);
+  ASSERT_TRUE(status.ok()) << status.error_message();
+  EXPECT_EQ(loaded.width(), 280);  // 14 m x 6 m at 5 cm
+  EXPECT_EQ(loaded.height(), 120);
+  v1::PlanPathResponse response;
+  ASSERT_TRUE(Plan(loaded.world_id(), Pose(1.5, 4.5), Pose(12.5, 1.5), &response).ok());
+  ASSERT_EQ(response.status(), v1::PLAN_STATUS_SUCCESS) << response.message();
+  EXPECT_THAT(
+      std::vector<std::string>(response.doors_crossed().begin(), response.doors_crossed().end()),
+      ::testing::ElementsAre("door_a", "door_b"));
+  // The SDF's door ids work with SetDoorState.
+  v1::SetDoorStateRequest close;
+  close.set_world_id(loaded.world_id());
+  close.set_door_id("door_b");
+  close.set_angle(0.0);
   grpc::ClientContext c2;
-  v1::LoadWorldResponse response;
-  EXPECT_EQ(stub_->LoadWorld(&c2, sdf, &response).error_code(), grpc::StatusCode::UNIMPLEMENTED);
+  v1::SetDoorStateResponse ignored;
+  ASSERT_TRUE(stub_->SetDoorState(&c2, close, &ignored).ok());
+  v1::PlanPathResponse blocked;
+  ASSERT_TRUE(Plan(loaded.world_id(), Pose(1.5, 4.5), Pose(12.5, 1.5), &blocked).ok());
+  EXPECT_EQ(blocked.status(), v1::PLAN_STATUS_GOAL_UNREACHABLE);
+  // A missing or malformed SDF file is INVALID_ARGUMENT naming the file.
+  sdf.set_sdf_path("/nonexistent/office.sdf");
+  grpc::ClientContext c3;
+  const grpc::Status missing = stub_->LoadWorld(&c3, sdf, &loaded);
+  EXPECT_EQ(missing.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(missing.error_message(), HasSubstr("/nonexistent/office.sdf"));
+  sdf.set_sdf_path(
+      (std::filesystem::path(EGRESS_OFFICE_MAP).parent_path() / "office.sdf").string());
+  sdf.set_sdf_resolution(0.001);
+  grpc::ClientContext c4;
+  EXPECT_EQ(stub_->LoadWorld(&c4, sdf, &loaded).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "egress/hsr_interface/error.h"
+#include "egress/perception/occupancy_grid.h"
 #include "test_paths.h"
 #include "twin_test_util.h"
 
@@ -91,6 +92,27 @@ TEST(SdfWorldLoaderTest, OurWorldsLoad) {
   for (const auto& d : office.doors)
     EXPECT_GT(d.CalcFreeEdge(1.2).x(), d.p_WH.x() + 0.5) << d.name;
   EXPECT_EQ(office.ShapesOfModel("table").size(), 1u);
+}
+
+TEST(SdfWorldLoaderTest, OfficeSdfRasterizesToTheOfficeMap) {
+  // One office: the SDF the twin simulates and the map_server map the planners load agree.
+  const WorldDescription office = LoadSdfWorld(WorldsDir() / "office/office.sdf");
+  std::vector<perception::Box2> boxes;
+  for (const auto& f : CalcFloorFootprints(office))
+    boxes.push_back({f.X_WF, f.size});
+  const auto from_sdf = perception::OccupancyGrid::FromBoxes(boxes, {0, 0}, {14, 6}, 0.05);
+  const auto from_pgm =
+      perception::OccupancyGrid::LoadMapServerYaml(WorldsDir() / "office/office.yaml");
+  ASSERT_EQ(from_sdf.geometry().width, from_pgm.geometry().width);
+  ASSERT_EQ(from_sdf.geometry().height, from_pgm.geometry().height);
+  int differ = 0, occupied = 0;
+  for (std::size_t i = 0; i < from_pgm.cells().size(); ++i) {
+    differ += from_sdf.cells()[i] != from_pgm.cells()[i] ? 1 : 0;
+    occupied += from_pgm.cells()[i] == perception::kLethalCost ? 1 : 0;
+  }
+  EXPECT_GT(occupied, 1000);
+  EXPECT_EQ(differ,
+            0);  // door leaves are doorways, not walls; the 2 cm buttons cover no cell centre
 }
 
 std::string DoorSdf(const std::string& leaf_geometry) {

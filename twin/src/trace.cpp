@@ -57,21 +57,68 @@ void TraceRecorder::Observe(const TwinWorld& world) {
     *out += '"';
   };
   if (header_.empty()) {
+    // The header carries the floor plan (wall rectangles and doors), so a trace renders alone.
     std::string h = "{\"scenario\":";
     quoted(&h, world.scenario().name);
     h += ",\"seed\":";
     h += std::to_string(world.seed());
     h += ",\"rate_hz\":";
     h += Fixed(1.0 / period_, 2);
-    h += ",\"doors\":[";
+    h += ",\"robot_radius\":";
+    h += Fixed(world.robot_radius(), 3);
+    h += ",\"walls\":[";
+    bool first = true;
+    auto add_footprint = [&](const FloorFootprint& f) {
+      if (!first) h += ',';
+      first = false;
+      h += '[';
+      h += Fixed(f.X_WF.x);
+      h += ',';
+      h += Fixed(f.X_WF.y);
+      h += ',';
+      h += Fixed(f.X_WF.yaw);
+      h += ',';
+      h += Fixed(f.size.x());
+      h += ',';
+      h += Fixed(f.size.y());
+      h += ']';
+    };
+    for (const auto& f : CalcFloorFootprints(world.world()))
+      add_footprint(f);
+    for (const auto& s : world.scenario().obstacles) {
+      if (const auto f = CalcFloorFootprint(s)) add_footprint(*f);
+    }
+    h += "],\"doors\":[";
     for (std::size_t i = 0; i < world.door_count(); ++i) {
+      const DoorDescription& d = world.door(i);
+      const Eigen::Vector3d edge = d.CalcFreeEdge(0.0);
       if (i) h += ',';
-      quoted(&h, world.door(i).name);
+      h += "{\"name\":";
+      quoted(&h, d.name);
+      h += ",\"hinge\":[";
+      h += Fixed(d.p_WH.x());
+      h += ',';
+      h += Fixed(d.p_WH.y());
+      h += "],\"latch\":[";
+      h += Fixed(edge.x());
+      h += ',';
+      h += Fixed(edge.y());
+      h += "],\"swing\":";
+      h += Fixed(d.open_sign * (d.axis_W.z() > 0 ? 1.0 : -1.0), 0);
+      h += ",\"glass\":";
+      h += world.door_is_glass(i) ? "true" : "false";
+      h += '}';
     }
     h += "],\"people\":[";
     for (std::size_t i = 0; i < world.people().size(); ++i) {
       if (i) h += ',';
       quoted(&h, world.people()[i].name);
+    }
+    h += "],\"payloads\":[";
+    const auto payloads = world.payload_names();
+    for (std::size_t i = 0; i < payloads.size(); ++i) {
+      if (i) h += ',';
+      quoted(&h, payloads[i]);
     }
     h += "]}";
     header_ = std::move(h);
@@ -106,6 +153,19 @@ void TraceRecorder::Observe(const TwinWorld& world) {
     s += Fixed(p.position.y());
     s += ',';
     quoted(&s, p.phase);
+    s += ']';
+  }
+  s += "],\"payloads\":[";
+  const auto names = world.payload_names();
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const Eigen::Vector3d p = world.payload_pose(names[i]).translation();
+    if (i) s += ',';
+    s += '[';
+    s += Fixed(p.x());
+    s += ',';
+    s += Fixed(p.y());
+    s += ',';
+    s += Fixed(p.z());
     s += ']';
   }
   s += "],\"held\":";

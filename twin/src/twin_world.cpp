@@ -1,5 +1,6 @@
 #include "egress/twin/twin_world.h"
 
+#include <BulletCollision/NarrowPhaseCollision/btRaycastCallback.h>
 #include <btBulletDynamicsCommon.h>
 
 #include <algorithm>
@@ -73,30 +74,57 @@ double HandWidth(double hand_q) {
          std::clamp((hand_q - kHandTouching) / (kHandOpen - kHandTouching), 0.0, 1.0);
 }
 
-// Footprint segments of a static shape in the plane (for the people's wall forces).
+// Outline segments of a static shape on the floor (for the people's wall forces).
 void AppendFootprint(const ShapeDescription& s, int obstacle, std::vector<WallSegment>* out) {
-  Eigen::Vector3d lo, hi;
-  s.CalcWorldBounds(&lo, &hi);
-  if (s.kind == ShapeKind::kPlane || hi.z() < 0.1 || lo.z() > 1.8) return;  // not at body height
-  std::vector<Eigen::Vector2d> corners;
-  if (s.kind == ShapeKind::kBox && std::abs(s.X_WS.rotation()(2, 2)) > 0.999) {
+  const auto f = CalcFloorFootprint(s, 0.1, 1.8);  // at body height
+  if (!f) return;
+  const Eigen::Vector2d h = f->size / 2;
+  const Eigen::Vector2d corners[4] = {
+      f->X_WF * Eigen::Vector2d(-h.x(), -h.y()), f->X_WF * Eigen::Vector2d(h.x(), -h.y()),
+      f->X_WF * Eigen::Vector2d(h.x(), h.y()), f->X_WF * Eigen::Vector2d(-h.x(), h.y())};
+  for (int i = 0; i < 4; ++i)
+    out->push_back({corners[i], corners[(i + 1) % 4], obstacle});
+}
+
+// Appends quad a-b-c-d (counter-clockwise seen from outside) as two triangles.
+void AppendQuad(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                const Eigen::Vector3d& d, btTriangleMesh* mesh) {
+  mesh->addTriangle(ToBt(a), ToBt(b), ToBt(c));
+  mesh->addTriangle(ToBt(a), ToBt(c), ToBt(d));
+}
+
+// Appends a static box's, plane's or mesh's triangles, in W, to `mesh`; false for other kinds.
+bool AppendTriangles(const ShapeDescription& s, btTriangleMesh* mesh) {
+  if (s.kind == ShapeKind::kBox) {
     const Eigen::Vector3d h = s.box_size / 2;
-    for (const auto& c : {Eigen::Vector3d(-h.x(), -h.y(), 0), Eigen::Vector3d(h.x(), -h.y(), 0),
-                          Eigen::Vector3d(h.x(), h.y(), 0), Eigen::Vector3d(-h.x(), h.y(), 0)}) {
-      corners.push_back((s.X_WS * c).head<2>());
-    }
-  } else if (s.kind == ShapeKind::kCylinder && std::abs(s.X_WS.rotation()(2, 2)) > 0.999) {
-    for (int k = 0; k < 8; ++k) {
-      const double a = k * M_PI / 4;
-      corners.push_back(s.X_WS.translation().head<2>() +
-                        s.radius / std::cos(M_PI / 8) * Eigen::Vector2d(std::cos(a), std::sin(a)));
-    }
-  } else {
-    corners = {{lo.x(), lo.y()}, {hi.x(), lo.y()}, {hi.x(), hi.y()}, {lo.x(), hi.y()}};
+    auto corner = [&](int i) {
+      return Eigen::Vector3d(s.X_WS * Eigen::Vector3d((i & 1) ? h.x() : -h.x(),
+                                                      (i & 2) ? h.y() : -h.y(),
+                                                      (i & 4) ? h.z() : -h.z()));
+    };
+    static constexpr int kFaces[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1},
+                                         {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
+    for (const auto& f : kFaces)
+      AppendQuad(corner(f[0]), corner(f[1]), corner(f[2]), corner(f[3]), mesh);
+    return true;
   }
-  for (std::size_t i = 0; i < corners.size(); ++i) {
-    out->push_back({corners[i], corners[(i + 1) % corners.size()], obstacle});
+  if (s.kind == ShapeKind::kPlane) {
+    // A finite quad (100 m square when the file gives no size) in the plane's frame.
+    const double hx = s.plane_size.x() > 0 ? s.plane_size.x() / 2 : 50.0;
+    const double hy = s.plane_size.y() > 0 ? s.plane_size.y() / 2 : 50.0;
+    AppendQuad(s.X_WS * Eigen::Vector3d(-hx, -hy, 0), s.X_WS * Eigen::Vector3d(hx, -hy, 0),
+               s.X_WS * Eigen::Vector3d(hx, hy, 0), s.X_WS * Eigen::Vector3d(-hx, hy, 0), mesh);
+    return true;
   }
+  if (s.kind == ShapeKind::kMesh) {
+    for (const auto& t : s.mesh->triangles) {
+      mesh->addTriangle(ToBt(s.X_WS * s.mesh->vertices[t[0]]),
+                        ToBt(s.X_WS * s.mesh->vertices[t[1]]),
+                        ToBt(s.X_WS * s.mesh->vertices[t[2]]));
+    }
+    return true;
+  }
+  return false;
 }
 
 std::unique_ptr<btCollisionShape> MakeShape(
@@ -223,6 +251,8 @@ struct TwinWorld::Impl {
     BuildRobot();
     BuildPayloads();
     BuildPeople();
+    BuildRayProxies();
+    SyncRayProxies();
   }
 
   ~Impl() {
@@ -258,15 +288,24 @@ struct TwinWorld::Impl {
     body->setActivationState(DISABLE_DEACTIVATION);
   }
 
+  // Static boxes, planes and meshes become one triangle mesh (one BVH for every ray); the entity of
+  // each triangle is kept so rays and contacts still name the model they touch.
   void BuildStatics() {
     bool has_floor = false;
+    auto merged = std::make_unique<btTriangleMesh>(true, false);
     auto add = [&](const ShapeDescription& s) {
       const bool floor = s.kind == ShapeKind::kPlane;
       has_floor = has_floor || floor;
       const int e = AddEntity(floor ? EntityKind::kFloor : EntityKind::kStatic, s.model, -1);
-      AddBody(MakeShape(s, &meshes), s.X_WS, 0.0, floor ? kGFloor : kGStatic,
-              floor ? kMaskFloor : kMaskStatic, e);
       if (!floor) AppendFootprint(s, e, &walls);
+      const int before = merged->getNumTriangles();
+      if (AppendTriangles(s, merged.get())) {
+        static_triangle_entity.resize(std::size_t(merged->getNumTriangles()), e);
+        (void)before;
+        return;
+      }
+      ray_targets.push_back(AddBody(MakeShape(s, &meshes), s.X_WS, 0.0, floor ? kGFloor : kGStatic,
+                                    floor ? kMaskFloor : kMaskStatic, e));
     };
     for (const auto& s : world.shapes)
       add(s);
@@ -278,6 +317,97 @@ struct TwinWorld::Impl {
       ground.kind = ShapeKind::kPlane;
       add(ground);
     }
+    if (merged->getNumTriangles() > 0) {
+      auto shape = std::make_unique<btBvhTriangleMeshShape>(merged.get(), true);
+      static_mesh_shape = shape.get();
+      meshes.push_back(std::move(merged));
+      static_mesh_body =
+          AddBody(std::move(shape), Pose3(), 0.0, kGStatic, kMaskStatic, kMergedStatic);
+    }
+  }
+
+  // A collision object outside the dynamics world with a triangle version of `source`'s shape,
+  // for ray casts only; it follows `source` (SyncRayProxies).
+  void AddRayProxy(const btCollisionObject* source, const std::vector<btVector3>& triangles_local) {
+    auto mesh = std::make_unique<btTriangleMesh>(true, false);
+    for (std::size_t i = 0; i + 2 < triangles_local.size(); i += 3) {
+      mesh->addTriangle(triangles_local[i], triangles_local[i + 1], triangles_local[i + 2]);
+    }
+    auto shape = std::make_unique<btBvhTriangleMeshShape>(mesh.get(), true);
+    auto proxy = std::make_unique<btCollisionObject>();
+    proxy->setCollisionShape(shape.get());
+    proxy->setUserIndex(source->getUserIndex());
+    proxy->setWorldTransform(source->getWorldTransform());
+    ray_targets.push_back(proxy.get());
+    ray_proxies.push_back({std::move(proxy), source});
+    meshes.push_back(std::move(mesh));
+    shapes.push_back(std::move(shape));
+  }
+
+  static std::vector<btVector3> BoxTriangles(const btVector3& h) {
+    auto corner = [&](int i) {
+      return btVector3((i & 1) ? h.x() : -h.x(), (i & 2) ? h.y() : -h.y(),
+                       (i & 4) ? h.z() : -h.z());
+    };
+    static constexpr int kFaces[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1},
+                                         {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
+    std::vector<btVector3> t;
+    for (const auto& f : kFaces) {
+      for (int k : {f[0], f[1], f[2], f[0], f[2], f[3]})
+        t.push_back(corner(k));
+    }
+    return t;
+  }
+
+  // A 16-sided prism along `axis` (0 = x, 2 = z) circumscribing a cylinder or capsule.
+  static std::vector<btVector3> PrismTriangles(double radius, double half_length, int axis) {
+    constexpr int kSides = 16;
+    const double r = radius / std::cos(M_PI / kSides);
+    auto point = [&](int k, double h) {
+      const double a = 2 * M_PI * k / kSides;
+      const double u = r * std::cos(a), v = r * std::sin(a);
+      return axis == 0 ? btVector3(h, u, v) : btVector3(u, v, h);
+    };
+    std::vector<btVector3> t;
+    const btVector3 top = axis == 0 ? btVector3(half_length, 0, 0) : btVector3(0, 0, half_length);
+    for (int k = 0; k < kSides; ++k) {
+      const btVector3 a0 = point(k, -half_length), a1 = point(k + 1, -half_length);
+      const btVector3 b0 = point(k, half_length), b1 = point(k + 1, half_length);
+      for (const auto& p : {a0, a1, b1, a0, b1, b0, top, b0, b1, -top, a1, a0})
+        t.push_back(p);
+    }
+    return t;
+  }
+
+  void BuildRayProxies() {
+    for (const auto& d : doors)
+      AddRayProxy(d.leaf, BoxTriangles(ToBt(d.desc->leaf_size / 2)));
+    for (const auto& p : people)
+      AddRayProxy(p.body, PrismTriangles(p.state.radius, kPersonHeight / 2, 2));
+    for (const auto& p : payloads) {
+      AddRayProxy(p.body, p.spec.kind == PayloadKind::kWaterBottle ? PrismTriangles(0.033, 0.105, 2)
+                                                                   : PrismTriangles(0.02, 0.1, 0));
+    }
+  }
+
+  void SyncRayProxies() {
+    for (auto& [proxy, source] : ray_proxies)
+      proxy->setWorldTransform(source->getWorldTransform());
+    ray_target_aabbs.resize(ray_targets.size());
+    for (std::size_t i = 0; i < ray_targets.size(); ++i) {
+      ray_targets[i]->getCollisionShape()->getAabb(ray_targets[i]->getWorldTransform(),
+                                                   ray_target_aabbs[i].first,
+                                                   ray_target_aabbs[i].second);
+    }
+  }
+
+  // The entity of a collision object; for the merged static mesh, of its triangle.
+  int EntityOf(const btCollisionObject* object, int triangle) const {
+    const int e = object->getUserIndex();
+    if (e != kMergedStatic) return e;
+    return triangle >= 0 && std::size_t(triangle) < static_triangle_entity.size()
+               ? static_triangle_entity[std::size_t(triangle)]
+               : -1;
   }
 
   void BuildDoors() {
@@ -891,34 +1021,38 @@ struct TwinWorld::Impl {
     const int n = dispatcher->getNumManifolds();
     for (int m = 0; m < n; ++m) {
       const btPersistentManifold* mf = dispatcher->getManifoldByIndexInternal(m);
-      bool touching = false;
-      for (int c = 0; c < mf->getNumContacts(); ++c)
-        touching = touching || mf->getContactPoint(c).getDistance() < 1e-3;
-      if (!touching) continue;
-      int a = mf->getBody0()->getUserIndex(), b = mf->getBody1()->getUserIndex();
-      if (a > b) std::swap(a, b);
-      now_touching.insert({a, b});
+      for (int c = 0; c < mf->getNumContacts(); ++c) {
+        const btManifoldPoint& pt = mf->getContactPoint(c);
+        if (pt.getDistance() >= 1e-3) continue;
+        int a = EntityOf(mf->getBody0(), pt.m_index0), b = EntityOf(mf->getBody1(), pt.m_index1);
+        if (a < 0 || b < 0) continue;
+        if (a > b) std::swap(a, b);
+        now_touching.insert({a, b});
+      }
     }
     // Kinematic–kinematic and kinematic–static pairs make no manifolds: test the arm directly.
     if (step % 8 == 0) {
       struct Collector : btCollisionWorld::ContactResultCallback {
+        const Impl* impl{nullptr};
         std::set<int> hits;
-        btScalar addSingleResult(btManifoldPoint& pt, const btCollisionObjectWrapper* a, int, int,
-                                 const btCollisionObjectWrapper* b, int, int) override {
+        btScalar addSingleResult(btManifoldPoint& pt, const btCollisionObjectWrapper* a, int,
+                                 int index_a, const btCollisionObjectWrapper* b, int,
+                                 int index_b) override {
           if (pt.getDistance() < 0) {
-            hits.insert(a->getCollisionObject()->getUserIndex());
-            hits.insert(b->getCollisionObject()->getUserIndex());
+            hits.insert(impl->EntityOf(a->getCollisionObject(), index_a));
+            hits.insert(impl->EntityOf(b->getCollisionObject(), index_b));
           }
           return 0;
         }
       };
       for (btRigidBody* arm : {hand_body, forearm_body}) {
         Collector collector;
+        collector.impl = this;
         collector.m_collisionFilterGroup = kGArm;
         collector.m_collisionFilterMask = kGStatic | kGPerson;
         dynamics->contactTest(arm, collector);
         for (int other : collector.hits) {
-          if (other == arm->getUserIndex()) continue;
+          if (other < 0 || other == arm->getUserIndex()) continue;
           int a = arm->getUserIndex(), b = other;
           if (a > b) std::swap(a, b);
           arm_touching.insert({a, b});
@@ -1003,6 +1137,20 @@ struct TwinWorld::Impl {
   std::vector<std::unique_ptr<btRigidBody>> bodies;
   std::vector<std::unique_ptr<btTypedConstraint>> constraints;
 
+  static constexpr int kMergedStatic = -2;  // user index of the merged static mesh body
+  std::vector<int> static_triangle_entity;
+  btBvhTriangleMeshShape* static_mesh_shape{nullptr};
+  btRigidBody* static_mesh_body{nullptr};
+  struct RayProxy {
+    std::unique_ptr<btCollisionObject> proxy;
+    const btCollisionObject* source;
+  };
+  std::vector<RayProxy> ray_proxies;
+  std::vector<const btCollisionObject*> ray_targets;              // cast one by one in CastRay
+  std::vector<std::pair<btVector3, btVector3>> ray_target_aabbs;  // their world bounds
+
+  RayHit CastSegment(const Eigen::Vector3d& from, const Eigen::Vector3d& to, GlassMode mode,
+                     double glass_max_incidence) const;
   std::vector<Entity> entities;
   std::vector<Door> doors;
   std::map<std::string, int> actuator_entity;
@@ -1239,19 +1387,21 @@ namespace {
 class TwinRayCallback : public btCollisionWorld::RayResultCallback {
  public:
   TwinRayCallback(const btVector3& dir, GlassMode mode, double cos_max,
-                  const std::function<bool(int)>& is_glass)
-      : dir_(dir.normalized()), mode_(mode), cos_max_(cos_max), is_glass_(is_glass) {}
-
-  bool needsCollision(btBroadphaseProxy* proxy) const override {
-    return (proxy->m_collisionFilterGroup & (kGStatic | kGFloor | kGDoor | kGPerson | kGPayload)) !=
-           0;
-  }
+                  const std::function<bool(int)>& is_glass,
+                  const std::function<int(const btCollisionObject*, int)>& entity_of)
+      : dir_(dir.normalized()),
+        mode_(mode),
+        cos_max_(cos_max),
+        is_glass_(is_glass),
+        entity_of_(entity_of) {}
 
   btScalar addSingleResult(btCollisionWorld::LocalRayResult& r, bool normal_in_world) override {
     const btVector3 n =
         normal_in_world ? r.m_hitNormalLocal
                         : r.m_collisionObject->getWorldTransform().getBasis() * r.m_hitNormalLocal;
-    const int entity = r.m_collisionObject->getUserIndex();
+    const int entity =
+        entity_of_(r.m_collisionObject,
+                   r.m_localShapeInfo != nullptr ? r.m_localShapeInfo->m_triangleIndex : -1);
     const bool glass = is_glass_(entity);
     if (glass && (mode_ == GlassMode::kTransparent ||
                   (mode_ == GlassMode::kLaser && std::abs(n.normalized().dot(dir_)) < cos_max_))) {
@@ -1274,27 +1424,90 @@ class TwinRayCallback : public btCollisionWorld::RayResultCallback {
   GlassMode mode_;
   double cos_max_;
   const std::function<bool(int)>& is_glass_;
+  const std::function<int(const btCollisionObject*, int)>& entity_of_;
+};
+
+// The static triangle mesh's hits, passed on to the twin's ray callback.
+class StaticMeshRayCallback : public btTriangleRaycastCallback {
+ public:
+  StaticMeshRayCallback(const btVector3& from, const btVector3& to, const btCollisionObject* mesh,
+                        TwinRayCallback* out,
+                        const std::function<int(const btCollisionObject*, int)>& entity_of)
+      : btTriangleRaycastCallback(from, to), mesh_(mesh), out_(out), entity_of_(entity_of) {}
+  btScalar reportHit(const btVector3& normal, btScalar fraction, int, int triangle) override {
+    if (fraction >= out_->m_closestHitFraction) return m_hitFraction;
+    out_->m_closestHitFraction = fraction;
+    out_->m_collisionObject = mesh_;
+    out_->normal = normal;
+    out_->entity = entity_of_(mesh_, triangle);
+    out_->glass = false;
+    return fraction;
+  }
+
+ private:
+  const btCollisionObject* mesh_;
+  TwinRayCallback* out_;
+  const std::function<int(const btCollisionObject*, int)>& entity_of_;
 };
 
 }  // namespace
 
-RayHit TwinWorld::CastRay(const Eigen::Vector3d& from, const Eigen::Vector3d& to, GlassMode mode,
-                          double glass_max_incidence) const {
+RayHit TwinWorld::Impl::CastSegment(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
+                                    GlassMode mode, double glass_max_incidence) const {
   const btVector3 a = ToBt(from), b = ToBt(to);
   const std::function<bool(int)> is_glass = [this](int e) {
-    return e >= 0 && impl_->entities[std::size_t(e)].glass;
+    return e >= 0 && entities[std::size_t(e)].glass;
   };
-  TwinRayCallback cb(b - a, mode, std::cos(glass_max_incidence), is_glass);
-  impl_->dynamics->rayTest(a, b, cb);
+  const std::function<int(const btCollisionObject*, int)> entity_of =
+      [this](const btCollisionObject* o, int t) { return EntityOf(o, t); };
+  TwinRayCallback cb(b - a, mode, std::cos(glass_max_incidence), is_glass, entity_of);
+  // Bullet's ray tests, object by object rather than through the broadphase: the static
+  // triangle mesh first, then every other ray target whose bounding box the ray still crosses
+  // before its closest hit so far. Dynamic bodies are cast as triangle proxies of their
+  // shapes (see BuildRayProxies): Bullet's triangle ray test is exact and much cheaper than
+  // its iterative convex cast.
+  if (static_mesh_shape != nullptr) {
+    StaticMeshRayCallback mesh_cb(a, b, static_mesh_body, &cb, entity_of);
+    static_mesh_shape->performRaycast(&mesh_cb, a, b);
+  }
+  const btTransform from_T(btQuaternion::getIdentity(), a), to_T(btQuaternion::getIdentity(), b);
+  for (std::size_t i = 0; i < ray_targets.size(); ++i) {
+    const btCollisionObject* target = ray_targets[i];
+    btVector3 normal;
+    btScalar param = cb.m_closestHitFraction;
+    const bool plane = target->getCollisionShape()->getShapeType() == STATIC_PLANE_PROXYTYPE;
+    if (!plane &&
+        !btRayAabb(a, b, ray_target_aabbs[i].first, ray_target_aabbs[i].second, param, normal))
+      continue;
+    btCollisionWorld::rayTestSingle(from_T, to_T, const_cast<btCollisionObject*>(target),
+                                    target->getCollisionShape(), target->getWorldTransform(), cb);
+  }
   RayHit hit;
   if (!cb.hasHit()) return hit;
   hit.hit = true;
   hit.distance = cb.m_closestHitFraction * (to - from).norm();
   hit.point = from + cb.m_closestHitFraction * (to - from);
-  hit.normal = FromBt(cb.normal);
+  hit.normal = FromBt(cb.normal).normalized();
   hit.entity = cb.entity;
   hit.glass = cb.glass;
   return hit;
+}
+
+RayHit TwinWorld::CastRay(const Eigen::Vector3d& from, const Eigen::Vector3d& to, GlassMode mode,
+                          double glass_max_incidence) const {
+  // Cast near first, then the rest: most rays indoors hit within a few metres, and a hit in the
+  // near piece skips the far piece's walk of the BVH.
+  constexpr double kNearSegment = 3.0;  // [m]
+  const double length = (to - from).norm();
+  if (length > 1.5 * kNearSegment) {
+    const Eigen::Vector3d mid = from + (to - from) * (kNearSegment / length);
+    RayHit near = impl_->CastSegment(from, mid, mode, glass_max_incidence);
+    if (near.hit) return near;
+    RayHit far = impl_->CastSegment(mid, to, mode, glass_max_incidence);
+    if (far.hit) far.distance += kNearSegment;
+    return far;
+  }
+  return impl_->CastSegment(from, to, mode, glass_max_incidence);
 }
 
 EntityKind TwinWorld::entity_kind(int entity) const {

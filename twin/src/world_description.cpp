@@ -1,5 +1,7 @@
 #include "egress/twin/world_description.h"
 
+#include <cmath>
+
 #include <Eigen/Geometry>
 
 namespace egress::twin {
@@ -62,6 +64,37 @@ Eigen::Vector3d DoorDescription::CalcFreeEdge(double angle) const {
   const Pose3 X_WL_now = CalcLeafPose(angle);
   const Eigen::Vector3d dir = HorizontalDirection(X_WL_now.translation() - p_WH);
   return Eigen::Vector3d(p_WH.x(), p_WH.y(), X_WL_now.translation().z()) + dir * LeafReach();
+}
+
+std::optional<FloorFootprint> CalcFloorFootprint(const ShapeDescription& s, double z_min,
+                                                 double z_max) {
+  if (s.kind == ShapeKind::kPlane) return std::nullopt;
+  Eigen::Vector3d lo, hi;
+  s.CalcWorldBounds(&lo, &hi);
+  if (hi.z() < z_min || lo.z() > z_max) return std::nullopt;
+  FloorFootprint f;
+  f.model = s.model;
+  const bool upright = std::abs(s.X_WS.rotation()(2, 2)) > 0.999;
+  if (upright && (s.kind == ShapeKind::kBox || s.kind == ShapeKind::kCylinder)) {
+    const Eigen::Vector3d x_axis = s.X_WS.rotation().col(0);
+    f.X_WF = {s.X_WS.translation().x(), s.X_WS.translation().y(),
+              std::atan2(x_axis.y(), x_axis.x())};
+    f.size = s.kind == ShapeKind::kBox ? Eigen::Vector2d(s.box_size.head<2>())
+                                       : Eigen::Vector2d::Constant(2 * s.radius);
+  } else {
+    f.X_WF = {(lo.x() + hi.x()) / 2, (lo.y() + hi.y()) / 2, 0.0};
+    f.size = (hi - lo).head<2>();
+  }
+  return f;
+}
+
+std::vector<FloorFootprint> CalcFloorFootprints(const WorldDescription& world, double z_min,
+                                                double z_max) {
+  std::vector<FloorFootprint> out;
+  for (const auto& s : world.shapes) {
+    if (auto f = CalcFloorFootprint(s, z_min, z_max)) out.push_back(std::move(*f));
+  }
+  return out;
 }
 
 std::vector<const ShapeDescription*> WorldDescription::ShapesOfModel(

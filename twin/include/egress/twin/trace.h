@@ -2,8 +2,15 @@
 /// @file
 /// Run trace: robot pose, people, door angles and phases, the held payload and the events since
 /// the previous sample, at a fixed rate (default 20 Hz) of simulated time. Written as JSON lines
-/// (one header line, then one object per sample) with fixed precision, so two runs of the same
-/// scenario and seed produce byte-identical files; Hash() fingerprints them.
+/// (one header line with the floor plan, then one object per sample) with fixed precision, so
+/// two runs of the same scenario and seed produce byte-identical files; Hash() fingerprints them.
+///
+/// Header: {"scenario", "seed", "rate_hz", "robot_radius", "walls": [[x, y, yaw, size_x, size_y]],
+///   "doors": [{"name", "hinge": [x, y], "latch": [x, y], "swing": ±1 (+1 opens counter-clockwise),
+///   "glass"}], "people": [names], "payloads": [names]}.
+/// Sample: {"t", "robot": [x, y, yaw], "doors": [[angle, phase]], "people": [[x, y, phase]],
+///   "payloads": [[x, y, z]], "held": name or null, "events": [{"t", "kind", "subject",
+///   "detail"}]}. Frame W, SI units.
 
 #include <cstdint>
 #include <filesystem>

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -64,6 +65,25 @@ struct DoorDescription {
   /// The free edge's point at the leaf's mid-height in W for opening angle `angle` [m].
   Eigen::Vector3d CalcFreeEdge(double angle) const;
 };
+
+/// A static shape's outline on the floor plan: an oriented rectangle in W. Boxes and cylinders
+/// standing upright keep their shape (a cylinder by its bounding square); tilted shapes and
+/// meshes use their world-axis bounds.
+struct FloorFootprint {
+  std::string model;
+  Pose2 X_WF;                                     ///< Rectangle centre and orientation in W.
+  Eigen::Vector2d size{Eigen::Vector2d::Zero()};  ///< Full extents [m].
+};
+
+struct WorldDescription;
+
+/// Footprints of the static shapes that reach into the height band [z_min, z_max] [m]; planes
+/// are skipped, and so are door leaves (doors are doorways, not walls, on a floor plan).
+std::vector<FloorFootprint> CalcFloorFootprints(const WorldDescription& world, double z_min = 0.05,
+                                                double z_max = 1.8);
+/// The same for a single shape; nullopt if it is a plane or outside the band.
+std::optional<FloorFootprint> CalcFloorFootprint(const ShapeDescription& shape, double z_min = 0.05,
+                                                 double z_max = 1.8);
 
 /// Everything the twin reads from one world file.
 struct WorldDescription {

@@ -1,0 +1,27 @@
+#pragma once
+/// @file
+/// An SDF world as the planners see it: its static shapes at body height rasterized into an
+/// occupancy grid, and its hinged doors as doorways. Used by egress-navd's LoadWorld and by
+/// `egress plan --map world.sdf`, so both read a world the same way.
+
+#include <cstdint>
+#include <vector>
+
+#include "egress/perception/costmap.h"
+#include "egress/perception/occupancy_grid.h"
+#include "egress/twin/world_description.h"
+
+namespace egress::apps {
+
+struct SdfMap {
+  perception::OccupancyGrid grid;
+  std::vector<perception::Doorway> doors;  ///< id = the SDF model name; hinge and latch jambs
+};
+
+/// Rasterizes `world` at `resolution` [m] over the bounds of its footprints (snapped to the
+/// grid). @throws InvalidArgument for a bad resolution, a world without walls, or more than
+/// `max_cells` cells.
+SdfMap RasterizeSdfWorld(const twin::WorldDescription& world, double resolution,
+                         std::int64_t max_cells);
+
+}  // namespace egress::apps

@@ -1,0 +1,198 @@
+// `egress sim`: one twin scenario end to end, with a readable verdict, a JSON verdict, a trace
+// and pictures. `egress render`: a recorded trace as a PNG or an MP4.
+//
+// Drivers: `idle` (the robot stands still) and `dead-reckoning` (a naive baseline that drives
+// straight at the goal on odometry alone). The robot brain becomes a driver with its issue.
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include <fmt/format.h>
+
+#include "commands.h"
+#include "egress/hsr_interface/error.h"
+#include "egress/twin/sdf_world_loader.h"
+#include "egress/twin/twin_run.h"
+#include "trace_render.h"
+
+namespace egress::apps {
+namespace {
+
+struct SimOptions {
+  std::string scenario;
+  std::optional<std::uint64_t> seed;
+  double duration{0.0};
+  std::string driver{"idle"};
+  std::string trace;
+  std::string json;
+  std::string png;
+  std::string mp4;
+  bool overwrite{false};
+  bool quiet{false};
+};
+
+void RefuseOverwrite(const std::string& path, bool overwrite) {
+  if (!path.empty() && std::filesystem::exists(path) && !overwrite) {
+    throw CommandFailed(fmt::format("'{}' exists; pass --overwrite to replace it", path));
+  }
+}
+
+// Drives straight at the goal from the scenario's nominal start, on odometry alone: what a
+// robot without perception would do. Useful as a baseline and to exercise the twin.
+twin::Controller DeadReckoningController(const twin::Scenario& scenario) {
+  if (!scenario.goal)
+    throw CommandFailed("--driver dead-reckoning needs robot.goal in the scenario");
+  const Pose2 X_MO = scenario.robot_start;
+  const Pose2 goal = *scenario.goal;
+  const double tolerance = scenario.goal_tolerance;
+  return [=](RobotPort& robot) {
+    const SensorSnapshot s = robot.Sense();
+    const Pose2 X_MB = X_MO * s.odometry.X_OB;
+    const Eigen::Vector2d p_BG = X_MB.Inverse() * goal.translation();
+    if (p_BG.norm() <= tolerance / 2) {
+      robot.SendBaseVelocity({});
+      return true;
+    }
+    const double speed = std::min(0.3, p_BG.norm());
+    const Eigen::Vector2d v = p_BG.normalized() * speed;
+    robot.SendBaseVelocity({v.x(), v.y(), 0.0});
+    return true;
+  };
+}
+
+void ProgressBar(double fraction) {
+  constexpr int kWidth = 40;
+  const int filled = int(fraction * kWidth);
+  std::fprintf(stderr, "\r  [%s%s] %3d%%", std::string(std::size_t(filled), '#').c_str(),
+               std::string(std::size_t(kWidth - filled), ' ').c_str(), int(fraction * 100));
+  if (fraction >= 1.0) std::fprintf(stderr, "\n");
+}
+
+void RunSim(const SimOptions& o) {
+  for (const auto* path : {&o.trace, &o.json, &o.png, &o.mp4})
+    RefuseOverwrite(*path, o.overwrite);
+  const twin::Scenario scenario = twin::LoadScenario(o.scenario);
+  const twin::WorldDescription world_description = twin::LoadSdfWorld(scenario.world_file);
+  const std::uint64_t seed = o.seed.value_or(scenario.seed);
+  auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
+  twin::TwinWorld world(scenario, world_description, seed, model);
+  twin::TwinRobot robot(&world);
+  twin::Controller controller;
+  if (o.driver == "idle") {
+    controller = twin::IdleController();
+  } else if (o.driver == "dead-reckoning") {
+    controller = DeadReckoningController(scenario);
+  } else {
+    throw CommandFailed(fmt::format("--driver '{}': expected idle or dead-reckoning", o.driver));
+  }
+  if (!o.quiet) {
+    fmt::print("scenario  {} ({})\n", scenario.name.empty() ? o.scenario : scenario.name,
+               o.scenario);
+    fmt::print("world     {}: {} static shapes, {} doors\n", scenario.world_file.string(),
+               world_description.shapes.size(), world_description.doors.size());
+    for (const auto& note : world_description.notes)
+      fmt::print("note      {}\n", note);
+    fmt::print("seed      {}   driver {}   time limit {:.0f} s\n", seed, o.driver,
+               scenario.time_limit);
+  }
+  twin::RunOptions options;
+  options.duration = o.duration;
+  if (!o.quiet && ::isatty(::fileno(stderr))) options.on_progress = ProgressBar;
+  const auto started = std::chrono::steady_clock::now();
+  const twin::RunResult result = twin::RunScenario(robot, controller, options);
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  if (!o.quiet) {
+    fmt::print("ran       {:.1f} s simulated in {:.2f} s ({:.0f}x real time), {} events\n",
+               result.simulated_time, wall, result.simulated_time / std::max(wall, 1e-9),
+               world.events().size());
+    for (const auto& e : world.events()) {
+      fmt::print("  {:7.2f}  {:<22} {:<14} {}\n", e.t, e.kind, e.subject, e.detail);
+    }
+  }
+  std::cout << twin::FormatVerdict(result.verdict);
+  if (!o.trace.empty()) {
+    result.trace->Write(o.trace);
+    fmt::print("trace     {} ({} samples, hash {:016x})\n", o.trace, result.trace->sample_count(),
+               result.trace->Hash());
+  }
+  if (!o.json.empty()) {
+    std::ofstream out(o.json);
+    out << twin::VerdictToJson(result.verdict) << "\n";
+    if (!out) throw CommandFailed(fmt::format("cannot write '{}'", o.json));
+    fmt::print("verdict   {}\n", o.json);
+  }
+  if (!o.png.empty() || !o.mp4.empty()) {
+    // Render from the trace text itself, exactly as `egress render` would from the file.
+    const auto path =
+        std::filesystem::temp_directory_path() / fmt::format("egress_sim_{}.jsonl", ::getpid());
+    result.trace->Write(path);
+    const TraceFile trace = ReadTrace(path);
+    std::filesystem::remove(path);
+    if (!o.png.empty()) {
+      WriteTracePng(trace, o.png);
+      fmt::print("picture   {}\n", o.png);
+    }
+    if (!o.mp4.empty()) {
+      WriteTraceVideo(trace, o.mp4);
+      fmt::print("video     {}\n", o.mp4);
+    }
+  }
+  if (!result.verdict.success) throw CommandFailed("");
+}
+
+}  // namespace
+
+void AddSimCommand(CLI::App& app) {
+  auto o = std::make_shared<SimOptions>();
+  auto* sim = app.add_subcommand("sim", "Run one twin scenario end to end and judge it");
+  sim->add_option("scenario", o->scenario, "scenario YAML (worlds/README.md)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  sim->add_option("--seed", o->seed, "seed (default: the scenario's)");
+  sim->add_option("--duration", o->duration,
+                  "simulated seconds (default: the scenario's time limit)");
+  sim->add_option("--driver", o->driver, "who drives the robot: idle | dead-reckoning")
+      ->capture_default_str();
+  sim->add_option("--trace", o->trace, "write the run's trace (JSON lines, 20 Hz)");
+  sim->add_option("--json", o->json, "write the verdict as JSON");
+  sim->add_option("--png", o->png, "draw the run (paths, final state) into this PNG");
+  sim->add_option("--mp4", o->mp4, "render the run to this MP4");
+  sim->add_flag("--overwrite", o->overwrite, "replace existing output files");
+  sim->add_flag("-q,--quiet", o->quiet, "print only the verdict");
+  sim->callback([o] { RunSim(*o); });
+
+  auto render_path = std::make_shared<std::string>();
+  auto render_out = std::make_shared<std::string>();
+  auto render_overwrite = std::make_shared<bool>(false);
+  auto* render =
+      app.add_subcommand("render", "Render a recorded run (egress sim --trace) to PNG or MP4");
+  render->add_option("trace", *render_path, "trace file (JSON lines)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  render
+      ->add_option("--out", *render_out,
+                   "output .png (last frame with paths) or .mp4 (the whole run)")
+      ->required();
+  render->add_flag("--overwrite", *render_overwrite, "replace an existing output file");
+  render->callback([render_path, render_out, render_overwrite] {
+    RefuseOverwrite(*render_out, *render_overwrite);
+    const TraceFile trace = ReadTrace(*render_path);
+    const std::string ext = std::filesystem::path(*render_out).extension().string();
+    if (ext == ".png") {
+      WriteTracePng(trace, *render_out);
+    } else if (ext == ".mp4") {
+      WriteTraceVideo(trace, *render_out);
+    } else {
+      throw CommandFailed(fmt::format("--out '{}': expected a .png or .mp4 file", *render_out));
+    }
+    fmt::print("{} samples ({:.1f} s) -> {}\n", trace.samples.size(),
+               trace.samples.back()["t"].get<double>(), *render_out);
+  });
+}
+
+}  // namespace egress::apps
