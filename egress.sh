@@ -76,21 +76,21 @@ case "$command" in
   demo)
     install_deps
     configure_and_build "$build_dir"
-    say "the main job: egress --version, then the HSR model the robot brain plans with"
+    say "the main job: egress --version (the libraries each module links)"
     "$build_dir/apps/egress" --version
     echo
-    "$build_dir/apps/egress" model info
+    say "a twin scenario end to end: the lab door held open by a person, the dead-reckoning baseline"
+    say "robot driving through it (the robot brain replaces this driver with its issue)"
+    "$build_dir/apps/egress" sim worlds/lab/lab_hold_door.yaml --driver dead-reckoning --duration 30 \
+      --png "$build_dir/demo_run.png" --trace "$build_dir/demo_run.jsonl" --overwrite
     echo
-    say "forward kinematics, arm horizontal (arm_flex = -pi/2): palm reach"
-    "$build_dir/apps/egress" model fk --arm 0 -1.5707963267948966
+    say "a base path across the office SDF world through door_a and door_b, drawn to $build_dir/demo_path.png"
+    "$build_dir/apps/egress" plan --local --map worlds/office/office.sdf --start 1.5 4.5 0 --goal 12.5 1.5 0 \
+      --png "$build_dir/demo_path.png" --overwrite
     echo
-    say "a base path across the office (worlds/office), through doors A and B, drawn to $build_dir/demo_path.png"
-    "$build_dir/apps/egress" plan --local --map worlds/office/office.yaml --start 1.5 4.5 0 --goal 12.5 1.5 0 \
-      --door A:5,2.5,5,3.5 --door B:9,1,9,2 --png "$build_dir/demo_path.png" --overwrite
-    echo
-    say "the same with door A closed: no path, and the planner says why"
-    "$build_dir/apps/egress" plan --local --map worlds/office/office.yaml --start 1.5 4.5 0 --goal 12.5 1.5 0 \
-      --door A:5,2.5,5,3.5 --door B:9,1,9,2 --closed A || true
+    say "the same with door_a closed: no path, and the planner says why"
+    "$build_dir/apps/egress" plan --local --map worlds/office/office.sdf --start 1.5 4.5 0 --goal 12.5 1.5 0 \
+      --closed door_a || true
     ;;
   test)
     install_deps
