@@ -81,7 +81,7 @@ case "$command" in
     echo
     say "a twin scenario end to end: the lab door held open by a person, the dead-reckoning baseline"
     say "robot driving through it (the robot brain replaces this driver with its issue)"
-    "$build_dir/apps/egress" sim worlds/lab/lab_hold_door.yaml --driver dead-reckoning --duration 30 \
+    "$build_dir/apps/egress" sim run worlds/lab/lab_hold_door.yaml --driver dead-reckoning --duration 30 \
       --png "$build_dir/demo_run.png" --trace "$build_dir/demo_run.jsonl" --overwrite
     echo
     say "a base path across the office SDF world through door_a and door_b, drawn to $build_dir/demo_path.png"

@@ -35,7 +35,8 @@ void AddPlanCommand(CLI::App& app);
 /// `egress bench plan`: the planners over the planning suite, OMPL benchmark logs + CSV.
 void AddBenchCommand(CLI::App& app);
 
-/// `egress sim SCENARIO` (one twin run, judged) and `egress render TRACE` (PNG/MP4).
+/// `egress sim run SCENARIO` (one twin run, judged), `egress sim batch` (reserved) and
+/// `egress render TRACE` (PNG/MP4).
 void AddSimCommand(CLI::App& app);
 /// A sub-command reserved for a capability that is not built yet: it is listed in --help with
 /// what it will do, and running it fails with a clear message.

@@ -23,9 +23,6 @@ int main(int argc, char** argv) {
   egress::apps::AddPlanCommand(app);
   egress::apps::AddBenchCommand(app);
   egress::apps::AddSimCommand(app);
-  egress::apps::AddPlannedCommand(app, "batch",
-                                  "Run many seeded trials with a progress bar and success table",
-                                  "the robot-brain issue");
 
   try {
     app.parse(argc, argv);

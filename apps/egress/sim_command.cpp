@@ -1,4 +1,4 @@
-// `egress sim`: one twin scenario end to end, with a readable verdict, a JSON verdict, a trace
+// `egress sim run`: one twin scenario end to end, with a readable verdict, a JSON verdict, a trace
 // and pictures. `egress render`: a recorded trace as a PNG or an MP4.
 //
 // Drivers: `idle` (the robot stands still) and `dead-reckoning` (a naive baseline that drives
@@ -149,7 +149,10 @@ void RunSim(const SimOptions& o) {
 
 void AddSimCommand(CLI::App& app) {
   auto o = std::make_shared<SimOptions>();
-  auto* sim = app.add_subcommand("sim", "Run one twin scenario end to end and judge it");
+  auto* sim_group =
+      app.add_subcommand("sim", "Digital-twin runs: `sim run` (one scenario, judged)");
+  sim_group->require_subcommand(1);
+  auto* sim = sim_group->add_subcommand("run", "Run one twin scenario end to end and judge it");
   sim->add_option("scenario", o->scenario, "scenario YAML (worlds/README.md)")
       ->required()
       ->check(CLI::ExistingFile);
@@ -161,10 +164,13 @@ void AddSimCommand(CLI::App& app) {
   sim->add_option("--trace", o->trace, "write the run's trace (JSON lines, 20 Hz)");
   sim->add_option("--json", o->json, "write the verdict as JSON");
   sim->add_option("--png", o->png, "draw the run (paths, final state) into this PNG");
-  sim->add_option("--mp4", o->mp4, "render the run to this MP4");
+  sim->add_option("--video,--mp4", o->mp4, "render the run to this top-down MP4");
   sim->add_flag("--overwrite", o->overwrite, "replace existing output files");
   sim->add_flag("-q,--quiet", o->quiet, "print only the verdict");
   sim->callback([o] { RunSim(*o); });
+  AddPlannedCommand(*sim_group, "batch",
+                    "Run many seeded trials in parallel with a progress bar and a success table",
+                    "the robot-brain issue");
 
   auto render_path = std::make_shared<std::string>();
   auto render_out = std::make_shared<std::string>();

@@ -76,7 +76,7 @@ TEST(EgressCliTest, ClearErrors) {
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_THAT(result.output, HasSubstr("arm_flex_joint"));
 
-  result = RunEgress("batch");
+  result = RunEgress("sim batch");
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_THAT(result.output, HasSubstr("not available in this build yet"));
 
@@ -284,7 +284,8 @@ TEST(EgressCliTest, SimRunsAScenarioWritesVerdictTraceAndPictures) {
                               (dir / "verdict.json").string() + " --png " +
                               (dir / "run.png").string();
   // The dead-reckoning baseline passes the held door: the verdict table says so, exit 0.
-  Result run = RunEgress("sim " + scenario + " --driver dead-reckoning --duration 25" + outputs);
+  Result run =
+      RunEgress("sim run " + scenario + " --driver dead-reckoning --duration 25" + outputs);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_THAT(run.output, HasSubstr("SUCCESS"));
   EXPECT_THAT(run.output, HasSubstr("PASS  door_open_when_crossed:lab_door"));
@@ -294,7 +295,8 @@ TEST(EgressCliTest, SimRunsAScenarioWritesVerdictTraceAndPictures) {
   EXPECT_EQ(verdict.at("metrics").at("crossings").size(), 1u);
   EXPECT_GT(std::filesystem::file_size(dir / "run.png"), 1000u);
   // Same seed, same trace; outputs are never overwritten without --overwrite.
-  Result again = RunEgress("sim " + scenario + " --driver dead-reckoning --duration 25" + outputs);
+  Result again =
+      RunEgress("sim run " + scenario + " --driver dead-reckoning --duration 25" + outputs);
   EXPECT_EQ(again.exit_code, 1);
   EXPECT_THAT(again.output, HasSubstr("--overwrite"));
   const auto trace_text = [&] {
@@ -302,12 +304,12 @@ TEST(EgressCliTest, SimRunsAScenarioWritesVerdictTraceAndPictures) {
     return std::string(std::istreambuf_iterator<char>(in), {});
   };
   const std::string first = trace_text();
-  Result rerun = RunEgress("sim " + scenario +
+  Result rerun = RunEgress("sim run " + scenario +
                            " --driver dead-reckoning --duration 25 --overwrite -q" + outputs);
   ASSERT_EQ(rerun.exit_code, 0) << rerun.output;
   EXPECT_EQ(trace_text(), first);
   // Standing still, the robot never reaches the goal: FAIL lines and exit 1.
-  Result idle = RunEgress("sim " + scenario + " --duration 5 -q");
+  Result idle = RunEgress("sim run " + scenario + " --duration 5 -q");
   EXPECT_EQ(idle.exit_code, 1);
   EXPECT_THAT(idle.output, HasSubstr("FAIL  reach_goal"));
   // egress render: the trace to a PNG; a bad trace names its line.
@@ -320,7 +322,7 @@ TEST(EgressCliTest, SimRunsAScenarioWritesVerdictTraceAndPictures) {
       RunEgress("render " + (dir / "bad.jsonl").string() + " --out " + (dir / "bad.png").string());
   EXPECT_EQ(bad.exit_code, 1);
   EXPECT_THAT(bad.output, HasSubstr("bad.jsonl:2"));
-  Result broken = RunEgress("sim " + (dir / "verdict.json").string());
+  Result broken = RunEgress("sim run " + (dir / "verdict.json").string());
   EXPECT_EQ(broken.exit_code, 1);
   EXPECT_THAT(broken.output, HasSubstr("verdict.json"));
   std::filesystem::remove_all(dir);

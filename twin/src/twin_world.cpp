@@ -503,9 +503,11 @@ struct TwinWorld::Impl {
     }
     // The hand: palm block and two fingers (fingers do not collide: grasps are decided
     // analytically, see UpdateGripper).
+    auto palm_block = std::make_unique<btBoxShape>(btVector3(0.04, 0.035, 0.02));
     auto hand = std::make_unique<btCompoundShape>();
     hand->addChildShape(btTransform(btQuaternion::getIdentity(), btVector3(0, 0, -0.01)),
-                        new btBoxShape(btVector3(0.04, 0.035, 0.02)));
+                        palm_block.get());
+    shapes.push_back(std::move(palm_block));  // the compound does not own its children
     const int he = AddEntity(EntityKind::kRobotArm, "hsrb_hand", -1);
     hand_body = AddBody(std::move(hand), Pose3(), 0.0, kGArm, kMaskArm, he);
     MakeKinematic(hand_body);
