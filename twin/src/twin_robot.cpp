@@ -3,16 +3,10 @@
 #include <chrono>
 
 #include "egress/hsr_interface/error.h"
+#include "seeds.h"
 
 namespace egress::twin {
 namespace {
-
-std::uint64_t StreamSeed(std::uint64_t seed, std::uint64_t stream) {
-  std::uint64_t z = seed + 0x9E3779B97F4A7C15ull * (stream + 101);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
-}
 
 // Moves outputs whose latency has elapsed from a queue to `sink`.
 template <typename Queue, typename Sink>
@@ -32,10 +26,10 @@ TwinRobot::TwinRobot(TwinWorld* world)
       laser_(config_),
       depth_(config_),
       detector_(config_, depth_.intrinsics()),
-      laser_rng_(StreamSeed(world->seed(), 1)),
-      depth_rng_(StreamSeed(world->seed(), 2)),
-      detector_rng_(StreamSeed(world->seed(), 3)),
-      odometry_rng_(StreamSeed(world->seed(), 4)),
+      laser_rng_(DeriveSeed(world->seed(), 101)),
+      depth_rng_(DeriveSeed(world->seed(), 102)),
+      detector_rng_(DeriveSeed(world->seed(), 103)),
+      odometry_rng_(DeriveSeed(world->seed(), 104)),
       odometry_(config_, world->robot_pose(), odometry_rng_) {
   ThrowUnless(world != nullptr, "TwinRobot: world is null");
   last_odometry_ = odometry_.Read(world->now());

@@ -13,6 +13,7 @@
 #include "egress/hsr_interface/error.h"
 #include "egress/twin/actuators.h"
 #include "egress/twin/social_force.h"
+#include "seeds.h"
 
 namespace egress::twin {
 namespace {
@@ -59,14 +60,6 @@ btTransform ToBt(const Pose3& X) {
 Pose3 FromBt(const btTransform& T) {
   const btQuaternion q = T.getRotation();
   return Pose3(Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()).normalized(), FromBt(T.getOrigin()));
-}
-
-// SplitMix64: independent seeds per component, so adding a sensor never shifts the people.
-std::uint64_t DeriveSeed(std::uint64_t seed, std::uint64_t stream) {
-  std::uint64_t z = seed + 0x9E3779B97F4A7C15ull * (stream + 1);
-  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-  return z ^ (z >> 31);
 }
 
 double HandWidth(double hand_q) {
