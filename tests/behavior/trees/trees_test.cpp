@@ -1,0 +1,201 @@
+// The executive's trees (behavior/trees/) load with the task-node model and decide as the paper
+// says, run with stand-in leaves whose outcomes each test scripts tick by tick.
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "egress/bt/factory.h"
+#include "egress/bt/tree.h"
+
+namespace egress::bt {
+namespace {
+
+const std::filesystem::path kTrees = EGRESS_TREES_DIR;
+
+// Runs `tree_id` with stand-ins: `outcome(tick, node)` decides each stand-in leaf; records which
+// leaves were ticked, by instance name (or type ID when unnamed), per tick.
+class ScriptedRun {
+ public:
+  ScriptedRun(const std::string& file, const std::string& tree_id,
+              std::function<NodeStatus(int, const TreeNode&)> outcome,
+              std::map<std::string, std::string> blackboard = {})
+      : outcome_(std::move(outcome)) {
+    factory_.RegisterStandInsFromModelFile(kTrees / "egress_nodes.xml");
+    factory_.RegisterTreesFromFile(kTrees / file);
+    auto bb = Blackboard::Create();
+    for (const auto& [k, v] : blackboard)
+      bb->Set(k, Any(v));
+    tree_ = std::make_unique<Tree>(factory_.CreateTree(tree_id, bb));
+    tree_->SetStandInDriver([this](const TreeNode& node) {
+      ticked_[tick_].push_back(node.name().empty() ? node.registration_id() : node.name());
+      return outcome_(tick_, node);
+    });
+  }
+  NodeStatus Tick() {
+    ++tick_;
+    return tree_->TickOnce();
+  }
+  const std::vector<std::string>& Ticked(int tick) { return ticked_[tick]; }
+  bool EverTicked(const std::string& name) const {
+    for (const auto& [t, names] : ticked_) {
+      for (const auto& n : names) {
+        if (n == name) return true;
+      }
+    }
+    return false;
+  }
+  Tree& tree() { return *tree_; }
+
+ private:
+  BehaviorTreeFactory factory_;
+  std::unique_ptr<Tree> tree_;
+  std::function<NodeStatus(int, const TreeNode&)> outcome_;
+  std::map<int, std::vector<std::string>> ticked_;
+  int tick_{0};
+};
+
+const std::map<std::string, std::string> kDoorA = {{"door", "door_a"}, {"max_yields", "5"}};
+
+bool Is(const TreeNode& n, const char* id) {
+  return n.registration_id() == id;
+}
+
+TEST(DoorTraversalTreeTest, EveryTreeLoadsWithTheTaskNodeModel) {
+  for (const auto& [file, id] : std::vector<std::pair<std::string, std::string>>{
+           {"door_traversal.xml", "DoorTraversal"},
+           {"fetch_and_deliver.xml", "FetchAndDeliver"},
+           {"mission.xml", "OfficeFetchMission"}}) {
+    BehaviorTreeFactory factory;
+    factory.RegisterStandInsFromModelFile(kTrees / "egress_nodes.xml");
+    factory.RegisterTreesFromFile(kTrees / file);
+    const Tree tree = factory.CreateTree(id);
+    EXPECT_EQ(tree.main_tree_id(), id);
+    EXPECT_TRUE(tree.stubbed_subtree_ids().empty()) << file;
+  }
+}
+
+TEST(DoorTraversalTreeTest, AClosedPushButtonDoorIsPressedThenTraversed) {
+  ScriptedRun run(
+      "door_traversal.xml", "DoorTraversal",
+      [](int, const TreeNode& n) {
+        if (Is(n, "IsDoorOpen") || Is(n, "IsPersonHoldingDoor")) return NodeStatus::kFailure;
+        if (Is(n, "ButtonType")) {
+          n.config().blackboard->Set("button_type", Any(std::string("push_button")));
+        }
+        return NodeStatus::kSuccess;
+      },
+      kDoorA);
+  EXPECT_EQ(run.Tick(), NodeStatus::kSuccess);
+  EXPECT_TRUE(run.EverTicked("PressButton"));
+  EXPECT_FALSE(run.EverTicked("WaveAtPlate"));
+  EXPECT_TRUE(run.EverTicked("traverse_opened"));
+  EXPECT_FALSE(run.EverTicked("retract"));
+}
+
+TEST(DoorTraversalTreeTest, AProximityPlateIsWavedAtNotPressed) {
+  ScriptedRun run(
+      "door_traversal.xml", "DoorTraversal",
+      [](int, const TreeNode& n) {
+        if (Is(n, "IsDoorOpen") || Is(n, "IsPersonHoldingDoor")) return NodeStatus::kFailure;
+        if (Is(n, "ButtonType")) {
+          n.config().blackboard->Set("button_type", Any(std::string("proximity_plate")));
+        }
+        return NodeStatus::kSuccess;
+      },
+      kDoorA);
+  EXPECT_EQ(run.Tick(), NodeStatus::kSuccess);
+  EXPECT_TRUE(run.EverTicked("WaveAtPlate"));
+  EXPECT_FALSE(run.EverTicked("PressButton"));
+}
+
+TEST(DoorTraversalTreeTest, AHeldDoorIsPassedWithoutPressing) {
+  ScriptedRun run(
+      "door_traversal.xml", "DoorTraversal",
+      [](int, const TreeNode& n) {
+        if (Is(n, "IsDoorOpen")) return NodeStatus::kFailure;  // half open: too narrow by itself
+        return NodeStatus::kSuccess;                           // but a person holds it
+      },
+      kDoorA);
+  EXPECT_EQ(run.Tick(), NodeStatus::kSuccess);
+  EXPECT_TRUE(run.EverTicked("traverse_open"));
+  EXPECT_FALSE(run.EverTicked("ApproachButton"));
+  EXPECT_FALSE(run.EverTicked("PressButton"));
+}
+
+TEST(DoorTraversalTreeTest, APersonEnteringPreemptsThePressInTheSameTickThenItResumes) {
+  // Tick 1: pressing (RUNNING). Tick 2: a person enters: the press is halted and the retract
+  // starts in that tick. Tick 3: retract done, waiting. Tick 4: clear again: the traversal is
+  // re-decided from the world (now the door is open) and passes.
+  ScriptedRun run(
+      "door_traversal.xml", "DoorTraversal",
+      [](int tick, const TreeNode& n) {
+        if (Is(n, "IsPathClear"))
+          return tick == 2 || tick == 3 ? NodeStatus::kFailure : NodeStatus::kSuccess;
+        if (Is(n, "IsDoorOpen")) return tick >= 4 ? NodeStatus::kSuccess : NodeStatus::kFailure;
+        if (Is(n, "IsPersonHoldingDoor")) return NodeStatus::kFailure;
+        if (Is(n, "ButtonType")) {
+          n.config().blackboard->Set("button_type", Any(std::string("push_button")));
+          return NodeStatus::kSuccess;
+        }
+        if (Is(n, "PressButton")) return NodeStatus::kRunning;
+        if (Is(n, "RetractToSafe")) return tick == 2 ? NodeStatus::kRunning : NodeStatus::kSuccess;
+        if (Is(n, "WaitForClear")) return NodeStatus::kRunning;
+        return NodeStatus::kSuccess;
+      },
+      kDoorA);
+  EXPECT_EQ(run.Tick(), NodeStatus::kRunning);
+  EXPECT_EQ(run.Ticked(1).back(), "PressButton");
+  EXPECT_EQ(run.Tick(), NodeStatus::kRunning);
+  // In tick 2 the check failed and the standby's retract was started, nothing else.
+  EXPECT_EQ(run.Ticked(2), (std::vector<std::string>{"reactive_check", "retract"}));
+  EXPECT_EQ(run.Tick(), NodeStatus::kRunning);
+  EXPECT_EQ(run.Ticked(3).back(), "WaitForClear");
+  EXPECT_EQ(run.Tick(), NodeStatus::kSuccess);
+  EXPECT_EQ(run.Ticked(4).back(), "traverse_open");
+}
+
+TEST(DoorTraversalTreeTest, GivesUpAfterMaxYields) {
+  ScriptedRun run("door_traversal.xml", "DoorTraversal",
+                  [](int, const TreeNode& n) {
+                    if (Is(n, "IsPathClear"))
+                      return NodeStatus::kFailure;  // someone always in the way
+                    return NodeStatus::kSuccess;    // standby completes at once
+                  },
+                  {{"door", "door_a"}, {"max_yields", "3"}});
+  NodeStatus status = NodeStatus::kRunning;
+  int ticks = 0;
+  while (status == NodeStatus::kRunning && ticks < 20) {
+    status = run.Tick();
+    ++ticks;
+  }
+  EXPECT_EQ(status, NodeStatus::kFailure);
+  EXPECT_LE(ticks, 4);
+}
+
+TEST(FetchTreeTest, RetriesAGraspTheGripperDidNotHoldThenDelivers) {
+  int holding_checks = 0;
+  ScriptedRun run("fetch_and_deliver.xml", "FetchAndDeliver",
+                  [&](int, const TreeNode& n) {
+                    if (Is(n, "IsHoldingPayload"))
+                      return ++holding_checks >= 2 ? NodeStatus::kSuccess : NodeStatus::kFailure;
+                    if (Is(n, "DetectPayload"))
+                      n.config().blackboard->Set("payload_position",
+                                                 Any(std::string("2.3;1.35;0.86")));
+                    return NodeStatus::kSuccess;
+                  },
+                  {{"payload", "bottle"}, {"pickup", "2.3;2.0;-1.57"}, {"dropoff", "12.5;1.5;0"}});
+  EXPECT_EQ(run.Tick(), NodeStatus::kSuccess);  // the first grasp missed; the second held
+  EXPECT_EQ(holding_checks, 2);
+  int grasps = 0;
+  for (const auto& name : run.Ticked(1))
+    grasps += name == "GraspPayload" ? 1 : 0;
+  EXPECT_EQ(grasps, 2);
+  EXPECT_EQ(run.Ticked(1).back(), "PlacePayload");
+}
+
+}  // namespace
+}  // namespace egress::bt
