@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <sstream>
 
 #include <fmt/format.h>
 
@@ -128,11 +129,8 @@ void RunSim(const SimOptions& o) {
   }
   if (!o.png.empty() || !o.mp4.empty()) {
     // Render from the trace text itself, exactly as `egress render` would from the file.
-    const auto path =
-        std::filesystem::temp_directory_path() / fmt::format("egress_sim_{}.jsonl", ::getpid());
-    result.trace->Write(path);
-    const TraceFile trace = ReadTrace(path);
-    std::filesystem::remove(path);
+    std::istringstream text(result.trace->ToJsonLines());
+    const TraceFile trace = ParseTrace(text, "trace");
     if (!o.png.empty()) {
       WriteTracePng(trace, o.png);
       fmt::print("picture   {}\n", o.png);

@@ -49,6 +49,10 @@ View MakeView(const TraceFile& trace, double scale) {
 TraceFile ReadTrace(const std::filesystem::path& path) {
   std::ifstream in(path);
   if (!in) throw CommandFailed(fmt::format("{}: cannot read the trace", path.string()));
+  return ParseTrace(in, path.string());
+}
+
+TraceFile ParseTrace(std::istream& in, const std::string& source) {
   TraceFile trace;
   std::string line;
   int number = 0;
@@ -59,24 +63,24 @@ TraceFile ReadTrace(const std::filesystem::path& path) {
     try {
       j = nlohmann::json::parse(line);
     } catch (const nlohmann::json::exception& e) {
-      throw CommandFailed(fmt::format("{}:{}: not JSON: {}", path.string(), number, e.what()));
+      throw CommandFailed(fmt::format("{}:{}: not JSON: {}", source, number, e.what()));
     }
     if (number == 1) {
       for (const char* key : {"walls", "doors", "people", "rate_hz", "robot_radius"}) {
         if (!j.contains(key))
-          throw CommandFailed(fmt::format("{}:1: trace header has no '{}'", path.string(), key));
+          throw CommandFailed(fmt::format("{}:1: trace header has no '{}'", source, key));
       }
       trace.header = std::move(j);
     } else {
       for (const char* key : {"t", "robot", "doors", "people"}) {
         if (!j.contains(key))
-          throw CommandFailed(fmt::format("{}:{}: sample has no '{}'", path.string(), number, key));
+          throw CommandFailed(fmt::format("{}:{}: sample has no '{}'", source, number, key));
       }
       trace.samples.push_back(std::move(j));
     }
   }
   if (trace.samples.empty())
-    throw CommandFailed(fmt::format("{}: the trace has no samples", path.string()));
+    throw CommandFailed(fmt::format("{}: the trace has no samples", source));
   return trace;
 }
 

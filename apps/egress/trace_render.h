@@ -3,6 +3,8 @@
 // per sample (walls, door leaves at their angles, people, the robot) and the paths so far.
 
 #include <filesystem>
+#include <istream>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -17,6 +19,8 @@ struct TraceFile {
 
 /// Reads a trace. @throws CommandFailed naming the file and line of bad JSON or a missing field.
 TraceFile ReadTrace(const std::filesystem::path& path);
+/// The same from trace text; `source` names it in errors.
+TraceFile ParseTrace(std::istream& in, const std::string& source);
 
 /// The frame of sample `index` (with the robot's and people's paths up to it).
 /// `pixels_per_metre` sets the scale.

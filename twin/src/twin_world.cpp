@@ -120,29 +120,11 @@ bool AppendTriangles(const ShapeDescription& s, btTriangleMesh* mesh) {
   return false;
 }
 
-std::unique_ptr<btCollisionShape> MakeShape(
-    const ShapeDescription& s, std::vector<std::unique_ptr<btStridingMeshInterface>>* meshes) {
-  switch (s.kind) {
-    case ShapeKind::kBox:
-      return std::make_unique<btBoxShape>(ToBt(s.box_size / 2));
-    case ShapeKind::kCylinder:
-      return std::make_unique<btCylinderShapeZ>(btVector3(s.radius, s.radius, s.length / 2));
-    case ShapeKind::kSphere:
-      return std::make_unique<btSphereShape>(s.radius);
-    case ShapeKind::kPlane:
-      return std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0);
-    case ShapeKind::kMesh: {
-      auto mesh = std::make_unique<btTriangleMesh>(true, false);
-      for (const auto& t : s.mesh->triangles) {
-        mesh->addTriangle(ToBt(s.mesh->vertices[t[0]]), ToBt(s.mesh->vertices[t[1]]),
-                          ToBt(s.mesh->vertices[t[2]]));
-      }
-      auto shape = std::make_unique<btBvhTriangleMeshShape>(mesh.get(), true);
-      meshes->push_back(std::move(mesh));
-      return shape;
-    }
-  }
-  return nullptr;
+// The convex static shapes; boxes, planes and meshes go into the merged triangle mesh
+// (AppendTriangles) instead.
+std::unique_ptr<btCollisionShape> MakeConvexShape(const ShapeDescription& s) {
+  if (s.kind == ShapeKind::kSphere) return std::make_unique<btSphereShape>(s.radius);
+  return std::make_unique<btCylinderShapeZ>(btVector3(s.radius, s.radius, s.length / 2));
 }
 
 }  // namespace
@@ -297,7 +279,7 @@ struct TwinWorld::Impl {
         (void)before;
         return;
       }
-      ray_targets.push_back(AddBody(MakeShape(s, &meshes), s.X_WS, 0.0, floor ? kGFloor : kGStatic,
+      ray_targets.push_back(AddBody(MakeConvexShape(s), s.X_WS, 0.0, floor ? kGFloor : kGStatic,
                                     floor ? kMaskFloor : kMaskStatic, e));
     };
     for (const auto& s : world.shapes)
