@@ -179,16 +179,19 @@ class Service final : public v1::Navigation::Service {
         }
         break;
       }
-      case v1::LoadWorldRequest::kSdfPath: {
+      case v1::LoadWorldRequest::kSdfPath:
+      case v1::LoadWorldRequest::kSdfText: {
+        const bool by_path = request.source_case() == v1::LoadWorldRequest::kSdfPath;
         try {
           const apps::SdfMap map = apps::RasterizeSdfWorld(
-              twin::LoadSdfWorld(request.sdf_path()),
+              by_path ? twin::LoadSdfWorld(request.sdf_path())
+                      : twin::LoadSdfWorldFromString(request.sdf_text(), "sdf_text"),
               request.sdf_resolution() != 0 ? request.sdf_resolution() : 0.05,
               config_.max_map_cells);
           grid = map.grid;
           sdf_doors = map.doors;
         } catch (const std::exception& e) {
-          return Invalid(std::string("sdf_path: ") + e.what());
+          return Invalid(std::string(by_path ? "sdf_path: " : "sdf_text: ") + e.what());
         }
         break;
       }

@@ -315,6 +315,22 @@ TEST_F(NavigationServerTest, LoadsTheOfficeSdfWorldWithItsDoors) {
   sdf.set_sdf_resolution(0.001);
   grpc::ClientContext c4;
   EXPECT_EQ(stub_->LoadWorld(&c4, sdf, &loaded).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  // By value: the same world as text; malformed text is INVALID_ARGUMENT naming sdf_text.
+  std::ifstream in(std::filesystem::path(EGRESS_OFFICE_MAP).parent_path() / "office.sdf");
+  v1::LoadWorldRequest by_value;
+  by_value.set_sdf_text(std::string(std::istreambuf_iterator<char>(in), {}));
+  grpc::ClientContext c5;
+  v1::LoadWorldResponse from_text;
+  ASSERT_TRUE(stub_->LoadWorld(&c5, by_value, &from_text).ok());
+  EXPECT_EQ(from_text.width(), 280);
+  v1::PlanPathResponse through;
+  ASSERT_TRUE(Plan(from_text.world_id(), Pose(1.5, 4.5), Pose(12.5, 1.5), &through).ok());
+  EXPECT_EQ(through.doors_crossed_size(), 2);
+  by_value.set_sdf_text("<sdf version='1.6'><world name='w'>");
+  grpc::ClientContext c6;
+  const grpc::Status bad = stub_->LoadWorld(&c6, by_value, &from_text);
+  EXPECT_EQ(bad.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(bad.error_message(), HasSubstr("sdf_text"));
 }
 
 }  // namespace
