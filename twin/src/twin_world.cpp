@@ -1128,6 +1128,12 @@ struct TwinWorld::Impl {
 
   RayHit CastSegment(const Eigen::Vector3d& from, const Eigen::Vector3d& to, GlassMode mode,
                      double glass_max_incidence) const;
+  // The ray callbacks' views of the entities, made once rather than per ray.
+  const std::function<bool(int)> ray_is_glass = [this](int e) {
+    return e >= 0 && entities[std::size_t(e)].glass;
+  };
+  const std::function<int(const btCollisionObject*, int)> ray_entity_of =
+      [this](const btCollisionObject* o, int t) { return EntityOf(o, t); };
   std::vector<Entity> entities;
   std::vector<Door> doors;
   std::map<std::string, int> actuator_entity;
@@ -1363,12 +1369,12 @@ namespace {
 
 class TwinRayCallback : public btCollisionWorld::RayResultCallback {
  public:
-  TwinRayCallback(const btVector3& dir, GlassMode mode, double cos_max,
+  TwinRayCallback(const btVector3& dir, GlassMode mode, double glass_max_incidence,
                   const std::function<bool(int)>& is_glass,
                   const std::function<int(const btCollisionObject*, int)>& entity_of)
       : dir_(dir.normalized()),
         mode_(mode),
-        cos_max_(cos_max),
+        glass_max_incidence_(glass_max_incidence),
         is_glass_(is_glass),
         entity_of_(entity_of) {}
 
@@ -1381,7 +1387,8 @@ class TwinRayCallback : public btCollisionWorld::RayResultCallback {
                    r.m_localShapeInfo != nullptr ? r.m_localShapeInfo->m_triangleIndex : -1);
     const bool glass = is_glass_(entity);
     if (glass && (mode_ == GlassMode::kTransparent ||
-                  (mode_ == GlassMode::kLaser && std::abs(n.normalized().dot(dir_)) < cos_max_))) {
+                  (mode_ == GlassMode::kLaser &&
+                   std::abs(n.normalized().dot(dir_)) < std::cos(glass_max_incidence_)))) {
       return m_closestHitFraction;  // the ray passes through the glass
     }
     m_closestHitFraction = r.m_hitFraction;
@@ -1399,21 +1406,27 @@ class TwinRayCallback : public btCollisionWorld::RayResultCallback {
  private:
   btVector3 dir_;
   GlassMode mode_;
-  double cos_max_;
+  double glass_max_incidence_;  // [rad]; its cosine is needed only on a glass hit
   const std::function<bool(int)>& is_glass_;
   const std::function<int(const btCollisionObject*, int)>& entity_of_;
 };
 
-// The static triangle mesh's hits, passed on to the twin's ray callback.
+// The static triangle mesh's hits, passed on to the twin's ray callback. The mesh may be cast on
+// a piece [0, scale] of the twin's ray; fractions are rescaled to the whole ray.
 class StaticMeshRayCallback : public btTriangleRaycastCallback {
  public:
-  StaticMeshRayCallback(const btVector3& from, const btVector3& to, const btCollisionObject* mesh,
-                        TwinRayCallback* out,
+  StaticMeshRayCallback(const btVector3& from, const btVector3& to, btScalar scale,
+                        const btCollisionObject* mesh, TwinRayCallback* out,
                         const std::function<int(const btCollisionObject*, int)>& entity_of)
-      : btTriangleRaycastCallback(from, to), mesh_(mesh), out_(out), entity_of_(entity_of) {}
+      : btTriangleRaycastCallback(from, to),
+        scale_(scale),
+        mesh_(mesh),
+        out_(out),
+        entity_of_(entity_of) {}
   btScalar reportHit(const btVector3& normal, btScalar fraction, int, int triangle) override {
-    if (fraction >= out_->m_closestHitFraction) return m_hitFraction;
-    out_->m_closestHitFraction = fraction;
+    const btScalar whole = fraction * scale_;
+    if (whole >= out_->m_closestHitFraction) return m_hitFraction;
+    out_->m_closestHitFraction = whole;
     out_->m_collisionObject = mesh_;
     out_->normal = normal;
     out_->entity = entity_of_(mesh_, triangle);
@@ -1422,6 +1435,7 @@ class StaticMeshRayCallback : public btTriangleRaycastCallback {
   }
 
  private:
+  btScalar scale_;
   const btCollisionObject* mesh_;
   TwinRayCallback* out_;
   const std::function<int(const btCollisionObject*, int)>& entity_of_;
@@ -1432,22 +1446,14 @@ class StaticMeshRayCallback : public btTriangleRaycastCallback {
 RayHit TwinWorld::Impl::CastSegment(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
                                     GlassMode mode, double glass_max_incidence) const {
   const btVector3 a = ToBt(from), b = ToBt(to);
-  const std::function<bool(int)> is_glass = [this](int e) {
-    return e >= 0 && entities[std::size_t(e)].glass;
-  };
-  const std::function<int(const btCollisionObject*, int)> entity_of =
-      [this](const btCollisionObject* o, int t) { return EntityOf(o, t); };
-  TwinRayCallback cb(b - a, mode, std::cos(glass_max_incidence), is_glass, entity_of);
-  // Bullet's ray tests, object by object rather than through the broadphase: the static
-  // triangle mesh first, then every other ray target whose bounding box the ray still crosses
-  // before its closest hit so far. Dynamic bodies are cast as triangle proxies of their
-  // shapes (see BuildRayProxies): Bullet's triangle ray test is exact and much cheaper than
-  // its iterative convex cast.
-  if (static_mesh_shape != nullptr) {
-    StaticMeshRayCallback mesh_cb(a, b, static_mesh_body, &cb, entity_of);
-    static_mesh_shape->performRaycast(&mesh_cb, a, b);
-  }
-  const btTransform from_T(btQuaternion::getIdentity(), a), to_T(btQuaternion::getIdentity(), b);
+  TwinRayCallback cb(b - a, mode, glass_max_incidence, ray_is_glass, ray_entity_of);
+  // Bullet's ray tests, object by object rather than through the broadphase: first the cheap
+  // targets (the ground plane, and every other target whose bounding box the ray still crosses
+  // before its closest hit so far), then the static triangle mesh on the ray clipped just past
+  // that hit: the mesh's BVH walk costs in proportion to the ray's length. Dynamic bodies are
+  // cast as triangle proxies of their shapes (see BuildRayProxies): Bullet's triangle ray test
+  // is exact and much cheaper than its iterative convex cast.
+  const btTransform from_T(btMatrix3x3::getIdentity(), a), to_T(btMatrix3x3::getIdentity(), b);
   for (std::size_t i = 0; i < ray_targets.size(); ++i) {
     const btCollisionObject* target = ray_targets[i];
     btVector3 normal;
@@ -1458,6 +1464,13 @@ RayHit TwinWorld::Impl::CastSegment(const Eigen::Vector3d& from, const Eigen::Ve
       continue;
     btCollisionWorld::rayTestSingle(from_T, to_T, const_cast<btCollisionObject*>(target),
                                     target->getCollisionShape(), target->getWorldTransform(), cb);
+  }
+  if (static_mesh_shape != nullptr) {
+    // A hair past the closest hit, so that a wall standing on the floor still wins the tie.
+    const btScalar scale = std::min<btScalar>(1.0, cb.m_closestHitFraction * 1.001 + 1e-6);
+    const btVector3 b_clipped = a + (b - a) * scale;
+    StaticMeshRayCallback mesh_cb(a, b_clipped, scale, static_mesh_body, &cb, ray_entity_of);
+    static_mesh_shape->performRaycast(&mesh_cb, a, b_clipped);
   }
   RayHit hit;
   if (!cb.hasHit()) return hit;
