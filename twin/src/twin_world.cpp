@@ -1078,6 +1078,7 @@ struct TwinWorld::Impl {
     RecordContacts();
     for (std::size_t i = 0; i < people.size(); ++i)
       states_cache[i] = people[i].state;
+    SyncRayProxies();  // the sensors see doors, people and payloads where they are now
   }
 
   Pose2 RobotPose() const {
