@@ -79,9 +79,9 @@ case "$command" in
     say "the main job: egress --version (the libraries each module links)"
     "$build_dir/apps/egress" --version
     echo
-    say "a twin scenario end to end: the lab door held open by a person, the dead-reckoning baseline"
-    say "robot driving through it (the robot brain replaces this driver with its issue)"
-    "$build_dir/apps/egress" sim run worlds/lab/lab_hold_door.yaml --driver dead-reckoning --duration 30 \
+    say "a twin scenario end to end, driven by the robot brain: S1, press the lab door's push button"
+    say "and drive through while the ADA operator holds it open"
+    "$build_dir/apps/egress" sim run worlds/scenarios/s1_nominal.yaml \
       --png "$build_dir/demo_run.png" --trace "$build_dir/demo_run.jsonl" --overwrite
     echo
     say "a base path across the office SDF world through door_a and door_b, drawn to $build_dir/demo_path.png"

@@ -1,8 +1,9 @@
 // `egress sim run`: one twin scenario end to end, with a readable verdict, a JSON verdict, a trace
 // and pictures. `egress render`: a recorded trace as a PNG or an MP4.
 //
-// Drivers: `idle` (the robot stands still) and `dead-reckoning` (a naive baseline that drives
-// straight at the goal on odometry alone). The robot brain becomes a driver with its issue.
+// Drivers: `brain` (the executive running the scenario's mission tree; the default when the
+// scenario has a `mission`), `idle` (the robot stands still) and `dead-reckoning` (a naive
+// baseline that drives straight at the goal on odometry alone).
 
 #include <unistd.h>
 
@@ -18,6 +19,7 @@
 #include "egress/hsr_interface/error.h"
 #include "egress/twin/sdf_world_loader.h"
 #include "egress/twin/twin_run.h"
+#include "sdf_map.h"
 #include "trace_render.h"
 
 namespace egress::apps {
@@ -27,7 +29,7 @@ struct SimOptions {
   std::string scenario;
   std::optional<std::uint64_t> seed;
   double duration{0.0};
-  std::string driver{"idle"};
+  std::string driver{"auto"};
   std::string trace;
   std::string json;
   std::string png;
@@ -83,12 +85,21 @@ void RunSim(const SimOptions& o) {
   twin::TwinWorld world(scenario, world_description, seed, model);
   twin::TwinRobot robot(&world);
   twin::Controller controller;
-  if (o.driver == "idle") {
+  std::unique_ptr<behavior::Executive> brain;
+  const std::string driver = o.driver != "auto" ? o.driver : (scenario.mission ? "brain" : "idle");
+  twin::RunOptions options;
+  if (driver == "brain") {
+    static const behavior::ExecutiveConfig kDefaults;
+    brain = MakeScenarioExecutive(scenario, world_description, world, model, kDefaults);
+    options.control_period = 1.0 / 100.0;
+    controller = [&brain](RobotPort& port) { return brain->Step(port); };
+  } else if (driver == "idle") {
     controller = twin::IdleController();
   } else if (o.driver == "dead-reckoning") {
     controller = DeadReckoningController(scenario);
   } else {
-    throw CommandFailed(fmt::format("--driver '{}': expected idle or dead-reckoning", o.driver));
+    throw CommandFailed(
+        fmt::format("--driver '{}': expected auto, brain, idle or dead-reckoning", o.driver));
   }
   if (!o.quiet) {
     fmt::print("scenario  {} ({})\n", scenario.name.empty() ? o.scenario : scenario.name,
@@ -97,10 +108,9 @@ void RunSim(const SimOptions& o) {
                world_description.shapes.size(), world_description.doors.size());
     for (const auto& note : world_description.notes)
       fmt::print("note      {}\n", note);
-    fmt::print("seed      {}   driver {}   time limit {:.0f} s\n", seed, o.driver,
+    fmt::print("seed      {}   driver {}   time limit {:.0f} s\n", seed, driver,
                scenario.time_limit);
   }
-  twin::RunOptions options;
   options.duration = o.duration;
   if (!o.quiet && ::isatty(::fileno(stderr))) options.on_progress = ProgressBar;
   const auto started = std::chrono::steady_clock::now();
@@ -113,6 +123,11 @@ void RunSim(const SimOptions& o) {
                world.events().size());
     for (const auto& e : world.events()) {
       fmt::print("  {:7.2f}  {:<22} {:<14} {}\n", e.t, e.kind, e.subject, e.detail);
+    }
+    if (brain) {
+      fmt::print("decisions ({}):\n", brain->decisions().size());
+      for (const auto& d : brain->decisions())
+        fmt::print("  {:7.2f}  {}\n", d.time, d.text);
     }
   }
   std::cout << twin::FormatVerdict(result.verdict);
@@ -157,7 +172,9 @@ void AddSimCommand(CLI::App& app) {
   sim->add_option("--seed", o->seed, "seed (default: the scenario's)");
   sim->add_option("--duration", o->duration,
                   "simulated seconds (default: the scenario's time limit)");
-  sim->add_option("--driver", o->driver, "who drives the robot: idle | dead-reckoning")
+  sim->add_option("--driver", o->driver,
+                  "who drives the robot: auto (brain if the scenario has a mission, else idle) | "
+                  "brain | idle | dead-reckoning")
       ->capture_default_str();
   sim->add_option("--trace", o->trace, "write the run's trace (JSON lines, 20 Hz)");
   sim->add_option("--json", o->json, "write the verdict as JSON");

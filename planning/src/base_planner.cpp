@@ -289,6 +289,21 @@ struct BasePlanner::Impl {
     } else {
       setup.setOptimizationObjective(length);
     }
+    if (config.deterministic) {
+      // No sampling: the string-pulled grid path, checked by the same validity checker.
+      auto seed = GridSeed(start, goal, s.get(), g.get());
+      if (!seed || seed->getStateCount() < 2 || !seed->check()) {
+        result.status = PlanStatus::kGoalUnreachable;
+        result.message = "no collision-free grid path between start and goal";
+        return result;
+      }
+      for (std::size_t i = 0; i < seed->getStateCount(); ++i) {
+        const auto* st = seed->getState(i)->as<ob::SE2StateSpace::StateType>();
+        result.path.push_back({st->getX(), st->getY(), st->getYaw()});
+      }
+      result.status = PlanStatus::kSuccess;
+      return result;
+    }
     setup.setPlanner(MakePlanner());
     const double sampling =
         config.grid_seed_after > 0.0 ? std::min(budget, config.grid_seed_after) : budget;

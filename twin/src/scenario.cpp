@@ -335,7 +335,7 @@ Scenario Parse(const YAML::Node& root, const FieldReader& r,
                const std::filesystem::path& base_dir) {
   r.CheckKeys(root, "",
               {"name", "world", "seed", "time_limit", "robot", "doors", "people", "payloads",
-               "obstacles", "randomize", "success", "sensors"});
+               "obstacles", "randomize", "success", "sensors", "mission"});
   Scenario s;
   s.name = root["name"] ? r.String(root["name"], "name") : std::string();
   const std::string world = r.String(r.Required(root, "", "world"), "world");
@@ -533,6 +533,27 @@ Scenario Parse(const YAML::Node& root, const FieldReader& r,
     }
   }
   if (const YAML::Node sensors = root["sensors"]) ParseSensors(r, sensors, &s.sensors);
+  if (const YAML::Node mission = root["mission"]) {
+    r.CheckKeys(mission, "mission", {"tree", "main", "blackboard"});
+    MissionSpec m;
+    const YAML::Node tree = r.Required(mission, "mission", "tree");
+    const std::filesystem::path file = r.String(tree, "mission.tree");
+    m.tree_file = file.is_absolute() ? file : base_dir / file;
+    m.tree_line = tree.Mark().line + 1;
+    if (!std::filesystem::exists(m.tree_file))
+      r.Fail(tree, "mission.tree", "no such file: " + m.tree_file.string());
+    if (mission["main"]) m.tree_id = r.String(mission["main"], "mission.main");
+    if (const YAML::Node bb = mission["blackboard"]) {
+      if (!bb.IsMap()) r.Fail(bb, "mission.blackboard", "expected a mapping of key: value");
+      for (const auto& kv : bb) {
+        const std::string key = kv.first.as<std::string>();
+        if (!kv.second.IsScalar())
+          r.Fail(kv.second, "mission.blackboard." + key, "expected a scalar value");
+        m.blackboard[key] = kv.second.Scalar();
+      }
+    }
+    s.mission = std::move(m);
+  }
   return s;
 }
 

@@ -51,6 +51,10 @@ struct BasePlannerConfig {
   /// shortcuts it (the result is re-checked). 0 disables the fallback (pure sampling).
   double grid_seed_after{0.25};  ///< [s]
   std::uint32_t seed{42};        ///< OMPL's process-wide seed (set once per process).
+  /// Skip sampling and use the string-pulled grid path alone (still checked by the validity
+  /// checker): a pure function of the costmap, for lock-step simulation where a run must be a
+  /// pure function of its seed. Wall-clock budgets make sampling planners vary run to run.
+  bool deterministic{false};
   void Validate() const;
 };
 

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <random>
 #include <string>
@@ -155,6 +156,16 @@ struct RandomizeSpec {
   Range person_speed_scale{1.0, 1.0};    ///< Multiplies sampled speeds.
 };
 
+/// The robot brain's task in a scenario. The twin does not read it (it knows nothing of the
+/// brain); the executive does: which behavior tree to run, and the blackboard entries it starts
+/// with (strings, converted by the tree's ports).
+struct MissionSpec {
+  std::filesystem::path tree_file;  ///< BehaviorTree.CPP v4 XML, resolved against the scenario.
+  std::string tree_id;              ///< Tree to run; empty = the file's main tree.
+  std::map<std::string, std::string> blackboard;
+  int tree_line{0};  ///< Line of `mission.tree` in the scenario file (for error messages).
+};
+
 struct Scenario {
   std::string name;
   std::filesystem::path source;      ///< The YAML file.
@@ -171,6 +182,7 @@ struct Scenario {
   RandomizeSpec randomize;
   std::vector<PredicateSpec> success;
   SensorConfig sensors;
+  std::optional<MissionSpec> mission;
 
   /// Checks the scenario against its world: doors and actuators exist, poses are free of
   /// walls. @throws LoadError naming the scenario file and field.

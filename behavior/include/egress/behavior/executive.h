@@ -1,0 +1,93 @@
+#pragma once
+/// @file
+/// Executive: the robot brain's loop, the same against the twin and the real robot. Each
+/// control step (100 Hz default): read the RobotPort → localize (odometry from the initial
+/// pose) → update perception (laser: costmap and door angles; camera: detections placed with
+/// depth, people tracked with intent) → every tick period (10 Hz default) tick the behavior tree
+/// → run the trajectory controller → send the commands. The executive reads time only from the
+/// port's clock, so in the twin it runs in lock-step with simulated time.
+
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "egress/behavior/mission_map.h"
+#include "egress/behavior/motion_executor.h"
+#include "egress/behavior/task_context.h"
+#include "egress/bt/status.h"
+#include "egress/hsr_interface/robot_port.h"
+#include "egress/perception/costmap.h"
+#include "egress/perception/world_state.h"
+#include "egress/planning/base_planner.h"
+
+namespace egress::behavior {
+
+struct ExecutiveConfig {
+  double tick_rate_hz{10.0};      ///< Behavior-tree ticks (the paper's 10 Hz).
+  double control_rate_hz{100.0};  ///< Controller steps; Step() is called at this rate.
+  TaskConfig tasks;
+  planning::TrajectoryConfig trajectory;
+  planning::ControllerConfig controller;
+  perception::PerceptionConfig perception;
+  perception::CostmapConfig costmap;
+  planning::BasePlannerConfig planner = [] {
+    planning::BasePlannerConfig c;
+    c.deterministic = true;  // a twin run must be a pure function of its seed
+    return c;
+  }();
+  void Validate() const;
+};
+
+/// The tree to run and the blackboard it starts with.
+struct MissionTree {
+  std::filesystem::path file;
+  std::string tree_id;  ///< Empty: the file's main tree.
+  std::map<std::string, std::string> blackboard;
+};
+
+/// One line of the run's decision log.
+struct Decision {
+  double time{0.0};  ///< [s] robot clock
+  std::string text;
+};
+
+class Executive {
+ public:
+  /// Loads the tree (every node must be a registered task node or a built-in).
+  /// @throws LogicError / InvalidArgument naming the file, line and node for a bad tree, an
+  /// unknown node or a bad map.
+  Executive(std::shared_ptr<const RobotModel> model, MissionMap map, MissionTree tree,
+            const Pose2& X_MB_initial, ExecutiveConfig config = {});
+  ~Executive();
+  Executive(const Executive&) = delete;
+  Executive& operator=(const Executive&) = delete;
+
+  /// One control step. Returns false once the tree has finished (success or failure); the
+  /// robot is then commanded to stand still.
+  bool Step(RobotPort& port);
+
+  bt::NodeStatus status() const { return status_; }
+  const std::vector<Decision>& decisions() const { return decisions_; }
+  /// The running action's name (instance name, else its type), or empty.
+  std::string active_action() const;
+  const Pose2& X_MB() const { return context_.X_MB; }
+  const perception::Costmap2D& costmap() const { return *costmap_; }
+  const TaskContext& context() const { return context_; }
+  /// Time of the first tick at which an IsPathClear check failed after having passed, and of
+  /// the first zero-velocity / retract command after it, per event [s] (preemption latency).
+  const std::vector<std::pair<double, double>>& preemptions() const { return preemptions_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  TaskContext context_;
+  std::unique_ptr<perception::Costmap2D> costmap_;
+  bt::NodeStatus status_{bt::NodeStatus::kIdle};
+  std::vector<Decision> decisions_;
+  std::vector<std::pair<double, double>> preemptions_;
+};
+
+}  // namespace egress::behavior

@@ -1,0 +1,44 @@
+#pragma once
+/// @file
+/// MissionMap: what the robot brain knows of a building before it moves — the floor plan (an
+/// occupancy grid of walls and fixed furniture), its doors (hinge, latch, opening side) and the
+/// door actuators (push buttons, proximity plates) with their mounting walls. A building map,
+/// not ground truth: people, payloads, door angles and obstacles the map does not show are
+/// perceived at run time.
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "egress/perception/costmap.h"
+#include "egress/perception/door_estimation.h"
+#include "egress/perception/occupancy_grid.h"
+#include "egress/planning/ik_solver.h"
+
+namespace egress::behavior {
+
+/// The button or plate that opens one door.
+struct MapActuator {
+  std::string id;    ///< Its name in the building map.
+  std::string door;  ///< The door it operates.
+  planning::ButtonType type{planning::ButtonType::kPushButton};
+  Eigen::Vector3d p_M{Eigen::Vector3d::Zero()};   ///< Face centre of the actuator [m].
+  Eigen::Vector3d n_M{Eigen::Vector3d::UnitX()};  ///< Outward normal of its wall (unit).
+};
+
+struct MissionMap {
+  perception::OccupancyGrid grid;
+  std::vector<perception::Doorway> doorways;  ///< The doors as the costmap and planner see them.
+  std::vector<perception::DoorModel> doors;   ///< The same doors for door-angle estimation.
+  std::vector<MapActuator> actuators;
+
+  const perception::DoorModel* FindDoor(const std::string& id) const;
+  /// The actuator of `door`, or nullptr for a door without one (opened by hand).
+  const MapActuator* FindActuatorOf(const std::string& door) const;
+  /// @throws InvalidArgument for a door without a doorway, an actuator of an unknown door or a
+  /// non-finite pose.
+  void Validate() const;
+};
+
+}  // namespace egress::behavior

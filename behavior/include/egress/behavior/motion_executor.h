@@ -1,0 +1,74 @@
+#pragma once
+/// @file
+/// MotionExecutor: runs the motions the task nodes start. Base paths become the paper's quintic
+/// whole-body trajectories (T = max(L/v, 1.5 s), 0.4 m/s through doors) followed by the
+/// feedforward-PD TrackingController at the control rate, with its watchdog; arm motions become
+/// timed joint trajectories for the robot's own arm controller. One motion of each kind at a
+/// time: a new one replaces the old. Time is the robot's clock, so a twin run is lock-step.
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "egress/hsr_interface/command_types.h"
+#include "egress/hsr_interface/geometry.h"
+#include "egress/hsr_interface/robot_model.h"
+#include "egress/hsr_interface/time.h"
+#include "egress/planning/tracking_controller.h"
+#include "egress/planning/trajectory.h"
+
+namespace egress::behavior {
+
+/// arm_lift [m], arm_flex, arm_roll, wrist_flex, wrist_roll [rad].
+using ArmPose = std::array<double, 5>;
+
+/// The arm folded over the base: nothing sticks out of the footprint.
+inline constexpr ArmPose kTuckedArm{0.0, 0.0, -1.5707963267948966, -1.5707963267948966, 0.0};
+
+/// The arm joints of a whole-body vector, and back.
+ArmPose ArmOf(const WholeBodyVector& q);
+WholeBodyVector WithArm(const WholeBodyVector& q, const ArmPose& arm);
+
+class MotionExecutor {
+ public:
+  MotionExecutor(const RobotModel& model, planning::TrajectoryConfig trajectory = {},
+                 planning::ControllerConfig controller = {});
+
+  /// Follows `path` (X_MB waypoints, the first one the current pose); `through_door[i]` marks
+  /// segment i as a door crossing (0.4 m/s). The arm holds `arm`.
+  /// @throws InvalidArgument for fewer than 2 waypoints or non-finite poses.
+  void FollowPath(const std::vector<Pose2>& path, const std::vector<bool>& through_door,
+                  const ArmPose& arm, Time now);
+  /// Stops the base: zero velocity from the next control step.
+  void StopBase();
+  /// Moves the arm through `knots` (seconds from now, pose). Sent with the next control step.
+  void MoveArm(const std::vector<std::pair<double, ArmPose>>& knots, Time now);
+
+  bool base_moving() const { return base_active_; }
+  /// The last base motion ended by the watchdog (tracking error beyond its limits).
+  bool base_failed() const { return base_failed_; }
+  const std::string& base_failure() const { return base_failure_; }
+  bool arm_moving(Time now) const { return now < arm_done_; }
+  Time arm_done() const { return arm_done_; }
+  /// The arm pose the last arm motion ends in.
+  const ArmPose& arm_target() const { return arm_target_; }
+
+  /// One control step: the base twist to send (zero when idle).
+  Twist2 Update(Time now, const Pose2& X_MB, const Twist2& V_B_measured);
+  /// The arm trajectory to send, once.
+  std::optional<JointTrajectory> TakeArmCommand();
+
+ private:
+  const RobotModel& model_;
+  planning::TrajectoryConfig trajectory_config_;
+  planning::TrackingController controller_;
+  bool base_active_{false};
+  bool base_failed_{false};
+  std::string base_failure_;
+  std::optional<JointTrajectory> pending_arm_;
+  Time arm_done_{};
+  ArmPose arm_target_{kTuckedArm};
+};
+
+}  // namespace egress::behavior

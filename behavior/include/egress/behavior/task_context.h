@@ -1,0 +1,89 @@
+#pragma once
+/// @file
+/// TaskContext: what the task nodes share — the robot's latest belief (pose, world state), the
+/// building map, the planner and the motion executor — and TaskConfig, their parameters. The
+/// executive owns one and refreshes it every control step; the nodes read it when ticked.
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "egress/behavior/mission_map.h"
+#include "egress/behavior/motion_executor.h"
+#include "egress/hsr_interface/robot_model.h"
+#include "egress/perception/world_state.h"
+#include "egress/planning/base_planner.h"
+#include "egress/planning/ik_solver.h"
+
+namespace egress::behavior {
+
+struct TaskConfig {
+  double footprint_radius{0.215};   ///< The HSR's round base [m].
+  double door_entry_distance{0.7};  ///< Entry pose this far before the door line [m].
+  double door_exit_distance{1.0};   ///< Exit pose this far past the door line [m].
+  double zone_depth{1.0};           ///< People-free zone each side of a door line [m].
+  double person_radius{0.3};        ///< [m]
+  double arm_tuck_time{1.5};        ///< [s]
+  double press_reach_time{2.0};     ///< Tucked → pre-press [s].
+  double press_time{1.0};           ///< Pre-press → press → pre-press, each way [s].
+  double wave_hold_time{1.5};       ///< Palm held at the plate [s].
+  /// Button targets. The press aims 20 mm past the cap's face, at the wall plane behind a
+  /// surface-mounted button: the cap switches after 4 mm, and odometry leaves the base up to a
+  /// centimetre or two off its planned pose after a few metres (no contact sensing in the loop).
+  planning::ButtonTargetsConfig buttons = [] {
+    planning::ButtonTargetsConfig c;
+    c.press_stroke = 0.02;
+    return c;
+  }();
+  planning::IkConfig ik;  ///< For button presses (fingertip for push buttons).
+  void Validate() const;
+};
+
+/// A press worked out by ApproachButton for PressButton / WaveAtPlate.
+struct ButtonPlan {
+  planning::ButtonType type{planning::ButtonType::kPushButton};
+  planning::ButtonTargets targets;
+  Pose2 X_MB_standoff;               ///< Where the base stands (from whole-body IK).
+  ArmPose approach_arm{kTuckedArm};  ///< The arm there (seed for the arm-only solves).
+};
+
+struct TaskContext {
+  const RobotModel* model{nullptr};
+  const MissionMap* map{nullptr};
+  TaskConfig config;
+  MotionExecutor* motion{nullptr};
+  const planning::BasePlanner* planner{nullptr};
+
+  // Refreshed every control step by the executive.
+  Time now{};
+  Pose2 X_MB;  ///< Localized base pose.
+  perception::WorldState world;
+  bool holding_object{false};
+  /// The last pose at which the robot stood outside every door zone.
+  std::optional<Pose2> last_safe;
+
+  // Kept by the nodes.
+  std::map<std::string, ButtonPlan> button_plans;  ///< Per door.
+  std::map<std::string, Time> zone_occupied_at;    ///< Per door: when a person last was in it.
+  std::vector<std::string> notes;                  ///< The nodes' reasons, for the run log.
+
+  double now_s() const { return ToSeconds(now); }
+  void Note(std::string text) { notes.push_back(std::move(text)); }
+};
+
+/// Geometry of one door as the robot approaches it.
+struct DoorPass {
+  Eigen::Vector2d centre;  ///< Middle of the opening [m].
+  Eigen::Vector2d n_M;     ///< Unit normal of the door line pointing to the robot's side.
+  double width{0.0};
+};
+/// @throws InvalidArgument for an unknown door id.
+DoorPass CalcDoorPass(const MissionMap& map, const std::string& door, const Pose2& X_MB);
+
+/// True when a person (not one holding this door) is in, or forecast into, the zone of `door`.
+bool IsDoorZoneOccupied(const TaskContext& context, const std::string& door);
+/// Clearance of the door's opening from the latest estimate, or nullopt if never observed.
+std::optional<double> DoorClearance(const TaskContext& context, const std::string& door);
+
+}  // namespace egress::behavior

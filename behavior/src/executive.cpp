@@ -1,0 +1,217 @@
+#include "egress/behavior/executive.h"
+
+#include <cmath>
+
+#include "egress/behavior/task_nodes.h"
+#include "egress/bt/clock.h"
+#include "egress/bt/factory.h"
+#include "egress/bt/loggers.h"
+#include "egress/bt/tree.h"
+#include "egress/hsr_interface/error.h"
+
+namespace egress::behavior {
+
+void ExecutiveConfig::Validate() const {
+  ThrowUnless(
+      tick_rate_hz > 0 && control_rate_hz >= tick_rate_hz,
+      "ExecutiveConfig: rates must be positive and the control rate at least the tick rate");
+  tasks.Validate();
+  trajectory.Validate();
+  controller.Validate();
+  planner.Validate();
+}
+
+namespace {
+
+std::string_view StatusWord(bt::NodeStatus s) {
+  switch (s) {
+    case bt::NodeStatus::kRunning:
+      return "started";
+    case bt::NodeStatus::kSuccess:
+      return "succeeded";
+    case bt::NodeStatus::kFailure:
+      return "failed";
+    default:
+      return "halted";
+  }
+}
+
+// Logs the actions' transitions (started / succeeded / failed / halted) as decisions.
+class ActionLog final : public bt::StatusObserver {
+ public:
+  ActionLog(bt::Tree& tree, std::vector<Decision>* out) : StatusObserver(tree), out_(out) {}
+  const bt::TreeNode* running() const { return running_; }
+
+ private:
+  void OnStatusChange(Duration time, const bt::TreeNode& node, bt::NodeStatus previous,
+                      bt::NodeStatus status) override {
+    if (node.kind() != bt::NodeKind::kAction) return;
+    if (status == bt::NodeStatus::kRunning) running_ = &node;
+    if (status != bt::NodeStatus::kRunning && running_ == &node) running_ = nullptr;
+    if (status == bt::NodeStatus::kIdle && previous != bt::NodeStatus::kRunning) return;
+    const std::string& name = node.name().empty() ? node.registration_id() : node.name();
+    out_->push_back({ToSeconds(time), StrCat(name, " ", StatusWord(status))});
+  }
+  std::vector<Decision>* out_;
+  const bt::TreeNode* running_{nullptr};
+};
+
+}  // namespace
+
+struct Executive::Impl {
+  std::shared_ptr<const RobotModel> model;
+  MissionMap map;
+  ExecutiveConfig config;
+  perception::PerceptionPipeline perception;
+  std::unique_ptr<planning::BasePlanner> planner;
+  MotionExecutor motion;
+  std::shared_ptr<bt::ManualClock> clock = std::make_shared<bt::ManualClock>();
+  bt::BehaviorTreeFactory factory;
+  std::optional<bt::Tree> tree;
+  std::unique_ptr<ActionLog> log;
+  std::optional<Pose2> X_MO;  // odometry frame in the map, fixed at the first step
+  Pose2 X_MB_initial;
+  std::optional<Time> next_tick;
+  std::optional<DepthImage> depth;
+  std::optional<Pose3> X_BC;
+  CameraIntrinsics intrinsics;
+  bool finished{false};
+  std::map<std::string, bool> zone_occupied;  // per door, at the last control step
+  std::optional<double> occupied_known_at;    // when perception first showed a person there
+
+  Impl(std::shared_ptr<const RobotModel> m, MissionMap mp, ExecutiveConfig c)
+      : model(std::move(m)),
+        map(std::move(mp)),
+        config(std::move(c)),
+        perception(map.doors, config.perception),
+        motion(*model, config.trajectory, config.controller) {}
+};
+
+Executive::Executive(std::shared_ptr<const RobotModel> model, MissionMap map, MissionTree tree,
+                     const Pose2& X_MB_initial, ExecutiveConfig config) {
+  ThrowUnless(model != nullptr, "Executive: no robot model");
+  ThrowUnless(X_MB_initial.IsFinite(), "Executive: the initial pose must be finite");
+  config.Validate();
+  map.Validate();
+  impl_ = std::make_unique<Impl>(std::move(model), std::move(map), std::move(config));
+  Impl& m = *impl_;
+  m.X_MB_initial = X_MB_initial;
+  costmap_ = std::make_unique<perception::Costmap2D>(m.map.grid, m.config.costmap);
+  planning::BasePlannerConfig planner_config = m.config.planner;
+  planner_config.footprint_radius = m.config.costmap.robot_radius;
+  m.planner = std::make_unique<planning::BasePlanner>(*costmap_, nullptr, planner_config);
+  for (const auto& doorway : m.map.doorways) {
+    costmap_->AddDoorway(doorway);
+    m.planner->AddDoor({doorway.id, doorway.p_MHinge, doorway.p_MLatch});
+  }
+  context_.model = m.model.get();
+  context_.map = &m.map;
+  context_.config = m.config.tasks;
+  context_.motion = &m.motion;
+  context_.planner = m.planner.get();
+  context_.X_MB = X_MB_initial;
+  context_.last_safe = X_MB_initial;
+  RegisterTaskNodes(m.factory, &context_);
+  auto blackboard = bt::Blackboard::Create();
+  for (const auto& [key, value] : tree.blackboard)
+    blackboard->Set(key, bt::Any(value));
+  m.factory.RegisterTreesFromFile(tree.file);
+  m.tree.emplace(m.factory.CreateTree(tree.tree_id, blackboard));
+  m.tree->SetClock(m.clock);
+  m.log = std::make_unique<ActionLog>(*m.tree, &decisions_);
+}
+
+Executive::~Executive() = default;
+
+std::string Executive::active_action() const {
+  const bt::TreeNode* node = impl_->log->running();
+  if (node == nullptr) return {};
+  return node->name().empty() ? node->registration_id() : node->name();
+}
+
+bool Executive::Step(RobotPort& port) {
+  Impl& m = *impl_;
+  const SensorSnapshot snapshot = port.Sense();
+  const Time now = port.clock().Now();
+  context_.now = now;
+  m.clock->Set(now);
+
+  // Localize: odometry composed onto the initial pose.
+  if (!m.X_MO) m.X_MO = m.X_MB_initial * snapshot.odometry.X_OB.Inverse();
+  context_.X_MB = *m.X_MO * snapshot.odometry.X_OB;
+  const Pose3 X_MB3 = Pose3::FromPose2(context_.X_MB);
+
+  // Perceive.
+  if (snapshot.depth) {
+    m.depth = snapshot.depth;
+    m.X_BC = snapshot.X_BC;
+    m.intrinsics = snapshot.depth_intrinsics;
+  }
+  const Pose3& X_BL = m.model->laser_pose();
+  if (snapshot.scan) {
+    const Pose3 X_ML3 = X_MB3 * X_BL;
+    const Pose2 X_ML = X_ML3.ToPose2();
+    costmap_->UpdateWithScan(*snapshot.scan, X_ML);
+    if (m.X_BC)
+      m.perception.ProcessScan(*snapshot.scan, X_ML, m.intrinsics, X_BL.Inverse() * *m.X_BC);
+  }
+  if (!snapshot.detections.empty() && m.depth && m.X_BC) {
+    m.perception.ProcessCameraFrame(snapshot.detections,
+                                    cv::Size(m.intrinsics.width, m.intrinsics.height), *m.depth,
+                                    m.intrinsics, X_MB3 * *m.X_BC);
+  }
+  context_.world =
+      m.perception.Snapshot(now, context_.X_MB, Eigen::Matrix3d::Zero(), costmap_.get());
+  context_.holding_object = snapshot.gripper.holding_object;
+  bool in_any_zone = false;
+  bool newly_occupied = false;
+  for (const auto& door : m.map.doors) {
+    const DoorPass pass = CalcDoorPass(m.map, door.id, context_.X_MB);
+    const double along = (context_.X_MB.translation() - pass.centre).dot(pass.n_M);
+    const double lateral = std::abs((context_.X_MB.translation() - pass.centre)
+                                        .dot(Eigen::Vector2d(-pass.n_M.y(), pass.n_M.x())));
+    if (along < context_.config.zone_depth && lateral < pass.width / 2 + 0.5) in_any_zone = true;
+    const bool occupied = IsDoorZoneOccupied(context_, door.id);
+    if (occupied && !m.zone_occupied[door.id]) newly_occupied = true;
+    m.zone_occupied[door.id] = occupied;
+  }
+  if (!in_any_zone && !m.motion.base_failed()) context_.last_safe = context_.X_MB;
+  if (newly_occupied && !m.occupied_known_at) m.occupied_known_at = ToSeconds(now);
+  bool any_occupied = false;
+  for (const auto& entry : m.zone_occupied)
+    any_occupied = any_occupied || entry.second;
+  if (!any_occupied) m.occupied_known_at.reset();
+
+  // Decide.
+  if (!m.finished && (!m.next_tick || now >= *m.next_tick)) {
+    m.next_tick = now + SecondsToDuration(1.0 / m.config.tick_rate_hz);
+    const std::size_t notes_before = context_.notes.size();
+    status_ = m.tree->TickOnce();
+    for (std::size_t i = notes_before; i < context_.notes.size(); ++i)
+      decisions_.push_back({ToSeconds(now), context_.notes[i]});
+    bool preempted = false;
+    for (std::size_t i = notes_before; i < context_.notes.size(); ++i)
+      preempted =
+          preempted || context_.notes[i].find("entering the door zone") != std::string::npos;
+    if (preempted && m.occupied_known_at) {
+      // The halt (zero velocity) and the standby's first command go out in this same step.
+      preemptions_.push_back({*m.occupied_known_at, ToSeconds(now)});
+      m.occupied_known_at.reset();
+    }
+    if (status_ == bt::NodeStatus::kSuccess || status_ == bt::NodeStatus::kFailure) {
+      m.finished = true;
+      m.motion.StopBase();
+      decisions_.push_back({ToSeconds(now), status_ == bt::NodeStatus::kSuccess
+                                                ? "mission succeeded"
+                                                : "mission failed"});
+    }
+  }
+
+  // Act.
+  const Twist2 V_B = m.motion.Update(now, context_.X_MB, snapshot.odometry.V_B);
+  port.SendBaseVelocity(V_B);
+  if (auto arm = m.motion.TakeArmCommand()) port.SendArmTrajectory(*arm);
+  return !m.finished;
+}
+
+}  // namespace egress::behavior

@@ -1,0 +1,95 @@
+#include "egress/behavior/motion_executor.h"
+
+#include <algorithm>
+
+#include "egress/hsr_interface/error.h"
+
+namespace egress::behavior {
+
+ArmPose ArmOf(const WholeBodyVector& q) {
+  return {q[kArmLift], q[kArmFlex], q[kArmRoll], q[kWristFlex], q[kWristRoll]};
+}
+
+WholeBodyVector WithArm(const WholeBodyVector& q, const ArmPose& arm) {
+  WholeBodyVector out = q;
+  for (int i = 0; i < 5; ++i)
+    out[kArmLift + i] = arm[std::size_t(i)];
+  return out;
+}
+
+MotionExecutor::MotionExecutor(const RobotModel& model, planning::TrajectoryConfig trajectory,
+                               planning::ControllerConfig controller)
+    : model_(model), trajectory_config_(trajectory), controller_(controller) {
+  trajectory_config_.Validate();
+}
+
+void MotionExecutor::FollowPath(const std::vector<Pose2>& path,
+                                const std::vector<bool>& through_door, const ArmPose& arm,
+                                Time now) {
+  ThrowUnless(path.size() >= 2, "FollowPath: a path needs at least 2 waypoints");
+  std::vector<WholeBodyVector> waypoints;
+  double previous_yaw = path.front().yaw;
+  for (const Pose2& X_MB : path) {
+    ThrowUnless(X_MB.IsFinite(), "FollowPath: non-finite waypoint");
+    WholeBodyVector q = WholeBodyVector::Zero();
+    // Unwrap the yaw so a quintic never turns the long way round through ±π.
+    const double yaw = previous_yaw + std::remainder(X_MB.yaw - previous_yaw, 2 * M_PI);
+    previous_yaw = yaw;
+    q[kBaseX] = X_MB.x;
+    q[kBaseY] = X_MB.y;
+    q[kBaseYaw] = yaw;
+    waypoints.push_back(WithArm(q, arm));
+  }
+  controller_.Start(
+      planning::WholeBodyTrajectory::Plan(waypoints, model_, trajectory_config_, through_door),
+      now);
+  base_active_ = true;
+  base_failed_ = false;
+  base_failure_.clear();
+}
+
+void MotionExecutor::StopBase() {
+  controller_.Stop();
+  base_active_ = false;
+}
+
+void MotionExecutor::MoveArm(const std::vector<std::pair<double, ArmPose>>& knots, Time now) {
+  ThrowUnless(!knots.empty(), "MoveArm: no knots");
+  JointTrajectory trajectory;
+  trajectory.joint_names = {"arm_lift_joint", "arm_flex_joint", "arm_roll_joint",
+                            "wrist_flex_joint", "wrist_roll_joint"};
+  for (const auto& [t, arm] : knots) {
+    JointTrajectoryPoint point;
+    point.positions.assign(arm.begin(), arm.end());
+    point.time_from_start = SecondsToDuration(t);
+    trajectory.points.push_back(std::move(point));
+  }
+  trajectory.Validate();
+  pending_arm_ = std::move(trajectory);
+  arm_done_ = now + SecondsToDuration(knots.back().first);
+  arm_target_ = knots.back().second;
+}
+
+Twist2 MotionExecutor::Update(Time now, const Pose2& X_MB, const Twist2& V_B_measured) {
+  if (!base_active_) return {};
+  const planning::ControlCommand command = controller_.Update(now, X_MB, V_B_measured);
+  if (command.watchdog_tripped) {
+    base_active_ = false;
+    base_failed_ = true;
+    base_failure_ = command.watchdog_reason;
+    return {};
+  }
+  if (command.finished || !command.active) {
+    base_active_ = false;
+    return {};
+  }
+  return command.V_B;
+}
+
+std::optional<JointTrajectory> MotionExecutor::TakeArmCommand() {
+  std::optional<JointTrajectory> out = std::move(pending_arm_);
+  pending_arm_.reset();
+  return out;
+}
+
+}  // namespace egress::behavior

@@ -1,0 +1,569 @@
+#include "egress/behavior/task_nodes.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "egress/hsr_interface/error.h"
+#include "egress/perception/person_tracker.h"
+
+namespace egress::behavior {
+
+using bt::InputPort;
+using bt::NodeConfig;
+using bt::NodeStatus;
+using bt::OutputPort;
+using bt::PortsList;
+
+void TaskConfig::Validate() const {
+  ThrowUnless(footprint_radius > 0 && door_entry_distance > 0 && door_exit_distance > 0 &&
+                  zone_depth > 0 && person_radius >= 0,
+              "TaskConfig: distances must be positive");
+  ThrowUnless(arm_tuck_time > 0 && press_reach_time > 0 && press_time > 0 && wave_hold_time >= 0,
+              "TaskConfig: motion times must be positive");
+  ik.Validate();
+}
+
+Pose2 ParsePose2(std::string_view text) {
+  std::vector<double> values;
+  std::stringstream in{std::string(text)};
+  std::string part;
+  while (std::getline(in, part, ';')) {
+    try {
+      std::size_t used = 0;
+      values.push_back(std::stod(part, &used));
+      if (part.find_first_not_of(" \t", used) != std::string::npos) throw std::invalid_argument("");
+    } catch (const std::exception&) {
+      throw InvalidArgument(StrCat("pose '", text, "': '", part, "' is not a number"));
+    }
+  }
+  ThrowUnless(values.size() == 2 || values.size() == 3, "pose '", text,
+              "': expected x;y;yaw (or x;y)");
+  const Pose2 X{values[0], values[1], values.size() == 3 ? values[2] : 0.0};
+  ThrowUnless(X.IsFinite(), "pose '", text, "': must be finite");
+  return X;
+}
+
+DoorPass CalcDoorPass(const MissionMap& map, const std::string& door, const Pose2& X_MB) {
+  const perception::DoorModel* model = map.FindDoor(door);
+  ThrowUnless(model != nullptr, "unknown door '", door, "' (not in the building map)");
+  DoorPass pass;
+  pass.centre = (model->p_MHinge + model->p_MLatch) / 2;
+  const Eigen::Vector2d along = (model->p_MLatch - model->p_MHinge).normalized();
+  Eigen::Vector2d n(-along.y(), along.x());
+  if (n.dot(X_MB.translation() - pass.centre) < 0) n = -n;
+  pass.n_M = n;
+  pass.width = model->width();
+  return pass;
+}
+
+bool IsDoorZoneOccupied(const TaskContext& context, const std::string& door) {
+  const perception::DoorModel* model = context.map->FindDoor(door);
+  ThrowUnless(model != nullptr, "unknown door '", door, "' (not in the building map)");
+  perception::DoorZone zone{*model, context.config.zone_depth, context.config.person_radius};
+  for (const auto& entry : context.world.people) {
+    // Someone holding this door open is why the robot may pass, not a reason to wait.
+    if (entry.intent == perception::PersonIntent::kHoldingDoor && entry.door_id == door) continue;
+    if (zone.Contains(entry.person.p_MP)) return true;
+    for (const auto& p : entry.person.forecast) {
+      if (zone.Contains(p)) return true;
+    }
+  }
+  return false;
+}
+
+std::optional<double> DoorClearance(const TaskContext& context, const std::string& door) {
+  for (const auto& d : context.world.doors) {
+    if (d.model.id == door) {
+      if (!d.state.observed) return std::nullopt;
+      return d.state.clearance_width;
+    }
+  }
+  throw InvalidArgument(StrCat("unknown door '", door, "' (not in the building map)"));
+}
+
+namespace {
+
+constexpr double kArmTolerance = 0.02;  // [rad or m] arm counts as at a pose
+
+bool ArmAt(const ArmPose& a, const ArmPose& b) {
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (std::abs(a[i] - b[i]) > kArmTolerance) return false;
+  }
+  return true;
+}
+
+std::string PoseText(const Pose2& X) {
+  return StrCat(std::round(X.x * 100) / 100, ", ", std::round(X.y * 100) / 100);
+}
+
+// Base for the nodes: access to the context and typed inputs that fail the node loudly.
+template <typename Base>
+class TaskNode : public Base {
+ public:
+  TaskNode(const std::string& name, NodeConfig config, TaskContext* context)
+      : Base(name, std::move(config)), ctx_(*context) {}
+
+ protected:
+  template <typename T>
+  T Input(std::string_view port) const {
+    auto value = this->template GetInput<T>(port);
+    if (!value) throw InvalidArgument(value.error());
+    return *value;
+  }
+  std::string Door() const { return Input<std::string>("door"); }
+  void Note(const std::string& text) const {
+    ctx_.Note(StrCat(this->name().empty() ? this->registration_id() : this->name(), ": ", text));
+  }
+  TaskContext& ctx_;
+};
+
+// Starts a base motion along a planned path; RUNNING until it ends.
+NodeStatus StartPath(TaskContext& ctx, const Pose2& goal, const std::string& what,
+                     const std::function<void(const std::string&)>& note) {
+  const planning::PlanResult plan = ctx.planner->Plan(ctx.X_MB, goal);
+  if (!plan.ok()) {
+    note(StrCat("no path to ", what, " (", PoseText(goal), "): ", plan.message));
+    return NodeStatus::kFailure;
+  }
+  std::vector<bool> through;
+  for (std::size_t i = 0; i + 1 < plan.path.size(); ++i)
+    through.push_back(false);
+  if (plan.path.size() < 2 ||
+      (plan.path.back().translation() - ctx.X_MB.translation()).norm() < 0.01) {
+    return NodeStatus::kSuccess;  // already there
+  }
+  ctx.motion->FollowPath(plan.path, through, ctx.motion->arm_target(), ctx.now);
+  note(StrCat("driving to ", what, " (", PoseText(goal), ", ", std::round(plan.length * 100) / 100,
+              " m)"));
+  return NodeStatus::kRunning;
+}
+
+NodeStatus BaseMotionStatus(const TaskContext& ctx,
+                            const std::function<void(const std::string&)>& note) {
+  if (ctx.motion->base_failed()) {
+    note("stopped: " + ctx.motion->base_failure());
+    return NodeStatus::kFailure;
+  }
+  return ctx.motion->base_moving() ? NodeStatus::kRunning : NodeStatus::kSuccess;
+}
+
+// ---- conditions
+
+class IsPathClear final : public TaskNode<bt::ConditionNode> {
+ public:
+  using TaskNode::TaskNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("door", "door whose zone must be free of people"),
+            InputPort<double>("clear_for", 1.0, "seconds the zone must have been clear [s]")};
+  }
+  NodeStatus Tick() override {
+    const std::string door = Door();
+    if (IsDoorZoneOccupied(ctx_, door)) {
+      if (last_ != NodeStatus::kFailure) Note("a person is in or entering the door zone");
+      ctx_.zone_occupied_at[door] = ctx_.now;
+      return last_ = NodeStatus::kFailure;
+    }
+    const auto it = ctx_.zone_occupied_at.find(door);
+    if (it != ctx_.zone_occupied_at.end() &&
+        ToSeconds(ctx_.now - it->second) < Input<double>("clear_for")) {
+      return last_ = NodeStatus::kFailure;
+    }
+    if (last_ == NodeStatus::kFailure) Note("door zone clear");
+    return last_ = NodeStatus::kSuccess;
+  }
+
+ private:
+  NodeStatus last_{NodeStatus::kIdle};
+};
+
+bool DoorPassable(const TaskContext& ctx, const std::string& door, double margin) {
+  const auto clearance = DoorClearance(ctx, door);
+  if (!clearance) return false;
+  for (const auto& d : ctx.world.doors) {
+    if (d.model.id == door && d.state.motion == perception::DoorMotion::kClosing) return false;
+  }
+  return *clearance >= 2 * ctx.config.footprint_radius + margin;
+}
+
+class IsDoorOpen final : public TaskNode<bt::ConditionNode> {
+ public:
+  using TaskNode::TaskNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("door", "door id"),
+            InputPort<double>("margin", 0.1, "clearance beyond the footprint [m]")};
+  }
+  NodeStatus Tick() override {
+    return DoorPassable(ctx_, Door(), Input<double>("margin")) ? NodeStatus::kSuccess
+                                                               : NodeStatus::kFailure;
+  }
+};
+
+class IsPersonHoldingDoor final : public TaskNode<bt::ConditionNode> {
+ public:
+  using TaskNode::TaskNode;
+  static PortsList ProvidedPorts() { return {InputPort<std::string>("door", "door id")}; }
+  NodeStatus Tick() override {
+    const std::string door = Door();
+    for (const auto& entry : ctx_.world.people) {
+      if (entry.door_id == door && entry.intent == perception::PersonIntent::kHoldingDoor &&
+          DoorPassable(ctx_, door, 0.0)) {
+        return NodeStatus::kSuccess;
+      }
+    }
+    return NodeStatus::kFailure;
+  }
+};
+
+class IsHoldingPayload final : public TaskNode<bt::ConditionNode> {
+ public:
+  using TaskNode::TaskNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("payload", "", "payload class; empty: any")};
+  }
+  NodeStatus Tick() override {
+    return ctx_.holding_object ? NodeStatus::kSuccess : NodeStatus::kFailure;
+  }
+};
+
+// ---- actions
+
+class ButtonType final : public TaskNode<bt::SyncActionNode> {
+ public:
+  using TaskNode::TaskNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("door", "door id"),
+            OutputPort<std::string>("type", "push_button or proximity_plate")};
+  }
+  NodeStatus Tick() override {
+    const MapActuator* actuator = ctx_.map->FindActuatorOf(Door());
+    if (actuator == nullptr) {
+      Note("door has no actuator");
+      return NodeStatus::kFailure;
+    }
+    this->SetOutput("type", std::string(actuator->type == planning::ButtonType::kPushButton
+                                            ? "push_button"
+                                            : "proximity_plate"));
+    return NodeStatus::kSuccess;
+  }
+};
+
+class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
+ public:
+  using TaskNode::TaskNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("goal", "goal pose x;y;yaw"),
+            InputPort<double>("speed", 0.2, "cruise speed [m/s]")};
+  }
+  NodeStatus OnStart() override {
+    const Pose2 goal = ParsePose2(Input<std::string>("goal"));
+    return StartPath(ctx_, goal, "goal", [this](const std::string& s) { Note(s); });
+  }
+  NodeStatus OnRunning() override {
+    return BaseMotionStatus(ctx_, [this](const std::string& s) { Note(s); });
+  }
+  void OnHalted() override { ctx_.motion->StopBase(); }
+};
+
+class ApproachButton final : public TaskNode<bt::StatefulActionNode> {
+ public:
+  using TaskNode::TaskNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("door", "door whose actuator to stand off")};
+  }
+  NodeStatus OnStart() override {
+    const std::string door = Door();
+    const MapActuator* actuator = ctx_.map->FindActuatorOf(door);
+    if (actuator == nullptr) {
+      Note("door has no actuator");
+      return NodeStatus::kFailure;
+    }
+    ButtonPlan plan;
+    plan.type = actuator->type;
+    plan.targets = planning::MakeButtonTargets(actuator->p_M, actuator->n_M, actuator->type,
+                                               ctx_.config.buttons);
+    // Whole-body IK from the standoff with the arm tucked picks where the base stands.
+    planning::IkConfig ik = ctx_.config.ik;
+    ik.fingertip = actuator->type == planning::ButtonType::kPushButton;
+    ik.use_base = true;
+    WholeBodyVector q0 = WholeBodyVector::Zero();
+    q0[kBaseX] = plan.targets.X_MB_standoff.x;
+    q0[kBaseY] = plan.targets.X_MB_standoff.y;
+    q0[kBaseYaw] = plan.targets.X_MB_standoff.yaw;
+    q0 = WithArm(q0, kTuckedArm);
+    const planning::IkResult solution =
+        planning::DlsIkSolver(*ctx_.model, ik).Solve(plan.targets.approach, q0);
+    plan.X_MB_standoff = solution.converged
+                             ? Pose2{solution.q[kBaseX], solution.q[kBaseY], solution.q[kBaseYaw]}
+                             : plan.targets.X_MB_standoff;
+    if (solution.converged) plan.approach_arm = ArmOf(solution.q);
+    if (!solution.converged) Note("whole-body IK did not converge; using the nominal standoff");
+    ctx_.button_plans[door] = plan;
+    return StartPath(ctx_, plan.X_MB_standoff, StrCat("the ", actuator->id, " standoff"),
+                     [this](const std::string& s) { Note(s); });
+  }
+  NodeStatus OnRunning() override {
+    return BaseMotionStatus(ctx_, [this](const std::string& s) { Note(s); });
+  }
+  void OnHalted() override { ctx_.motion->StopBase(); }
+};
+
+// Arm-only IK at the current base pose (the base stays where it stopped).
+std::optional<ArmPose> SolveArm(const TaskContext& ctx, const planning::IkTarget& target,
+                                const ArmPose& from, bool fingertip) {
+  planning::IkConfig ik = ctx.config.ik;
+  ik.fingertip = fingertip;
+  ik.use_base = false;
+  WholeBodyVector q = WholeBodyVector::Zero();
+  q[kBaseX] = ctx.X_MB.x;
+  q[kBaseY] = ctx.X_MB.y;
+  q[kBaseYaw] = ctx.X_MB.yaw;
+  q = WithArm(q, from);
+  const planning::DlsIkSolver solver(*ctx.model, ik);
+  planning::IkResult r = solver.Solve(target, q);
+  if (!r.converged && target.approach_M) {
+    // With the base a little off its planned pose the arm alone may not hold the approach
+    // axis too: the position is what presses.
+    planning::IkTarget position_only = target;
+    position_only.approach_M.reset();
+    r = solver.Solve(position_only, q);
+  }
+  if (!r.converged) return std::nullopt;
+  return ArmOf(r.q);
+}
+
+// Presses (push button) or waves (proximity plate): one arm motion, RUNNING until it ends.
+class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
+ public:
+  ActuatorAction(const std::string& name, NodeConfig config, TaskContext* context,
+                 planning::ButtonType type)
+      : TaskNode(name, std::move(config), context), type_(type) {}
+  NodeStatus OnStart() override {
+    const std::string door = Door();
+    const auto it = ctx_.button_plans.find(door);
+    if (it == ctx_.button_plans.end() || it->second.type != type_) {
+      Note("no standoff for this actuator: ApproachButton must run first");
+      return NodeStatus::kFailure;
+    }
+    const ButtonPlan& plan = it->second;
+    const bool push = type_ == planning::ButtonType::kPushButton;
+    const auto approach = SolveArm(ctx_, plan.targets.approach, plan.approach_arm, push);
+    if (!approach) {
+      Note("the actuator is out of the arm's reach from here");
+      return NodeStatus::kFailure;
+    }
+    const TaskConfig& c = ctx_.config;
+    if (push) {
+      planning::IkTarget press = plan.targets.press;
+      press.approach_M.reset();  // the arm alone cannot also hold the approach axis exactly
+      const auto pressed = SolveArm(ctx_, press, *approach, true);
+      if (!pressed) {
+        Note("the press point is out of the arm's reach from here");
+        return NodeStatus::kFailure;
+      }
+      ctx_.motion->MoveArm({{c.press_reach_time, *approach},
+                            {c.press_reach_time + c.press_time, *pressed},
+                            {c.press_reach_time + 2 * c.press_time, *approach}},
+                           ctx_.now);
+      Note("pressing the push button");
+    } else {
+      ctx_.motion->MoveArm(
+          {{c.press_reach_time, *approach}, {c.press_reach_time + c.wave_hold_time, *approach}},
+          ctx_.now);
+      Note("waving at the proximity plate");
+    }
+    return NodeStatus::kRunning;
+  }
+  NodeStatus OnRunning() override {
+    return ctx_.motion->arm_moving(ctx_.now) ? NodeStatus::kRunning : NodeStatus::kSuccess;
+  }
+  void OnHalted() override {}  // the arm is tucked by whoever runs next (standby or traversal)
+
+ private:
+  planning::ButtonType type_;
+};
+
+class PressButton final : public ActuatorAction {
+ public:
+  PressButton(const std::string& name, NodeConfig config, TaskContext* context)
+      : ActuatorAction(name, std::move(config), context, planning::ButtonType::kPushButton) {}
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("door", "door whose push button to press")};
+  }
+};
+
+class WaveAtPlate final : public ActuatorAction {
+ public:
+  WaveAtPlate(const std::string& name, NodeConfig config, TaskContext* context)
+      : ActuatorAction(name, std::move(config), context, planning::ButtonType::kProximityPlate) {}
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("door", "door whose proximity plate to wave at")};
+  }
+};
+
+// Drives through a door in two legs: to the entry pose on the door's axis (the arm tucking on
+// the way), where the laser sees through the opening; then, once the leaf leaves room for the
+// footprint, through the doorway to the exit pose. Both legs run at the door speed: the ADA
+// hold window is short.
+class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
+ public:
+  using TaskNode::TaskNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("door", "door to drive through"),
+            InputPort<double>("speed", 0.4, "speed through the doorway [m/s]"),
+            InputPort<double>("wait_timeout", 8.0, "how long to wait for the leaf to open [s]")};
+  }
+  NodeStatus OnStart() override {
+    door_ = Door();
+    pass_ = CalcDoorPass(*ctx_.map, door_, ctx_.X_MB);
+    if (!ArmAt(ctx_.motion->arm_target(), kTuckedArm) || ctx_.motion->arm_moving(ctx_.now)) {
+      ctx_.motion->MoveArm({{ctx_.config.arm_tuck_time, kTuckedArm}}, ctx_.now);
+    }
+    yaw_ = std::atan2(-pass_.n_M.y(), -pass_.n_M.x());  // facing through the door
+    const Eigen::Vector2d entry = pass_.centre + pass_.n_M * ctx_.config.door_entry_distance;
+    const Eigen::Vector2d offset = ctx_.X_MB.translation() - pass_.centre;
+    const double lateral = std::abs(offset.dot(Eigen::Vector2d(-pass_.n_M.y(), pass_.n_M.x())));
+    phase_ = Phase::kWaiting;
+    waiting_since_ = ctx_.now;
+    if (lateral > 0.05 || offset.dot(pass_.n_M) > ctx_.config.door_entry_distance + 0.05) {
+      ctx_.motion->FollowPath({ctx_.X_MB, {entry.x(), entry.y(), yaw_}}, {true}, kTuckedArm,
+                              ctx_.now);
+      Note("lining up on the door's axis");
+      phase_ = Phase::kToEntry;
+    }
+    return OnRunning();
+  }
+  NodeStatus OnRunning() override {
+    const auto note = [this](const std::string& t) { Note(t); };
+    switch (phase_) {
+      case Phase::kToEntry: {
+        const NodeStatus s = BaseMotionStatus(ctx_, note);
+        if (s != NodeStatus::kSuccess) return s;
+        phase_ = Phase::kWaiting;
+        waiting_since_ = ctx_.now;
+        [[fallthrough]];
+      }
+      case Phase::kWaiting: {
+        if (ctx_.motion->arm_moving(ctx_.now)) return NodeStatus::kRunning;
+        if (!DoorPassable(ctx_, door_, 0.0)) {
+          if (ToSeconds(ctx_.now - waiting_since_) > Input<double>("wait_timeout")) {
+            Note("the door did not open in time");
+            return NodeStatus::kFailure;
+          }
+          return NodeStatus::kRunning;  // the leaf is still opening
+        }
+        const Eigen::Vector2d exit = pass_.centre - pass_.n_M * ctx_.config.door_exit_distance;
+        ctx_.motion->FollowPath({ctx_.X_MB, {exit.x(), exit.y(), yaw_}}, {true}, kTuckedArm,
+                                ctx_.now);
+        Note(StrCat("door open: driving through at ", Input<double>("speed"), " m/s"));
+        phase_ = Phase::kThrough;
+        return NodeStatus::kRunning;
+      }
+      case Phase::kThrough: {
+        const NodeStatus s = BaseMotionStatus(ctx_, note);
+        if (s == NodeStatus::kSuccess) Note("through the door");
+        return s;
+      }
+    }
+    return NodeStatus::kFailure;
+  }
+  void OnHalted() override { ctx_.motion->StopBase(); }
+
+ private:
+  enum class Phase { kToEntry, kWaiting, kThrough };
+  std::string door_;
+  DoorPass pass_;
+  double yaw_{0.0};
+  Phase phase_{Phase::kWaiting};
+  Time waiting_since_{};
+};
+
+class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
+ public:
+  using TaskNode::TaskNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<bool>("back_off", true, "also drive back to the last safe waypoint")};
+  }
+  NodeStatus OnStart() override {
+    ctx_.motion->StopBase();
+    if (!ArmAt(ctx_.motion->arm_target(), kTuckedArm) || ctx_.motion->arm_moving(ctx_.now)) {
+      ctx_.motion->MoveArm({{ctx_.config.arm_tuck_time, kTuckedArm}}, ctx_.now);
+      Note("tucking the arm");
+    }
+    if (Input<bool>("back_off") && ctx_.last_safe &&
+        (ctx_.last_safe->translation() - ctx_.X_MB.translation()).norm() > 0.05) {
+      ctx_.motion->FollowPath({ctx_.X_MB, *ctx_.last_safe}, {false}, kTuckedArm, ctx_.now);
+      Note(StrCat("backing off to the last safe waypoint (", PoseText(*ctx_.last_safe), ")"));
+    }
+    return NodeStatus::kRunning;
+  }
+  NodeStatus OnRunning() override {
+    if (ctx_.motion->base_failed()) ctx_.motion->StopBase();  // blocked: stay, arm tucked
+    const bool busy = ctx_.motion->arm_moving(ctx_.now) || ctx_.motion->base_moving();
+    return busy ? NodeStatus::kRunning : NodeStatus::kSuccess;
+  }
+  void OnHalted() override { ctx_.motion->StopBase(); }
+};
+
+class WaitForClear final : public TaskNode<bt::StatefulActionNode> {
+ public:
+  using TaskNode::TaskNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("door", "door whose zone to watch"),
+            InputPort<double>("timeout", 30.0, "give up after [s]")};
+  }
+  NodeStatus OnStart() override {
+    started_ = ctx_.now;
+    Note("waiting for the door zone to clear");
+    return OnRunning();
+  }
+  NodeStatus OnRunning() override {
+    if (!IsDoorZoneOccupied(ctx_, Door())) return NodeStatus::kSuccess;
+    if (ToSeconds(ctx_.now - started_) > Input<double>("timeout")) {
+      Note("gave up waiting");
+      return NodeStatus::kFailure;
+    }
+    return NodeStatus::kRunning;
+  }
+  void OnHalted() override {}
+
+ private:
+  Time started_{};
+};
+
+template <typename T>
+void Register(bt::BehaviorTreeFactory& factory, const std::string& id, TaskContext* context) {
+  bt::NodeManifest manifest;
+  manifest.id = id;
+  if constexpr (std::is_base_of_v<bt::ConditionNode, T>) {
+    manifest.kind = bt::NodeKind::kCondition;
+  } else {
+    manifest.kind = bt::NodeKind::kAction;
+  }
+  manifest.ports = T::ProvidedPorts();
+  factory.RegisterBuilder(std::move(manifest), [context](const std::string& name, NodeConfig c) {
+    return std::make_unique<T>(name, std::move(c), context);
+  });
+}
+
+}  // namespace
+
+void RegisterTaskNodes(bt::BehaviorTreeFactory& factory, TaskContext* context) {
+  ThrowUnless(context != nullptr && context->map != nullptr && context->model != nullptr &&
+                  context->motion != nullptr && context->planner != nullptr,
+              "RegisterTaskNodes: the context needs a map, a robot model, a motion executor and a "
+              "planner");
+  Register<IsPathClear>(factory, "IsPathClear", context);
+  Register<IsDoorOpen>(factory, "IsDoorOpen", context);
+  Register<IsPersonHoldingDoor>(factory, "IsPersonHoldingDoor", context);
+  Register<IsHoldingPayload>(factory, "IsHoldingPayload", context);
+  Register<ButtonType>(factory, "ButtonType", context);
+  Register<NavigateTo>(factory, "NavigateTo", context);
+  Register<ApproachButton>(factory, "ApproachButton", context);
+  Register<PressButton>(factory, "PressButton", context);
+  Register<WaveAtPlate>(factory, "WaveAtPlate", context);
+  Register<TraverseDoor>(factory, "TraverseDoor", context);
+  Register<RetractToSafe>(factory, "RetractToSafe", context);
+  Register<WaitForClear>(factory, "WaitForClear", context);
+}
+
+}  // namespace egress::behavior

@@ -1,0 +1,137 @@
+// The paper's scenarios (worlds/scenarios/) at a fixed seed, driven by the robot brain and
+// judged by the twin's ground truth.
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "egress/twin/sdf_world_loader.h"
+#include "egress/twin/twin_run.h"
+#include "sdf_map.h"
+
+namespace egress {
+namespace {
+
+const std::filesystem::path kScenarios = std::filesystem::path(EGRESS_WORLDS_DIR) / "scenarios";
+
+struct BrainRun {
+  twin::RunResult result;
+  std::unique_ptr<twin::TwinWorld> world;
+  std::unique_ptr<behavior::Executive> brain;
+  int presses{0};
+};
+
+BrainRun RunWithBrain(const std::filesystem::path& file, std::uint64_t seed) {
+  const twin::Scenario scenario = twin::LoadScenario(file);
+  const twin::WorldDescription description = twin::LoadSdfWorld(scenario.world_file);
+  auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
+  BrainRun run;
+  run.world = std::make_unique<twin::TwinWorld>(scenario, description, seed, model);
+  twin::TwinRobot robot(run.world.get());
+  const behavior::ExecutiveConfig config;
+  run.brain = apps::MakeScenarioExecutive(scenario, description, *run.world, model, config);
+  twin::RunOptions options;
+  options.control_period = 0.01;
+  options.record_trace = false;
+  const bool debug = std::getenv("EGRESS_SCENARIO_DEBUG") != nullptr;
+  double last = -1.0;
+  run.result = twin::RunScenario(
+      robot,
+      [&](RobotPort& port) {
+        const bool more = run.brain->Step(port);
+        if (debug && run.world->time() - last >= 0.25) {
+          last = run.world->time();
+          const auto f = run.world->fingertip_position();
+          const auto b = run.world->robot_pose();
+          const auto e = run.brain->X_MB();
+          std::printf(
+              "%6.2f tip %.3f %.3f %.3f base %.3f %.3f %.3f belief %.3f %.3f %.3f "
+              "door %.2f %s\n",
+              run.world->time(), f.x(), f.y(), f.z(), b.x, b.y, b.yaw, e.x, e.y, e.yaw,
+              run.world->door_angle(0), run.brain->active_action().c_str());
+          for (const auto& d : run.brain->context().world.doors) {
+            std::printf("         door %s observed %d angle %.2f clearance %.2f motion %d\n",
+                        d.model.id.c_str(), int(d.state.observed), d.state.angle,
+                        d.state.clearance_width, int(d.state.motion));
+          }
+        }
+        return more;
+      },
+      options);
+  if (debug) {
+    for (const auto& d : run.brain->decisions())
+      std::printf("  %7.2f  %s\n", d.time, d.text.c_str());
+  }
+  for (const auto& e : run.world->events())
+    run.presses += e.kind == "button_pressed" ? 1 : 0;
+  return run;
+}
+
+TEST(ScenarioTest, S1NominalPressesAndPasses) {
+  const BrainRun run = RunWithBrain(kScenarios / "s1_nominal.yaml", 1);
+  EXPECT_TRUE(run.result.verdict.success) << twin::FormatVerdict(run.result.verdict);
+  EXPECT_EQ(run.presses, 1);
+}
+
+TEST(ScenarioTest, S3HeldDoorIsPassedWithoutPressing) {
+  const BrainRun run = RunWithBrain(kScenarios / "s3_held_door.yaml", 1);
+  EXPECT_TRUE(run.result.verdict.success) << twin::FormatVerdict(run.result.verdict);
+  EXPECT_EQ(run.presses, 0);
+  EXPECT_EQ(run.world->button_presses(0), 0);
+}
+
+// A scenario whose mission names `tree_xml` (written next to it).
+std::string LoadError(const std::string& tree_xml, const std::string& mission_extra = "") {
+  const auto dir =
+      std::filesystem::temp_directory_path() /
+      ("egress_scenario_" +
+       std::to_string(::testing::UnitTest::GetInstance()->current_test_info()->line()));
+  std::filesystem::create_directories(dir);
+  const auto tree = dir / "tree.xml";
+  if (!tree_xml.empty()) std::ofstream(tree) << tree_xml;
+  const auto file = dir / "scenario.yaml";
+  std::ofstream(file) << "world: " << EGRESS_WORLDS_DIR << "/lab/lab.sdf\n"
+                      << "robot: {start: {x: 0, y: 1}}\n"
+                      << "mission:\n  tree: tree.xml\n"
+                      << mission_extra;
+  try {
+    const twin::Scenario scenario = twin::LoadScenario(file);
+    const twin::WorldDescription description = twin::LoadSdfWorld(scenario.world_file);
+    auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
+    twin::TwinWorld world(scenario, description, 1, model);
+    const behavior::ExecutiveConfig config;
+    apps::MakeScenarioExecutive(scenario, description, world, model, config);
+  } catch (const std::exception& e) {
+    std::filesystem::remove_all(dir);
+    return e.what();
+  }
+  std::filesystem::remove_all(dir);
+  return "";
+}
+
+TEST(ScenarioTest, AMissionWithAnUnknownNodeFailsNamingIt) {
+  const std::string error = LoadError(
+      "<root BTCPP_format=\"4\"><BehaviorTree ID=\"T\"><Sequence>\n"
+      "<IsPathClear door=\"lab_door\"/>\n<OpenDoorByMagic door=\"lab_door\"/>\n"
+      "</Sequence></BehaviorTree></root>");
+  EXPECT_NE(error.find("OpenDoorByMagic"), std::string::npos) << error;
+  EXPECT_NE(error.find("tree.xml"), std::string::npos) << error;
+}
+
+TEST(ScenarioTest, AMissingTreeFileOrABadFieldFailsNamingTheField) {
+  const std::string missing = LoadError("");
+  EXPECT_NE(missing.find("mission.tree"), std::string::npos) << missing;
+  EXPECT_NE(missing.find("no such file"), std::string::npos) << missing;
+  const std::string bad = LoadError(
+      "<root BTCPP_format=\"4\"><BehaviorTree ID=\"T\"><AlwaysSuccess/></BehaviorTree></root>",
+      "  blackbord: {door: lab_door}\n");
+  EXPECT_NE(bad.find("mission.blackbord"), std::string::npos) << bad;
+  EXPECT_NE(bad.find("unknown field"), std::string::npos) << bad;
+}
+
+}  // namespace
+}  // namespace egress
