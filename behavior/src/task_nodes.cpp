@@ -120,7 +120,26 @@ class TaskNode : public Base {
 // Starts a base motion along a planned path; RUNNING until it ends.
 NodeStatus StartPath(TaskContext& ctx, const Pose2& goal, const std::string& what,
                      const std::function<void(const std::string&)>& note) {
-  const planning::PlanResult plan = ctx.planner->Plan(ctx.X_MB, goal);
+  planning::PlanResult plan = ctx.planner->Plan(ctx.X_MB, goal);
+  if (plan.status == planning::PlanStatus::kStartInCollision) {
+    // The robot stands where the costmap says it cannot (inflation around a leaf or a person
+    // seen close by): step straight towards the goal to the first free pose, plan from there.
+    const Eigen::Vector2d towards = (goal.translation() - ctx.X_MB.translation()).normalized();
+    for (double step = 0.05; step <= 0.8 && plan.status == planning::PlanStatus::kStartInCollision;
+         step += 0.05) {
+      const Eigen::Vector2d p = ctx.X_MB.translation() + towards * step;
+      const Pose2 escape{p.x(), p.y(), ctx.X_MB.yaw};
+      if (!ctx.planner->IsValid(escape)) continue;
+      planning::PlanResult rest = ctx.planner->Plan(escape, goal);
+      if (!rest.ok()) {
+        plan = rest;
+        break;
+      }
+      rest.path.insert(rest.path.begin(), ctx.X_MB);
+      rest.length += step;
+      plan = rest;
+    }
+  }
   if (!plan.ok()) {
     note(StrCat("no path to ", what, " (", PoseText(goal), "): ", plan.message));
     return NodeStatus::kFailure;
@@ -132,7 +151,18 @@ NodeStatus StartPath(TaskContext& ctx, const Pose2& goal, const std::string& wha
       (plan.path.back().translation() - ctx.X_MB.translation()).norm() < 0.01) {
     return NodeStatus::kSuccess;  // already there
   }
-  ctx.motion->FollowPath(plan.path, through, ctx.motion->arm_target(), ctx.now);
+  // The base is holonomic: turn from the start yaw to the goal yaw evenly along the path
+  // rather than through the planner's intermediate headings.
+  std::vector<Pose2> path = plan.path;
+  path.front().yaw = ctx.X_MB.yaw;
+  const double turn = std::remainder(goal.yaw - ctx.X_MB.yaw, 2 * M_PI);
+  double travelled = 0.0;
+  for (std::size_t i = 1; i < path.size(); ++i) {
+    travelled += (path[i].translation() - path[i - 1].translation()).norm();
+    const double fraction = plan.length > 0 ? std::min(1.0, travelled / plan.length) : 1.0;
+    path[i].yaw = ctx.X_MB.yaw + turn * fraction;
+  }
+  ctx.motion->FollowPath(path, through, ctx.motion->arm_target(), ctx.now);
   note(StrCat("driving to ", what, " (", PoseText(goal), ", ", std::round(plan.length * 100) / 100,
               " m)"));
   return NodeStatus::kRunning;

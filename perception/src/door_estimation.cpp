@@ -116,7 +116,15 @@ std::optional<DoorAngleMeasurement> MeasureDoorAngle(const DoorModel& door,
   door.Validate();
   constexpr double kMargin = 10.0 * std::numbers::pi / 180.0;
   const double w = door.width();
-  std::vector<double> votes;
+  // A leaf is a segment from the hinge: its points share a polar angle and spread along the
+  // radius. Anything else in the sector (a person in the doorway, a leg, a bag) shares an angle
+  // over a short radial stretch only. Vote per angle bin, keep the bin (with its neighbours)
+  // whose points reach furthest along the radius, and take the median angle there.
+  constexpr double kBin = 3.0 * std::numbers::pi / 180.0;
+  struct Vote {
+    double phi, r;
+  };
+  std::vector<Vote> votes;
   for (const auto& p : p_MPoints) {
     if (!p.allFinite()) continue;
     const Eigen::Vector2d d = p - door.p_MHinge;
@@ -124,12 +132,49 @@ std::optional<DoorAngleMeasurement> MeasureDoorAngle(const DoorModel& door,
     if (r < 0.15 * w || r > 0.95 * w) continue;
     const double phi = door.swing_sign * WrapAngle(std::atan2(d.y(), d.x()) - door.closed_yaw());
     if (phi < -kMargin || phi > door.max_open_angle + kMargin) continue;
-    votes.push_back(phi);
+    votes.push_back({phi, r});
   }
   if (votes.size() < std::max<std::size_t>(1, min_support)) return std::nullopt;
-  auto middle = votes.begin() + std::ptrdiff_t(votes.size() / 2);
-  std::nth_element(votes.begin(), middle, votes.end());
-  return DoorAngleMeasurement{std::clamp(*middle, 0.0, door.max_open_angle), votes.size()};
+  const int bins = int(std::ceil((door.max_open_angle + 2 * kMargin) / kBin)) + 1;
+  std::vector<double> r_min(std::size_t(bins), 1e9), r_max(std::size_t(bins), -1e9);
+  std::vector<int> count(std::size_t(bins), 0);
+  const auto bin_of = [&](double phi) {
+    return std::clamp(int((phi + kMargin) / kBin), 0, bins - 1);
+  };
+  for (const Vote& v : votes) {
+    const auto b = std::size_t(bin_of(v.phi));
+    r_min[b] = std::min(r_min[b], v.r);
+    r_max[b] = std::max(r_max[b], v.r);
+    ++count[b];
+  }
+  int best = -1;
+  double best_extent = -1.0;
+  for (int b = 0; b < bins; ++b) {
+    double lo = 1e9, hi = -1e9;
+    int n = 0;
+    for (int k = std::max(0, b - 1); k <= std::min(bins - 1, b + 1); ++k) {
+      if (count[std::size_t(k)] == 0) continue;
+      lo = std::min(lo, r_min[std::size_t(k)]);
+      hi = std::max(hi, r_max[std::size_t(k)]);
+      n += count[std::size_t(k)];
+    }
+    if (n == 0) continue;
+    const double extent = hi - lo + 1e-3 * n;  // ties: more points
+    if (extent > best_extent) {
+      best_extent = extent;
+      best = b;
+    }
+  }
+  // A leaf seen over less than a quarter of its width is not told from a person's outline.
+  if (best < 0 || best_extent < 0.25 * w) return std::nullopt;
+  std::vector<double> chosen;
+  for (const Vote& v : votes) {
+    if (std::abs(bin_of(v.phi) - best) <= 1) chosen.push_back(v.phi);
+  }
+  if (chosen.size() < std::max<std::size_t>(1, min_support)) return std::nullopt;
+  auto middle = chosen.begin() + std::ptrdiff_t(chosen.size() / 2);
+  std::nth_element(chosen.begin(), middle, chosen.end());
+  return DoorAngleMeasurement{std::clamp(*middle, 0.0, door.max_open_angle), chosen.size()};
 }
 
 double DoorAngleFromLine(const DoorModel& door, const LineFit& line) {

@@ -37,7 +37,14 @@ void PerceptionPipeline::ProcessCameraFrame(const std::vector<Detection2D>& dete
 
 void PerceptionPipeline::ProcessScan(const LaserScan& scan, const Pose2& X_ML,
                                      const CameraIntrinsics& intrinsics, const Pose3& X_LC) {
-  const std::vector<Eigen::Vector2d> points = ScanPoints(scan, X_ML);
+  // People are not door leaves: returns from around a tracked person never vote for an angle.
+  std::vector<Eigen::Vector2d> points;
+  for (const Eigen::Vector2d& p : ScanPoints(scan, X_ML)) {
+    bool on_person = false;
+    for (const auto& person : people_.people())
+      on_person = on_person || (p - person.p_MP).norm() < config_.person_mask_radius;
+    if (!on_person) points.push_back(p);
+  }
   std::vector<bool> measured(doors_.size(), false);
   // Glass leaves: a line fit in the slice under each box, assigned to the nearest door.
   for (const Detection2D& box : unplaced_glass_) {

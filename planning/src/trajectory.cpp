@@ -44,6 +44,7 @@ void TrajectoryConfig::Validate() const {
   ThrowUnless(nominal_speed > 0.0 && door_speed > 0.0,
               "Invalid TrajectoryConfig: speeds must be > 0.");
   ThrowUnless(min_duration > 0.0, "Invalid TrajectoryConfig: min_duration must be > 0.");
+  ThrowUnless(max_yaw_rate > 0.0, "Invalid TrajectoryConfig: max_yaw_rate must be > 0.");
 }
 
 double SegmentDuration(double base_distance, bool through_door, const TrajectoryConfig& config) {
@@ -77,6 +78,9 @@ WholeBodyTrajectory WholeBodyTrajectory::Plan(const std::vector<WholeBodyVector>
     const double distance =
         std::hypot(next[kBaseX] - previous[kBaseX], next[kBaseY] - previous[kBaseY]);
     double T = SegmentDuration(distance, !through_door.empty() && through_door[s - 1], config);
+    // The base turns no faster than the tracking controller can follow.
+    T = std::max(T, kQuinticPeakFactor * std::abs(next[kBaseYaw] - previous[kBaseYaw]) /
+                        config.max_yaw_rate);
     for (int j = kArmLift; j < kNumWholeBodyJoints; ++j) {
       const double limit = model.limits(WholeBodyJoint(j)).velocity;
       if (limit > 0.0)

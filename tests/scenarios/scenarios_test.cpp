@@ -77,6 +77,15 @@ TEST(ScenarioTest, S1NominalPressesAndPasses) {
   EXPECT_EQ(run.presses, 1);
 }
 
+TEST(ScenarioTest, S2YieldsToThePersonCrossingThenPasses) {
+  const BrainRun run = RunWithBrain(kScenarios / "s2_person_crosses.yaml", 1);
+  EXPECT_TRUE(run.result.verdict.success) << twin::FormatVerdict(run.result.verdict);
+  // The brain saw the person enter the door zone and stopped within one tick (0.1 s).
+  ASSERT_FALSE(run.brain->preemptions().empty());
+  for (const auto& [known, commanded] : run.brain->preemptions())
+    EXPECT_LE(commanded - known, 0.1 + 1e-9);
+}
+
 TEST(ScenarioTest, S3HeldDoorIsPassedWithoutPressing) {
   const BrainRun run = RunWithBrain(kScenarios / "s3_held_door.yaml", 1);
   EXPECT_TRUE(run.result.verdict.success) << twin::FormatVerdict(run.result.verdict);

@@ -72,8 +72,11 @@ struct DoorAngleMeasurement {
 };
 
 /// The leaf angle from points near the door: those between 15% and 95% of the leaf width from
-/// the hinge, within the swept sector (±10° margin), vote with their polar angle; the median
-/// wins. nullopt with fewer than `min_support` votes (leaf not seen).
+/// the hinge, within the swept sector (±10° margin), vote with their polar angle in 3° bins; the
+/// bins (with their neighbours) whose points spread furthest along the radius — a leaf, not a
+/// person standing in the doorway — win, and their median angle is the measurement. nullopt
+/// with fewer than `min_support` votes, or when the winning points span less than a quarter of
+/// the leaf's width along the radius (leaf not seen, or hidden behind someone).
 std::optional<DoorAngleMeasurement> MeasureDoorAngle(const DoorModel& door,
                                                      const std::vector<Eigen::Vector2d>& p_MPoints,
                                                      std::size_t min_support = 4);

@@ -63,6 +63,8 @@ struct PerceptionConfig {
   DoorStateConfig door_state;
   IntentConfig intent;
   double door_zone_depth{1.0};  ///< [m]
+  /// Laser returns within this of a tracked person are left out of door-angle estimates [m].
+  double person_mask_radius{0.5};
   LineFitConfig glass_line;
 };
 

@@ -34,6 +34,9 @@ struct TrajectoryConfig {
   double nominal_speed{0.2};  ///< v_target [m/s]
   double door_speed{0.4};     ///< v_target through a door [m/s]
   double min_duration{1.5};   ///< T_min [s]
+  /// Peak base yaw rate [rad/s]: a segment that turns further takes longer (half the tracking
+  /// controller's 1.2 rad/s limit, leaving it room to correct).
+  double max_yaw_rate{0.6};
   void Validate() const;
 };
 
