@@ -81,6 +81,7 @@ behavior::MissionMap BuildMissionMap(const twin::WorldDescription& world,
     for (int i = 0; i < 3; ++i)
       half += std::abs(actuator.n_M.dot(R.col(i))) * shape.box_size[i] / 2;
     actuator.p_M = centre + actuator.n_M * half;
+    actuator.protrusion = 2 * half;  // mounted on the wall's surface
     map.actuators.push_back(actuator);
   }
   map.Validate();

@@ -70,6 +70,8 @@ struct Executive::Impl {
   std::optional<bt::Tree> tree;
   std::unique_ptr<ActionLog> log;
   std::optional<Pose2> X_MO;  // odometry frame in the map, fixed at the first step
+  std::optional<perception::ParticleFilterLocalizer> localizer;
+  std::optional<Pose2> last_odometry;
   Pose2 X_MB_initial;
   std::optional<Time> next_tick;
   std::optional<DepthImage> depth;
@@ -92,6 +94,7 @@ Executive::Executive(std::shared_ptr<const RobotModel> model, MissionMap map, Mi
   ThrowUnless(model != nullptr, "Executive: no robot model");
   ThrowUnless(X_MB_initial.IsFinite(), "Executive: the initial pose must be finite");
   config.Validate();
+  config.localizer.Validate();
   map.Validate();
   impl_ = std::make_unique<Impl>(std::move(model), std::move(map), std::move(config));
   Impl& m = *impl_;
@@ -104,7 +107,14 @@ Executive::Executive(std::shared_ptr<const RobotModel> model, MissionMap map, Mi
     costmap_->AddDoorway(doorway);
     m.planner->AddDoor({doorway.id, doorway.p_MHinge, doorway.p_MLatch});
   }
+  if (m.config.localize) {
+    const Pose2 X_BL = m.model->laser_pose().ToPose2();
+    m.localizer.emplace(m.map.grid, X_BL, m.config.localizer);
+    const double sigma = m.config.initial_pose_sigma;
+    m.localizer->Initialize(X_MB_initial, Eigen::Vector3d::Constant(sigma * sigma).asDiagonal());
+  }
   context_.model = m.model.get();
+  context_.X_BL = m.model->laser_pose().ToPose2();
   context_.map = &m.map;
   context_.config = m.config.tasks;
   context_.motion = &m.motion;
@@ -136,9 +146,17 @@ bool Executive::Step(RobotPort& port) {
   context_.now = now;
   m.clock->Set(now);
 
-  // Localize: odometry composed onto the initial pose.
-  if (!m.X_MO) m.X_MO = m.X_MB_initial * snapshot.odometry.X_OB.Inverse();
-  context_.X_MB = *m.X_MO * snapshot.odometry.X_OB;
+  // Localize: odometry predicts, laser scans correct on the building map (or odometry alone
+  // from the initial pose).
+  if (m.localizer) {
+    if (m.last_odometry) m.localizer->Predict(*m.last_odometry, snapshot.odometry.X_OB);
+    m.last_odometry = snapshot.odometry.X_OB;
+    if (snapshot.scan) m.localizer->Correct(*snapshot.scan);
+    context_.X_MB = m.localizer->Estimate();
+  } else {
+    if (!m.X_MO) m.X_MO = m.X_MB_initial * snapshot.odometry.X_OB.Inverse();
+    context_.X_MB = *m.X_MO * snapshot.odometry.X_OB;
+  }
   const Pose3 X_MB3 = Pose3::FromPose2(context_.X_MB);
 
   // Perceive.
@@ -163,6 +181,7 @@ bool Executive::Step(RobotPort& port) {
   context_.world =
       m.perception.Snapshot(now, context_.X_MB, Eigen::Matrix3d::Zero(), costmap_.get());
   context_.holding_object = snapshot.gripper.holding_object;
+  if (snapshot.scan) context_.scan = snapshot.scan;
   bool in_any_zone = false;
   bool newly_occupied = false;
   for (const auto& door : m.map.doors) {

@@ -206,13 +206,33 @@ class IsPathClear final : public TaskNode<bt::ConditionNode> {
   NodeStatus last_{NodeStatus::kIdle};
 };
 
+// Far enough past the door line that the closing leaf cannot reach the footprint.
+double ExitDistance(const TaskContext& ctx, const std::string& door) {
+  const double w = ctx.map->FindDoor(door)->width();
+  return std::max(ctx.config.door_exit_distance, w + ctx.config.footprint_radius + 0.15);
+}
+
+// The leaf leaves room for the footprint (plus `margin`), is not closing, and — unless a person
+// holds it — an operator's hold window leaves time to drive clear of the leaf's sweep.
 bool DoorPassable(const TaskContext& ctx, const std::string& door, double margin) {
   const auto clearance = DoorClearance(ctx, door);
-  if (!clearance) return false;
-  for (const auto& d : ctx.world.doors) {
-    if (d.model.id == door && d.state.motion == perception::DoorMotion::kClosing) return false;
+  if (!clearance || *clearance < 2 * ctx.config.footprint_radius + margin) return false;
+  bool held_by_person = false;
+  for (const auto& entry : ctx.world.people) {
+    held_by_person = held_by_person || (entry.door_id == door &&
+                                        entry.intent == perception::PersonIntent::kHoldingDoor);
   }
-  return *clearance >= 2 * ctx.config.footprint_radius + margin;
+  for (const auto& d : ctx.world.doors) {
+    if (d.model.id != door) continue;
+    if (d.state.motion == perception::DoorMotion::kClosing) return false;
+    if (held_by_person || d.state.motion != perception::DoorMotion::kHeldOpen) continue;
+    const DoorPass pass = CalcDoorPass(*ctx.map, door, ctx.X_MB);
+    const double to_clear = std::max(0.0, (ctx.X_MB.translation() - pass.centre).dot(pass.n_M)) +
+                            ExitDistance(ctx, door);
+    const double needed = to_clear / ctx.motion->trajectory_config().door_speed;
+    if (d.state.steady_for + needed > ctx.config.door_hold_window) return false;
+  }
+  return true;
 }
 
 class IsDoorOpen final : public TaskNode<bt::ConditionNode> {
@@ -338,15 +358,16 @@ class ApproachButton final : public TaskNode<bt::StatefulActionNode> {
 };
 
 // Arm-only IK at the current base pose (the base stays where it stopped).
-std::optional<ArmPose> SolveArm(const TaskContext& ctx, const planning::IkTarget& target,
-                                const ArmPose& from, bool fingertip) {
+std::optional<ArmPose> SolveArm(const TaskContext& ctx, const Pose2& X_MB,
+                                const planning::IkTarget& target, const ArmPose& from,
+                                bool fingertip) {
   planning::IkConfig ik = ctx.config.ik;
   ik.fingertip = fingertip;
   ik.use_base = false;
   WholeBodyVector q = WholeBodyVector::Zero();
-  q[kBaseX] = ctx.X_MB.x;
-  q[kBaseY] = ctx.X_MB.y;
-  q[kBaseYaw] = ctx.X_MB.yaw;
+  q[kBaseX] = X_MB.x;
+  q[kBaseY] = X_MB.y;
+  q[kBaseYaw] = X_MB.yaw;
   q = WithArm(q, from);
   const planning::DlsIkSolver solver(*ctx.model, ik);
   planning::IkResult r = solver.Solve(target, q);
@@ -359,6 +380,41 @@ std::optional<ArmPose> SolveArm(const TaskContext& ctx, const planning::IkTarget
   }
   if (!r.converged) return std::nullopt;
   return ArmOf(r.q);
+}
+
+// The base pose relative to the actuator's wall, corrected by the laser: the distance to the
+// wall straight ahead, measured, against the distance the believed pose predicts. Pressing a
+// 4 mm button stroke needs the wall's distance to a few millimetres; the localizer's estimate
+// is good to a few centimetres. Along the wall nothing changes (the button is 10 cm wide).
+Pose2 WallAlignedPose(const TaskContext& ctx, const MapActuator& actuator,
+                      const std::function<void(const std::string&)>& note) {
+  if (!ctx.scan) return ctx.X_MB;
+  const Eigen::Vector2d n = actuator.n_M.head<2>().normalized();
+  const Eigen::Vector2d t(-n.y(), n.x());
+  const Eigen::Vector2d p_MWall = actuator.p_M.head<2>() - n * actuator.protrusion;
+  const Pose2 X_ML = ctx.X_MB * ctx.X_BL;
+  std::vector<double> distances;
+  const LaserScan& scan = *ctx.scan;
+  for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
+    const double r = scan.ranges[i];
+    if (!std::isfinite(r) || r < scan.range_min || r > 2.0) continue;
+    const double a = scan.angle_min + double(i) * scan.angle_increment;
+    const Eigen::Vector2d p_M = X_ML * Eigen::Vector2d(r * std::cos(a), r * std::sin(a));
+    // Near the wall plane, within 0.4 m of the actuator along the wall.
+    if (std::abs((p_M - p_MWall).dot(n)) > 0.15 || std::abs((p_M - p_MWall).dot(t)) > 0.4) continue;
+    distances.push_back((X_ML.translation() - p_M).dot(n));
+  }
+  if (distances.size() < 5) return ctx.X_MB;
+  auto middle = distances.begin() + std::ptrdiff_t(distances.size() / 2);
+  std::nth_element(distances.begin(), middle, distances.end());
+  const double expected = (X_ML.translation() - p_MWall).dot(n);
+  const double error = *middle - expected;
+  Pose2 corrected = ctx.X_MB;
+  corrected.x += n.x() * error;
+  corrected.y += n.y() * error;
+  note(StrCat("wall ", std::round(*middle * 1000) / 1000, " m ahead by laser, ",
+              std::round(error * 1000), " mm off the estimate"));
+  return corrected;
 }
 
 // Presses (push button) or waves (proximity plate): one arm motion, RUNNING until it ends.
@@ -376,7 +432,9 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
     }
     const ButtonPlan& plan = it->second;
     const bool push = type_ == planning::ButtonType::kPushButton;
-    const auto approach = SolveArm(ctx_, plan.targets.approach, plan.approach_arm, push);
+    const Pose2 X_MB = WallAlignedPose(ctx_, *ctx_.map->FindActuatorOf(door),
+                                       [this](const std::string& t) { Note(t); });
+    const auto approach = SolveArm(ctx_, X_MB, plan.targets.approach, plan.approach_arm, push);
     if (!approach) {
       Note("the actuator is out of the arm's reach from here");
       return NodeStatus::kFailure;
@@ -385,7 +443,7 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
     if (push) {
       planning::IkTarget press = plan.targets.press;
       press.approach_M.reset();  // the arm alone cannot also hold the approach axis exactly
-      const auto pressed = SolveArm(ctx_, press, *approach, true);
+      const auto pressed = SolveArm(ctx_, X_MB, press, *approach, true);
       if (!pressed) {
         Note("the press point is out of the arm's reach from here");
         return NodeStatus::kFailure;
@@ -481,9 +539,20 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
           }
           return NodeStatus::kRunning;  // the leaf is still opening
         }
-        const Eigen::Vector2d exit = pass_.centre - pass_.n_M * ctx_.config.door_exit_distance;
-        ctx_.motion->FollowPath({ctx_.X_MB, {exit.x(), exit.y(), yaw_}}, {true}, kTuckedArm,
-                                ctx_.now);
+        // Through the middle of the clear opening, between the latch jamb and the leaf.
+        const Eigen::Vector2d centre = ClearOpeningCentre();
+        const Eigen::Vector2d exit = centre - pass_.n_M * ExitDistance(ctx_, door_);
+        const Eigen::Vector2d offset = ctx_.X_MB.translation() - centre;
+        std::vector<Pose2> path{ctx_.X_MB};
+        std::vector<bool> through;
+        if (offset.dot(pass_.n_M) > 0.1) {  // square up on the opening's centre line first
+          const Eigen::Vector2d in = centre + pass_.n_M * std::min(offset.dot(pass_.n_M), 0.4);
+          path.push_back({in.x(), in.y(), yaw_});
+          through.push_back(true);
+        }
+        path.push_back({exit.x(), exit.y(), yaw_});
+        through.push_back(true);
+        ctx_.motion->FollowPath(path, through, kTuckedArm, ctx_.now);
         Note(StrCat("door open: driving through at ", Input<double>("speed"), " m/s"));
         phase_ = Phase::kThrough;
         return NodeStatus::kRunning;
@@ -499,6 +568,19 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
   void OnHalted() override { ctx_.motion->StopBase(); }
 
  private:
+  Eigen::Vector2d ClearOpeningCentre() const {
+    const perception::DoorModel& door = *ctx_.map->FindDoor(door_);
+    double angle = M_PI / 2;
+    for (const auto& d : ctx_.world.doors) {
+      if (d.model.id == door_ && d.state.observed) angle = std::min(d.state.angle, M_PI / 2);
+    }
+    constexpr double kLeafHalfThickness = 0.03;  // [m] with a margin
+    const double w = door.width();
+    const double clear_from = std::min(w, w * std::cos(angle) + kLeafHalfThickness);
+    const Eigen::Vector2d along = (door.p_MLatch - door.p_MHinge) / w;
+    return door.p_MHinge + along * (clear_from + w) / 2;
+  }
+
   enum class Phase { kToEntry, kWaiting, kThrough };
   std::string door_;
   DoorPass pass_;

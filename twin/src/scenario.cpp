@@ -227,13 +227,15 @@ PredicateSpec ParsePredicate(const FieldReader& r, const YAML::Node& node,
       p.kind = K::kReachGoal;
     else if (s == "no_person_contact")
       p.kind = K::kNoPersonContact;
+    else if (s == "no_door_strike")
+      p.kind = K::kNoDoorStrike;
     else if (s == "within_time_limit")
       p.kind = K::kWithinTimeLimit;
     else
       r.Fail(node, field,
              "'" + s +
                  "' is not a predicate without arguments (reach_goal, "
-                 "no_person_contact, within_time_limit)");
+                 "no_person_contact, no_door_strike, within_time_limit)");
     return p;
   }
   if (!node.IsMap() || node.size() != 1) r.Fail(node, field, "expected one predicate");
@@ -262,7 +264,8 @@ PredicateSpec ParsePredicate(const FieldReader& r, const YAML::Node& node,
            "'" + key +
                "' is not a predicate (reach_goal, cross_door, "
                "door_open_when_crossed, button_pressed, button_not_pressed, "
-               "payload_held, payload_delivered, no_person_contact, within_time_limit)");
+               "payload_held, payload_delivered, no_person_contact, no_door_strike, "
+               "within_time_limit)");
   }
   return p;
 }
@@ -603,6 +606,8 @@ std::string ToString(const PredicateSpec& p) {
       return "payload_delivered:" + p.payload;
     case K::kNoPersonContact:
       return "no_person_contact";
+    case K::kNoDoorStrike:
+      return "no_door_strike";
     case K::kWithinTimeLimit:
       return "within_time_limit";
   }

@@ -166,6 +166,12 @@ Verdict ScenarioJudge::Finish(const TwinWorld& world) const {
         r.detail = std::to_string(n) + " contact(s)";
         break;
       }
+      case K::kNoDoorStrike: {
+        const int n = m.contacts.count("door") ? m.contacts.at("door") : 0;
+        r.passed = n == 0;
+        r.detail = std::to_string(n) + " leaf contact(s)";
+        break;
+      }
       case K::kWithinTimeLimit:
         has_time_limit_predicate = true;
         r.passed = time_ok;

@@ -1,11 +1,12 @@
 #pragma once
 /// @file
 /// Executive: the robot brain's loop, the same against the twin and the real robot. Each
-/// control step (100 Hz default): read the RobotPort → localize (odometry from the initial
-/// pose) → update perception (laser: costmap and door angles; camera: detections placed with
-/// depth, people tracked with intent) → every tick period (10 Hz default) tick the behavior tree
-/// → run the trajectory controller → send the commands. The executive reads time only from the
-/// port's clock, so in the twin it runs in lock-step with simulated time.
+/// control step (100 Hz default): read the RobotPort → localize (particle filter on the
+/// building map: odometry predicts, laser scans correct) → update perception (laser: costmap and
+/// door angles; camera: detections placed with depth, people tracked with intent) → every tick
+/// period (10 Hz default) tick the behavior tree → run the trajectory controller → send the
+/// commands. The executive reads time only from the port's clock, so in the twin it runs in
+/// lock-step with simulated time.
 
 #include <filesystem>
 #include <map>
@@ -20,6 +21,7 @@
 #include "egress/bt/status.h"
 #include "egress/hsr_interface/robot_port.h"
 #include "egress/perception/costmap.h"
+#include "egress/perception/particle_filter_localizer.h"
 #include "egress/perception/world_state.h"
 #include "egress/planning/base_planner.h"
 
@@ -33,6 +35,10 @@ struct ExecutiveConfig {
   planning::ControllerConfig controller;
   perception::PerceptionConfig perception;
   perception::CostmapConfig costmap;
+  /// Laser localization on the building map (AMCL-style); false: odometry alone.
+  bool localize{true};
+  perception::LocalizerConfig localizer;
+  double initial_pose_sigma{0.05};  ///< Spread of the initial pose estimate [m and rad].
   planning::BasePlannerConfig planner = [] {
     planning::BasePlannerConfig c;
     c.deterministic = true;  // a twin run must be a pure function of its seed

@@ -25,6 +25,7 @@ struct MapActuator {
   planning::ButtonType type{planning::ButtonType::kPushButton};
   Eigen::Vector3d p_M{Eigen::Vector3d::Zero()};   ///< Face centre of the actuator [m].
   Eigen::Vector3d n_M{Eigen::Vector3d::UnitX()};  ///< Outward normal of its wall (unit).
+  double protrusion{0.0};                         ///< How far its face stands out of the wall [m].
 };
 
 struct MissionMap {

@@ -45,6 +45,7 @@ class MotionExecutor {
   /// Moves the arm through `knots` (seconds from now, pose). Sent with the next control step.
   void MoveArm(const std::vector<std::pair<double, ArmPose>>& knots, Time now);
 
+  const planning::TrajectoryConfig& trajectory_config() const { return trajectory_config_; }
   bool base_moving() const { return base_active_; }
   /// The last base motion ended by the watchdog (tracking error beyond its limits).
   bool base_failed() const { return base_failed_; }

@@ -137,6 +137,7 @@ struct PredicateSpec {
     kPayloadHeld,          ///< `payload` in the gripper at the end.
     kPayloadDelivered,     ///< `payload` within `radius` of `target` (xy) at the end, released.
     kNoPersonContact,      ///< No robot–person contact.
+    kNoDoorStrike,         ///< The robot's body or arm never touched a door leaf.
     kWithinTimeLimit,      ///< Finished before the time limit (always checked).
   };
   Kind kind{Kind::kReachGoal};
