@@ -15,6 +15,7 @@
 
 #include <fmt/format.h>
 
+#include "batch.h"
 #include "commands.h"
 #include "egress/hsr_interface/error.h"
 #include "egress/twin/sdf_world_loader.h"
@@ -163,7 +164,7 @@ void RunSim(const SimOptions& o) {
 void AddSimCommand(CLI::App& app) {
   auto o = std::make_shared<SimOptions>();
   auto* sim_group =
-      app.add_subcommand("sim", "Digital-twin runs: `sim run` (one scenario, judged)");
+      app.add_subcommand("sim", "Digital-twin runs: `sim run` (one scenario, judged), `sim batch`");
   sim_group->require_subcommand(1);
   auto* sim = sim_group->add_subcommand("run", "Run one twin scenario end to end and judge it");
   sim->add_option("scenario", o->scenario, "scenario YAML (worlds/README.md)")
@@ -183,9 +184,7 @@ void AddSimCommand(CLI::App& app) {
   sim->add_flag("--overwrite", o->overwrite, "replace existing output files");
   sim->add_flag("-q,--quiet", o->quiet, "print only the verdict");
   sim->callback([o] { RunSim(*o); });
-  AddPlannedCommand(*sim_group, "batch",
-                    "Run many seeded trials in parallel with a progress bar and a success table",
-                    "the robot-brain issue");
+  AddSimBatchCommand(*sim_group);
 
   auto render_path = std::make_shared<std::string>();
   auto render_out = std::make_shared<std::string>();

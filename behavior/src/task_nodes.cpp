@@ -424,16 +424,54 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
                  planning::ButtonType type)
       : TaskNode(name, std::move(config), context), type_(type) {}
   NodeStatus OnStart() override {
-    const std::string door = Door();
-    const auto it = ctx_.button_plans.find(door);
+    door_ = Door();
+    const auto it = ctx_.button_plans.find(door_);
     if (it == ctx_.button_plans.end() || it->second.type != type_) {
       Note("no standoff for this actuator: ApproachButton must run first");
       return NodeStatus::kFailure;
     }
-    const ButtonPlan& plan = it->second;
+    alignments_ = 0;
+    arm_started_ = false;
+    return AlignOrOperate();
+  }
+  NodeStatus OnRunning() override {
+    if (!arm_started_) {
+      if (ctx_.motion->base_failed()) {
+        Note("could not square up to the actuator: " + ctx_.motion->base_failure());
+        return NodeStatus::kFailure;
+      }
+      if (ctx_.motion->base_moving()) return NodeStatus::kRunning;
+      return AlignOrOperate();
+    }
+    return ctx_.motion->arm_moving(ctx_.now) ? NodeStatus::kRunning : NodeStatus::kSuccess;
+  }
+  void OnHalted() override { ctx_.motion->StopBase(); }  // the arm is tucked by whoever runs next
+
+ private:
+  static constexpr double kAlignTolerance = 0.01;  // [m] base off its standoff along the normal
+  static constexpr int kMaxAlignments = 2;
+
+  // The base squares up to the planned standoff (by the laser's wall distance) first, then the
+  // arm presses or waves.
+  NodeStatus AlignOrOperate() {
+    const ButtonPlan& plan = ctx_.button_plans.at(door_);
+    const MapActuator& actuator = *ctx_.map->FindActuatorOf(door_);
+    const Pose2 X_MB = WallAlignedPose(ctx_, actuator, [this](const std::string& t) { Note(t); });
+    const Eigen::Vector2d n = actuator.n_M.head<2>().normalized();
+    const double off = (X_MB.translation() - plan.X_MB_standoff.translation()).dot(n);
+    if (std::abs(off) > kAlignTolerance && alignments_ < kMaxAlignments) {
+      ++alignments_;
+      const Pose2 target{ctx_.X_MB.x - n.x() * off, ctx_.X_MB.y - n.y() * off,
+                         plan.X_MB_standoff.yaw};
+      ctx_.motion->FollowPath({ctx_.X_MB, target}, {false}, ctx_.motion->arm_target(), ctx_.now);
+      Note(StrCat("squaring up: ", std::round(off * 1000), " mm off the standoff"));
+      return NodeStatus::kRunning;
+    }
+    return Operate(plan, X_MB);
+  }
+
+  NodeStatus Operate(const ButtonPlan& plan, const Pose2& X_MB) {
     const bool push = type_ == planning::ButtonType::kPushButton;
-    const Pose2 X_MB = WallAlignedPose(ctx_, *ctx_.map->FindActuatorOf(door),
-                                       [this](const std::string& t) { Note(t); });
     const auto approach = SolveArm(ctx_, X_MB, plan.targets.approach, plan.approach_arm, push);
     if (!approach) {
       Note("the actuator is out of the arm's reach from here");
@@ -459,15 +497,14 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
           ctx_.now);
       Note("waving at the proximity plate");
     }
+    arm_started_ = true;
     return NodeStatus::kRunning;
   }
-  NodeStatus OnRunning() override {
-    return ctx_.motion->arm_moving(ctx_.now) ? NodeStatus::kRunning : NodeStatus::kSuccess;
-  }
-  void OnHalted() override {}  // the arm is tucked by whoever runs next (standby or traversal)
 
- private:
   planning::ButtonType type_;
+  std::string door_;
+  int alignments_{0};
+  bool arm_started_{false};
 };
 
 class PressButton final : public ActuatorAction {

@@ -77,8 +77,8 @@ TEST(EgressCliTest, ClearErrors) {
   EXPECT_THAT(result.output, HasSubstr("arm_flex_joint"));
 
   result = RunEgress("sim batch");
-  EXPECT_EQ(result.exit_code, 1);
-  EXPECT_THAT(result.output, HasSubstr("not available in this build yet"));
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_THAT(result.output, HasSubstr("scenarios is required"));
 
   result = RunEgress("no-such-command");
   EXPECT_NE(result.exit_code, 0);
@@ -325,6 +325,50 @@ TEST(EgressCliTest, SimRunsAScenarioWritesVerdictTraceAndPictures) {
   Result broken = RunEgress("sim run " + (dir / "verdict.json").string());
   EXPECT_EQ(broken.exit_code, 1);
   EXPECT_THAT(broken.output, HasSubstr("verdict.json"));
+  std::filesystem::remove_all(dir);
+}
+
+// ---- egress sim batch
+
+const std::string kWorldsDir =
+    std::filesystem::path(EGRESS_OFFICE_MAP).parent_path().parent_path().string();
+
+TEST(EgressCliTest, SimBatchPrintsTheTableAndWritesTheSameResultsForAnyJobCount) {
+  const auto dir = egress::testing::TestTempPath("batch");
+  const std::string scenario = kWorldsDir + "/scenarios/s3_held_door.yaml";
+  Result two = RunEgress("sim batch " + scenario + " --trials 2 --jobs 2 -q --out " +
+                         (dir / "two").string());
+  ASSERT_EQ(two.exit_code, 0) << two.output;
+  // 2 of 2: the 95% Wilson interval is [34.2%, 100%] (the paper's table reads like this).
+  EXPECT_THAT(two.output, HasSubstr("S3 held door"));
+  EXPECT_THAT(two.output, HasSubstr("[ 34.2, 100.0]"));
+  Result one = RunEgress("sim batch " + scenario + " --trials 2 --jobs 1 -q --out " +
+                         (dir / "one").string());
+  ASSERT_EQ(one.exit_code, 0) << one.output;
+  const auto trials = [&](const std::string& run) {
+    const auto j = nlohmann::json::parse(std::ifstream(dir / run / "batch.json"));
+    nlohmann::json out = j.at("trials");
+    for (auto& t : out)
+      t.erase("wall_time");
+    return out;
+  };
+  EXPECT_EQ(trials("one"), trials("two"));
+  EXPECT_EQ(trials("one").size(), 2u);
+  std::ifstream csv(dir / "one" / "trials.csv");
+  int lines = 0;
+  for (std::string line; std::getline(csv, line);)
+    ++lines;
+  EXPECT_EQ(lines, 3);
+  // Results are never overwritten without --overwrite; a scenario without a mission is refused.
+  Result again =
+      RunEgress("sim batch " + scenario + " --trials 1 -q --out " + (dir / "one").string());
+  EXPECT_EQ(again.exit_code, 1);
+  EXPECT_THAT(again.output, HasSubstr("--overwrite"));
+  Result no_mission =
+      RunEgress("sim batch " + kWorldsDir + "/lab/lab_hold_door.yaml --trials 1 -q --out " +
+                (dir / "x").string());
+  EXPECT_EQ(no_mission.exit_code, 1);
+  EXPECT_THAT(no_mission.output, HasSubstr("no 'mission' section"));
   std::filesystem::remove_all(dir);
 }
 

@@ -1,0 +1,415 @@
+// `egress sim batch`: many seeded trials of twin scenarios, driven by the robot brain, in
+// parallel worker processes, with a progress bar; then a table like the paper's Table I
+// (success rate with a 95% Wilson interval, median time, closest person, failure reasons),
+// CSV and JSON files, and the seed of every failed trial to replay it with `sim run`.
+//
+// Trial i of a scenario runs with seed `seed_base + i`; a trial is a pure function of its
+// scenario file and seed, so the results do not depend on --jobs, and a batch can be split into
+// shards (--first) whose merged files equal one machine's.
+
+#include <poll.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <numeric>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "batch.h"
+#include "commands.h"
+#include "egress/hsr_interface/error.h"
+#include "egress/twin/sdf_world_loader.h"
+#include "egress/twin/twin_run.h"
+#include "sdf_map.h"
+
+namespace egress::apps {
+
+WilsonInterval CalcWilsonInterval(int successes, int trials, double z) {
+  ThrowUnless(trials >= 0 && successes >= 0 && successes <= trials,
+              "Wilson interval: need 0 <= successes <= trials");
+  if (trials == 0) return {0.0, 1.0};
+  const double n = trials;
+  const double p = successes / n;
+  const double denominator = 1.0 + z * z / n;
+  const double centre = (p + z * z / (2 * n)) / denominator;
+  const double half = z * std::sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denominator;
+  return {std::max(0.0, centre - half), std::min(1.0, centre + half)};
+}
+
+TrialResult RunBrainTrial(const std::string& scenario_path, std::uint64_t seed) {
+  const auto started = std::chrono::steady_clock::now();
+  const twin::Scenario scenario = twin::LoadScenario(scenario_path);
+  const twin::WorldDescription description = twin::LoadSdfWorld(scenario.world_file);
+  auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
+  twin::TwinWorld world(scenario, description, seed, model);
+  twin::TwinRobot robot(&world);
+  const behavior::ExecutiveConfig config;
+  auto brain = MakeScenarioExecutive(scenario, description, world, model, config);
+  twin::RunOptions options;
+  options.control_period = 0.01;
+  options.record_trace = false;
+  const twin::RunResult run = twin::RunScenario(
+      robot, [&](RobotPort& port) { return brain->Step(port); }, options);
+  TrialResult r;
+  r.scenario = scenario_path;
+  r.name =
+      scenario.name.empty() ? std::filesystem::path(scenario_path).stem().string() : scenario.name;
+  r.seed = seed;
+  r.success = run.verdict.success;
+  for (const auto& p : run.verdict.predicates) {
+    if (!p.passed) r.failed.push_back(p.name);
+  }
+  const twin::RunMetrics& m = run.verdict.metrics;
+  r.time = m.time_to_goal.value_or(m.end_time);
+  r.min_person_distance = m.min_person_distance;
+  r.person_contacts = m.contacts.count("person") ? m.contacts.at("person") : 0;
+  for (const auto& [door, n] : m.button_presses)
+    r.presses += n;
+  for (const auto& [known, commanded] : brain->preemptions())
+    r.preemption_latencies.push_back(commanded - known);
+  r.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return r;
+}
+
+nlohmann::json ToJson(const TrialResult& r) {
+  return {{"scenario", r.scenario},
+          {"name", r.name},
+          {"seed", r.seed},
+          {"success", r.success},
+          {"failed", r.failed},
+          {"time", r.time},
+          {"min_person_distance", std::isfinite(r.min_person_distance)
+                                      ? nlohmann::json(r.min_person_distance)
+                                      : nlohmann::json(nullptr)},
+          {"person_contacts", r.person_contacts},
+          {"presses", r.presses},
+          {"preemption_latencies", r.preemption_latencies},
+          {"wall_time", r.wall_time},
+          {"error", r.error}};
+}
+
+TrialResult TrialFromJson(const nlohmann::json& j) {
+  TrialResult r;
+  r.scenario = j.at("scenario").get<std::string>();
+  r.name = j.at("name").get<std::string>();
+  r.seed = j.at("seed").get<std::uint64_t>();
+  r.success = j.at("success").get<bool>();
+  r.failed = j.at("failed").get<std::vector<std::string>>();
+  r.time = j.at("time").get<double>();
+  r.min_person_distance = j.at("min_person_distance").is_null()
+                              ? std::numeric_limits<double>::infinity()
+                              : j.at("min_person_distance").get<double>();
+  r.person_contacts = j.at("person_contacts").get<int>();
+  r.presses = j.at("presses").get<int>();
+  r.preemption_latencies = j.at("preemption_latencies").get<std::vector<double>>();
+  r.wall_time = j.at("wall_time").get<double>();
+  r.error = j.at("error").get<std::string>();
+  return r;
+}
+
+std::vector<ScenarioSummary> Summarize(const std::vector<TrialResult>& trials) {
+  std::vector<ScenarioSummary> out;
+  std::map<std::string, std::size_t> index;
+  for (const TrialResult& t : trials) {
+    auto [it, inserted] = index.try_emplace(t.scenario, out.size());
+    if (inserted) {
+      ScenarioSummary fresh;
+      fresh.scenario = t.scenario;
+      fresh.name = t.name;
+      out.push_back(std::move(fresh));
+    }
+    ScenarioSummary& s = out[it->second];
+    ++s.trials;
+    s.successes += t.success ? 1 : 0;
+    s.person_contacts += t.person_contacts;
+    s.min_person_distance = std::min(s.min_person_distance, t.min_person_distance);
+    if (t.success) s.times.push_back(t.time);
+    if (!t.success) s.failed_seeds.push_back(t.seed);
+    for (const auto& f : t.failed)
+      ++s.failure_reasons[f];
+    if (!t.error.empty()) ++s.failure_reasons["error: " + t.error];
+  }
+  for (ScenarioSummary& s : out) {
+    s.rate = CalcWilsonInterval(s.successes, s.trials);
+    if (!s.times.empty()) {
+      std::vector<double> t = s.times;
+      std::nth_element(t.begin(), t.begin() + std::ptrdiff_t(t.size() / 2), t.end());
+      s.median_time = t[t.size() / 2];
+    }
+  }
+  return out;
+}
+
+std::string FormatSummaryTable(const std::vector<ScenarioSummary>& summaries) {
+  std::ostringstream out;
+  out << fmt::format("{:<28} {:>6} {:>5} {:>7}  {:<15} {:>8} {:>9} {:>8}  {}\n", "scenario",
+                     "trials", "ok", "rate", "95% Wilson", "median", "closest", "contacts",
+                     "failure reasons");
+  int trials = 0, successes = 0;
+  for (const ScenarioSummary& s : summaries) {
+    std::string reasons;
+    for (const auto& [reason, n] : s.failure_reasons)
+      reasons += fmt::format("{}{} x{}", reasons.empty() ? "" : ", ", reason, n);
+    out << fmt::format(
+        "{:<28} {:>6} {:>5} {:>6.1f}%  [{:>5.1f}, {:>5.1f}] {:>7} {:>9} {:>8}  {}\n",
+        s.name.substr(0, 28), s.trials, s.successes, 100.0 * s.successes / std::max(1, s.trials),
+        100 * s.rate.low, 100 * s.rate.high,
+        s.median_time ? fmt::format("{:.1f} s", *s.median_time) : "-",
+        std::isfinite(s.min_person_distance) ? fmt::format("{:.2f} m", s.min_person_distance) : "-",
+        s.person_contacts, reasons.empty() ? "-" : reasons);
+    trials += s.trials;
+    successes += s.successes;
+  }
+  const WilsonInterval all = CalcWilsonInterval(successes, trials);
+  out << fmt::format("{:<28} {:>6} {:>5} {:>6.1f}%  [{:>5.1f}, {:>5.1f}]\n", "total", trials,
+                     successes, 100.0 * successes / std::max(1, trials), 100 * all.low,
+                     100 * all.high);
+  return out.str();
+}
+
+namespace {
+
+struct BatchOptions {
+  std::vector<std::string> scenarios;
+  int trials{10};
+  int jobs{2};
+  std::uint64_t seed_base{1};
+  std::string out{"batch"};
+  bool overwrite{false};
+  bool quiet{false};
+};
+
+// One worker process per job; worker j runs every J-th trial and writes one JSON line per trial
+// to its pipe. The parent reads all pipes and draws the progress bar.
+std::vector<TrialResult> RunTrialsInWorkers(
+    const std::vector<std::pair<std::string, std::uint64_t>>& work, int jobs, bool progress) {
+  jobs = std::max(1, std::min<int>(jobs, int(work.size())));
+  std::fflush(nullptr);
+  struct Worker {
+    pid_t pid;
+    int fd;
+    std::string buffer;
+    bool open{true};
+  };
+  std::vector<Worker> workers;
+  for (int j = 0; j < jobs; ++j) {
+    int fds[2];
+    if (::pipe(fds) != 0) throw CommandFailed("sim batch: cannot create a pipe");
+    const pid_t pid = ::fork();
+    if (pid < 0) throw CommandFailed("sim batch: cannot fork a worker");
+    if (pid == 0) {
+      ::close(fds[0]);
+      for (std::size_t k = std::size_t(j); k < work.size(); k += std::size_t(jobs)) {
+        TrialResult r;
+        try {
+          r = RunBrainTrial(work[k].first, work[k].second);
+        } catch (const std::exception& e) {
+          r.scenario = work[k].first;
+          r.name = std::filesystem::path(work[k].first).stem().string();
+          r.seed = work[k].second;
+          r.error = e.what();
+        }
+        const std::string line = ToJson(r).dump() + "\n";
+        std::size_t written = 0;
+        while (written < line.size()) {
+          const ssize_t n = ::write(fds[1], line.data() + written, line.size() - written);
+          if (n <= 0) ::_exit(3);
+          written += std::size_t(n);
+        }
+      }
+      ::close(fds[1]);
+      ::_exit(0);
+    }
+    ::close(fds[1]);
+    workers.push_back({pid, fds[0], {}});
+  }
+  std::vector<TrialResult> results;
+  const auto started = std::chrono::steady_clock::now();
+  const auto draw = [&] {
+    if (!progress) return;
+    const double fraction = double(results.size()) / double(work.size());
+    const int filled = int(fraction * 40);
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    std::fprintf(
+        stderr, "\r  [%s%s] %zu/%zu trials  %.0f s", std::string(std::size_t(filled), '#').c_str(),
+        std::string(std::size_t(40 - filled), ' ').c_str(), results.size(), work.size(), elapsed);
+    std::fflush(stderr);
+  };
+  draw();
+  std::size_t open = workers.size();
+  while (open > 0) {
+    std::vector<pollfd> fds;
+    for (const Worker& w : workers) {
+      if (w.open) fds.push_back({w.fd, POLLIN, 0});
+    }
+    if (::poll(fds.data(), fds.size(), -1) < 0) continue;
+    for (Worker& w : workers) {
+      if (!w.open) continue;
+      const auto it =
+          std::find_if(fds.begin(), fds.end(), [&](const pollfd& p) { return p.fd == w.fd; });
+      if (it == fds.end() || it->revents == 0) continue;
+      char chunk[4096];
+      const ssize_t n = ::read(w.fd, chunk, sizeof chunk);
+      if (n <= 0) {
+        ::close(w.fd);
+        w.open = false;
+        --open;
+        continue;
+      }
+      w.buffer.append(chunk, std::size_t(n));
+      std::size_t newline;
+      while ((newline = w.buffer.find('\n')) != std::string::npos) {
+        results.push_back(TrialFromJson(nlohmann::json::parse(w.buffer.substr(0, newline))));
+        w.buffer.erase(0, newline + 1);
+        draw();
+      }
+    }
+  }
+  for (const Worker& w : workers) {
+    int status = 0;
+    ::waitpid(w.pid, &status, 0);
+  }
+  if (progress) std::fprintf(stderr, "\n");
+  if (results.size() != work.size()) {
+    throw CommandFailed(fmt::format("sim batch: {} of {} trials reported (a worker died)",
+                                    results.size(), work.size()));
+  }
+  // The order of the work list, whatever order the workers finished in.
+  std::map<std::pair<std::string, std::uint64_t>, std::size_t> order;
+  for (std::size_t k = 0; k < work.size(); ++k)
+    order[work[k]] = k;
+  std::sort(results.begin(), results.end(), [&](const TrialResult& a, const TrialResult& b) {
+    return order[{a.scenario, a.seed}] < order[{b.scenario, b.seed}];
+  });
+  return results;
+}
+
+void RunBatch(const BatchOptions& o) {
+  if (o.trials < 1) throw CommandFailed("--trials must be at least 1");
+  if (o.jobs < 1) throw CommandFailed("--jobs must be at least 1");
+  const std::filesystem::path dir(o.out);
+  const auto csv_path = dir / "trials.csv";
+  const auto json_path = dir / "batch.json";
+  for (const auto& p : {csv_path, json_path}) {
+    if (std::filesystem::exists(p) && !o.overwrite) {
+      throw CommandFailed(fmt::format("'{}' exists; pass --overwrite to replace it", p.string()));
+    }
+  }
+  // Check every scenario (and its mission) before starting any worker.
+  for (const auto& s : o.scenarios) {
+    const twin::Scenario scenario = twin::LoadScenario(s);
+    if (!scenario.mission) {
+      throw CommandFailed(
+          fmt::format("{}: no 'mission' section: sim batch runs the robot brain", s));
+    }
+  }
+  std::vector<std::pair<std::string, std::uint64_t>> work;
+  for (const auto& s : o.scenarios) {
+    for (int i = 0; i < o.trials; ++i)
+      work.emplace_back(s, o.seed_base + std::uint64_t(i));
+  }
+  if (!o.quiet) {
+    fmt::print("{} scenario(s) x {} trials = {} runs on {} worker process(es)\n",
+               o.scenarios.size(), o.trials, work.size(),
+               std::min<std::size_t>(std::size_t(o.jobs), work.size()));
+  }
+  const auto started = std::chrono::steady_clock::now();
+  const std::vector<TrialResult> results =
+      RunTrialsInWorkers(work, o.jobs, !o.quiet && ::isatty(::fileno(stderr)));
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  const std::vector<ScenarioSummary> summaries = Summarize(results);
+  std::cout << FormatSummaryTable(summaries);
+  std::vector<double> latencies;
+  for (const auto& r : results)
+    latencies.insert(latencies.end(), r.preemption_latencies.begin(), r.preemption_latencies.end());
+  if (!latencies.empty()) {
+    std::sort(latencies.begin(), latencies.end());
+    fmt::print(
+        "preemption (person seen in the door zone -> stop command): {} events, median {:.3f} s, "
+        "max {:.3f} s\n",
+        latencies.size(), latencies[latencies.size() / 2], latencies.back());
+  }
+  fmt::print("wall time {:.1f} s for {} trials ({} jobs)\n", wall, results.size(), o.jobs);
+  for (const auto& r : results) {
+    if (r.success) continue;
+    std::string why;
+    for (const auto& f : r.failed)
+      why += (why.empty() ? "" : ", ") + f;
+    if (!r.error.empty()) why = r.error;
+    fmt::print("  failed: {} seed {} ({})  replay: egress sim run {} --seed {}\n", r.name, r.seed,
+               why, r.scenario, r.seed);
+  }
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream csv(csv_path);
+    csv << "scenario,name,seed,success,time_s,min_person_distance_m,person_contacts,presses,"
+           "failed,wall_s\n";
+    for (const auto& r : results) {
+      std::string failed;
+      for (const auto& f : r.failed)
+        failed += (failed.empty() ? "" : ";") + f;
+      csv << fmt::format(
+          "{},\"{}\",{},{},{:.2f},{},{},{},\"{}\",{:.2f}\n", r.scenario, r.name, r.seed,
+          r.success ? 1 : 0, r.time,
+          std::isfinite(r.min_person_distance) ? fmt::format("{:.3f}", r.min_person_distance) : "",
+          r.person_contacts, r.presses, r.error.empty() ? failed : r.error, r.wall_time);
+    }
+    if (!csv) throw CommandFailed(fmt::format("cannot write '{}'", csv_path.string()));
+  }
+  nlohmann::json summary = nlohmann::json::array();
+  for (const auto& s : summaries) {
+    summary.push_back(
+        {{"scenario", s.scenario},
+         {"name", s.name},
+         {"trials", s.trials},
+         {"successes", s.successes},
+         {"rate", double(s.successes) / std::max(1, s.trials)},
+         {"wilson95", {s.rate.low, s.rate.high}},
+         {"median_time", s.median_time ? nlohmann::json(*s.median_time) : nlohmann::json(nullptr)},
+         {"person_contacts", s.person_contacts},
+         {"failure_reasons", s.failure_reasons},
+         {"failed_seeds", s.failed_seeds}});
+  }
+  nlohmann::json trials = nlohmann::json::array();
+  for (const auto& r : results)
+    trials.push_back(ToJson(r));
+  std::ofstream(json_path) << nlohmann::json{{"wall_s", wall},
+                                             {"jobs", o.jobs},
+                                             {"summary", summary},
+                                             {"trials", trials}}
+                                  .dump(2)
+                           << "\n";
+  fmt::print("wrote {} and {}\n", csv_path.string(), json_path.string());
+}
+
+}  // namespace
+
+void AddSimBatchCommand(CLI::App& sim_group) {
+  auto o = std::make_shared<BatchOptions>();
+  auto* batch = sim_group.add_subcommand(
+      "batch", "Run seeded trials of scenarios in parallel and print a success table");
+  batch->add_option("scenarios", o->scenarios, "scenario YAML files with a mission")
+      ->required()
+      ->check(CLI::ExistingFile);
+  batch->add_option("--trials", o->trials, "trials per scenario")->capture_default_str();
+  batch->add_option("--jobs,-j", o->jobs, "worker processes")->capture_default_str();
+  batch->add_option("--seed-base", o->seed_base, "trial i runs with seed seed-base + i")
+      ->capture_default_str();
+  batch->add_option("--out", o->out, "directory for trials.csv and batch.json")
+      ->capture_default_str();
+  batch->add_flag("--overwrite", o->overwrite, "replace existing result files");
+  batch->add_flag("-q,--quiet", o->quiet, "no progress bar");
+  batch->callback([o] { RunBatch(*o); });
+}
+
+}  // namespace egress::apps
