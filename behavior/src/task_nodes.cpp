@@ -56,6 +56,13 @@ DoorPass CalcDoorPass(const MissionMap& map, const std::string& door, const Pose
   return pass;
 }
 
+DoorPass CalcApproachPass(TaskContext& context, const std::string& door) {
+  DoorPass pass = CalcDoorPass(*context.map, door, context.X_MB);
+  const auto [it, inserted] = context.door_approach_side.try_emplace(door, pass.n_M);
+  pass.n_M = it->second;
+  return pass;
+}
+
 bool IsDoorZoneOccupied(const TaskContext& context, const std::string& door) {
   const perception::DoorModel* model = context.map->FindDoor(door);
   ThrowUnless(model != nullptr, "unknown door '", door, "' (not in the building map)");
@@ -188,6 +195,9 @@ class IsPathClear final : public TaskNode<bt::ConditionNode> {
   }
   NodeStatus Tick() override {
     const std::string door = Door();
+    // A standby retreat runs to its end before the robot resumes: stopping it half-way can
+    // leave the robot in the doorway with the leaf about to close.
+    if (ctx_.retreating) return last_ = NodeStatus::kFailure;
     if (IsDoorZoneOccupied(ctx_, door)) {
       if (last_ != NodeStatus::kFailure) Note("a person is in or entering the door zone");
       ctx_.zone_occupied_at[door] = ctx_.now;
@@ -226,9 +236,12 @@ bool DoorPassable(const TaskContext& ctx, const std::string& door, double margin
     if (d.model.id != door) continue;
     if (d.state.motion == perception::DoorMotion::kClosing) return false;
     if (held_by_person || d.state.motion != perception::DoorMotion::kHeldOpen) continue;
-    const DoorPass pass = CalcDoorPass(*ctx.map, door, ctx.X_MB);
-    const double to_clear = std::max(0.0, (ctx.X_MB.translation() - pass.centre).dot(pass.n_M)) +
-                            ExitDistance(ctx, door);
+    DoorPass pass = CalcDoorPass(*ctx.map, door, ctx.X_MB);
+    if (const auto side = ctx.door_approach_side.find(door); side != ctx.door_approach_side.end())
+      pass.n_M = side->second;
+    // From here to beyond the leaf's sweep on the far side (less if already past the line).
+    const double to_clear = std::max(
+        0.0, (ctx.X_MB.translation() - pass.centre).dot(pass.n_M) + ExitDistance(ctx, door));
     const double needed = to_clear / ctx.motion->trajectory_config().door_speed;
     if (d.state.steady_for + needed > ctx.config.door_hold_window) return false;
   }
@@ -327,6 +340,7 @@ class ApproachButton final : public TaskNode<bt::StatefulActionNode> {
       Note("door has no actuator");
       return NodeStatus::kFailure;
     }
+    CalcApproachPass(ctx_, door);  // remember which side is "before" the door
     ButtonPlan plan;
     plan.type = actuator->type;
     plan.targets = planning::MakeButtonTargets(actuator->p_M, actuator->n_M, actuator->type,
@@ -539,7 +553,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
   }
   NodeStatus OnStart() override {
     door_ = Door();
-    pass_ = CalcDoorPass(*ctx_.map, door_, ctx_.X_MB);
+    pass_ = CalcApproachPass(ctx_, door_);
     if (!ArmAt(ctx_.motion->arm_target(), kTuckedArm) || ctx_.motion->arm_moving(ctx_.now)) {
       ctx_.motion->MoveArm({{ctx_.config.arm_tuck_time, kTuckedArm}}, ctx_.now);
     }
@@ -640,7 +654,29 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
     }
     if (Input<bool>("back_off") && ctx_.last_safe &&
         (ctx_.last_safe->translation() - ctx_.X_MB.translation()).norm() > 0.05) {
-      ctx_.motion->FollowPath({ctx_.X_MB, *ctx_.last_safe}, {false}, kTuckedArm, ctx_.now);
+      // Out of a doorway straight back along the door's normal first (a diagonal line to the
+      // safe waypoint would cut the jamb or the leaf), then to the waypoint.
+      std::vector<Pose2> path{ctx_.X_MB};
+      for (const auto& door : ctx_.map->doors) {
+        const auto side = ctx_.door_approach_side.find(door.id);
+        DoorPass pass = CalcDoorPass(*ctx_.map, door.id, ctx_.X_MB);
+        if (side != ctx_.door_approach_side.end()) pass.n_M = side->second;
+        const Eigen::Vector2d offset = ctx_.X_MB.translation() - pass.centre;
+        const double along = offset.dot(pass.n_M);
+        const double lateral = std::abs(offset.dot(Eigen::Vector2d(-pass.n_M.y(), pass.n_M.x())));
+        const double entry = ctx_.config.door_entry_distance;
+        if (along < entry - 0.05 && along > -ExitDistance(ctx_, door.id) &&
+            lateral < pass.width / 2 + 0.3) {
+          const Eigen::Vector2d out = ctx_.X_MB.translation() + pass.n_M * (entry - along);
+          path.push_back({out.x(), out.y(), ctx_.X_MB.yaw});
+          break;
+        }
+      }
+      if ((path.back().translation() - ctx_.last_safe->translation()).norm() > 0.05)
+        path.push_back(*ctx_.last_safe);
+      ctx_.motion->FollowPath(path, std::vector<bool>(path.size() - 1, false), kTuckedArm,
+                              ctx_.now);
+      ctx_.retreating = true;
       Note(StrCat("backing off to the last safe waypoint (", PoseText(*ctx_.last_safe), ")"));
     }
     return NodeStatus::kRunning;
@@ -648,9 +684,13 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
   NodeStatus OnRunning() override {
     if (ctx_.motion->base_failed()) ctx_.motion->StopBase();  // blocked: stay, arm tucked
     const bool busy = ctx_.motion->arm_moving(ctx_.now) || ctx_.motion->base_moving();
+    if (!busy) ctx_.retreating = false;
     return busy ? NodeStatus::kRunning : NodeStatus::kSuccess;
   }
-  void OnHalted() override { ctx_.motion->StopBase(); }
+  void OnHalted() override {
+    ctx_.motion->StopBase();
+    ctx_.retreating = false;
+  }
 };
 
 class WaitForClear final : public TaskNode<bt::StatefulActionNode> {

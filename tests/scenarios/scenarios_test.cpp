@@ -93,6 +93,22 @@ TEST(ScenarioTest, S3HeldDoorIsPassedWithoutPressing) {
   EXPECT_EQ(run.world->button_presses(0), 0);
 }
 
+TEST(ScenarioTest, S6RetreatsFromAPersonCuttingThePathThenPasses) {
+  const BrainRun run = RunWithBrain(kScenarios / "s6_person_cuts_path.yaml", 1);
+  EXPECT_TRUE(run.result.verdict.success) << twin::FormatVerdict(run.result.verdict);
+  bool retreated = false;
+  for (const auto& d : run.brain->decisions())
+    retreated =
+        retreated || d.text.find("backing off to the last safe waypoint") != std::string::npos;
+  EXPECT_TRUE(retreated);
+}
+
+TEST(ScenarioTest, S7GoesRoundAnUnmappedObstacleAndPassesTheHeldDoor) {
+  const BrainRun run = RunWithBrain(kScenarios / "s7_obstacle_held_door.yaml", 1);
+  EXPECT_TRUE(run.result.verdict.success) << twin::FormatVerdict(run.result.verdict);
+  EXPECT_EQ(run.presses, 0);
+}
+
 // A scenario whose mission names `tree_xml` (written next to it).
 std::string LoadError(const std::string& tree_xml, const std::string& mission_extra = "") {
   const auto dir =

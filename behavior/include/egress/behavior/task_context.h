@@ -72,7 +72,13 @@ struct TaskContext {
   // Kept by the nodes.
   std::map<std::string, ButtonPlan> button_plans;  ///< Per door.
   std::map<std::string, Time> zone_occupied_at;    ///< Per door: when a person last was in it.
-  std::vector<std::string> notes;                  ///< The nodes' reasons, for the run log.
+  /// Per door: the unit normal of the door line pointing to the side the robot came from
+  /// (fixed when it first works at the door, so a robot caught mid-doorway still knows which
+  /// way is forward).
+  std::map<std::string, Eigen::Vector2d> door_approach_side;
+  /// A standby retreat is under way: it is finished before the robot resumes.
+  bool retreating{false};
+  std::vector<std::string> notes;  ///< The nodes' reasons, for the run log.
 
   double now_s() const { return ToSeconds(now); }
   void Note(std::string text) { notes.push_back(std::move(text)); }
@@ -86,6 +92,9 @@ struct DoorPass {
 };
 /// @throws InvalidArgument for an unknown door id.
 DoorPass CalcDoorPass(const MissionMap& map, const std::string& door, const Pose2& X_MB);
+/// The same, with the normal pointing to the side the robot approached the door from (the side
+/// it is on now, the first time; remembered in the context).
+DoorPass CalcApproachPass(TaskContext& context, const std::string& door);
 
 /// True when a person (not one holding this door) is in, or forecast into, the zone of `door`.
 bool IsDoorZoneOccupied(const TaskContext& context, const std::string& door);
