@@ -125,8 +125,10 @@ class TaskNode : public Base {
 };
 
 // Starts a base motion along a planned path; RUNNING until it ends.
+// Plans from the robot to `goal` on the costmap and starts following the path; `door_speed`
+// runs every segment at the door speed (a door approach inside the hold window).
 NodeStatus StartPath(TaskContext& ctx, const Pose2& goal, const std::string& what,
-                     const std::function<void(const std::string&)>& note) {
+                     const std::function<void(const std::string&)>& note, bool door_speed = false) {
   planning::PlanResult plan = ctx.planner->Plan(ctx.X_MB, goal);
   if (plan.status == planning::PlanStatus::kStartInCollision) {
     // The robot stands where the costmap says it cannot (inflation around a leaf or a person
@@ -151,9 +153,7 @@ NodeStatus StartPath(TaskContext& ctx, const Pose2& goal, const std::string& wha
     note(StrCat("no path to ", what, " (", PoseText(goal), "): ", plan.message));
     return NodeStatus::kFailure;
   }
-  std::vector<bool> through;
-  for (std::size_t i = 0; i + 1 < plan.path.size(); ++i)
-    through.push_back(false);
+  const std::vector<bool> through(plan.path.size() > 0 ? plan.path.size() - 1 : 0, door_speed);
   if (plan.path.size() < 2 ||
       (plan.path.back().translation() - ctx.X_MB.translation()).norm() < 0.01) {
     return NodeStatus::kSuccess;  // already there
@@ -236,6 +236,8 @@ bool DoorPassable(const TaskContext& ctx, const std::string& door, double margin
     if (d.model.id != door) continue;
     if (d.state.motion == perception::DoorMotion::kClosing) return false;
     if (held_by_person || d.state.motion != perception::DoorMotion::kHeldOpen) continue;
+    // Still open well past an operator's window: someone or something out of sight holds it.
+    if (d.state.steady_for > ctx.config.door_hold_window + ctx.config.door_hold_margin) continue;
     DoorPass pass = CalcDoorPass(*ctx.map, door, ctx.X_MB);
     if (const auto side = ctx.door_approach_side.find(door); side != ctx.door_approach_side.end())
       pass.n_M = side->second;
@@ -564,9 +566,16 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     phase_ = Phase::kWaiting;
     waiting_since_ = ctx_.now;
     if (lateral > 0.05 || offset.dot(pass_.n_M) > ctx_.config.door_entry_distance + 0.05) {
-      ctx_.motion->FollowPath({ctx_.X_MB, {entry.x(), entry.y(), yaw_}}, {true}, kTuckedArm,
-                              ctx_.now);
-      Note("lining up on the door's axis");
+      // Straight when the costmap allows (the usual case), else round what is in the way.
+      const Pose2 X_MB_entry{entry.x(), entry.y(), yaw_};
+      if (ctx_.planner->IsPathValid({ctx_.X_MB, X_MB_entry})) {
+        ctx_.motion->FollowPath({ctx_.X_MB, X_MB_entry}, {true}, kTuckedArm, ctx_.now);
+        Note("lining up on the door's axis");
+      } else {
+        const NodeStatus s = StartPath(
+            ctx_, X_MB_entry, "the door's axis", [this](const std::string& t) { Note(t); }, true);
+        if (s != NodeStatus::kRunning) return s;
+      }
       phase_ = Phase::kToEntry;
     }
     return OnRunning();

@@ -114,9 +114,14 @@ PersonIntent ClassifyIntent(const TrackedPerson& person, const DoorZone& zone,
                             const DoorState& door, const IntentConfig& config) {
   const DoorModel& model = zone.door;
   const double speed = person.v_MP.norm();
+  // Holding: still, beside an open leaf (at its edge, or at the hinge side pushing it).
+  const Eigen::Vector2d tip = model.LeafTip(door.angle);
+  const Eigen::Vector2d leaf = tip - model.p_MHinge;
+  const double s =
+      std::clamp((person.p_MP - model.p_MHinge).dot(leaf) / leaf.squaredNorm(), 0.0, 1.0);
+  const double to_leaf = (person.p_MP - (model.p_MHinge + s * leaf)).norm();
   if (door.observed && door.open_fraction >= config.holding_min_open &&
-      speed < config.stationary_speed * 2 &&
-      (person.p_MP - model.LeafTip(door.angle)).norm() <= config.holding_distance) {
+      speed < config.stationary_speed * 2 && to_leaf <= config.holding_distance) {
     return PersonIntent::kHoldingDoor;
   }
   if (speed < config.stationary_speed) return PersonIntent::kStationary;

@@ -26,6 +26,7 @@ struct BrainRun {
 };
 
 BrainRun RunWithBrain(const std::filesystem::path& file, std::uint64_t seed) {
+  if (const char* s = std::getenv("EGRESS_SCENARIO_SEED")) seed = std::stoull(s);
   const twin::Scenario scenario = twin::LoadScenario(file);
   const twin::WorldDescription description = twin::LoadSdfWorld(scenario.world_file);
   auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
@@ -53,6 +54,15 @@ BrainRun RunWithBrain(const std::filesystem::path& file, std::uint64_t seed) {
               "door %.2f %s\n",
               run.world->time(), f.x(), f.y(), f.z(), b.x, b.y, b.yaw, e.x, e.y, e.yaw,
               run.world->door_angle(0), run.brain->active_action().c_str());
+          for (const auto& p : run.world->people()) {
+            std::printf("         TRUE %s at %.2f %.2f phase %s\n", p.name.c_str(), p.position.x(),
+                        p.position.y(), p.phase.c_str());
+          }
+          for (const auto& p : run.brain->context().world.people) {
+            std::printf("         person %d at %.2f %.2f v %.2f %.2f intent %d door %s\n",
+                        p.person.id, p.person.p_MP.x(), p.person.p_MP.y(), p.person.v_MP.x(),
+                        p.person.v_MP.y(), int(p.intent), p.door_id.c_str());
+          }
           for (const auto& d : run.brain->context().world.doors) {
             std::printf("         door %s observed %d angle %.2f clearance %.2f motion %d\n",
                         d.model.id.c_str(), int(d.state.observed), d.state.angle,

@@ -33,6 +33,9 @@ constexpr int kMaskFloor = kGPayload;
 constexpr int kMaskDoor = kGBase | kGArm | kGPerson | kGPayload;
 constexpr int kMaskBase = kGStatic | kGDoor | kGPerson | kGPayload;
 constexpr int kMaskArm = kGStatic | kGDoor | kGPerson | kGPayload;
+constexpr double kStuckSec =
+    2.0;  // [s] a walker that wants to move but has not, this long, is stuck
+constexpr double kKeepRight = 0.2;  // [m] off the doorway axis, clear of a 0.9 m door's jambs
 constexpr int kMaskPerson = kGStatic | kGDoor | kGBase | kGArm | kGPayload;
 constexpr int kMaskPayload = kGStatic | kGFloor | kGDoor | kGBase | kGArm | kGPerson | kGPayload;
 
@@ -188,6 +191,8 @@ struct TwinWorld::Impl {
     int door{-1};
     int wait_before_waypoint{-1};  // route index (counted from the start) of the doorway centre
     int reached{0};                // waypoints reached so far
+    double stuck_for{0.0};         // [s] wanting to walk but not moving
+    bool realigned{false};         // stepped back onto the door's axis once
     double hold_angle{0.0};
     double hold_duration{0.0};
     double hold_started{-1.0};
@@ -579,14 +584,14 @@ struct TwinWorld::Impl {
     auto through_door = [&](int door_index) {
       const Door& d = doors[door_index];
       const double side = (start - d.centre).dot(d.normal) >= 0 ? 1.0 : -1.0;
-      // People keep right: wait and leave 0.3 m to the right of the doorway's axis, so two
+      // People keep right: wait and leave kKeepRight to the right of the doorway's axis, so two
       // walkers crossing in opposite directions do not meet head-on at its ends.
       const Eigen::Vector2d heading = -d.normal * side;
       const Eigen::Vector2d right(heading.y(), -heading.x());
-      p->route.push_back(d.centre - heading * 1.0 + right * 0.3);
+      p->route.push_back(d.centre - heading * 1.0 + right * kKeepRight);
       p->wait_before_waypoint = int(p->route.size());
       p->route.push_back(d.centre);
-      p->route.push_back(d.centre + heading * 1.0 + right * 0.3);
+      p->route.push_back(d.centre + heading * 1.0 + right * kKeepRight);
     };
     switch (spec.behavior) {
       case PersonBehavior::kCrossDoorway:
@@ -688,6 +693,21 @@ struct TwinWorld::Impl {
         p.walker.desired_speed = 0.0;
       } else if (p.state.phase == "waiting_for_door") {
         p.state.phase = "walking";
+      }
+      // Pushed against a jamb (a social-force local minimum, e.g. after making way for the
+      // robot), a walker heading for the doorway steps back onto the door's axis and goes again.
+      const bool heading_for_doorway =
+          p.door >= 0 && p.reached == p.wait_before_waypoint && p.state.phase == "walking";
+      p.stuck_for = heading_for_doorway && p.walker.velocity.norm() < 0.05 ? p.stuck_for + dt : 0.0;
+      if (p.stuck_for > kStuckSec && !p.realigned) {
+        const Door& d = doors[std::size_t(p.door)];
+        const double side = (p.walker.position - d.centre).dot(d.normal) >= 0 ? 1.0 : -1.0;
+        p.route.insert(p.route.begin(), d.centre + d.normal * side * 0.8);
+        --p.reached;  // the doorway centre stays the next waypoint after this one
+        p.realigned = true;
+        p.stuck_for = 0.0;
+        p.walker.target = p.route.front();
+        p.walker.final_target = false;
       }
       const double reached_radius = p.route.size() == 1 ? 0.25 : 0.4;
       if ((p.walker.position - p.route.front()).norm() < reached_radius &&

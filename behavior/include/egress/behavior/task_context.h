@@ -26,6 +26,9 @@ struct TaskConfig {
   /// How long an ADA operator holds its door open (the paper's ~10 s auto-close window): a held
   /// door is passed only if the robot can clear the leaf's sweep within it [s].
   double door_hold_window{10.0};
+  /// A door still steady this long past the window is held by someone out of sight (the
+  /// holder often stands behind the jamb) [s].
+  double door_hold_margin{2.0};
   double zone_depth{1.0};        ///< People-free zone each side of a door line [m].
   double person_radius{0.3};     ///< [m]
   double arm_tuck_time{1.5};     ///< [s]

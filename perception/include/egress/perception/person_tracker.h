@@ -73,7 +73,7 @@ struct DoorZone {
 
 struct IntentConfig {
   double stationary_speed{0.15};  ///< Below this a person is not walking [m/s].
-  double holding_distance{0.7};   ///< From the leaf's free edge, for holding the door [m].
+  double holding_distance{0.7};   ///< From the leaf (hinge to free edge), for holding it [m].
   double holding_min_open{0.25};  ///< The door must be open at least this fraction.
   double parallel_ratio{0.5};     ///< |v·normal| < ratio·|v|: walking past.
   double crossing_horizon{2.0};   ///< Reaching the door line within this: crossing [s].
