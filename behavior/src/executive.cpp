@@ -101,7 +101,7 @@ Executive::Executive(std::shared_ptr<const RobotModel> model, MissionMap map, Mi
   m.X_MB_initial = X_MB_initial;
   costmap_ = std::make_unique<perception::Costmap2D>(m.map.grid, m.config.costmap);
   planning::BasePlannerConfig planner_config = m.config.planner;
-  planner_config.footprint_radius = m.config.costmap.robot_radius;
+  planner_config.footprint_radius = m.config.costmap.robot_radius + m.config.path_clearance;
   m.planner = std::make_unique<planning::BasePlanner>(*costmap_, nullptr, planner_config);
   for (const auto& doorway : m.map.doorways) {
     costmap_->AddDoorway(doorway);

@@ -131,22 +131,32 @@ NodeStatus StartPath(TaskContext& ctx, const Pose2& goal, const std::string& wha
                      const std::function<void(const std::string&)>& note, bool door_speed = false) {
   planning::PlanResult plan = ctx.planner->Plan(ctx.X_MB, goal);
   if (plan.status == planning::PlanStatus::kStartInCollision) {
-    // The robot stands where the costmap says it cannot (inflation around a leaf or a person
-    // seen close by): step straight towards the goal to the first free pose, plan from there.
+    // The robot stands where the costmap says it cannot (inflation around a leaf, a person seen
+    // close by, an obstacle it brushed): step to the nearest free pose — never across an
+    // obstacle cell — preferring the goal's direction, and plan from there.
     const Eigen::Vector2d towards = (goal.translation() - ctx.X_MB.translation()).normalized();
-    for (double step = 0.05; step <= 0.8 && plan.status == planning::PlanStatus::kStartInCollision;
-         step += 0.05) {
-      const Eigen::Vector2d p = ctx.X_MB.translation() + towards * step;
-      const Pose2 escape{p.x(), p.y(), ctx.X_MB.yaw};
-      if (!ctx.planner->IsValid(escape)) continue;
-      planning::PlanResult rest = ctx.planner->Plan(escape, goal);
-      if (!rest.ok()) {
+    const double heading = std::atan2(towards.y(), towards.x());
+    const perception::Costmap2D& costmap = *ctx.world.costmap;
+    bool escaped = false;
+    for (double step = 0.05; step <= 0.6 && !escaped; step += 0.05) {
+      for (int k = 0; k < 16 && !escaped; ++k) {
+        // 0, +22.5°, -22.5°, +45°, ... around the goal's direction.
+        const double a = heading + (k % 2 == 0 ? 1 : -1) * ((k + 1) / 2) * M_PI / 8;
+        const Eigen::Vector2d d(std::cos(a), std::sin(a));
+        const Eigen::Vector2d p = ctx.X_MB.translation() + d * step;
+        const Pose2 escape{p.x(), p.y(), ctx.X_MB.yaw};
+        if (!ctx.planner->IsValid(escape)) continue;
+        bool crosses = false;
+        for (double s = 0.02; s < step && !crosses; s += 0.02)
+          crosses = costmap.CostAt(ctx.X_MB.translation() + d * s) >= perception::kLethalCost;
+        if (crosses) continue;
+        planning::PlanResult rest = ctx.planner->Plan(escape, goal);
+        if (!rest.ok()) continue;
+        rest.path.insert(rest.path.begin(), ctx.X_MB);
+        rest.length += step;
         plan = rest;
-        break;
+        escaped = true;
       }
-      rest.path.insert(rest.path.begin(), ctx.X_MB);
-      rest.length += step;
-      plan = rest;
     }
   }
   if (!plan.ok()) {

@@ -119,6 +119,17 @@ TEST(ScenarioTest, S7GoesRoundAnUnmappedObstacleAndPassesTheHeldDoor) {
   EXPECT_EQ(run.presses, 0);
 }
 
+TEST(ScenarioTest, HardHalfOpenDoorIsNotDrivenIntoButOpenedByTheButton) {
+  const BrainRun run = RunWithBrain(kScenarios / "hard" / "h1_half_open_held_door.yaml", 1);
+  EXPECT_TRUE(run.result.verdict.success) << twin::FormatVerdict(run.result.verdict);
+  EXPECT_GE(run.presses, 1);
+}
+
+TEST(ScenarioTest, HardNarrowCorridorIsFoundAndPassed) {
+  const BrainRun run = RunWithBrain(kScenarios / "hard" / "h3_narrow_corridor.yaml", 1);
+  EXPECT_TRUE(run.result.verdict.success) << twin::FormatVerdict(run.result.verdict);
+}
+
 // A scenario whose mission names `tree_xml` (written next to it).
 std::string LoadError(const std::string& tree_xml, const std::string& mission_extra = "") {
   const auto dir =

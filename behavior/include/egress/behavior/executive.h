@@ -35,6 +35,9 @@ struct ExecutiveConfig {
   planning::ControllerConfig controller;
   perception::PerceptionConfig perception;
   perception::CostmapConfig costmap;
+  /// Paths keep this much more than the footprint's radius from obstacles: string-pulled paths
+  /// hug corners, and tracking is good to a centimetre or two [m].
+  double path_clearance{0.03};
   /// Laser localization on the building map (AMCL-style); false: odometry alone.
   bool localize{true};
   perception::LocalizerConfig localizer;
