@@ -71,7 +71,8 @@ struct Executive::Impl {
   std::unique_ptr<ActionLog> log;
   std::optional<Pose2> X_MO;  // odometry frame in the map, fixed at the first step
   std::optional<perception::ParticleFilterLocalizer> localizer;
-  std::optional<Pose2> last_odometry;
+  std::optional<Pose2> last_odometry;  // X_OB at the last scan the localizer used
+  Pose2 X_MB_at_scan;                  // the localizer's estimate then
   Pose2 X_MB_initial;
   std::optional<Time> next_tick;
   std::optional<DepthImage> depth;
@@ -149,10 +150,20 @@ bool Executive::Step(RobotPort& port) {
   // Localize: odometry predicts, laser scans correct on the building map (or odometry alone
   // from the initial pose).
   if (m.localizer) {
-    if (m.last_odometry) m.localizer->Predict(*m.last_odometry, snapshot.odometry.X_OB);
-    m.last_odometry = snapshot.odometry.X_OB;
-    if (snapshot.scan) m.localizer->Correct(*snapshot.scan);
-    context_.X_MB = m.localizer->Estimate();
+    // The filter moves its particles once per scan, by the odometry since the last scan (as
+    // AMCL does): per-step increments would hardly spread the particles, and the cloud could
+    // not catch up with odometry drift. Between scans, odometry carries the estimate.
+    if (!m.last_odometry) {
+      m.last_odometry = snapshot.odometry.X_OB;
+      m.X_MB_at_scan = m.localizer->Estimate();
+    }
+    if (snapshot.scan) {
+      m.localizer->Predict(*m.last_odometry, snapshot.odometry.X_OB);
+      m.localizer->Correct(*snapshot.scan);
+      m.last_odometry = snapshot.odometry.X_OB;
+      m.X_MB_at_scan = m.localizer->Estimate();
+    }
+    context_.X_MB = m.X_MB_at_scan * (m.last_odometry->Inverse() * snapshot.odometry.X_OB);
   } else {
     if (!m.X_MO) m.X_MO = m.X_MB_initial * snapshot.odometry.X_OB.Inverse();
     context_.X_MB = *m.X_MO * snapshot.odometry.X_OB;
@@ -230,6 +241,7 @@ bool Executive::Step(RobotPort& port) {
   const Twist2 V_B = m.motion.Update(now, context_.X_MB, snapshot.odometry.V_B);
   port.SendBaseVelocity(V_B);
   if (auto arm = m.motion.TakeArmCommand()) port.SendArmTrajectory(*arm);
+  if (auto gripper = m.motion.TakeGripperCommand()) port.SendGripperCommand(*gripper);
   return !m.finished;
 }
 

@@ -738,6 +738,162 @@ class WaitForClear final : public TaskNode<bt::StatefulActionNode> {
   Time started_{};
 };
 
+// "x;y;z" → point. @throws InvalidArgument naming the text.
+Eigen::Vector3d ParsePoint3(std::string_view text) {
+  const Pose2 xy = ParsePose2(text);  // x;y;z parses as x;y;yaw
+  return {xy.x, xy.y, xy.yaw};
+}
+
+// Waits (up to `timeout`) for the perception pipeline to confirm a payload of the class, and
+// writes its position.
+class DetectPayload final : public TaskNode<bt::StatefulActionNode> {
+ public:
+  using TaskNode::TaskNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("kind", "bottle or flashlight"),
+            InputPort<double>("timeout", 4.0, "how long to look [s]"),
+            OutputPort<std::string>("pose", "payload position x;y;z in the map")};
+  }
+  NodeStatus OnStart() override {
+    started_ = ctx_.now;
+    return OnRunning();
+  }
+  NodeStatus OnRunning() override {
+    const std::string kind = Input<std::string>("kind");
+    const perception::TrackedObject* best = nullptr;
+    for (const auto& object : ctx_.world.payloads) {
+      if (object.label != kind) continue;
+      if (best == nullptr || (object.p_MO.head<2>() - ctx_.X_MB.translation()).norm() <
+                                 (best->p_MO.head<2>() - ctx_.X_MB.translation()).norm()) {
+        best = &object;
+      }
+    }
+    if (best != nullptr) {
+      this->SetOutput("pose", StrCat(best->p_MO.x(), ";", best->p_MO.y(), ";", best->p_MO.z()));
+      Note(StrCat("found a ", kind, " at (", std::round(best->p_MO.x() * 100) / 100, ", ",
+                  std::round(best->p_MO.y() * 100) / 100, ", ",
+                  std::round(best->p_MO.z() * 100) / 100, ")"));
+      return NodeStatus::kSuccess;
+    }
+    if (ToSeconds(ctx_.now - started_) > Input<double>("timeout")) {
+      Note(StrCat("no ", kind, " in sight"));
+      return NodeStatus::kFailure;
+    }
+    return NodeStatus::kRunning;
+  }
+  void OnHalted() override {}
+
+ private:
+  Time started_{};
+};
+
+// Grasps a payload seen at `pose`: the base goes where whole-body IK puts it (palm level,
+// approaching horizontally from the robot's side), the arm reaches a pre-grasp 12 cm short, then
+// the grasp, the gripper closes, and the arm lifts 10 cm. Success when the gripper holds it.
+class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
+ public:
+  using TaskNode::TaskNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("pose", "payload position x;y;z")};
+  }
+  NodeStatus OnStart() override {
+    const Eigen::Vector3d p_seen = ParsePoint3(Input<std::string>("pose"));
+    Eigen::Vector2d a = p_seen.head<2>() - ctx_.X_MB.translation();
+    if (a.norm() < 1e-6) a = Eigen::Vector2d(std::cos(ctx_.X_MB.yaw), std::sin(ctx_.X_MB.yaw));
+    a.normalize();
+    approach_ = Eigen::Vector3d(a.x(), a.y(), 0.0);
+    // The camera sees the near surface; the centre is a radius further.
+    centre_ = p_seen + approach_ * kPayloadRadius;
+    const planning::IkTarget grasp{centre_ - approach_ * kGraspDepthInPalm, approach_};
+    WholeBodyVector q0 = WholeBodyVector::Zero();
+    const Eigen::Vector2d base = centre_.head<2>() - a * 0.6;
+    q0[kBaseX] = base.x();
+    q0[kBaseY] = base.y();
+    q0[kBaseYaw] = std::atan2(a.y(), a.x());
+    q0 = WithArm(q0, kReachArm);
+    planning::IkConfig ik = ctx_.config.ik;
+    ik.fingertip = false;
+    ik.use_base = true;
+    const planning::IkResult r = planning::DlsIkSolver(*ctx_.model, ik).Solve(grasp, q0);
+    if (!r.converged) {
+      Note("no whole-body reach for the grasp");
+      return NodeStatus::kFailure;
+    }
+    grasp_arm_ = ArmOf(r.q);
+    X_MB_grasp_ = {r.q[kBaseX], r.q[kBaseY], r.q[kBaseYaw]};
+    GripperCommand open;
+    open.mode = GripperCommand::Mode::kOpen;
+    ctx_.motion->SetGripper(open);
+    phase_ = Phase::kToBase;
+    return StartPath(ctx_, X_MB_grasp_, "the grasp pose",
+                     [this](const std::string& t) { Note(t); });
+  }
+  NodeStatus OnRunning() override {
+    switch (phase_) {
+      case Phase::kToBase: {
+        const NodeStatus s = BaseMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+        if (s != NodeStatus::kSuccess) return s;
+        // Arm-only from where the base stopped.
+        const auto grasp =
+            SolveArm(ctx_, ctx_.X_MB, {centre_ - approach_ * kGraspDepthInPalm, approach_},
+                     grasp_arm_, false);
+        const auto pre =
+            SolveArm(ctx_, ctx_.X_MB, {centre_ - approach_ * (kGraspDepthInPalm + 0.12), approach_},
+                     grasp ? *grasp : grasp_arm_, false);
+        if (!grasp || !pre) {
+          Note("the payload is out of the arm's reach from here");
+          return NodeStatus::kFailure;
+        }
+        ctx_.motion->MoveArm({{2.0, *pre}, {3.5, *grasp}}, ctx_.now);
+        lifted_ = *grasp;
+        lifted_[0] += 0.10;  // arm_lift
+        phase_ = Phase::kReach;
+        Note("reaching for the payload");
+        return NodeStatus::kRunning;
+      }
+      case Phase::kReach: {
+        if (ctx_.motion->arm_moving(ctx_.now)) return NodeStatus::kRunning;
+        GripperCommand close;
+        close.mode = GripperCommand::Mode::kGrasp;
+        close.effort = 10.0;
+        ctx_.motion->SetGripper(close);
+        closing_since_ = ctx_.now;
+        phase_ = Phase::kClose;
+        return NodeStatus::kRunning;
+      }
+      case Phase::kClose: {
+        if (ToSeconds(ctx_.now - closing_since_) < 1.5) return NodeStatus::kRunning;
+        ctx_.motion->MoveArm({{1.0, lifted_}}, ctx_.now);
+        phase_ = Phase::kLift;
+        return NodeStatus::kRunning;
+      }
+      case Phase::kLift: {
+        if (ctx_.motion->arm_moving(ctx_.now)) return NodeStatus::kRunning;
+        if (!ctx_.holding_object) {
+          Note("the gripper closed on nothing");
+          return NodeStatus::kFailure;
+        }
+        Note("holding the payload");
+        return NodeStatus::kSuccess;
+      }
+    }
+    return NodeStatus::kFailure;
+  }
+  void OnHalted() override { ctx_.motion->StopBase(); }
+
+ private:
+  static constexpr double kPayloadRadius = 0.03;     // [m] a bottle's, about
+  static constexpr double kGraspDepthInPalm = 0.07;  // grasp centre ahead of the palm [m]
+  static constexpr ArmPose kReachArm{0.2, -1.0, 0.0, -0.5, 0.0};
+  enum class Phase { kToBase, kReach, kClose, kLift };
+  Phase phase_{Phase::kToBase};
+  Eigen::Vector3d approach_{Eigen::Vector3d::UnitX()};
+  Eigen::Vector3d centre_{Eigen::Vector3d::Zero()};
+  ArmPose grasp_arm_{kTuckedArm}, lifted_{kTuckedArm};
+  Pose2 X_MB_grasp_;
+  Time closing_since_{};
+};
+
 template <typename T>
 void Register(bt::BehaviorTreeFactory& factory, const std::string& id, TaskContext* context) {
   bt::NodeManifest manifest;
@@ -772,6 +928,8 @@ void RegisterTaskNodes(bt::BehaviorTreeFactory& factory, TaskContext* context) {
   Register<TraverseDoor>(factory, "TraverseDoor", context);
   Register<RetractToSafe>(factory, "RetractToSafe", context);
   Register<WaitForClear>(factory, "WaitForClear", context);
+  Register<DetectPayload>(factory, "DetectPayload", context);
+  Register<GraspPayload>(factory, "GraspPayload", context);
 }
 
 }  // namespace egress::behavior

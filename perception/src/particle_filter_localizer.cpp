@@ -1,5 +1,6 @@
 #include "egress/perception/particle_filter_localizer.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -102,9 +103,23 @@ void ParticleFilterLocalizer::Predict(const Pose2& X_OB_previous, const Pose2& X
 }
 
 double ParticleFilterLocalizer::LikelihoodFieldDistance(const Eigen::Vector2d& p_MQ) const {
-  const auto cell = geometry_.CellOf(p_MQ);
-  if (!cell) return std::numeric_limits<double>::infinity();
-  return distance_[geometry_.Index(cell->x(), cell->y())];
+  if (!geometry_.CellOf(p_MQ)) return std::numeric_limits<double>::infinity();
+  // Bilinear between cell centres, less half a cell: the distance to an obstacle's surface, not
+  // to its nearest cell centre. A per-cell step would favour poses that put the beam endpoints
+  // inside the walls, and bias the estimate by up to half a cell towards them.
+  const double res = geometry_.resolution;
+  const double u = (p_MQ.x() - geometry_.origin.x()) / res - 0.5;
+  const double v = (p_MQ.y() - geometry_.origin.y()) / res - 0.5;
+  const int i0 = int(std::floor(u)), j0 = int(std::floor(v));
+  const double fu = u - i0, fv = v - j0;
+  const auto at = [&](int i, int j) {
+    i = std::clamp(i, 0, geometry_.width - 1);
+    j = std::clamp(j, 0, geometry_.height - 1);
+    return double(distance_[geometry_.Index(i, j)]);
+  };
+  const double d = (1 - fu) * (1 - fv) * at(i0, j0) + fu * (1 - fv) * at(i0 + 1, j0) +
+                   (1 - fu) * fv * at(i0, j0 + 1) + fu * fv * at(i0 + 1, j0 + 1);
+  return std::max(0.0, d - 0.5 * res);
 }
 
 bool ParticleFilterLocalizer::Correct(const LaserScan& scan) {

@@ -215,9 +215,9 @@ struct BasePlanner::Impl {
   bool MotionValid(const Pose2& a, const Pose2& b) const {
     ob::ScopedState<ob::SE2StateSpace> sa(space), sb(space);
     sa->setXY(a.x, a.y);
-    sa->setYaw(a.yaw);
+    sa->setYaw(WrapAngle(a.yaw));  // SO2 asserts its bounds
     sb->setXY(b.x, b.y);
-    sb->setYaw(b.yaw);
+    sb->setYaw(WrapAngle(b.yaw));  // SO2 asserts its bounds
     return si->checkMotion(sa.get(), sb.get());
   }
 
@@ -275,9 +275,9 @@ struct BasePlanner::Impl {
     og::SimpleSetup setup(si);
     ob::ScopedState<ob::SE2StateSpace> s(space), g(space);
     s->setXY(start.x, start.y);
-    s->setYaw(start.yaw);
+    s->setYaw(WrapAngle(start.yaw));  // SO2 asserts its bounds
     g->setXY(goal.x, goal.y);
-    g->setYaw(goal.yaw);
+    g->setYaw(WrapAngle(goal.yaw));  // SO2 asserts its bounds
     setup.setStartAndGoalStates(s, g);
     auto length = std::make_shared<ob::PathLengthOptimizationObjective>(si);
     if (config.costmap_cost_weight > 0.0) {
@@ -480,9 +480,9 @@ std::vector<BasePlanner::BenchmarkSummary> BasePlanner::RunOmplBenchmark(
   og::SimpleSetup setup(impl_->si);
   ob::ScopedState<ob::SE2StateSpace> s(impl_->space), g(impl_->space);
   s->setXY(start.x, start.y);
-  s->setYaw(start.yaw);
+  s->setYaw(WrapAngle(start.yaw));  // SO2 asserts its bounds
   g->setXY(goal.x, goal.y);
-  g->setYaw(goal.yaw);
+  g->setYaw(WrapAngle(goal.yaw));  // SO2 asserts its bounds
   setup.setStartAndGoalStates(s, g);
   setup.setOptimizationObjective(std::make_shared<ob::PathLengthOptimizationObjective>(impl_->si));
   ompl::tools::Benchmark benchmark(setup, experiment);

@@ -103,6 +103,18 @@ TEST(ScenarioTest, S3HeldDoorIsPassedWithoutPressing) {
   EXPECT_EQ(run.world->button_presses(0), 0);
 }
 
+TEST(ScenarioTest, S4aFetchesTheBottleAndTakesItThroughTheDoor) {
+  const BrainRun run = RunWithBrain(kScenarios / "s4a_fetch_bottle.yaml", 1);
+  EXPECT_TRUE(run.result.verdict.success) << twin::FormatVerdict(run.result.verdict);
+  EXPECT_EQ(run.world->held_payload(), "bottle");
+}
+
+TEST(ScenarioTest, S4bFetchesTheFlashlightAndTakesItThroughTheDoor) {
+  const BrainRun run = RunWithBrain(kScenarios / "s4b_fetch_flashlight.yaml", 1);
+  EXPECT_TRUE(run.result.verdict.success) << twin::FormatVerdict(run.result.verdict);
+  EXPECT_EQ(run.world->held_payload(), "flashlight");
+}
+
 TEST(ScenarioTest, S6RetreatsFromAPersonCuttingThePathThenPasses) {
   const BrainRun run = RunWithBrain(kScenarios / "s6_person_cuts_path.yaml", 1);
   EXPECT_TRUE(run.result.verdict.success) << twin::FormatVerdict(run.result.verdict);

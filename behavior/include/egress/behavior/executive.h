@@ -40,7 +40,12 @@ struct ExecutiveConfig {
   double path_clearance{0.03};
   /// Laser localization on the building map (AMCL-style); false: odometry alone.
   bool localize{true};
-  perception::LocalizerConfig localizer;
+  perception::LocalizerConfig localizer = [] {
+    perception::LocalizerConfig c;
+    c.max_beams = 180;   // a 270° scan at 1.5°: the room's corners and jambs pin the pose
+    c.sigma_hit = 0.05;  // the twin's laser is good to a centimetre
+    return c;
+  }();
   double initial_pose_sigma{0.05};  ///< Spread of the initial pose estimate [m and rad].
   planning::BasePlannerConfig planner = [] {
     planning::BasePlannerConfig c;

@@ -59,6 +59,14 @@ class MotionExecutor {
   Twist2 Update(Time now, const Pose2& X_MB, const Twist2& V_B_measured);
   /// The arm trajectory to send, once.
   std::optional<JointTrajectory> TakeArmCommand();
+  /// Commands the gripper (sent with the next control step).
+  void SetGripper(const GripperCommand& command) { pending_gripper_ = command; }
+  /// The gripper command to send, once.
+  std::optional<GripperCommand> TakeGripperCommand() {
+    auto out = pending_gripper_;
+    pending_gripper_.reset();
+    return out;
+  }
 
  private:
   const RobotModel& model_;
@@ -68,6 +76,7 @@ class MotionExecutor {
   bool base_failed_{false};
   std::string base_failure_;
   std::optional<JointTrajectory> pending_arm_;
+  std::optional<GripperCommand> pending_gripper_;
   Time arm_done_{};
   ArmPose arm_target_{kTuckedArm};
 };

@@ -7,8 +7,8 @@
 ///
 /// Registered now: IsPathClear, IsDoorOpen, IsPersonHoldingDoor, IsHoldingPayload, ButtonType,
 /// NavigateTo, ApproachButton, PressButton, WaveAtPlate, TraverseDoor, RetractToSafe,
-/// WaitForClear. Not yet: DetectPayload, GraspPayload, PlacePayload, HandOver (a tree using
-/// them fails to load with an unknown-node error naming the file and line).
+/// WaitForClear, DetectPayload, GraspPayload. Not yet: PlacePayload, HandOver (a tree using them
+/// fails to load with an unknown-node error naming the file and line).
 
 #include "egress/behavior/task_context.h"
 #include "egress/bt/factory.h"
