@@ -33,9 +33,10 @@ struct TrialResult {
   double min_person_distance{std::numeric_limits<double>::infinity()};  ///< [m]
   int person_contacts{0};
   int presses{0};
-  std::vector<double> preemption_latencies;  ///< [s] person seen in the zone -> stop.
-  double wall_time{0.0};                     ///< [s]
-  std::string error;                         ///< The run threw this.
+  std::vector<double> preemption_latencies;        ///< [s] person seen in the zone -> stop.
+  std::vector<double> preemption_total_latencies;  ///< [s] person in the zone (truth) -> stop.
+  double wall_time{0.0};                           ///< [s]
+  std::string error;                               ///< The run threw this.
 };
 
 /// One trial in this process. @throws like `egress sim run` for a bad scenario.
