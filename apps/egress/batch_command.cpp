@@ -334,21 +334,38 @@ void RunBatch(const BatchOptions& o) {
     }
   }
   // Check every scenario (and its mission) before starting any worker.
-  for (const auto& s : o.scenarios) {
-    const twin::Scenario scenario = twin::LoadScenario(s);
+  // SCENARIO or SCENARIO:N (N trials of that one, e.g. the paper's protocol).
+  std::vector<std::pair<std::string, int>> plan;
+  for (const auto& arg : o.scenarios) {
+    std::string file = arg;
+    int trials = o.trials;
+    if (const auto colon = arg.rfind(':');
+        colon != std::string::npos && !std::filesystem::exists(arg)) {
+      const std::string count = arg.substr(colon + 1);
+      if (count.empty() || count.find_first_not_of("0123456789") != std::string::npos ||
+          std::stoll(count) < 1 || std::stoll(count) > 1000000) {
+        throw CommandFailed(fmt::format("'{}': expected SCENARIO or SCENARIO:TRIALS", arg));
+      }
+      file = arg.substr(0, colon);
+      trials = int(std::stoll(count));
+    }
+    if (!std::filesystem::exists(file))
+      throw CommandFailed(fmt::format("'{}': no such scenario file", file));
+    // Check every scenario (and its mission) before starting any worker.
+    const twin::Scenario scenario = twin::LoadScenario(file);
     if (!scenario.mission) {
       throw CommandFailed(
-          fmt::format("{}: no 'mission' section: sim batch runs the robot brain", s));
+          fmt::format("{}: no 'mission' section: sim batch runs the robot brain", file));
     }
+    plan.emplace_back(file, trials);
   }
   std::vector<std::pair<std::string, std::uint64_t>> work;
-  for (const auto& s : o.scenarios) {
-    for (int i = 0; i < o.trials; ++i)
-      work.emplace_back(s, o.seed_base + std::uint64_t(i));
+  for (const auto& [file, trials] : plan) {
+    for (int i = 0; i < trials; ++i)
+      work.emplace_back(file, o.seed_base + std::uint64_t(i));
   }
   if (!o.quiet) {
-    fmt::print("{} scenario(s) x {} trials = {} runs on {} worker process(es)\n",
-               o.scenarios.size(), o.trials, work.size(),
+    fmt::print("{} scenario(s), {} runs on {} worker process(es)\n", plan.size(), work.size(),
                std::min<std::size_t>(std::size_t(o.jobs), work.size()));
   }
   const auto started = std::chrono::steady_clock::now();
@@ -431,9 +448,10 @@ void AddSimBatchCommand(CLI::App& sim_group) {
   auto o = std::make_shared<BatchOptions>();
   auto* batch = sim_group.add_subcommand(
       "batch", "Run seeded trials of scenarios in parallel and print a success table");
-  batch->add_option("scenarios", o->scenarios, "scenario YAML files with a mission")
-      ->required()
-      ->check(CLI::ExistingFile);
+  batch
+      ->add_option("scenarios", o->scenarios,
+                   "scenario YAML files with a mission; FILE:N runs N trials of that one")
+      ->required();
   batch->add_option("--trials", o->trials, "trials per scenario")->capture_default_str();
   batch->add_option("--jobs,-j", o->jobs, "worker processes")->capture_default_str();
   batch->add_option("--seed-base", o->seed_base, "trial i runs with seed seed-base + i")

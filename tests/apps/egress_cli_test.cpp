@@ -359,6 +359,13 @@ TEST(EgressCliTest, SimBatchPrintsTheTableAndWritesTheSameResultsForAnyJobCount)
   for (std::string line; std::getline(csv, line);)
     ++lines;
   EXPECT_EQ(lines, 3);
+  // FILE:N runs N trials of that scenario; a bad count is refused naming the argument.
+  Result counted = RunEgress("sim batch " + scenario + ":1 -q --out " + (dir / "n").string());
+  ASSERT_EQ(counted.exit_code, 0) << counted.output;
+  EXPECT_EQ(nlohmann::json::parse(std::ifstream(dir / "n" / "batch.json")).at("trials").size(), 1u);
+  Result bad_count = RunEgress("sim batch " + scenario + ":x -q --out " + (dir / "m").string());
+  EXPECT_EQ(bad_count.exit_code, 1);
+  EXPECT_THAT(bad_count.output, HasSubstr("SCENARIO:TRIALS"));
   // Results are never overwritten without --overwrite; a scenario without a mission is refused.
   Result again =
       RunEgress("sim batch " + scenario + " --trials 1 -q --out " + (dir / "one").string());
