@@ -94,6 +94,15 @@ void RunSim(const SimOptions& o) {
     brain = MakeScenarioExecutive(scenario, world_description, world, model, kDefaults);
     options.control_period = 1.0 / 100.0;
     controller = [&brain](RobotPort& port) { return brain->Step(port); };
+    // The video shows the running action and the planned path (the map frame is W here: the
+    // brain starts from the twin's start pose).
+    options.annotate = [&brain] {
+      twin::TraceAnnotation note;
+      note.label = brain->active_action();
+      for (const Pose2& X : brain->context().motion->path())
+        note.path.push_back(X.translation());
+      return note;
+    };
   } else if (driver == "idle") {
     controller = twin::IdleController();
   } else if (o.driver == "dead-reckoning") {

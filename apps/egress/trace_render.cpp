@@ -123,10 +123,35 @@ cv::Mat RenderTraceFrame(const TraceFile& trace, std::size_t index, double pixel
                v(b["people"][p][0], b["people"][p][1]), cv::Scalar(60, 150, 240), 1, cv::LINE_AA);
     }
   }
+  // The driver's planned path (the brain's), if the trace has one.
+  if (sample.contains("path") && sample["path"].is_array()) {
+    const auto& path = sample["path"];
+    for (std::size_t k = 1; k < path.size(); ++k) {
+      cv::line(image, v(path[k - 1][0], path[k - 1][1]), v(path[k][0], path[k][1]),
+               cv::Scalar(60, 180, 60), 2, cv::LINE_AA);
+    }
+  }
   for (std::size_t p = 0; p < people; ++p) {
     const auto& q = sample["people"][p];
     cv::circle(image, v(q[0], q[1]), int(0.25 * v.scale), cv::Scalar(30, 110, 230), cv::FILLED,
                cv::LINE_AA);
+    // Velocity arrow: where the person will be in a second.
+    if (index > 0 && p < trace.samples[index - 1]["people"].size()) {
+      const auto& before = trace.samples[index - 1];
+      const double dt = sample["t"].get<double>() - before["t"].get<double>();
+      if (dt > 0) {
+        const double vx = (q[0].get<double>() - before["people"][p][0].get<double>()) / dt;
+        const double vy = (q[1].get<double>() - before["people"][p][1].get<double>()) / dt;
+        if (std::hypot(vx, vy) > 0.1) {
+          cv::arrowedLine(image, v(q[0], q[1]), v(q[0].get<double>() + vx, q[1].get<double>() + vy),
+                          cv::Scalar(20, 80, 200), 2, cv::LINE_AA, 0, 0.2);
+        }
+      }
+    }
+    if (q.size() > 2 && q[2].is_string()) {
+      cv::putText(image, q[2].get<std::string>(), v(q[0], q[1]) + cv::Point(8, -8),
+                  cv::FONT_HERSHEY_SIMPLEX, 0.35, cv::Scalar(20, 80, 200), 1, cv::LINE_AA);
+    }
   }
   if (sample.contains("payloads")) {
     for (const auto& q : sample["payloads"]) {
@@ -149,6 +174,11 @@ cv::Mat RenderTraceFrame(const TraceFile& trace, std::size_t index, double pixel
       fmt::format("{}  seed {}  t = {:.1f} s{}", trace.header.value("scenario", std::string()),
                   trace.header.value("seed", 0), sample["t"].get<double>(), held),
       {6, v.height - 8}, cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(20, 20, 20), 1, cv::LINE_AA);
+  if (sample.contains("label") && sample["label"].is_string()) {
+    const std::string label = sample["label"].get<std::string>();
+    cv::putText(image, "BT: " + (label.empty() ? std::string("-") : label), {6, 18},
+                cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(20, 20, 20), 1, cv::LINE_AA);
+  }
   return image;
 }
 

@@ -44,6 +44,7 @@ void MotionExecutor::FollowPath(const std::vector<Pose2>& path,
       planning::WholeBodyTrajectory::Plan(waypoints, model_, trajectory_config_, through_door),
       now);
   base_active_ = true;
+  path_ = path;
   base_failed_ = false;
   base_failure_.clear();
 }
@@ -51,6 +52,7 @@ void MotionExecutor::FollowPath(const std::vector<Pose2>& path,
 void MotionExecutor::StopBase() {
   controller_.Stop();
   base_active_ = false;
+  path_.clear();
 }
 
 void MotionExecutor::MoveArm(const std::vector<std::pair<double, ArmPose>>& knots, Time now) {
@@ -75,12 +77,14 @@ Twist2 MotionExecutor::Update(Time now, const Pose2& X_MB, const Twist2& V_B_mea
   const planning::ControlCommand command = controller_.Update(now, X_MB, V_B_measured);
   if (command.watchdog_tripped) {
     base_active_ = false;
+    path_.clear();
     base_failed_ = true;
     base_failure_ = command.watchdog_reason;
     return {};
   }
   if (command.finished || !command.active) {
     base_active_ = false;
+    path_.clear();
     return {};
   }
   return command.V_B;

@@ -333,6 +333,22 @@ TEST(EgressCliTest, SimRunsAScenarioWritesVerdictTraceAndPictures) {
 const std::string kWorldsDir =
     std::filesystem::path(EGRESS_OFFICE_MAP).parent_path().parent_path().string();
 
+TEST(EgressCliTest, SimRunWithTheBrainPrintsDecisionsAndTracesTheRunningAction) {
+  const auto dir = egress::testing::TestTempPath("brain");
+  std::filesystem::create_directories(dir);
+  const std::string scenario = kWorldsDir + "/scenarios/s3_held_door.yaml";
+  Result run = RunEgress("sim run " + scenario + " --trace " + (dir / "run.jsonl").string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("driver brain"));
+  EXPECT_THAT(run.output, HasSubstr("traverse_open started"));
+  EXPECT_THAT(run.output, HasSubstr("mission succeeded"));
+  std::ifstream in(dir / "run.jsonl");
+  const std::string trace((std::istreambuf_iterator<char>(in)), {});
+  EXPECT_THAT(trace, HasSubstr("\"label\":\"traverse_open\""));
+  EXPECT_THAT(trace, HasSubstr("\"path\":[["));
+  std::filesystem::remove_all(dir);
+}
+
 TEST(EgressCliTest, SimBatchPrintsTheTableAndWritesTheSameResultsForAnyJobCount) {
   const auto dir = egress::testing::TestTempPath("batch");
   const std::string scenario = kWorldsDir + "/scenarios/s3_held_door.yaml";

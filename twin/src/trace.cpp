@@ -49,7 +49,7 @@ TraceRecorder::TraceRecorder(double rate_hz) : period_(1.0 / rate_hz) {
   ThrowUnless(rate_hz > 0, "trace: rate must be positive");
 }
 
-void TraceRecorder::Observe(const TwinWorld& world) {
+void TraceRecorder::Observe(const TwinWorld& world, const TraceAnnotation* annotation) {
   // Built with += only: GCC 12 warns falsely (-Wrestrict) on "literal" + std::string.
   auto quoted = [](std::string* out, const std::string& text) {
     *out += '"';
@@ -190,7 +190,22 @@ void TraceRecorder::Observe(const TwinWorld& world) {
     s += '}';
   }
   events_seen_ = events.size();
-  s += "]}";
+  s += ']';
+  if (annotation != nullptr) {
+    s += ",\"label\":";
+    quoted(&s, annotation->label);
+    s += ",\"path\":[";
+    for (std::size_t i = 0; i < annotation->path.size(); ++i) {
+      if (i) s += ',';
+      s += '[';
+      s += Fixed(annotation->path[i].x());
+      s += ',';
+      s += Fixed(annotation->path[i].y());
+      s += ']';
+    }
+    s += ']';
+  }
+  s += '}';
   samples_.push_back(std::move(s));
 }
 

@@ -24,7 +24,14 @@ RunResult RunScenario(TwinRobot& robot, const Controller& controller, const RunO
     while (world.time() < period_end - 1e-9) {
       robot.Advance(world.step_size());
       judge.Observe(world);
-      if (result.trace) result.trace->Observe(world);
+      if (result.trace) {
+        if (options.annotate && result.trace->SampleDue(world)) {
+          const TraceAnnotation note = options.annotate();
+          result.trace->Observe(world, &note);
+        } else {
+          result.trace->Observe(world);
+        }
+      }
     }
     const int percent = int(std::floor(100.0 * (1.0 - (end - world.time()) / duration)));
     if (options.on_progress && percent != last_percent) {

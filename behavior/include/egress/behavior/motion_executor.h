@@ -47,6 +47,8 @@ class MotionExecutor {
 
   const planning::TrajectoryConfig& trajectory_config() const { return trajectory_config_; }
   bool base_moving() const { return base_active_; }
+  /// The path being followed (empty when the base is idle).
+  const std::vector<Pose2>& path() const { return path_; }
   /// The last base motion ended by the watchdog (tracking error beyond its limits).
   bool base_failed() const { return base_failed_; }
   const std::string& base_failure() const { return base_failure_; }
@@ -73,6 +75,7 @@ class MotionExecutor {
   planning::TrajectoryConfig trajectory_config_;
   planning::TrackingController controller_;
   bool base_active_{false};
+  std::vector<Pose2> path_;
   bool base_failed_{false};
   std::string base_failure_;
   std::optional<JointTrajectory> pending_arm_;

@@ -10,7 +10,7 @@
 ///   "glass"}], "people": [names], "payloads": [names]}.
 /// Sample: {"t", "robot": [x, y, yaw], "doors": [[angle, phase]], "people": [[x, y, phase]],
 ///   "payloads": [[x, y, z]], "held": name or null, "events": [{"t", "kind", "subject",
-///   "detail"}]}. Frame W, SI units.
+///   "detail"}], optional "label" and "path": [[x, y]] from the driver}. Frame W, SI units.
 
 #include <cstdint>
 #include <filesystem>
@@ -21,11 +21,21 @@
 
 namespace egress::twin {
 
+/// What whoever drives the robot wants shown with a sample (the brain: its running action and
+/// its planned path). Not ground truth, and the twin does not read it.
+struct TraceAnnotation {
+  std::string label;                  ///< e.g. the behavior tree's running action
+  std::vector<Eigen::Vector2d> path;  ///< planned base path in W [m]
+};
+
 class TraceRecorder {
  public:
   explicit TraceRecorder(double rate_hz = 20.0);
-  /// Call after every world step; records a sample when one is due.
-  void Observe(const TwinWorld& world);
+  /// Call after every world step; records a sample when one is due, with `annotation` (if any)
+  /// as "label" and "path".
+  void Observe(const TwinWorld& world, const TraceAnnotation* annotation = nullptr);
+  /// Whether Observe at `world`'s time would record a sample.
+  bool SampleDue(const TwinWorld& world) const { return world.time() + 1e-9 >= next_; }
   /// The whole trace as JSON lines.
   std::string ToJsonLines() const;
   /// Writes ToJsonLines() to `path`. @throws LoadError if it cannot be written.

@@ -20,6 +20,8 @@ struct RunOptions {
   double trace_rate_hz{20.0};
   /// Called with the fraction done (0..1) about every 1 % of the run.
   std::function<void(double)> on_progress;
+  /// Called when a trace sample is recorded: what the driver wants shown with it.
+  std::function<TraceAnnotation()> annotate;
 };
 
 /// Called once per control period; return false to end the run early (e.g. the task is done).
