@@ -82,7 +82,8 @@ case "$command" in
     say "a twin scenario end to end, driven by the robot brain: S1, press the lab door's push button"
     say "and drive through while the ADA operator holds it open"
     "$build_dir/apps/egress" sim run worlds/scenarios/s1_nominal.yaml \
-      --png "$build_dir/demo_run.png" --trace "$build_dir/demo_run.jsonl" --overwrite
+      --png "$build_dir/demo_run.png" --video "$build_dir/demo_run.mp4" \
+      --trace "$build_dir/demo_run.jsonl" --overwrite
     echo
     say "a base path across the office SDF world through door_a and door_b, drawn to $build_dir/demo_path.png"
     "$build_dir/apps/egress" plan --local --map worlds/office/office.sdf --start 1.5 4.5 0 --goal 12.5 1.5 0 \
