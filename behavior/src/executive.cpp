@@ -192,6 +192,18 @@ bool Executive::Step(RobotPort& port) {
   context_.world =
       m.perception.Snapshot(now, context_.X_MB, Eigen::Matrix3d::Zero(), costmap_.get());
   context_.holding_object = snapshot.gripper.holding_object;
+  // Each door's current opening starts when it is first seen wide enough to pass, and ends
+  // when it is seen closed or closing (a dip in the estimate, e.g. a person in front of the
+  // leaf, does not end it).
+  for (const auto& d : context_.world.doors) {
+    if (!d.state.observed) continue;
+    if (d.state.motion == perception::DoorMotion::kClosed ||
+        d.state.motion == perception::DoorMotion::kClosing) {
+      context_.door_open_since.erase(d.model.id);
+    } else if (d.state.clearance_width >= 2 * context_.config.footprint_radius) {
+      context_.door_open_since.try_emplace(d.model.id, now);
+    }
+  }
   if (snapshot.scan) context_.scan = snapshot.scan;
   bool in_any_zone = false;
   bool newly_occupied = false;

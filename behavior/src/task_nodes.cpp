@@ -247,7 +247,12 @@ bool DoorPassable(const TaskContext& ctx, const std::string& door, double margin
     if (d.state.motion == perception::DoorMotion::kClosing) return false;
     if (held_by_person || d.state.motion != perception::DoorMotion::kHeldOpen) continue;
     // Still open well past an operator's window: someone or something out of sight holds it.
-    if (d.state.steady_for > ctx.config.door_hold_window + ctx.config.door_hold_margin) continue;
+    // How long it has been open in this opening (not the estimate's steady time, which a
+    // person passing in front of the leaf resets).
+    const auto since = ctx.door_open_since.find(door);
+    const double open_for =
+        since != ctx.door_open_since.end() ? ToSeconds(ctx.now - since->second) : 0.0;
+    if (open_for > ctx.config.door_hold_window + ctx.config.door_hold_margin) continue;
     DoorPass pass = CalcDoorPass(*ctx.map, door, ctx.X_MB);
     if (const auto side = ctx.door_approach_side.find(door); side != ctx.door_approach_side.end())
       pass.n_M = side->second;
@@ -255,7 +260,7 @@ bool DoorPassable(const TaskContext& ctx, const std::string& door, double margin
     const double to_clear = std::max(
         0.0, (ctx.X_MB.translation() - pass.centre).dot(pass.n_M) + ExitDistance(ctx, door));
     const double needed = to_clear / ctx.motion->trajectory_config().door_speed;
-    if (d.state.steady_for + needed > ctx.config.door_hold_window) return false;
+    if (open_for + needed > ctx.config.door_hold_window) return false;
   }
   return true;
 }
@@ -469,7 +474,10 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
       if (ctx_.motion->base_moving()) return NodeStatus::kRunning;
       return AlignOrOperate();
     }
-    return ctx_.motion->arm_moving(ctx_.now) ? NodeStatus::kRunning : NodeStatus::kSuccess;
+    if (ctx_.motion->arm_moving(ctx_.now)) return NodeStatus::kRunning;
+    // A press (or wave) restarts the operator's hold window of an open door.
+    if (ctx_.door_open_since.count(door_) > 0) ctx_.door_open_since[door_] = ctx_.now;
+    return NodeStatus::kSuccess;
   }
   void OnHalted() override { ctx_.motion->StopBase(); }  // the arm is tucked by whoever runs next
 

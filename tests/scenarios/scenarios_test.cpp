@@ -64,9 +64,14 @@ BrainRun RunWithBrain(const std::filesystem::path& file, std::uint64_t seed) {
                         p.person.v_MP.y(), int(p.intent), p.door_id.c_str());
           }
           for (const auto& d : run.brain->context().world.doors) {
-            std::printf("         door %s observed %d angle %.2f clearance %.2f motion %d\n",
-                        d.model.id.c_str(), int(d.state.observed), d.state.angle,
-                        d.state.clearance_width, int(d.state.motion));
+            const auto since = run.brain->context().door_open_since.find(d.model.id);
+            std::printf(
+                "         door %s observed %d angle %.2f clearance %.2f motion %d open since "
+                "%.2f\n",
+                d.model.id.c_str(), int(d.state.observed), d.state.angle, d.state.clearance_width,
+                int(d.state.motion),
+                since == run.brain->context().door_open_since.end() ? -1.0
+                                                                    : ToSeconds(since->second));
           }
         }
         return more;

@@ -79,6 +79,9 @@ struct TaskContext {
   /// (fixed when it first works at the door, so a robot caught mid-doorway still knows which
   /// way is forward).
   std::map<std::string, Eigen::Vector2d> door_approach_side;
+  /// Per door: since when it has been open enough to pass in its current opening (kept by the
+  /// executive from the angle estimate; a press restarts it).
+  std::map<std::string, Time> door_open_since;
   /// A standby retreat is under way: it is finished before the robot resumes.
   bool retreating{false};
   std::vector<std::string> notes;  ///< The nodes' reasons, for the run log.
