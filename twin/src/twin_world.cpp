@@ -370,7 +370,9 @@ struct TwinWorld::Impl {
     }
   }
 
-  void SyncRayProxies() {
+  // Const because ray casts are: the proxies are a cache of the bodies' poses.
+  void SyncRayProxies() const {
+    ray_proxies_stale = false;
     for (auto& [proxy, source] : ray_proxies)
       proxy->setWorldTransform(source->getWorldTransform());
     ray_target_aabbs.resize(ray_targets.size());
@@ -1098,7 +1100,7 @@ struct TwinWorld::Impl {
     RecordContacts();
     for (std::size_t i = 0; i < people.size(); ++i)
       states_cache[i] = people[i].state;
-    SyncRayProxies();  // the sensors see doors, people and payloads where they are now
+    ray_proxies_stale = true;  // re-posed before the next ray cast (sensors run at 5-40 Hz)
   }
 
   Pose2 RobotPose() const {
@@ -1144,8 +1146,9 @@ struct TwinWorld::Impl {
     const btCollisionObject* source;
   };
   std::vector<RayProxy> ray_proxies;
-  std::vector<const btCollisionObject*> ray_targets;              // cast one by one in CastRay
-  std::vector<std::pair<btVector3, btVector3>> ray_target_aabbs;  // their world bounds
+  std::vector<const btCollisionObject*> ray_targets;  // cast one by one in CastRay
+  mutable std::vector<std::pair<btVector3, btVector3>> ray_target_aabbs;  // their world bounds
+  mutable bool ray_proxies_stale{true};  // bodies moved since the proxies were posed
 
   RayHit CastSegment(const Eigen::Vector3d& from, const Eigen::Vector3d& to, GlassMode mode,
                      double glass_max_incidence) const;
@@ -1506,6 +1509,8 @@ RayHit TwinWorld::Impl::CastSegment(const Eigen::Vector3d& from, const Eigen::Ve
 
 RayHit TwinWorld::CastRay(const Eigen::Vector3d& from, const Eigen::Vector3d& to, GlassMode mode,
                           double glass_max_incidence) const {
+  // The sensors see doors, people and payloads where they are now.
+  if (impl_->ray_proxies_stale) impl_->SyncRayProxies();
   // Cast near first, then the rest: most rays indoors hit within a few metres, and a hit in the
   // near piece skips the far piece's walk of the BVH.
   constexpr double kNearSegment = 3.0;  // [m]
