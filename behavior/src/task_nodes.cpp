@@ -56,10 +56,18 @@ DoorPass CalcDoorPass(const MissionMap& map, const std::string& door, const Pose
   return pass;
 }
 
-DoorPass CalcApproachPass(TaskContext& context, const std::string& door) {
+DoorPass CalcKnownPass(const TaskContext& context, const std::string& door) {
   DoorPass pass = CalcDoorPass(*context.map, door, context.X_MB);
-  const auto [it, inserted] = context.door_approach_side.try_emplace(door, pass.n_M);
-  pass.n_M = it->second;
+  if (const auto side = context.door_approach_side.find(door);
+      side != context.door_approach_side.end()) {
+    pass.n_M = side->second;
+  }
+  return pass;
+}
+
+DoorPass CalcApproachPass(TaskContext& context, const std::string& door) {
+  const DoorPass pass = CalcKnownPass(context, door);
+  context.door_approach_side.try_emplace(door, pass.n_M);
   return pass;
 }
 
@@ -253,9 +261,7 @@ bool DoorPassable(const TaskContext& ctx, const std::string& door, double margin
     const double open_for =
         since != ctx.door_open_since.end() ? ToSeconds(ctx.now - since->second) : 0.0;
     if (open_for > ctx.config.door_hold_window + ctx.config.door_hold_margin) continue;
-    DoorPass pass = CalcDoorPass(*ctx.map, door, ctx.X_MB);
-    if (const auto side = ctx.door_approach_side.find(door); side != ctx.door_approach_side.end())
-      pass.n_M = side->second;
+    const DoorPass pass = CalcKnownPass(ctx, door);
     // From here to beyond the leaf's sweep on the far side (less if already past the line).
     const double to_clear = std::max(
         0.0, (ctx.X_MB.translation() - pass.centre).dot(pass.n_M) + ExitDistance(ctx, door));
@@ -685,9 +691,7 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
       // safe waypoint would cut the jamb or the leaf), then to the waypoint.
       std::vector<Pose2> path{ctx_.X_MB};
       for (const auto& door : ctx_.map->doors) {
-        const auto side = ctx_.door_approach_side.find(door.id);
-        DoorPass pass = CalcDoorPass(*ctx_.map, door.id, ctx_.X_MB);
-        if (side != ctx_.door_approach_side.end()) pass.n_M = side->second;
+        const DoorPass pass = CalcKnownPass(ctx_, door.id);
         const Eigen::Vector2d offset = ctx_.X_MB.translation() - pass.centre;
         const double along = offset.dot(pass.n_M);
         const double lateral = std::abs(offset.dot(Eigen::Vector2d(-pass.n_M.y(), pass.n_M.x())));

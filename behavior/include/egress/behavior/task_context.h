@@ -98,8 +98,10 @@ struct DoorPass {
 };
 /// @throws InvalidArgument for an unknown door id.
 DoorPass CalcDoorPass(const MissionMap& map, const std::string& door, const Pose2& X_MB);
-/// The same, with the normal pointing to the side the robot approached the door from (the side
-/// it is on now, the first time; remembered in the context).
+/// The same, with the normal pointing to the side the robot approached the door from, if the
+/// context remembers one (else the side it is on now).
+DoorPass CalcKnownPass(const TaskContext& context, const std::string& door);
+/// CalcKnownPass, remembering the side the first time (the robot's side now).
 DoorPass CalcApproachPass(TaskContext& context, const std::string& door);
 
 /// True when a person (not one holding this door) is in, or forecast into, the zone of `door`.
