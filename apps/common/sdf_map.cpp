@@ -56,33 +56,35 @@ behavior::MissionMap BuildMissionMap(const twin::WorldDescription& world,
     map.doors.push_back(door);
   }
   for (const auto& spec : scenario.doors) {
-    if (spec.kind == twin::OperatorKind::kManual || spec.actuator.empty()) continue;
-    const auto shapes = world.ShapesOfModel(spec.actuator);
-    ThrowUnless(!shapes.empty(), scenario.source.string(), ": actuator '", spec.actuator,
-                "' has no shape in ", world.source.string());
-    const twin::ShapeDescription& shape = *shapes.front();
-    const perception::DoorModel* door = map.FindDoor(spec.door);
-    ThrowUnless(door != nullptr, scenario.source.string(), ": door '", spec.door,
-                "' is not a door of ", world.source.string());
-    behavior::MapActuator actuator;
-    actuator.id = spec.actuator;
-    actuator.door = spec.door;
-    actuator.type = spec.kind == twin::OperatorKind::kPushButton
-                        ? planning::ButtonType::kPushButton
-                        : planning::ButtonType::kProximityPlate;
-    const Eigen::Vector3d centre = shape.X_WS.translation();
-    const Eigen::Vector2d along = (door->p_MLatch - door->p_MHinge).normalized();
-    Eigen::Vector2d n(-along.y(), along.x());
-    if (n.dot(centre.head<2>() - door->p_MHinge) < 0) n = -n;
-    actuator.n_M = Eigen::Vector3d(n.x(), n.y(), 0.0);
-    // The face: half the box's extent along the normal in front of its centre.
-    const Eigen::Matrix3d& R = shape.X_WS.rotation();
-    double half = 0.0;
-    for (int i = 0; i < 3; ++i)
-      half += std::abs(actuator.n_M.dot(R.col(i))) * shape.box_size[i] / 2;
-    actuator.p_M = centre + actuator.n_M * half;
-    actuator.protrusion = 2 * half;  // mounted on the wall's surface
-    map.actuators.push_back(actuator);
+    if (spec.kind == twin::OperatorKind::kManual) continue;
+    for (const auto& id : spec.actuators) {
+      const auto shapes = world.ShapesOfModel(id);
+      ThrowUnless(!shapes.empty(), scenario.source.string(), ": actuator '", id,
+                  "' has no shape in ", world.source.string());
+      const twin::ShapeDescription& shape = *shapes.front();
+      const perception::DoorModel* door = map.FindDoor(spec.door);
+      ThrowUnless(door != nullptr, scenario.source.string(), ": door '", spec.door,
+                  "' is not a door of ", world.source.string());
+      behavior::MapActuator actuator;
+      actuator.id = id;
+      actuator.door = spec.door;
+      actuator.type = spec.kind == twin::OperatorKind::kPushButton
+                          ? planning::ButtonType::kPushButton
+                          : planning::ButtonType::kProximityPlate;
+      const Eigen::Vector3d centre = shape.X_WS.translation();
+      const Eigen::Vector2d along = (door->p_MLatch - door->p_MHinge).normalized();
+      Eigen::Vector2d n(-along.y(), along.x());
+      if (n.dot(centre.head<2>() - door->p_MHinge) < 0) n = -n;
+      actuator.n_M = Eigen::Vector3d(n.x(), n.y(), 0.0);
+      // The face: half the box's extent along the normal in front of its centre.
+      const Eigen::Matrix3d& R = shape.X_WS.rotation();
+      double half = 0.0;
+      for (int i = 0; i < 3; ++i)
+        half += std::abs(actuator.n_M.dot(R.col(i))) * shape.box_size[i] / 2;
+      actuator.p_M = centre + actuator.n_M * half;
+      actuator.protrusion = 2 * half;  // mounted on the wall's surface
+      map.actuators.push_back(actuator);
+    }
   }
   map.Validate();
   return map;

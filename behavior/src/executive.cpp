@@ -184,10 +184,18 @@ bool Executive::Step(RobotPort& port) {
     if (m.X_BC)
       m.perception.ProcessScan(*snapshot.scan, X_ML, m.intrinsics, X_BL.Inverse() * *m.X_BC);
   }
+  // Where the base was when the detections' image was taken (the detector runs behind).
+  pose_history_.emplace_back(now, context_.X_MB);
+  while (!pose_history_.empty() && ToSeconds(now - pose_history_.front().first) > kPoseHistorySec)
+    pose_history_.pop_front();
   if (!snapshot.detections.empty() && m.depth && m.X_BC) {
-    m.perception.ProcessCameraFrame(snapshot.detections,
-                                    cv::Size(m.intrinsics.width, m.intrinsics.height), *m.depth,
-                                    m.intrinsics, X_MB3 * *m.X_BC);
+    Pose2 X_MB_capture = context_.X_MB;
+    for (const auto& [t, X] : pose_history_) {
+      if (t <= snapshot.detections.front().stamp) X_MB_capture = X;
+    }
+    m.perception.ProcessCameraFrame(
+        snapshot.detections, cv::Size(m.intrinsics.width, m.intrinsics.height), *m.depth,
+        m.intrinsics, X_MB3 * *m.X_BC, Pose3::FromPose2(X_MB_capture) * *m.X_BC);
   }
   context_.world =
       m.perception.Snapshot(now, context_.X_MB, Eigen::Matrix3d::Zero(), costmap_.get());

@@ -11,9 +11,24 @@ const perception::DoorModel* MissionMap::FindDoor(const std::string& id) const {
   return nullptr;
 }
 
-const MapActuator* MissionMap::FindActuatorOf(const std::string& door) const {
+const MapActuator* MissionMap::FindActuatorOf(const std::string& door,
+                                              const Eigen::Vector2d& p_M) const {
+  const MapActuator* best = nullptr;
+  double best_distance = 0.0;
   for (const auto& a : actuators) {
-    if (a.door == door) return &a;
+    const Eigen::Vector2d offset = p_M - a.p_M.head<2>();
+    if (a.door != door || offset.dot(a.n_M.head<2>()) <= 0.0) continue;
+    if (best == nullptr || offset.norm() < best_distance) {
+      best = &a;
+      best_distance = offset.norm();
+    }
+  }
+  return best;
+}
+
+const MapActuator* MissionMap::FindActuator(const std::string& id) const {
+  for (const auto& a : actuators) {
+    if (a.id == id) return &a;
   }
   return nullptr;
 }

@@ -234,10 +234,20 @@ class IsPathClear final : public TaskNode<bt::ConditionNode> {
   NodeStatus last_{NodeStatus::kIdle};
 };
 
+constexpr double kLeafClearance = 0.15;  // [m] kept between the footprint and a leaf's sweep
+
 // Far enough past the door line that the closing leaf cannot reach the footprint.
 double ExitDistance(const TaskContext& ctx, const std::string& door) {
   const double w = ctx.map->FindDoor(door)->width();
-  return std::max(ctx.config.door_exit_distance, w + ctx.config.footprint_radius + 0.15);
+  return std::max(ctx.config.door_exit_distance, w + ctx.config.footprint_radius + kLeafClearance);
+}
+
+// How far before the door line the robot lines up and waits: on the side the leaf opens into,
+// beyond its sweep (the opening leaf would strike a robot waiting closer).
+double EntryDistance(const TaskContext& ctx, const std::string& door, const DoorPass& pass) {
+  const perception::DoorModel& model = *ctx.map->FindDoor(door);
+  if (pass.n_M.dot(model.SwingSide()) <= 0.0) return ctx.config.door_entry_distance;
+  return std::max(ctx.config.door_entry_distance, ExitDistance(ctx, door));
 }
 
 // The leaf leaves room for the footprint (plus `margin`), is not closing, and — unless a person
@@ -262,9 +272,13 @@ bool DoorPassable(const TaskContext& ctx, const std::string& door, double margin
         since != ctx.door_open_since.end() ? ToSeconds(ctx.now - since->second) : 0.0;
     if (open_for > ctx.config.door_hold_window + ctx.config.door_hold_margin) continue;
     const DoorPass pass = CalcKnownPass(ctx, door);
-    // From here to beyond the leaf's sweep on the far side (less if already past the line).
-    const double to_clear = std::max(
-        0.0, (ctx.X_MB.translation() - pass.centre).dot(pass.n_M) + ExitDistance(ctx, door));
+    // From here to beyond the leaf's sweep on the far side (less if already past the line); a
+    // leaf that opens towards the robot closes away from it: just past the line is clear.
+    const bool opens_towards_robot = pass.n_M.dot(ctx.map->FindDoor(door)->SwingSide()) > 0.0;
+    const double beyond = opens_towards_robot ? ctx.config.footprint_radius + kLeafClearance
+                                              : ExitDistance(ctx, door);
+    const double to_clear =
+        std::max(0.0, (ctx.X_MB.translation() - pass.centre).dot(pass.n_M) + beyond);
     const double needed = to_clear / ctx.motion->trajectory_config().door_speed;
     if (open_for + needed > ctx.config.door_hold_window) return false;
   }
@@ -321,9 +335,9 @@ class ButtonType final : public TaskNode<bt::SyncActionNode> {
             OutputPort<std::string>("type", "push_button or proximity_plate")};
   }
   NodeStatus Tick() override {
-    const MapActuator* actuator = ctx_.map->FindActuatorOf(Door());
+    const MapActuator* actuator = ctx_.map->FindActuatorOf(Door(), ctx_.X_MB.translation());
     if (actuator == nullptr) {
-      Note("door has no actuator");
+      Note("door has no actuator on this side");
       return NodeStatus::kFailure;
     }
     this->SetOutput("type", std::string(actuator->type == planning::ButtonType::kPushButton
@@ -333,21 +347,61 @@ class ButtonType final : public TaskNode<bt::SyncActionNode> {
   }
 };
 
+// Plans and follows a path to `goal`. A goal or path blocked for now (a person standing on it,
+// the tracker of a blocked path stopping the base) is planned again every `replan_period` for
+// up to `patience` before the node fails.
 class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
  public:
   using TaskNode::TaskNode;
   static PortsList ProvidedPorts() {
     return {InputPort<std::string>("goal", "goal pose x;y;yaw"),
-            InputPort<double>("speed", 0.2, "cruise speed [m/s]")};
+            InputPort<double>("speed", 0.2, "cruise speed [m/s]"),
+            InputPort<double>("patience", 15.0, "how long to keep re-planning a blocked goal [s]")};
   }
   NodeStatus OnStart() override {
-    const Pose2 goal = ParsePose2(Input<std::string>("goal"));
-    return StartPath(ctx_, goal, "goal", [this](const std::string& s) { Note(s); });
+    blocked_since_.reset();
+    return Start();
   }
   NodeStatus OnRunning() override {
-    return BaseMotionStatus(ctx_, [this](const std::string& s) { Note(s); });
+    if (blocked_since_) {
+      if (ToSeconds(ctx_.now - last_try_) < kReplanPeriod) return NodeStatus::kRunning;
+      return Start();
+    }
+    const NodeStatus s = BaseMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+    return s == NodeStatus::kFailure ? Blocked() : s;
   }
   void OnHalted() override { ctx_.motion->StopBase(); }
+
+ private:
+  static constexpr double kReplanPeriod = 0.5;  // [s]
+  NodeStatus Start() {
+    last_try_ = ctx_.now;
+    const Pose2 goal = ParsePose2(Input<std::string>("goal"));
+    // Quiet while re-planning: the first failure is noted, not every retry.
+    const NodeStatus s = StartPath(ctx_, goal, "goal", [this](const std::string& t) {
+      if (!blocked_since_) Note(t);
+    });
+    if (s != NodeStatus::kFailure) {
+      if (blocked_since_) Note("the way is free again");
+      blocked_since_.reset();
+      return s;
+    }
+    return Blocked();
+  }
+  NodeStatus Blocked() {
+    if (!blocked_since_) {
+      blocked_since_ = ctx_.now;
+      last_try_ = ctx_.now;
+      Note(StrCat("waiting up to ", Input<double>("patience"), " s for a way"));
+    }
+    if (ToSeconds(ctx_.now - *blocked_since_) > Input<double>("patience")) {
+      Note("gave up: the goal stayed blocked");
+      return NodeStatus::kFailure;
+    }
+    return NodeStatus::kRunning;
+  }
+  std::optional<Time> blocked_since_;
+  Time last_try_{};
 };
 
 class ApproachButton final : public TaskNode<bt::StatefulActionNode> {
@@ -358,13 +412,14 @@ class ApproachButton final : public TaskNode<bt::StatefulActionNode> {
   }
   NodeStatus OnStart() override {
     const std::string door = Door();
-    const MapActuator* actuator = ctx_.map->FindActuatorOf(door);
+    const MapActuator* actuator = ctx_.map->FindActuatorOf(door, ctx_.X_MB.translation());
     if (actuator == nullptr) {
-      Note("door has no actuator");
+      Note("door has no actuator on this side");
       return NodeStatus::kFailure;
     }
     CalcApproachPass(ctx_, door);  // remember which side is "before" the door
     ButtonPlan plan;
+    plan.actuator = actuator->id;
     plan.type = actuator->type;
     plan.targets = planning::MakeButtonTargets(actuator->p_M, actuator->n_M, actuator->type,
                                                ctx_.config.buttons);
@@ -394,10 +449,12 @@ class ApproachButton final : public TaskNode<bt::StatefulActionNode> {
   void OnHalted() override { ctx_.motion->StopBase(); }
 };
 
-// Arm-only IK at the current base pose (the base stays where it stopped).
+// Arm-only IK at the current base pose (the base stays where it stopped). A solve that ends
+// within `accept_error` of the target counts (0: only a converged one; DLS with the paper's
+// damping creeps over the last millimetres, which a grasp does not need).
 std::optional<ArmPose> SolveArm(const TaskContext& ctx, const Pose2& X_MB,
                                 const planning::IkTarget& target, const ArmPose& from,
-                                bool fingertip) {
+                                bool fingertip, double accept_error = 0.0) {
   planning::IkConfig ik = ctx.config.ik;
   ik.fingertip = fingertip;
   ik.use_base = false;
@@ -407,15 +464,19 @@ std::optional<ArmPose> SolveArm(const TaskContext& ctx, const Pose2& X_MB,
   q[kBaseYaw] = X_MB.yaw;
   q = WithArm(q, from);
   const planning::DlsIkSolver solver(*ctx.model, ik);
+  const auto good = [&](const planning::IkResult& r) {
+    return r.converged || (r.position_error <= accept_error &&
+                           r.orientation_error <= ctx.config.ik.orientation_tolerance);
+  };
   planning::IkResult r = solver.Solve(target, q);
-  if (!r.converged && target.approach_M) {
+  if (!good(r) && target.approach_M) {
     // With the base a little off its planned pose the arm alone may not hold the approach
     // axis too: the position is what presses.
     planning::IkTarget position_only = target;
     position_only.approach_M.reset();
     r = solver.Solve(position_only, q);
   }
-  if (!r.converged) return std::nullopt;
+  if (!good(r)) return std::nullopt;
   return ArmOf(r.q);
 }
 
@@ -495,7 +556,7 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
   // arm presses or waves.
   NodeStatus AlignOrOperate() {
     const ButtonPlan& plan = ctx_.button_plans.at(door_);
-    const MapActuator& actuator = *ctx_.map->FindActuatorOf(door_);
+    const MapActuator& actuator = *ctx_.map->FindActuator(plan.actuator);
     const Pose2 X_MB = WallAlignedPose(ctx_, actuator, [this](const std::string& t) { Note(t); });
     const Eigen::Vector2d n = actuator.n_M.head<2>().normalized();
     const double off = (X_MB.translation() - plan.X_MB_standoff.translation()).dot(n);
@@ -584,16 +645,27 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
       ctx_.motion->MoveArm({{ctx_.config.arm_tuck_time, kTuckedArm}}, ctx_.now);
     }
     yaw_ = std::atan2(-pass_.n_M.y(), -pass_.n_M.x());  // facing through the door
-    const Eigen::Vector2d entry = pass_.centre + pass_.n_M * ctx_.config.door_entry_distance;
+    entry_distance_ = EntryDistance(ctx_, door_, pass_);
+    const Eigen::Vector2d entry = pass_.centre + pass_.n_M * entry_distance_;
     const Eigen::Vector2d offset = ctx_.X_MB.translation() - pass_.centre;
     const double lateral = std::abs(offset.dot(Eigen::Vector2d(-pass_.n_M.y(), pass_.n_M.x())));
     phase_ = Phase::kWaiting;
     waiting_since_ = ctx_.now;
-    if (lateral > 0.05 || offset.dot(pass_.n_M) > ctx_.config.door_entry_distance + 0.05) {
+    if (lateral > 0.05 || offset.dot(pass_.n_M) > entry_distance_ + 0.05) {
       // Straight when the costmap allows (the usual case), else round what is in the way.
       const Pose2 X_MB_entry{entry.x(), entry.y(), yaw_};
-      if (ctx_.planner->IsPathValid({ctx_.X_MB, X_MB_entry})) {
-        ctx_.motion->FollowPath({ctx_.X_MB, X_MB_entry}, {true}, kTuckedArm, ctx_.now);
+      // On the side the leaf opens into, out beyond its sweep first, then across to the axis: a
+      // straight line from beside the hinge (a button's standoff) would cut the opening leaf.
+      std::vector<Pose2> line_up{ctx_.X_MB};
+      const double out = offset.dot(pass_.n_M);
+      if (entry_distance_ > ctx_.config.door_entry_distance && out < entry_distance_ - 0.05) {
+        const Eigen::Vector2d p = ctx_.X_MB.translation() + pass_.n_M * (entry_distance_ - out);
+        line_up.push_back({p.x(), p.y(), yaw_});
+      }
+      line_up.push_back(X_MB_entry);
+      if (ctx_.planner->IsPathValid(line_up)) {
+        ctx_.motion->FollowPath(line_up, std::vector<bool>(line_up.size() - 1, true), kTuckedArm,
+                                ctx_.now);
         Note("lining up on the door's axis");
       } else {
         const NodeStatus s = StartPath(
@@ -643,7 +715,10 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
       }
       case Phase::kThrough: {
         const NodeStatus s = BaseMotionStatus(ctx_, note);
-        if (s == NodeStatus::kSuccess) Note("through the door");
+        if (s == NodeStatus::kSuccess) {
+          Note("through the door");
+          ctx_.door_approach_side.erase(door_);  // a later traversal may come the other way
+        }
         return s;
       }
     }
@@ -668,6 +743,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
   enum class Phase { kToEntry, kWaiting, kThrough };
   std::string door_;
   DoorPass pass_;
+  double entry_distance_{0.0};
   double yaw_{0.0};
   Phase phase_{Phase::kWaiting};
   Time waiting_since_{};
@@ -695,7 +771,7 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
         const Eigen::Vector2d offset = ctx_.X_MB.translation() - pass.centre;
         const double along = offset.dot(pass.n_M);
         const double lateral = std::abs(offset.dot(Eigen::Vector2d(-pass.n_M.y(), pass.n_M.x())));
-        const double entry = ctx_.config.door_entry_distance;
+        const double entry = EntryDistance(ctx_, door.id, pass);
         if (along < entry - 0.05 && along > -ExitDistance(ctx_, door.id) &&
             lateral < pass.width / 2 + 0.3) {
           const Eigen::Vector2d out = ctx_.X_MB.translation() + pass.n_M * (entry - along);
@@ -799,6 +875,49 @@ class DetectPayload final : public TaskNode<bt::StatefulActionNode> {
   Time started_{};
 };
 
+constexpr double kGraspDepthInPalm = 0.07;  // grasp centre ahead of the palm [m]
+constexpr double kPreGraspOffset = 0.12;    // pre-grasp / pre-place this far short [m]
+constexpr double kHandError = 0.005;        // [m] a grasp or release this close is good
+
+// The palm target that holds a grasp centre `p_M`, approached along the unit `approach_M`.
+planning::IkTarget PalmTarget(const Eigen::Vector3d& p_M, const Eigen::Vector3d& approach_M) {
+  return {p_M - approach_M * kGraspDepthInPalm, approach_M};
+}
+
+// Where the base stands, and the arm there, for the hand to hold a grasp centre `p_M`
+// approached horizontally along `approach_M` (whole-body IK from 0.6 m short); nullopt if out
+// of reach.
+struct HandReach {
+  Pose2 X_MB;
+  ArmPose arm;
+};
+std::optional<HandReach> SolveHandReach(const TaskContext& ctx, const Eigen::Vector3d& p_M,
+                                        const Eigen::Vector3d& approach_M) {
+  static constexpr ArmPose kReachArm{0.2, -1.0, 0.0, -0.5, 0.0};
+  const Eigen::Vector2d a = approach_M.head<2>();
+  const Eigen::Vector2d base = p_M.head<2>() - a * 0.6;
+  WholeBodyVector q0 = WholeBodyVector::Zero();
+  q0[kBaseX] = base.x();
+  q0[kBaseY] = base.y();
+  q0[kBaseYaw] = std::atan2(a.y(), a.x());
+  q0 = WithArm(q0, kReachArm);
+  planning::IkConfig ik = ctx.config.ik;
+  ik.fingertip = false;
+  ik.use_base = true;
+  const planning::IkResult r =
+      planning::DlsIkSolver(*ctx.model, ik).Solve(PalmTarget(p_M, approach_M), q0);
+  if (!r.converged) return std::nullopt;
+  return HandReach{{r.q[kBaseX], r.q[kBaseY], r.q[kBaseYaw]}, ArmOf(r.q)};
+}
+
+// The unit horizontal direction from the robot to `p_M` (the robot's heading if it is there).
+Eigen::Vector3d HorizontalApproach(const Pose2& X_MB, const Eigen::Vector3d& p_M) {
+  Eigen::Vector2d a = p_M.head<2>() - X_MB.translation();
+  if (a.norm() < 1e-6) a = Eigen::Vector2d(std::cos(X_MB.yaw), std::sin(X_MB.yaw));
+  a.normalize();
+  return {a.x(), a.y(), 0.0};
+}
+
 // Grasps a payload seen at `pose`: the base goes where whole-body IK puts it (palm level,
 // approaching horizontally from the robot's side), the arm reaches a pre-grasp 12 cm short, then
 // the grasp, the gripper closes, and the arm lifts 10 cm. Success when the gripper holds it.
@@ -810,29 +929,16 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
   }
   NodeStatus OnStart() override {
     const Eigen::Vector3d p_seen = ParsePoint3(Input<std::string>("pose"));
-    Eigen::Vector2d a = p_seen.head<2>() - ctx_.X_MB.translation();
-    if (a.norm() < 1e-6) a = Eigen::Vector2d(std::cos(ctx_.X_MB.yaw), std::sin(ctx_.X_MB.yaw));
-    a.normalize();
-    approach_ = Eigen::Vector3d(a.x(), a.y(), 0.0);
+    approach_ = HorizontalApproach(ctx_.X_MB, p_seen);
     // The camera sees the near surface; the centre is a radius further.
     centre_ = p_seen + approach_ * kPayloadRadius;
-    const planning::IkTarget grasp{centre_ - approach_ * kGraspDepthInPalm, approach_};
-    WholeBodyVector q0 = WholeBodyVector::Zero();
-    const Eigen::Vector2d base = centre_.head<2>() - a * 0.6;
-    q0[kBaseX] = base.x();
-    q0[kBaseY] = base.y();
-    q0[kBaseYaw] = std::atan2(a.y(), a.x());
-    q0 = WithArm(q0, kReachArm);
-    planning::IkConfig ik = ctx_.config.ik;
-    ik.fingertip = false;
-    ik.use_base = true;
-    const planning::IkResult r = planning::DlsIkSolver(*ctx_.model, ik).Solve(grasp, q0);
-    if (!r.converged) {
+    const auto reach = SolveHandReach(ctx_, centre_, approach_);
+    if (!reach) {
       Note("no whole-body reach for the grasp");
       return NodeStatus::kFailure;
     }
-    grasp_arm_ = ArmOf(r.q);
-    X_MB_grasp_ = {r.q[kBaseX], r.q[kBaseY], r.q[kBaseYaw]};
+    grasp_arm_ = reach->arm;
+    X_MB_grasp_ = reach->X_MB;
     GripperCommand open;
     open.mode = GripperCommand::Mode::kOpen;
     ctx_.motion->SetGripper(open);
@@ -846,12 +952,11 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
         const NodeStatus s = BaseMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
         if (s != NodeStatus::kSuccess) return s;
         // Arm-only from where the base stopped.
-        const auto grasp =
-            SolveArm(ctx_, ctx_.X_MB, {centre_ - approach_ * kGraspDepthInPalm, approach_},
-                     grasp_arm_, false);
+        const auto grasp = SolveArm(ctx_, ctx_.X_MB, PalmTarget(centre_, approach_), grasp_arm_,
+                                    false, kHandError);
         const auto pre =
-            SolveArm(ctx_, ctx_.X_MB, {centre_ - approach_ * (kGraspDepthInPalm + 0.12), approach_},
-                     grasp ? *grasp : grasp_arm_, false);
+            SolveArm(ctx_, ctx_.X_MB, PalmTarget(centre_ - approach_ * kPreGraspOffset, approach_),
+                     grasp ? *grasp : grasp_arm_, false, kHandError);
         if (!grasp || !pre) {
           Note("the payload is out of the arm's reach from here");
           return NodeStatus::kFailure;
@@ -894,9 +999,7 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
   void OnHalted() override { ctx_.motion->StopBase(); }
 
  private:
-  static constexpr double kPayloadRadius = 0.03;     // [m] a bottle's, about
-  static constexpr double kGraspDepthInPalm = 0.07;  // grasp centre ahead of the palm [m]
-  static constexpr ArmPose kReachArm{0.2, -1.0, 0.0, -0.5, 0.0};
+  static constexpr double kPayloadRadius = 0.03;  // [m] a bottle's, about
   enum class Phase { kToBase, kReach, kClose, kLift };
   Phase phase_{Phase::kToBase};
   Eigen::Vector3d approach_{Eigen::Vector3d::UnitX()};
@@ -904,6 +1007,192 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
   ArmPose grasp_arm_{kTuckedArm}, lifted_{kTuckedArm};
   Pose2 X_MB_grasp_;
   Time closing_since_{};
+};
+
+// Lets go of the held payload where the hand takes it: the base goes where whole-body IK puts
+// it, the arm carries the payload in from 12 cm short (and a little higher), waits until
+// ReadyToRelease, opens the gripper, draws back and tucks. Success when the gripper is empty.
+class ReleaseAction : public TaskNode<bt::StatefulActionNode> {
+ public:
+  using TaskNode::TaskNode;
+  NodeStatus OnStart() override {
+    if (!ctx_.holding_object) {
+      Note("not holding a payload");
+      return NodeStatus::kFailure;
+    }
+    const auto target = ReleaseTarget();
+    if (!target) return NodeStatus::kFailure;
+    const auto [centre, X_MB_stand] = *target;
+    centre_ = centre;
+    approach_ = HorizontalApproach(X_MB_stand, centre_);
+    approaches_ = 0;
+    return DriveToReach();
+  }
+  NodeStatus OnRunning() override {
+    switch (phase_) {
+      case Phase::kToBase: {
+        const NodeStatus s = BaseMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+        if (s != NodeStatus::kSuccess) return s;
+        const auto at = SolveArm(ctx_, ctx_.X_MB, PalmTarget(centre_, approach_), release_arm_,
+                                 false, kHandError);
+        const Eigen::Vector3d p_pre =
+            centre_ - approach_ * kPreGraspOffset + Eigen::Vector3d(0, 0, kPreReleaseRise);
+        const auto pre = SolveArm(ctx_, ctx_.X_MB, PalmTarget(p_pre, approach_),
+                                  at ? *at : release_arm_, false, kHandError);
+        if (!at || !pre) {
+          // The base stopped a little off the planned pose: plan the reach again from here.
+          Note("the release point is out of the arm's reach from here");
+          return approaches_ < kMaxApproaches ? DriveToReach() : NodeStatus::kFailure;
+        }
+        pre_arm_ = *pre;
+        ctx_.motion->MoveArm({{2.0, *pre}, {3.5, *at}}, ctx_.now);
+        phase_ = Phase::kReach;
+        waiting_since_ = ctx_.now;
+        return NodeStatus::kRunning;
+      }
+      case Phase::kReach: {
+        if (ctx_.motion->arm_moving(ctx_.now)) return NodeStatus::kRunning;
+        const Release release = ReadyToRelease(centre_);
+        if (release == Release::kGiveUp) return NodeStatus::kFailure;  // still holding it
+        if (release == Release::kWait) return NodeStatus::kRunning;
+        GripperCommand open;
+        open.mode = GripperCommand::Mode::kOpen;
+        ctx_.motion->SetGripper(open);
+        opened_at_ = ctx_.now;
+        phase_ = Phase::kOpen;
+        return NodeStatus::kRunning;
+      }
+      case Phase::kOpen: {
+        if (ToSeconds(ctx_.now - opened_at_) < kOpenTime) return NodeStatus::kRunning;
+        ctx_.motion->MoveArm({{1.5, pre_arm_}, {1.5 + ctx_.config.arm_tuck_time, kTuckedArm}},
+                             ctx_.now);
+        phase_ = Phase::kWithdraw;
+        return NodeStatus::kRunning;
+      }
+      case Phase::kWithdraw: {
+        if (ctx_.motion->arm_moving(ctx_.now)) return NodeStatus::kRunning;
+        if (ctx_.holding_object) {
+          Note("the payload is still in the gripper");
+          return NodeStatus::kFailure;
+        }
+        Note("let go of the payload");
+        return NodeStatus::kSuccess;
+      }
+    }
+    return NodeStatus::kFailure;
+  }
+  void OnHalted() override { ctx_.motion->StopBase(); }
+
+ protected:
+  // Where the payload's centre goes when released [m, M], and the pose the robot approaches
+  // it from; nullopt (with a note) if there is none.
+  virtual std::optional<std::pair<Eigen::Vector3d, Pose2>> ReleaseTarget() = 0;
+  enum class Release { kWait, kNow, kGiveUp };
+  // Whether to let go now, the payload being held at `p_M_payload`.
+  virtual Release ReadyToRelease(const Eigen::Vector3d& /*p_M_payload*/) { return Release::kNow; }
+  Time waiting_since() const { return waiting_since_; }
+
+ private:
+  static constexpr double kPreReleaseRise = 0.05;  // [m] the payload comes in from above
+  static constexpr int kMaxApproaches = 3;
+
+  NodeStatus DriveToReach() {
+    ++approaches_;
+    const auto reach = SolveHandReach(ctx_, centre_, approach_);
+    if (!reach) {
+      Note("no whole-body reach for the release point");
+      return NodeStatus::kFailure;
+    }
+    release_arm_ = reach->arm;
+    phase_ = Phase::kToBase;
+    const NodeStatus s =
+        StartPath(ctx_, reach->X_MB, "the release pose", [this](const std::string& t) { Note(t); });
+    return s == NodeStatus::kSuccess ? OnRunning() : s;  // already there: reach now
+  }
+  int approaches_{0};
+  static constexpr double kOpenTime = 1.0;  // [s] for the fingers to open
+  enum class Phase { kToBase, kReach, kOpen, kWithdraw };
+  Phase phase_{Phase::kToBase};
+  Eigen::Vector3d centre_{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d approach_{Eigen::Vector3d::UnitX()};
+  ArmPose release_arm_{kTuckedArm}, pre_arm_{kTuckedArm};
+  Time waiting_since_{}, opened_at_{};
+};
+
+// Places the held payload on a surface: `pose` is where its centre goes (the surface height
+// plus half the payload's height plus a centimetre or so, which it drops).
+class PlacePayload final : public ReleaseAction {
+ public:
+  using ReleaseAction::ReleaseAction;
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("pose", "payload centre x;y;z in the map when let go [m]")};
+  }
+
+ private:
+  std::optional<std::pair<Eigen::Vector3d, Pose2>> ReleaseTarget() override {
+    return std::make_pair(ParsePoint3(Input<std::string>("pose")), ctx_.X_MB);
+  }
+};
+
+// Hands the held payload to a responder standing near `pose`: the robot holds it out at
+// hand height toward the nearest person tracked within `search_radius` of it and lets go once
+// that person stands within `reach` of the payload (the twin has no hands: there the payload
+// drops at the person's feet; on the robot a wrist-force pull would be the cue).
+class HandOver final : public ReleaseAction {
+ public:
+  using ReleaseAction::ReleaseAction;
+  static PortsList ProvidedPorts() {
+    return {
+        InputPort<std::string>("pose", "where the responder is expected x;y[;yaw]"),
+        InputPort<double>("search_radius", 1.5, "person this close to pose is the recipient [m]"),
+        InputPort<double>("hand_height", 0.9, "payload held out at this height [m]"),
+        InputPort<double>("reach", 0.8, "recipient this close to the payload takes it [m]"),
+        InputPort<double>("timeout", 20.0, "how long to hold it out [s]")};
+  }
+
+ private:
+  std::optional<std::pair<Eigen::Vector3d, Pose2>> ReleaseTarget() override {
+    const Pose2 expected = ParsePose2(Input<std::string>("pose"));
+    const auto* recipient = Recipient(expected.translation());
+    if (recipient == nullptr) {
+      Note("no responder in sight near " + PoseText(expected));
+      return std::nullopt;
+    }
+    // Held out half-way between a comfortable standoff and the person.
+    const Eigen::Vector2d p_MP = recipient->person.p_MP;
+    Eigen::Vector2d to_robot = ctx_.X_MB.translation() - p_MP;
+    if (to_robot.norm() < 1e-6) to_robot = Eigen::Vector2d::UnitX();
+    const Eigen::Vector2d p = p_MP + to_robot.normalized() * kOfferDistance;
+    const Eigen::Vector3d centre(p.x(), p.y(), Input<double>("hand_height"));
+    return std::make_pair(centre, ctx_.X_MB);
+  }
+  Release ReadyToRelease(const Eigen::Vector3d& p_M_payload) override {
+    const Pose2 expected = ParsePose2(Input<std::string>("pose"));
+    const auto* recipient = Recipient(expected.translation());
+    if (recipient != nullptr &&
+        (recipient->person.p_MP - p_M_payload.head<2>()).norm() < Input<double>("reach")) {
+      Note("the responder is within reach: letting go");
+      return Release::kNow;
+    }
+    if (ToSeconds(ctx_.now - waiting_since()) > Input<double>("timeout")) {
+      Note("nobody took the payload in time");
+      return Release::kGiveUp;
+    }
+    return Release::kWait;
+  }
+  const perception::TrackedPersonWithIntent* Recipient(const Eigen::Vector2d& expected) const {
+    const perception::TrackedPersonWithIntent* best = nullptr;
+    double best_distance = Input<double>("search_radius");
+    for (const auto& entry : ctx_.world.people) {
+      const double d = (entry.person.p_MP - expected).norm();
+      if (d <= best_distance) {
+        best = &entry;
+        best_distance = d;
+      }
+    }
+    return best;
+  }
+  static constexpr double kOfferDistance = 0.45;  // [m] payload from the person
 };
 
 template <typename T>
@@ -942,6 +1231,8 @@ void RegisterTaskNodes(bt::BehaviorTreeFactory& factory, TaskContext* context) {
   Register<WaitForClear>(factory, "WaitForClear", context);
   Register<DetectPayload>(factory, "DetectPayload", context);
   Register<GraspPayload>(factory, "GraspPayload", context);
+  Register<PlacePayload>(factory, "PlacePayload", context);
+  Register<HandOver>(factory, "HandOver", context);
 }
 
 }  // namespace egress::behavior

@@ -21,6 +21,11 @@ Eigen::Vector2d DoorModel::LeafTip(double angle) const {
   return p_MHinge + width() * Eigen::Vector2d(std::cos(yaw), std::sin(yaw));
 }
 
+Eigen::Vector2d DoorModel::SwingSide() const {
+  const Eigen::Vector2d along = (p_MLatch - p_MHinge).normalized();
+  return swing_sign * Eigen::Vector2d(-along.y(), along.x());
+}
+
 double DoorModel::ClearanceWidth(double angle) const {
   const double a = std::clamp(angle, 0.0, std::numbers::pi / 2);
   return width() * (1.0 - std::cos(a));
@@ -177,14 +182,71 @@ std::optional<DoorAngleMeasurement> MeasureDoorAngle(const DoorModel& door,
   return DoorAngleMeasurement{std::clamp(*middle, 0.0, door.max_open_angle), chosen.size()};
 }
 
-double DoorAngleFromLine(const DoorModel& door, const LineFit& line) {
+std::optional<double> DoorAngleFromLine(const DoorModel& door, const LineFit& line,
+                                        double hinge_tolerance) {
   door.Validate();
+  const Eigen::Vector2d from_hinge = line.p_M - door.p_MHinge;
+  const double off_line =
+      std::abs(from_hinge.x() * line.direction.y() - from_hinge.y() * line.direction.x());
+  const double w = door.width();
+  if (off_line > hinge_tolerance || from_hinge.norm() > 1.2 * w || from_hinge.norm() < w / 8)
+    return std::nullopt;
   // The line's direction is ambiguous by pi; take the orientation pointing away from the hinge.
   Eigen::Vector2d direction = line.direction;
-  if ((line.p_M - door.p_MHinge).dot(direction) < 0.0) direction = -direction;
+  if (from_hinge.dot(direction) < 0.0) direction = -direction;
   const double phi =
       door.swing_sign * WrapAngle(std::atan2(direction.y(), direction.x()) - door.closed_yaw());
+  constexpr double kMargin = 10.0 * std::numbers::pi / 180.0;
+  if (phi < -kMargin || phi > door.max_open_angle + kMargin) return std::nullopt;
   return std::clamp(phi, 0.0, door.max_open_angle);
+}
+
+std::optional<double> DoorAngleFromBearings(const DoorModel& door, const Pose2& X_MV,
+                                            std::optional<double> lo, std::optional<double> hi,
+                                            double max_error) {
+  door.Validate();
+  ThrowUnless(X_MV.IsFinite(), "Invalid viewpoint X_MV: must be finite.");
+  if (!lo && !hi) return std::nullopt;
+  const Pose2 X_VM = X_MV.Inverse();
+  const auto bearing = [&](const Eigen::Vector2d& p_M) {
+    const Eigen::Vector2d p_V = X_VM * p_M;
+    return std::atan2(p_V.y(), p_V.x());
+  };
+  const double hinge = bearing(door.p_MHinge);
+  constexpr double kStep = std::numbers::pi / 180.0;
+  // One box edge within this of the hinge's bearing is the hinge's own: any angle with the free
+  // edge on the cut side explains it (a few degrees: detector noise, the leaf's thickness).
+  constexpr double kHingeEdgeMargin = 6.0 * std::numbers::pi / 180.0;  // [rad]
+  std::vector<std::pair<double, double>> errors;                       // (angle, error)
+  std::optional<double> best;
+  double best_error = std::numeric_limits<double>::infinity();
+  bool best_tip_is_lo = false;
+  for (double angle = 0.0; angle <= door.max_open_angle + 1e-9; angle += kStep) {
+    const double tip = bearing(door.LeafTip(angle));
+    double error = 0.0;
+    if (lo) error += std::abs(*lo - std::min(tip, hinge));
+    if (hi) error += std::abs(*hi - std::max(tip, hinge));
+    errors.emplace_back(angle, error);
+    if (error < best_error) {
+      best_error = error;
+      best = angle;
+      best_tip_is_lo = tip < hinge;
+    }
+  }
+  // Seen from some places a leaf projects alike at quite different angles (near its plane,
+  // or close to the swing side): then the box says nothing.
+  constexpr double kAmbiguity = 0.05;                             // [rad]
+  constexpr double kMaxSpread = 10.0 * std::numbers::pi / 180.0;  // [rad]
+  for (const auto& [angle, error] : errors) {
+    if (best && error <= best_error + kAmbiguity && std::abs(angle - *best) > kMaxSpread)
+      return std::nullopt;
+  }
+  if (!best || best_error > max_error) return std::nullopt;
+  if (lo && hi) return best;
+  const double edge = lo ? *lo : *hi;
+  if (std::abs(edge - hinge) < kHingeEdgeMargin || best_tip_is_lo != lo.has_value())
+    return std::nullopt;
+  return best;
 }
 
 std::string_view ToString(DoorMotion motion) {

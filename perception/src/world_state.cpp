@@ -14,17 +14,23 @@ PerceptionPipeline::PerceptionPipeline(std::vector<DoorModel> doors, PerceptionC
 
 void PerceptionPipeline::ProcessCameraFrame(const std::vector<Detection2D>& detections,
                                             cv::Size detection_image, const DepthImage& depth,
-                                            const CameraIntrinsics& intrinsics, const Pose3& X_MC) {
+                                            const CameraIntrinsics& intrinsics, const Pose3& X_MC,
+                                            const std::optional<Pose3>& X_MC_detections) {
   std::vector<PlacedDetection> placed;
   std::vector<Eigen::Vector2d> people;
-  unplaced_glass_.clear();
+  glass_boxes_.clear();
+  glass_image_width_ = detection_image.width;
+  glass_X_MC_ = X_MC_detections.value_or(X_MC);
   for (const Detection2D& detection : config_.confidence.Apply(detections)) {
-    const auto p_MO =
-        PlaceDetection(detection, detection_image, depth, intrinsics, X_MC, config_.placement);
-    if (!p_MO) {
-      if (detection.label == labels::kGlassDoor) unplaced_glass_.push_back(detection);
+    // Glass leaves go to the door-angle estimate of the next scan: their depth is invalid, and
+    // what depth there is under the box is the room behind.
+    if (detection.label == labels::kGlassDoor) {
+      glass_boxes_.push_back(detection);
       continue;
     }
+    const auto p_MO =
+        PlaceDetection(detection, detection_image, depth, intrinsics, X_MC, config_.placement);
+    if (!p_MO) continue;
     if (detection.label == labels::kPerson) {
       people.push_back(p_MO->head<2>());
     } else {
@@ -47,26 +53,65 @@ void PerceptionPipeline::ProcessScan(const LaserScan& scan, const Pose2& X_ML,
   }
   std::vector<bool> measured(doors_.size(), false);
   // Glass leaves: a line fit in the slice under each box, assigned to the nearest door.
-  for (const Detection2D& box : unplaced_glass_) {
+  for (const Detection2D& box : glass_boxes_) {
     const auto [lo, hi] = BoxBearingsInLaser(box.box, intrinsics, X_LC);
     const auto fit = FitLineRansac(ScanPointsInBearings(scan, X_ML, lo, hi), config_.glass_line);
-    if (!fit) continue;
+    // The door whose leaf the line can be (through its hinge, on its swing side), nearest.
     std::size_t best = doors_.size();
+    std::optional<double> line_angle;
     double best_distance = std::numeric_limits<double>::infinity();
-    for (std::size_t i = 0; i < doors_.size(); ++i) {
+    for (std::size_t i = 0; fit && i < doors_.size(); ++i) {
       const double d = (fit->p_M - doors_[i].door().p_MHinge).norm();
-      if (d < best_distance && d <= doors_[i].door().width() * 1.2) {
+      const auto a = DoorAngleFromLine(doors_[i].door(), *fit);
+      if (a && d < best_distance) {
         best = i;
         best_distance = d;
+        line_angle = a;
       }
     }
-    if (best == doors_.size()) continue;
-    doors_[best].Update(DoorAngleFromLine(doors_[best].door(), *fit), scan.stamp);
+    if (line_angle) {
+      doors_[best].Update(*line_angle, scan.stamp);
+      measured[best] = true;
+      continue;
+    }
+    // No leaf line (an open glass leaf is seen edge-on, beyond the laser's incidence limit): the
+    // box's edges against the leaf's projection, for the door that explains them best. The box
+    // is from the camera's pose when the image was taken (the detector's latency), not now.
+    const Eigen::Matrix3d& R_MC = glass_X_MC_.rotation();
+    const Eigen::Vector3d forward_M = R_MC.col(2);
+    const Pose2 X_MV{glass_X_MC_.translation().x(), glass_X_MC_.translation().y(),
+                     std::atan2(forward_M.y(), forward_M.x())};
+    const double v = (box.box.v_min + box.box.v_max) / 2;
+    const auto edge = [&](double u) {
+      const Eigen::Vector3d ray_M =
+          R_MC * Eigen::Vector3d((u - intrinsics.cx) / intrinsics.fx,
+                                 (v - intrinsics.cy) / intrinsics.fy, 1.0);
+      return WrapAngle(std::atan2(ray_M.y(), ray_M.x()) - X_MV.yaw);
+    };
+    constexpr double kBorderPx = 4.0;  // an edge this near the border may be cut
+    std::optional<double> at_u_min, at_u_max;
+    if (box.box.u_min > kBorderPx) at_u_min = edge(box.box.u_min);
+    if (box.box.u_max < glass_image_width_ - kBorderPx) at_u_max = edge(box.box.u_max);
+    const bool u_min_is_lo = edge(box.box.u_min) < edge(box.box.u_max);
+    const std::optional<double> box_lo = u_min_is_lo ? at_u_min : at_u_max;
+    const std::optional<double> box_hi = u_min_is_lo ? at_u_max : at_u_min;
+    std::optional<double> angle;
+    for (std::size_t i = 0; i < doors_.size(); ++i) {
+      if (measured[i]) continue;
+      if (const auto a = DoorAngleFromBearings(doors_[i].door(), X_MV, box_lo, box_hi)) {
+        if (!angle) best = i;  // the first door that explains the box; boxes rarely fit two
+        angle = angle ? angle : a;
+      }
+    }
+    if (best == doors_.size() || !angle) continue;
+    doors_[best].Update(*angle, scan.stamp);
     measured[best] = true;
   }
   for (std::size_t i = 0; i < doors_.size(); ++i) {
     if (measured[i]) continue;
-    if (auto m = MeasureDoorAngle(doors_[i].door(), points)) doors_[i].Update(m->angle, scan.stamp);
+    if (auto m = MeasureDoorAngle(doors_[i].door(), points)) {
+      doors_[i].Update(m->angle, scan.stamp);
+    }
   }
 }
 

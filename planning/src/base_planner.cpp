@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <mutex>
+#include <numbers>
 #include <queue>
 
 #include <fcl/geometry/octree/octree.h>
@@ -66,6 +67,13 @@ std::vector<std::string> BasePlanner::PlannerNames() {
 }
 
 namespace {
+
+// OMPL's SO2 asserts yaw in [-pi, pi) — WrapAngle's (-pi, pi] differs at exactly pi (a door
+// normal along -x gives atan2(+0, -1) = pi).
+double So2Yaw(double yaw) {
+  const double wrapped = WrapAngle(yaw);
+  return wrapped >= std::numbers::pi ? wrapped - 2.0 * std::numbers::pi : wrapped;
+}
 
 // Checks a base pose against the costmap and, if present, the OctoMap through FCL.
 class FootprintValidityChecker final : public ob::StateValidityChecker {
@@ -215,9 +223,9 @@ struct BasePlanner::Impl {
   bool MotionValid(const Pose2& a, const Pose2& b) const {
     ob::ScopedState<ob::SE2StateSpace> sa(space), sb(space);
     sa->setXY(a.x, a.y);
-    sa->setYaw(WrapAngle(a.yaw));  // SO2 asserts its bounds
+    sa->setYaw(So2Yaw(a.yaw));
     sb->setXY(b.x, b.y);
-    sb->setYaw(WrapAngle(b.yaw));  // SO2 asserts its bounds
+    sb->setYaw(So2Yaw(b.yaw));
     return si->checkMotion(sa.get(), sb.get());
   }
 
@@ -275,9 +283,9 @@ struct BasePlanner::Impl {
     og::SimpleSetup setup(si);
     ob::ScopedState<ob::SE2StateSpace> s(space), g(space);
     s->setXY(start.x, start.y);
-    s->setYaw(WrapAngle(start.yaw));  // SO2 asserts its bounds
+    s->setYaw(So2Yaw(start.yaw));
     g->setXY(goal.x, goal.y);
-    g->setYaw(WrapAngle(goal.yaw));  // SO2 asserts its bounds
+    g->setYaw(So2Yaw(goal.yaw));
     setup.setStartAndGoalStates(s, g);
     auto length = std::make_shared<ob::PathLengthOptimizationObjective>(si);
     if (config.costmap_cost_weight > 0.0) {
@@ -480,9 +488,9 @@ std::vector<BasePlanner::BenchmarkSummary> BasePlanner::RunOmplBenchmark(
   og::SimpleSetup setup(impl_->si);
   ob::ScopedState<ob::SE2StateSpace> s(impl_->space), g(impl_->space);
   s->setXY(start.x, start.y);
-  s->setYaw(WrapAngle(start.yaw));  // SO2 asserts its bounds
+  s->setYaw(So2Yaw(start.yaw));
   g->setXY(goal.x, goal.y);
-  g->setYaw(WrapAngle(goal.yaw));  // SO2 asserts its bounds
+  g->setYaw(So2Yaw(goal.yaw));
   setup.setStartAndGoalStates(s, g);
   setup.setOptimizationObjective(std::make_shared<ob::PathLengthOptimizationObjective>(impl_->si));
   ompl::tools::Benchmark benchmark(setup, experiment);

@@ -74,7 +74,9 @@ TEST(DoorEstimationTest, GlassDoorLineFitRecoversTheAngleWithin3Degrees) {
       points.emplace_back(clutter(random), clutter(random));  // ~30% outliers
     const auto fit = FitLineRansac(points);
     ASSERT_TRUE(fit.has_value());
-    EXPECT_NEAR(DoorAngleFromLine(door, *fit) / kDeg, degrees, 3.0);
+    const auto angle = DoorAngleFromLine(door, *fit);
+    ASSERT_TRUE(angle.has_value());
+    EXPECT_NEAR(*angle / kDeg, degrees, 3.0);
     EXPECT_LT(fit->rms, 0.02);
   }
   EXPECT_FALSE(FitLineRansac({{0, 0}, {1, 1}}).has_value());  // too few points
@@ -111,6 +113,57 @@ TEST(DoorStateTrackerTest, OpeningHeldAndClosing) {
   EXPECT_THROW(tracker.Update(std::nan(""), t), InvalidArgument);
   EXPECT_THROW(tracker.Update(0.0, Time{0}), InvalidArgument);  // time went backwards
   EXPECT_THROW(DoorStateTracker({"bad", {0, 0}, {0, 0}}), InvalidArgument);
+}
+
+TEST(DoorEstimationTest, ALineThatIsNotTheLeafGivesNoAngle) {
+  const DoorModel door = LabDoor();
+  const auto line_through = [](Eigen::Vector2d a, Eigen::Vector2d b) {
+    std::vector<Eigen::Vector2d> points;
+    for (double s = 0.0; s <= 1.0; s += 0.05)
+      points.push_back(a + s * (b - a));
+    return *FitLineRansac(points);
+  };
+  // The wall past the hinge: the line runs through the hinge but away from the leaf's side.
+  EXPECT_FALSE(DoorAngleFromLine(door, line_through({-0.6, 0.0}, {-0.05, 0.0})).has_value());
+  // Something parallel half a metre into the room: misses the hinge.
+  EXPECT_FALSE(DoorAngleFromLine(door, line_through({0.0, 0.5}, {0.9, 0.5})).has_value());
+  // Only the jamb at the hinge.
+  EXPECT_FALSE(DoorAngleFromLine(door, line_through({0.0, -0.03}, {0.0, 0.03})).has_value());
+  // The leaf itself at 30°.
+  const auto leaf = DoorAngleFromLine(door, line_through(door.p_MHinge, door.LeafTip(30 * kDeg)));
+  ASSERT_TRUE(leaf.has_value());
+  EXPECT_NEAR(*leaf / kDeg, 30.0, 0.5);
+}
+
+TEST(DoorEstimationTest, GlassLeafAngleFromTheDetectorBoxEdges) {
+  const DoorModel door = LabDoor();  // opens towards +y
+  // The camera 1.2 m before the door on the other side, facing it.
+  const Pose2 X_MV{0.45, -1.2, std::numbers::pi / 2};
+  const Pose2 X_VM = X_MV.Inverse();
+  const auto bearing = [&](const Eigen::Vector2d& p_M) {
+    const Eigen::Vector2d p_V = X_VM * p_M;
+    return std::atan2(p_V.y(), p_V.x());
+  };
+  const double hinge = bearing(door.p_MHinge);
+  for (double degrees : {0.0, 40.0, 80.0}) {
+    const double tip = bearing(door.LeafTip(degrees * kDeg));
+    // Both edges, each a degree off (detector noise).
+    const auto both =
+        DoorAngleFromBearings(door, X_MV, std::min(tip, hinge) + kDeg, std::max(tip, hinge) - kDeg);
+    ASSERT_TRUE(both.has_value()) << degrees;
+    EXPECT_NEAR(*both / kDeg, degrees, 4.0);
+    if (degrees > 0.0) {
+      // Only the free edge's side in the image: still enough.
+      const auto free_edge = DoorAngleFromBearings(door, X_MV, tip, std::nullopt);
+      ASSERT_TRUE(free_edge.has_value()) << degrees;
+      EXPECT_NEAR(*free_edge / kDeg, degrees, 2.0);
+    }
+  }
+  // Only the hinge's edge in the image: any angle would do, so none is claimed.
+  EXPECT_FALSE(DoorAngleFromBearings(door, X_MV, std::nullopt, hinge).has_value());
+  EXPECT_FALSE(DoorAngleFromBearings(door, X_MV, std::nullopt, std::nullopt).has_value());
+  // A box nowhere near the door.
+  EXPECT_FALSE(DoorAngleFromBearings(door, X_MV, -1.2, -1.0).has_value());
 }
 
 }  // namespace

@@ -74,6 +74,19 @@ TEST_F(BasePlannerTest, ThroughOpenDoorwaysOnTheirCentrelines) {
   EXPECT_GT(result.planning_time, 0.0);
 }
 
+TEST_F(BasePlannerTest, WestwardThroughDoorsAndYawsOfExactlyPiArePlanned) {
+  // Westward crossings put the door poses at atan2(+0, -1) = pi, which OMPL's SO2 rejects
+  // unless mapped into [-pi, pi); start and goal yaws of +-pi too.
+  BasePlannerConfig config;
+  config.deterministic = true;
+  for (const BasePlanner& planner : {MakePlanner(), MakePlanner(nullptr, config)}) {
+    const PlanResult result = planner.Plan({12.5, 1.5, M_PI}, {1.5, 4.5, -M_PI});
+    ASSERT_TRUE(result.ok()) << result.message;
+    EXPECT_THAT(result.doors_crossed, ElementsAre("B", "A"));
+    ExpectCollisionFree(planner, result.path);
+  }
+}
+
 TEST_F(BasePlannerTest, ClosedDoorMeansNoPath) {
   costmap_.SetDoorLeafAngle("A", 0.0);
   const PlanResult result = MakePlanner().Plan({1.5, 4.5, 0.0}, {12.5, 1.5, 0.0});

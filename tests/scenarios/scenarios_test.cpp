@@ -1,11 +1,13 @@
 // The paper's scenarios (worlds/scenarios/) at a fixed seed, driven by the robot brain and
 // judged by the twin's ground truth.
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -118,6 +120,21 @@ TEST(ScenarioTest, S4bFetchesTheFlashlightAndTakesItThroughTheDoor) {
   const BrainRun run = RunWithBrain(kScenarios / "s4b_fetch_flashlight.yaml", 1);
   EXPECT_TRUE(run.result.verdict.success) << twin::FormatVerdict(run.result.verdict);
   EXPECT_EQ(run.world->held_payload(), "flashlight");
+}
+
+TEST(ScenarioTest, S5FetchesFromTheFarRoomThroughTwoDoorsAndPlacesOnTheStartTable) {
+  const BrainRun run = RunWithBrain(kScenarios / "s5_office_chain.yaml", 1);
+  EXPECT_TRUE(run.result.verdict.success) << twin::FormatVerdict(run.result.verdict);
+  EXPECT_FALSE(run.world->held_payload().has_value());
+  // Out through each door by its west actuator, back by the one on the other side.
+  std::vector<std::string> operated;
+  for (const auto& e : run.world->events()) {
+    if (e.kind == "button_pressed") operated.push_back(e.detail);
+  }
+  for (const char* actuator :
+       {"door_a_button", "door_b_plate", "door_b_plate_east", "door_a_button_east"}) {
+    EXPECT_NE(std::find(operated.begin(), operated.end(), actuator), operated.end()) << actuator;
+  }
 }
 
 TEST(ScenarioTest, S6RetreatsFromAPersonCuttingThePathThenPasses) {

@@ -9,6 +9,7 @@
 namespace egress::twin {
 namespace {
 
+using ::testing::ElementsAre;
 using ::testing::HasSubstr;
 using testing::WorldsDir;
 
@@ -83,6 +84,30 @@ TEST(ScenarioTest, ValidationAgainstTheWorldNamesTheField) {
       Minimal("doors:\n  - {door: lab_door, operator: push, actuator: wall_north_button}\n"),
       "v.yaml", WorldsDir() / "lab");
   EXPECT_THROW(t.ValidateAgainst(LoadSdfWorld(t.world_file)), LoadError);
+}
+
+TEST(ScenarioTest, ADoorMayHaveAnActuatorOnEachSide) {
+  const auto office = [](const std::string& actuators) {
+    return LoadScenarioFromString(
+        "world: office.sdf\nrobot: {start: {x: 1, y: 3}}\ndoors:\n"
+        "  - {door: door_a, operator: push, actuator: " +
+            actuators + "}\n",
+        "v.yaml", WorldsDir() / "office");
+  };
+  const Scenario s = office("[door_a_button, door_a_button_east]");
+  ASSERT_EQ(s.doors.size(), 1u);
+  EXPECT_THAT(s.doors[0].actuators, ElementsAre("door_a_button", "door_a_button_east"));
+  EXPECT_NO_THROW(s.ValidateAgainst(LoadSdfWorld(s.world_file)));
+  const Scenario misspelt = office("[door_a_button, door_a_buton_east]");
+  try {
+    misspelt.ValidateAgainst(LoadSdfWorld(misspelt.world_file));
+    FAIL();
+  } catch (const LoadError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("doors[0].actuator"));
+    EXPECT_THAT(e.what(), HasSubstr("door_a_buton_east"));
+  }
+  ExpectError(Minimal("doors:\n  - {door: lab_door, operator: push, actuator: []}\n"),
+              "doors[0].actuator", "at least one");
 }
 
 TEST(ScenarioTest, RangeSamplesWithinBoundsAndFixedValues) {

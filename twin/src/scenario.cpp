@@ -254,11 +254,12 @@ PredicateSpec ParsePredicate(const FieldReader& r, const YAML::Node& node,
     p.payload = r.String(value, sub);
   } else if (key == "payload_delivered") {
     p.kind = K::kPayloadDelivered;
-    r.CheckKeys(value, sub, {"payload", "x", "y", "radius"});
+    r.CheckKeys(value, sub, {"payload", "x", "y", "radius", "min_z"});
     p.payload = r.String(r.Required(value, sub, "payload"), sub + ".payload");
     p.target = {r.Number(r.Required(value, sub, "x"), sub + ".x"),
                 r.Number(r.Required(value, sub, "y"), sub + ".y")};
     if (value["radius"]) p.radius = r.Positive(value["radius"], sub + ".radius");
+    if (value["min_z"]) p.min_z = r.Number(value["min_z"], sub + ".min_z");
   } else {
     r.Fail(node, field,
            "'" + key +
@@ -381,7 +382,14 @@ Scenario Parse(const YAML::Node& root, const FieldReader& r,
       op.door = r.String(r.Required(d, f, "door"), f + ".door");
       op.kind = ParseOperator(r, r.Required(d, f, "operator"), f + ".operator");
       if (op.kind != OperatorKind::kManual) {
-        op.actuator = r.String(r.Required(d, f, "actuator"), f + ".actuator");
+        const YAML::Node a = r.Required(d, f, "actuator");
+        if (a.IsSequence()) {
+          if (a.size() == 0) r.Fail(a, f + ".actuator", "expected at least one actuator");
+          for (std::size_t k = 0; k < a.size(); ++k)
+            op.actuators.push_back(r.String(a[k], StrCat(f, ".actuator[", k, "]")));
+        } else {
+          op.actuators.push_back(r.String(a, f + ".actuator"));
+        }
       }
       if (d["glass"]) op.glass = r.Bool(d["glass"], f + ".glass");
       auto& t = op.timing;
@@ -623,11 +631,11 @@ void Scenario::ValidateAgainst(const WorldDescription& world) const {
       throw LoadError(
           StrCat(f, ".door': world ", world_file.string(), " has no hinged door '", op.door, "'"));
     }
-    if (!op.actuator.empty()) {
-      const auto shapes = world.ShapesOfModel(op.actuator);
+    for (const auto& actuator : op.actuators) {
+      const auto shapes = world.ShapesOfModel(actuator);
       if (shapes.size() != 1 || shapes.front()->kind != ShapeKind::kBox) {
         throw LoadError(StrCat(f, ".actuator': world ", world_file.string(), " has no model '",
-                               op.actuator, "' with exactly one box collision"));
+                               actuator, "' with exactly one box collision"));
       }
     }
   }

@@ -153,11 +153,13 @@ Verdict ScenarioJudge::Finish(const TwinWorld& world) const {
         break;
       }
       case K::kPayloadDelivered: {
-        const Eigen::Vector2d xy = world.payload_pose(p.payload).translation().head<2>();
-        const double dist = (xy - p.target).norm();
+        const Eigen::Vector3d p_W = world.payload_pose(p.payload).translation();
+        const double dist = (p_W.head<2>() - p.target).norm();
         const bool released = !(world.held_payload() && *world.held_payload() == p.payload);
-        r.passed = released && dist <= p.radius;
-        r.detail = Fmt(dist) + " m from target" + (released ? "" : ", still held");
+        const bool high_enough = p_W.z() >= p.min_z;
+        r.passed = released && dist <= p.radius && high_enough;
+        r.detail = Fmt(dist) + " m from target" + (released ? "" : ", still held") +
+                   (high_enough ? "" : ", fell (centre at z = " + Fmt(p_W.z()) + " m)");
         break;
       }
       case K::kNoPersonContact: {

@@ -164,8 +164,8 @@ struct TwinWorld::Impl {
     const DoorDescription* desc{nullptr};
     std::optional<DoorOperatorSpec> spec;
     std::optional<AdaDoorOperator> op;
-    std::optional<PushButton> button;
-    std::optional<ProximityPlate> plate;
+    std::vector<PushButton> buttons;     // one per push-button actuator, in spec order
+    std::vector<ProximityPlate> plates;  // one per proximity-plate actuator, in spec order
     std::size_t next_open_at{0};
     btRigidBody* leaf{nullptr};
     btHingeConstraint* hinge{nullptr};
@@ -438,16 +438,15 @@ struct TwinWorld::Impl {
       door.normal = Eigen::Vector2d(-door.along.y(), door.along.x());
       if (door.spec) {
         door.op.emplace(door.spec->timing, d.max_open_angle);
-        if (!door.spec->actuator.empty()) {
-          const ShapeDescription& a = *world.ShapesOfModel(door.spec->actuator).front();
+        for (const auto& actuator : door.spec->actuators) {
+          const ShapeDescription& a = *world.ShapesOfModel(actuator).front();
           ActuatorBox box{a.X_WS, a.box_size};
           if (door.spec->kind == OperatorKind::kPushButton) {
-            door.button.emplace(box, door.spec->button_stroke, door.spec->button_spring_force,
-                                door.spec->button_max_force);
+            door.buttons.emplace_back(box, door.spec->button_stroke, door.spec->button_spring_force,
+                                      door.spec->button_max_force);
           } else if (door.spec->kind == OperatorKind::kProximityPlate) {
-            door.plate.emplace(box, door.spec->proximity_range);
+            door.plates.emplace_back(box, door.spec->proximity_range);
           }
-          actuator_entity[door.spec->actuator] = int(i);
         }
       }
       doors.push_back(std::move(door));
@@ -942,25 +941,27 @@ struct TwinWorld::Impl {
     const std::vector<Eigen::Vector3d> hand_points = {fingertip, palm.translation()};
     for (std::size_t i = 0; i < doors.size(); ++i) {
       Door& d = doors[i];
-      bool triggered = false;
-      if (d.button) {
-        const auto result = d.button->Update(fingertip);
+      const std::string* triggered = nullptr;  // the actuator that opened the door this step
+      for (std::size_t k = 0; k < d.buttons.size(); ++k) {
+        const auto result = d.buttons[k].Update(fingertip);
         if (result == PushButton::Result::kPressed) {
-          triggered = true;
+          triggered = &d.spec->actuators[k];
         } else if (result == PushButton::Result::kOverForce) {
-          AddEvent("button_overforce", d.desc->name, StrCat(d.button->force(), " N"));
+          AddEvent("button_overforce", d.desc->name, StrCat(d.buttons[k].force(), " N"));
         }
       }
-      if (d.plate && d.plate->Update(hand_points)) triggered = true;
+      for (std::size_t k = 0; k < d.plates.size(); ++k) {
+        if (d.plates[k].Update(hand_points)) triggered = &d.spec->actuators[k];
+      }
       if (d.spec && d.next_open_at < d.spec->open_at.size() &&
           time >= d.spec->open_at[d.next_open_at]) {
         ++d.next_open_at;
         AddEvent("door_triggered", d.desc->name, "scheduled");
         d.op->Trigger(time);
       }
-      if (triggered) {
+      if (triggered != nullptr) {
         ++d.presses;
-        AddEvent("button_pressed", d.desc->name, d.spec->actuator);
+        AddEvent("button_pressed", d.desc->name, *triggered);
         d.op->Trigger(time);
       }
     }
@@ -1160,7 +1161,6 @@ struct TwinWorld::Impl {
       [this](const btCollisionObject* o, int t) { return EntityOf(o, t); };
   std::vector<Entity> entities;
   std::vector<Door> doors;
-  std::map<std::string, int> actuator_entity;
   std::vector<Person> people;
   std::vector<PersonState> states_cache;
   std::vector<Payload> payloads;
@@ -1361,8 +1361,9 @@ std::vector<DetectableObject> TwinWorld::DetectableObjects() const {
     out.push_back({door_is_glass(i) ? "glass_door" : "door", d.desc->name,
                    FromBt(d.leaf->getWorldTransform()), d.desc->leaf_size / 2,
                    d.leaf->getUserIndex()});
-    if (d.spec && !d.spec->actuator.empty()) {
-      const ShapeDescription& a = *I.world.ShapesOfModel(d.spec->actuator).front();
+    if (!d.spec) continue;
+    for (const auto& actuator : d.spec->actuators) {
+      const ShapeDescription& a = *I.world.ShapesOfModel(actuator).front();
       int entity = -1;
       for (std::size_t e = 0; e < I.entities.size(); ++e) {
         if (I.entities[e].name == a.model && I.entities[e].kind == EntityKind::kStatic)

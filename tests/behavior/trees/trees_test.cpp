@@ -187,7 +187,7 @@ TEST(FetchTreeTest, RetriesAGraspTheGripperDidNotHoldThenDelivers) {
                                                  Any(std::string("2.3;1.35;0.86")));
                     return NodeStatus::kSuccess;
                   },
-                  {{"payload", "bottle"}, {"pickup", "2.3;2.0;-1.57"}, {"dropoff", "12.5;1.5;0"}});
+                  {{"payload", "bottle"}, {"pickup", "2.3;2.0;-1.57"}, {"dropoff", "2.5;1.3;0.87"}});
   EXPECT_EQ(run.Tick(), NodeStatus::kSuccess);  // the first grasp missed; the second held
   EXPECT_EQ(holding_checks, 2);
   int grasps = 0;

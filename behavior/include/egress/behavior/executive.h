@@ -8,6 +8,7 @@
 /// commands. The executive reads time only from the port's clock, so in the twin it runs in
 /// lock-step with simulated time.
 
+#include <deque>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -102,6 +103,8 @@ class Executive {
   bt::NodeStatus status_{bt::NodeStatus::kIdle};
   std::vector<Decision> decisions_;
   std::vector<std::pair<double, double>> preemptions_;
+  static constexpr double kPoseHistorySec = 1.0;     ///< Longer than the detector's latency.
+  std::deque<std::pair<Time, Pose2>> pose_history_;  ///< Localized X_MB per control step.
 };
 
 }  // namespace egress::behavior

@@ -35,8 +35,12 @@ struct MissionMap {
   std::vector<MapActuator> actuators;
 
   const perception::DoorModel* FindDoor(const std::string& id) const;
-  /// The actuator of `door`, or nullptr for a door without one (opened by hand).
-  const MapActuator* FindActuatorOf(const std::string& door) const;
+  /// The actuator of `door` on the side of the wall where `p_M` is (the nearest if there are
+  /// several), or nullptr if there is none on that side (a door opened by hand, or one with its
+  /// button only on the other side).
+  const MapActuator* FindActuatorOf(const std::string& door, const Eigen::Vector2d& p_M) const;
+  /// The actuator named `id`, or nullptr.
+  const MapActuator* FindActuator(const std::string& id) const;
   /// @throws InvalidArgument for a door without a doorway, an actuator of an unknown door or a
   /// non-finite pose.
   void Validate() const;

@@ -49,6 +49,7 @@ struct TaskConfig {
 
 /// A press worked out by ApproachButton for PressButton / WaveAtPlate.
 struct ButtonPlan {
+  std::string actuator;  ///< Id of the button or plate in the mission map.
   planning::ButtonType type{planning::ButtonType::kPushButton};
   planning::ButtonTargets targets;
   Pose2 X_MB_standoff;               ///< Where the base stands (from whole-body IK).
@@ -77,7 +78,7 @@ struct TaskContext {
   std::map<std::string, Time> zone_occupied_at;    ///< Per door: when a person last was in it.
   /// Per door: the unit normal of the door line pointing to the side the robot came from
   /// (fixed when it first works at the door, so a robot caught mid-doorway still knows which
-  /// way is forward).
+  /// way is forward; forgotten once it is through, so it can come back the other way).
   std::map<std::string, Eigen::Vector2d> door_approach_side;
   /// Per door: since when it has been open enough to pass in its current opening (kept by the
   /// executive from the angle estimate; a press restarts it).

@@ -31,6 +31,8 @@ struct DoorModel {
   double max_open_angle{1.5707963267948966};  ///< [rad]
   double width() const { return (p_MLatch - p_MHinge).norm(); }
   double closed_yaw() const;
+  /// Unit normal of the door line pointing into the room the leaf opens into.
+  Eigen::Vector2d SwingSide() const;
   /// Where the leaf's free edge is at `angle` [m, in M].
   Eigen::Vector2d LeafTip(double angle) const;
   /// Clear width of the opening at `angle`: w·(1 − cos θ) up to 90°, w beyond [m].
@@ -80,9 +82,24 @@ struct DoorAngleMeasurement {
 std::optional<DoorAngleMeasurement> MeasureDoorAngle(const DoorModel& door,
                                                      const std::vector<Eigen::Vector2d>& p_MPoints,
                                                      std::size_t min_support = 4);
-/// The leaf angle of a fitted leaf line (a glass door): the line's direction against the closed
-/// line, on the swing side, clamped to [0, max_open_angle].
-double DoorAngleFromLine(const DoorModel& door, const LineFit& line);
+/// The leaf angle of a fitted leaf line (a glass door): the line's direction (away from the
+/// hinge) against the closed line, on the swing side, clamped to [0, max_open_angle]. nullopt
+/// when the line cannot be the leaf: it misses the hinge by more than `hinge_tolerance` [m],
+/// its inliers' centroid lies beyond the leaf or within an eighth of its width of the hinge
+/// (the jamb), or it points more than 10° outside the leaf's range (a wall past the hinge).
+std::optional<double> DoorAngleFromLine(const DoorModel& door, const LineFit& line,
+                                        double hinge_tolerance = 0.1);
+
+/// The leaf angle whose leaf (hinge to free edge) spans, seen from V, the bearings closest to
+/// a detector box's edges `lo`, `hi` [rad, about V's z from its x axis] — for a glass leaf the
+/// laser sees only near normal incidence, i.e. not once it swings open. V is the camera's
+/// position with the bearings' axes (e.g. the laser frame's). An edge cut by the image border
+/// is passed as nullopt. nullopt when the best angle misses the box by more than `max_error`
+/// [rad, summed over the edges], or, with one edge, when that edge is not the free edge's or
+/// lies within a few degrees of the hinge's bearing (then any angle explains it).
+std::optional<double> DoorAngleFromBearings(const DoorModel& door, const Pose2& X_MV,
+                                            std::optional<double> lo, std::optional<double> hi,
+                                            double max_error = 0.15);
 
 enum class DoorMotion { kUnknown, kClosed, kOpening, kOpen, kHeldOpen, kClosing };
 std::string_view ToString(DoorMotion motion);

@@ -73,13 +73,17 @@ class PerceptionPipeline {
   PerceptionPipeline(std::vector<DoorModel> doors, PerceptionConfig config = {});
 
   /// One camera frame: filter, place and track. `detection_image` is the size of the image the
-  /// boxes refer to. Boxes that cannot be placed (no valid depth: glass) are kept for
-  /// ProcessScan's line fit.
+  /// boxes refer to. Glass-door boxes are not placed (their depth is invalid, or the room
+  /// behind) but kept for ProcessScan. X_MC is the camera when `depth` was taken (boxes are
+  /// placed in it); `X_MC_detections`, if given, when the boxes' image was (the detector's
+  /// latency later the robot has moved on), for the glass boxes' bearings.
   void ProcessCameraFrame(const std::vector<Detection2D>& detections, cv::Size detection_image,
                           const DepthImage& depth, const CameraIntrinsics& intrinsics,
-                          const Pose3& X_MC);
+                          const Pose3& X_MC,
+                          const std::optional<Pose3>& X_MC_detections = std::nullopt);
   /// One laser scan: every door's angle from the points near its hinge; glass doors from the
-  /// last frame's unplaced glass_door boxes (the scan slice under the box, RANSAC line).
+  /// last frame's glass_door boxes (a RANSAC line in the scan slice under the box; when there
+  /// is none, the box's edges against the leaf's projection).
   /// X_LC (camera in laser frame) maps those boxes to bearings.
   void ProcessScan(const LaserScan& scan, const Pose2& X_ML, const CameraIntrinsics& intrinsics,
                    const Pose3& X_LC);
@@ -98,7 +102,9 @@ class PerceptionPipeline {
   std::vector<DoorStateTracker> doors_;
   ObjectTracker objects_;
   PersonTracker people_;
-  std::vector<Detection2D> unplaced_glass_;
+  std::vector<Detection2D> glass_boxes_;
+  int glass_image_width_{0};  ///< Width of the image those boxes are in [px].
+  Pose3 glass_X_MC_;          ///< The camera when that image was taken.
 };
 
 }  // namespace egress::perception

@@ -48,7 +48,9 @@ enum class OperatorKind {
 /// One door and its operator.
 struct DoorOperatorSpec {
   std::string door;      ///< SDF model name of the hinged door.
-  std::string actuator;  ///< SDF model name of the button or plate (empty for kManual).
+  /// SDF model names of its buttons or plates, all of the operator's kind: one on each side of
+  /// the wall is usual for ADA doors (empty for kManual).
+  std::vector<std::string> actuators;
   OperatorKind kind{OperatorKind::kPushButton};
   bool glass{false};  ///< Glass leaf: the laser sees it only near normal incidence.
   DoorTiming timing;
@@ -135,7 +137,8 @@ struct PredicateSpec {
     kButtonPressed,        ///< `door`'s actuator was pressed at least once.
     kButtonNotPressed,     ///< ... never.
     kPayloadHeld,          ///< `payload` in the gripper at the end.
-    kPayloadDelivered,     ///< `payload` within `radius` of `target` (xy) at the end, released.
+    kPayloadDelivered,     ///< `payload` within `radius` of `target` (xy) at the end, released,
+                           ///< its centre at least `min_z` high (on a table, not the floor).
     kNoPersonContact,      ///< No robot–person contact.
     kNoDoorStrike,         ///< The robot's body or arm never touched a door leaf.
     kWithinTimeLimit,      ///< Finished before the time limit (always checked).
@@ -145,6 +148,7 @@ struct PredicateSpec {
   std::string payload;
   Eigen::Vector2d target{Eigen::Vector2d::Zero()};
   double radius{0.3};
+  double min_z{-1e9};  ///< [m] for kPayloadDelivered
 };
 std::string ToString(const PredicateSpec& predicate);
 
