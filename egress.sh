@@ -79,9 +79,10 @@ case "$command" in
     say "the main job: egress --version (the libraries each module links)"
     "$build_dir/apps/egress" --version
     echo
-    say "a twin scenario end to end, driven by the robot brain: S1, press the lab door's push button"
-    say "and drive through while the ADA operator holds it open"
-    "$build_dir/apps/egress" sim run worlds/scenarios/s1_nominal.yaml \
+    say "a twin scenario end to end, driven by the robot brain: S5, through the office's two doors"
+    say "(push button, then glass door with a proximity plate) to fetch a water bottle from the far"
+    say "room, back through both and onto the start room's table"
+    "$build_dir/apps/egress" sim run worlds/scenarios/s5_office_chain.yaml \
       --png "$build_dir/demo_run.png" --video "$build_dir/demo_run.mp4" \
       --trace "$build_dir/demo_run.jsonl" --overwrite
     echo

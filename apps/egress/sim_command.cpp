@@ -26,6 +26,28 @@
 namespace egress::apps {
 namespace {
 
+constexpr double kCostmapSnapshotPeriodSec = 1.0;
+
+// The costmap's inflated and lethal cells for the trace.
+twin::TraceAnnotation::Grid CostmapLayer(const perception::Costmap2D& costmap) {
+  twin::TraceAnnotation::Grid grid;
+  const auto& g = costmap.geometry();
+  grid.origin = g.origin;
+  grid.resolution = g.resolution;
+  grid.width = g.width;
+  grid.height = g.height;
+  const auto& costs = costmap.costs();
+  for (std::size_t i = 0; i < costs.size(); ++i) {
+    if (costs[i] == perception::kUnknownCost) continue;
+    if (costs[i] >= perception::kLethalCost) {
+      grid.lethal.push_back(std::uint32_t(i));
+    } else if (costs[i] >= perception::kInscribedCost) {
+      grid.inflated.push_back(std::uint32_t(i));
+    }
+  }
+  return grid;
+}
+
 struct SimOptions {
   std::string scenario;
   std::optional<std::uint64_t> seed;
@@ -94,13 +116,17 @@ void RunSim(const SimOptions& o) {
     brain = MakeScenarioExecutive(scenario, world_description, world, model, kDefaults);
     options.control_period = 1.0 / 100.0;
     controller = [&brain](RobotPort& port) { return brain->Step(port); };
-    // The video shows the running action and the planned path (the map frame is W here: the
-    // brain starts from the twin's start pose).
-    options.annotate = [&brain] {
+    // The video shows the running action, the planned path and, once a second, the costmap
+    // (the map frame is W here: the brain starts from the twin's start pose).
+    options.annotate = [&brain, &world, next_costmap = 0.0]() mutable {
       twin::TraceAnnotation note;
       note.label = brain->active_action();
       for (const Pose2& X : brain->context().motion->path())
         note.path.push_back(X.translation());
+      if (world.time() + 1e-9 >= next_costmap) {
+        next_costmap = world.time() + kCostmapSnapshotPeriodSec;
+        note.costmap = CostmapLayer(brain->costmap());
+      }
       return note;
     };
   } else if (driver == "idle") {

@@ -87,6 +87,26 @@ TraceFile ParseTrace(std::istream& in, const std::string& source) {
 cv::Mat RenderTraceFrame(const TraceFile& trace, std::size_t index, double pixels_per_metre) {
   const View v = MakeView(trace, pixels_per_metre);
   cv::Mat image(v.height, v.width, CV_8UC3, cv::Scalar(250, 250, 250));
+  // Under everything, the driver's latest costmap snapshot: inflation light orange, lethal
+  // cells (walls, leaves, people and obstacles as the laser sees them) red.
+  for (std::size_t k = index + 1; k-- > 0;) {
+    const auto& s = trace.samples[k];
+    if (!s.contains("costmap")) continue;
+    const auto& c = s["costmap"];
+    const double res = c.value("resolution", 0.05), ox = c["origin"][0], oy = c["origin"][1];
+    const int width = c.value("width", 0);
+    const auto draw = [&](const char* key, const cv::Scalar& colour) {
+      if (!c.contains(key) || width <= 0) return;
+      for (const auto& cell : c[key]) {
+        const std::uint32_t i = cell.get<std::uint32_t>();
+        const double x = ox + (i % width) * res, y = oy + (i / width) * res;
+        cv::rectangle(image, v(x, y), v(x + res, y + res), colour, cv::FILLED);
+      }
+    };
+    draw("inflated", cv::Scalar(200, 228, 255));
+    draw("lethal", cv::Scalar(110, 120, 235));
+    break;
+  }
   for (const auto& w : trace.header.at("walls")) {
     const cv::RotatedRect rect(
         v(w[0].get<double>(), w[1].get<double>()),

@@ -235,6 +235,10 @@ class IsPathClear final : public TaskNode<bt::ConditionNode> {
 };
 
 constexpr double kLeafClearance = 0.15;  // [m] kept between the footprint and a leaf's sweep
+// [s] A low-energy ADA operator takes at least this long to open (ANSI A156.19: >= 3 s to the
+// back check), and at most about the second: the hold window starts in between.
+constexpr double kOperatorMinOpeningTime = 3.0;
+constexpr double kOperatorOpeningTime = 4.0;
 
 // Far enough past the door line that the closing leaf cannot reach the footprint.
 double ExitDistance(const TaskContext& ctx, const std::string& door) {
@@ -263,14 +267,27 @@ bool DoorPassable(const TaskContext& ctx, const std::string& door, double margin
   for (const auto& d : ctx.world.doors) {
     if (d.model.id != door) continue;
     if (d.state.motion == perception::DoorMotion::kClosing) return false;
-    if (held_by_person || d.state.motion != perception::DoorMotion::kHeldOpen) continue;
-    // Still open well past an operator's window: someone or something out of sight holds it.
+    if (held_by_person) continue;
+    const double window = ctx.config.door_hold_window;
+    // Opened by our own press or wave and not seen opening right after it (a glass leaf may be
+    // seen open only seconds later): the window runs from the press plus the shortest opening
+    // time at the latest.
+    const auto operated = ctx.door_operated_at.find(door);
+    const double since_press = operated != ctx.door_operated_at.end()
+                                   ? ToSeconds(ctx.now - operated->second)
+                                   : std::numeric_limits<double>::infinity();
+    const bool ours = since_press < window + ctx.config.door_hold_margin + kOperatorOpeningTime;
+    if (!ours && d.state.motion != perception::DoorMotion::kHeldOpen) continue;
     // How long it has been open in this opening (not the estimate's steady time, which a
     // person passing in front of the leaf resets).
     const auto since = ctx.door_open_since.find(door);
-    const double open_for =
-        since != ctx.door_open_since.end() ? ToSeconds(ctx.now - since->second) : 0.0;
-    if (open_for > ctx.config.door_hold_window + ctx.config.door_hold_margin) continue;
+    double open_for = since != ctx.door_open_since.end() ? ToSeconds(ctx.now - since->second) : 0.0;
+    // Still open well past an operator's window: someone or something out of sight holds it.
+    if (!ours && open_for > window + ctx.config.door_hold_margin) continue;
+    if (ours && (since == ctx.door_open_since.end() ||
+                 ToSeconds(since->second - operated->second) > kOperatorOpeningTime)) {
+      open_for = std::max(open_for, since_press - kOperatorMinOpeningTime);
+    }
     const DoorPass pass = CalcKnownPass(ctx, door);
     // From here to beyond the leaf's sweep on the far side (less if already past the line); a
     // leaf that opens towards the robot closes away from it: just past the line is clear.
@@ -280,7 +297,7 @@ bool DoorPassable(const TaskContext& ctx, const std::string& door, double margin
     const double to_clear =
         std::max(0.0, (ctx.X_MB.translation() - pass.centre).dot(pass.n_M) + beyond);
     const double needed = to_clear / ctx.motion->trajectory_config().door_speed;
-    if (open_for + needed > ctx.config.door_hold_window) return false;
+    if (open_for + needed > window) return false;
   }
   return true;
 }
@@ -573,6 +590,8 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
 
   NodeStatus Operate(const ButtonPlan& plan, const Pose2& X_MB) {
     const bool push = type_ == planning::ButtonType::kPushButton;
+    // The hand reaches the actuator's approach pose then; the press or wave follows.
+    ctx_.door_operated_at[door_] = ctx_.now + SecondsToDuration(ctx_.config.press_reach_time);
     const auto approach = SolveArm(ctx_, X_MB, plan.targets.approach, plan.approach_arm, push);
     if (!approach) {
       Note("the actuator is out of the arm's reach from here");
@@ -1164,6 +1183,7 @@ class HandOver final : public ReleaseAction {
     if (to_robot.norm() < 1e-6) to_robot = Eigen::Vector2d::UnitX();
     const Eigen::Vector2d p = p_MP + to_robot.normalized() * kOfferDistance;
     const Eigen::Vector3d centre(p.x(), p.y(), Input<double>("hand_height"));
+    Note(StrCat("holding it out to the responder at ", PoseText({p_MP.x(), p_MP.y(), 0.0})));
     return std::make_pair(centre, ctx_.X_MB);
   }
   Release ReadyToRelease(const Eigen::Vector3d& p_M_payload) override {
@@ -1171,7 +1191,9 @@ class HandOver final : public ReleaseAction {
     const auto* recipient = Recipient(expected.translation());
     if (recipient != nullptr &&
         (recipient->person.p_MP - p_M_payload.head<2>()).norm() < Input<double>("reach")) {
-      Note("the responder is within reach: letting go");
+      Note(StrCat("the responder is within reach (at ",
+                  PoseText({recipient->person.p_MP.x(), recipient->person.p_MP.y(), 0.0}),
+                  "): letting go"));
       return Release::kNow;
     }
     if (ToSeconds(ctx_.now - waiting_since()) > Input<double>("timeout")) {
@@ -1192,7 +1214,8 @@ class HandOver final : public ReleaseAction {
     }
     return best;
   }
-  static constexpr double kOfferDistance = 0.45;  // [m] payload from the person
+  static constexpr double kOfferDistance =
+      0.3;  // [m] payload from the person (as tracked: its near side)
 };
 
 template <typename T>

@@ -153,6 +153,16 @@ TEST(ScenarioTest, S7GoesRoundAnUnmappedObstacleAndPassesTheHeldDoor) {
   EXPECT_EQ(run.presses, 0);
 }
 
+TEST(ScenarioTest, TheFetchedBottleIsHandedToTheResponder) {
+  const BrainRun run = RunWithBrain(kScenarios / "extra" / "hand_over_bottle.yaml", 1);
+  EXPECT_TRUE(run.result.verdict.success) << twin::FormatVerdict(run.result.verdict);
+  EXPECT_FALSE(run.world->held_payload().has_value());
+  bool waited_for_reach = false;
+  for (const auto& d : run.brain->decisions())
+    waited_for_reach = waited_for_reach || d.text.find("within reach") != std::string::npos;
+  EXPECT_TRUE(waited_for_reach);
+}
+
 TEST(ScenarioTest, HardHalfOpenDoorIsNotDrivenIntoButOpenedByTheButton) {
   const BrainRun run = RunWithBrain(kScenarios / "hard" / "h1_half_open_held_door.yaml", 1);
   EXPECT_TRUE(run.result.verdict.success) << twin::FormatVerdict(run.result.verdict);

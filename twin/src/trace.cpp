@@ -204,6 +204,24 @@ void TraceRecorder::Observe(const TwinWorld& world, const TraceAnnotation* annot
       s += ']';
     }
     s += ']';
+    if (const auto& g = annotation->costmap) {
+      s += ",\"costmap\":{\"origin\":[" + Fixed(g->origin.x()) + ',' + Fixed(g->origin.y()) +
+           "],\"resolution\":" + Fixed(g->resolution) + ",\"width\":" + std::to_string(g->width) +
+           ",\"height\":" + std::to_string(g->height);
+      const auto cells = [&s](const char* key, const std::vector<std::uint32_t>& indices) {
+        s += ",\"";
+        s += key;
+        s += "\":[";
+        for (std::size_t i = 0; i < indices.size(); ++i) {
+          if (i) s += ',';
+          s += std::to_string(indices[i]);
+        }
+        s += ']';
+      };
+      cells("inflated", g->inflated);
+      cells("lethal", g->lethal);
+      s += '}';
+    }
   }
   s += '}';
   samples_.push_back(std::move(s));

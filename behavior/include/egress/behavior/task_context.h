@@ -83,6 +83,9 @@ struct TaskContext {
   /// Per door: since when it has been open enough to pass in its current opening (kept by the
   /// executive from the angle estimate; a press restarts it).
   std::map<std::string, Time> door_open_since;
+  /// Per door: when the robot's hand last reached its actuator to press or wave (the operator's
+  /// hold window starts soon after, whether or not the door is seen opening).
+  std::map<std::string, Time> door_operated_at;
   /// A standby retreat is under way: it is finished before the robot resumes.
   bool retreating{false};
   std::vector<std::string> notes;  ///< The nodes' reasons, for the run log.

@@ -14,6 +14,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,6 +27,17 @@ namespace egress::twin {
 struct TraceAnnotation {
   std::string label;                  ///< e.g. the behavior tree's running action
   std::vector<Eigen::Vector2d> path;  ///< planned base path in W [m]
+  /// The driver's costmap (a snapshot now and then: it is large), as the row-major indices of
+  /// its inflated and lethal cells; cell (0, 0) has its corner at `origin` in W.
+  struct Grid {
+    Eigen::Vector2d origin{Eigen::Vector2d::Zero()};  ///< [m]
+    double resolution{0.05};                          ///< [m]
+    int width{0};
+    int height{0};
+    std::vector<std::uint32_t> inflated;
+    std::vector<std::uint32_t> lethal;
+  };
+  std::optional<Grid> costmap;
 };
 
 class TraceRecorder {
