@@ -175,6 +175,11 @@ bool Executive::Step(RobotPort& port) {
     m.depth = snapshot.depth;
     m.X_BC = snapshot.X_BC;
     m.intrinsics = snapshot.depth_intrinsics;
+    if (m.X_BC) {
+      context_.depth = snapshot.depth;
+      context_.X_MC = X_MB3 * *m.X_BC;
+      context_.depth_intrinsics = snapshot.depth_intrinsics;
+    }
   }
   const Pose3& X_BL = m.model->laser_pose();
   if (snapshot.scan) {

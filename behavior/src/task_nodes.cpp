@@ -937,6 +937,47 @@ Eigen::Vector3d HorizontalApproach(const Pose2& X_MB, const Eigen::Vector3d& p_M
   return {a.x(), a.y(), 0.0};
 }
 
+// How far a payload's centre stands above the surface it rests on [m]: a bottle upright, a
+// flashlight lying; unknown kinds get a middle value.
+double PayloadCentreHeight(std::string_view kind) {
+  if (kind == perception::labels::kBottle) return 0.105;
+  if (kind == perception::labels::kFlashlight) return 0.021;
+  return 0.05;
+}
+
+// The highest depth point standing out of the surface the payload rests on (`surface_z`) in the
+// corridor the hand sweeps horizontally towards a grasp centre `p_M` along `approach_M` (from
+// the pre-grasp to just before the payload, within a hand's width of the line), or nullopt if
+// there is none.
+std::optional<double> ClutterTopBeforeGrasp(const TaskContext& ctx, const Eigen::Vector3d& p_M,
+                                            const Eigen::Vector3d& approach_M,
+                                            double payload_radius, double surface_z) {
+  if (!ctx.depth) return std::nullopt;
+  constexpr double kHandHalfWidth = 0.07;  // [m] fingers open, with a margin
+  constexpr double kFlat = 0.02;           // [m] bumps lower than this are the surface
+  const DepthImage& depth = *ctx.depth;
+  const CameraIntrinsics& K = ctx.depth_intrinsics;
+  const Eigen::Vector2d a = approach_M.head<2>().normalized();
+  std::optional<double> top;
+  for (int v = 0; v < depth.height; ++v) {
+    for (int u = 0; u < depth.width; ++u) {
+      if (!depth.IsValidAt(u, v)) continue;
+      const double z = depth.At(u, v);
+      const Eigen::Vector3d p =
+          ctx.X_MC * Eigen::Vector3d((u + 0.5 - K.cx) / K.fx * z, (v + 0.5 - K.cy) / K.fy * z, z);
+      const Eigen::Vector2d d = p.head<2>() - p_M.head<2>();
+      const double along = d.dot(a);
+      const double lateral = (d - along * a).norm();
+      if (along > -(payload_radius + 0.01) || along < -(kPreGraspOffset + 0.1) ||
+          lateral > kHandHalfWidth || p.z() < surface_z + kFlat) {
+        continue;
+      }
+      top = top ? std::max(*top, p.z()) : p.z();
+    }
+  }
+  return top;
+}
+
 // Grasps a payload seen at `pose`: the base goes where whole-body IK puts it (palm level,
 // approaching horizontally from the robot's side), the arm reaches a pre-grasp 12 cm short, then
 // the grasp, the gripper closes, and the arm lifts 10 cm. Success when the gripper holds it.
@@ -944,13 +985,23 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
  public:
   using TaskNode::TaskNode;
   static PortsList ProvidedPorts() {
-    return {InputPort<std::string>("pose", "payload position x;y;z")};
+    return {InputPort<std::string>("pose", "payload position x;y;z"),
+            InputPort<std::string>("kind", "", "bottle or flashlight (how it stands)")};
   }
   NodeStatus OnStart() override {
     const Eigen::Vector3d p_seen = ParsePoint3(Input<std::string>("pose"));
     approach_ = HorizontalApproach(ctx_.X_MB, p_seen);
     // The camera sees the near surface; the centre is a radius further.
     centre_ = p_seen + approach_ * kPayloadRadius;
+    // Something low in front of it (books, a box): grasp higher, so the hand passes above it.
+    const double surface_z = centre_.z() - PayloadCentreHeight(Input<std::string>("kind"));
+    if (const auto top = ClutterTopBeforeGrasp(ctx_, centre_, approach_, kPayloadRadius, surface_z);
+        top && *top + kHandBelowGrasp > centre_.z()) {
+      const double raised = std::min(*top + kHandBelowGrasp, centre_.z() + kMaxGraspRaise);
+      Note(StrCat("something in front of it up to ", std::round(*top * 100) / 100, " m: grasping ",
+                  std::round((raised - centre_.z()) * 100), " cm higher"));
+      centre_.z() = raised;
+    }
     const auto reach = SolveHandReach(ctx_, centre_, approach_);
     if (!reach) {
       Note("no whole-body reach for the grasp");
@@ -1018,7 +1069,9 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
   void OnHalted() override { ctx_.motion->StopBase(); }
 
  private:
-  static constexpr double kPayloadRadius = 0.03;  // [m] a bottle's, about
+  static constexpr double kPayloadRadius = 0.03;   // [m] a bottle's, about
+  static constexpr double kHandBelowGrasp = 0.06;  // [m] the hand's lowest point, with margin
+  static constexpr double kMaxGraspRaise = 0.06;   // [m] still on the payload's body
   enum class Phase { kToBase, kReach, kClose, kLift };
   Phase phase_{Phase::kToBase};
   Eigen::Vector3d approach_{Eigen::Vector3d::UnitX()};

@@ -169,6 +169,13 @@ TEST(ScenarioTest, HardHalfOpenDoorIsNotDrivenIntoButOpenedByTheButton) {
   EXPECT_GE(run.presses, 1);
 }
 
+TEST(ScenarioTest, HardPartlyOccludedBottleIsGraspedOverTheClutterWithoutTouchingIt) {
+  const BrainRun run = RunWithBrain(kScenarios / "hard" / "h5_occluded_bottle.yaml", 1);
+  EXPECT_TRUE(run.result.verdict.success) << twin::FormatVerdict(run.result.verdict);
+  for (const auto& e : run.world->events())
+    EXPECT_FALSE(e.kind == "contact" && e.subject == "books") << e.t << " " << e.detail;
+}
+
 TEST(ScenarioTest, HardNarrowCorridorIsFoundAndPassed) {
   const BrainRun run = RunWithBrain(kScenarios / "hard" / "h3_narrow_corridor.yaml", 1);
   EXPECT_TRUE(run.result.verdict.success) << twin::FormatVerdict(run.result.verdict);

@@ -69,7 +69,11 @@ struct TaskContext {
   perception::WorldState world;
   bool holding_object{false};
   std::optional<LaserScan> scan;  ///< The latest laser scan.
-  Pose2 X_BL;                     ///< The laser in the base frame.
+  /// The latest head depth image, the camera in M when it was taken, and its intrinsics.
+  std::optional<DepthImage> depth;
+  Pose3 X_MC;
+  CameraIntrinsics depth_intrinsics;
+  Pose2 X_BL;  ///< The laser in the base frame.
   /// The last pose at which the robot stood outside every door zone.
   std::optional<Pose2> last_safe;
 
