@@ -45,6 +45,25 @@ ParticleFilterLocalizer::ParticleFilterLocalizer(const OccupancyGrid& map, const
       distance_[geometry_.Index(ix, iy)] = distance.at<float>(iy, ix) * float(geometry_.resolution);
     }
   }
+  // exp and log per beam per particle cost more than the rest of the correction; beyond
+  // 8 sigma the hit term is negligible next to the uniform one.
+  const double inv_2sigma2 = 1.0 / (2.0 * config_.sigma_hit * config_.sigma_hit);
+  const double uniform = (1.0 - config_.z_hit) / config_.laser_max_range;
+  const auto entries = std::size_t(std::ceil(8.0 * config_.sigma_hit / kBeamTableStep)) + 2;
+  beam_log_likelihood_.resize(entries);
+  for (std::size_t i = 0; i < entries; ++i) {
+    const double d = double(i) * kBeamTableStep;
+    beam_log_likelihood_[i] = std::log(config_.z_hit * std::exp(-d * d * inv_2sigma2) + uniform);
+  }
+}
+
+double ParticleFilterLocalizer::BeamLogLikelihood(double d) const {
+  if (!(d < double(beam_log_likelihood_.size() - 1) * kBeamTableStep))  // far, or off the map
+    return beam_log_likelihood_.back();
+  const double x = d / kBeamTableStep;
+  const auto i = std::size_t(x);
+  const double f = x - double(i);
+  return (1.0 - f) * beam_log_likelihood_[i] + f * beam_log_likelihood_[i + 1];
 }
 
 void ParticleFilterLocalizer::Initialize(const Pose2& X_MB, const Eigen::Matrix3d& covariance) {
@@ -103,13 +122,17 @@ void ParticleFilterLocalizer::Predict(const Pose2& X_OB_previous, const Pose2& X
 }
 
 double ParticleFilterLocalizer::LikelihoodFieldDistance(const Eigen::Vector2d& p_MQ) const {
-  if (!geometry_.CellOf(p_MQ)) return std::numeric_limits<double>::infinity();
   // Bilinear between cell centres, less half a cell: the distance to an obstacle's surface, not
   // to its nearest cell centre. A per-cell step would favour poses that put the beam endpoints
   // inside the walls, and bias the estimate by up to half a cell towards them.
   const double res = geometry_.resolution;
-  const double u = (p_MQ.x() - geometry_.origin.x()) / res - 0.5;
-  const double v = (p_MQ.y() - geometry_.origin.y()) / res - 0.5;
+  const double gx = (p_MQ.x() - geometry_.origin.x()) / res;
+  const double gy = (p_MQ.y() - geometry_.origin.y()) / res;
+  // Outside the grid (or not finite: every comparison fails).
+  if (!(gx >= 0.0 && gy >= 0.0 && gx < geometry_.width && gy < geometry_.height))
+    return std::numeric_limits<double>::infinity();
+  const double u = gx - 0.5;
+  const double v = gy - 0.5;
   const int i0 = int(std::floor(u)), j0 = int(std::floor(v));
   const double fu = u - i0, fv = v - j0;
   const auto at = [&](int i, int j) {
@@ -126,27 +149,24 @@ bool ParticleFilterLocalizer::Correct(const LaserScan& scan) {
   scan.Validate();
   ThrowUnless(initialized(), "ParticleFilterLocalizer::Correct: call Initialize first.");
   if (!moved_since_correction_) return false;
-  std::vector<std::pair<double, double>> beams;  // (angle in L, range)
+  std::vector<Eigen::Vector2d> beams;  // end points in L
   const std::size_t n = scan.ranges.size();
   const std::size_t step = std::max<std::size_t>(1, n / std::size_t(config_.max_beams));
   for (std::size_t i = 0; i < n; i += step) {
     if (!scan.IsValidReturn(i) || scan.ranges[i] > config_.laser_max_range) continue;
-    beams.emplace_back(scan.AngleAt(i), scan.ranges[i]);
+    const double angle = scan.AngleAt(i), range = scan.ranges[i];
+    beams.emplace_back(range * std::cos(angle), range * std::sin(angle));
   }
   if (beams.empty()) return false;
-  const double inv_2sigma2 = 1.0 / (2.0 * config_.sigma_hit * config_.sigma_hit);
-  const double uniform = (1.0 - config_.z_hit) / config_.laser_max_range;
   std::vector<double> log_weights(particles_.size());
   for (std::size_t k = 0; k < particles_.size(); ++k) {
     const Pose2 X_ML = particles_[k].X_MB * X_BL_;
     const double c = std::cos(X_ML.yaw), s = std::sin(X_ML.yaw);
     double log_w = 0.0;
-    for (const auto& [angle, range] : beams) {
-      const double lx = range * std::cos(angle), ly = range * std::sin(angle);
+    for (const Eigen::Vector2d& p_LQ : beams) {
+      const double lx = p_LQ.x(), ly = p_LQ.y();
       const Eigen::Vector2d p(X_ML.x + c * lx - s * ly, X_ML.y + s * lx + c * ly);
-      const double d = LikelihoodFieldDistance(p);
-      const double hit = std::isfinite(d) ? config_.z_hit * std::exp(-d * d * inv_2sigma2) : 0.0;
-      log_w += std::log(hit + uniform);
+      log_w += BeamLogLikelihood(LikelihoodFieldDistance(p));
     }
     log_weights[k] = std::log(particles_[k].weight) + log_w;
   }

@@ -70,11 +70,17 @@ class ParticleFilterLocalizer {
     double weight;
   };
   double LikelihoodFieldDistance(const Eigen::Vector2d& p_MQ) const;
+  /// log(z_hit·exp(−d²/2σ²) + (1 − z_hit)/range_max) of the beam end point's distance d
+  /// (an end point off the map: the uniform part only), from a table.
+  double BeamLogLikelihood(double d) const;
   void Resample();
 
   LocalizerConfig config_;
   GridGeometry geometry_;
   std::vector<float> distance_;  // to the nearest occupied cell [m], per cell
+  // BeamLogLikelihood at d = i·kBeamTableStep, out to where the hit term no longer counts.
+  static constexpr double kBeamTableStep = 0.0005;  // [m]
+  std::vector<double> beam_log_likelihood_;
   Pose2 X_BL_;
   std::vector<Particle> particles_;
   std::mt19937_64 random_;
