@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <map>
 #include <random>
 #include <set>
@@ -268,20 +269,35 @@ struct TwinWorld::Impl {
     body->setActivationState(DISABLE_DEACTIVATION);
   }
 
-  // Static boxes, planes and meshes become one triangle mesh (one BVH for every ray); the entity of
-  // each triangle is kept so rays and contacts still name the model they touch.
+  // Static boxes, planes and meshes become one triangle mesh (one BVH for contacts); the entity
+  // of each triangle is kept so rays and contacts still name the model they touch. Rays test
+  // boxes and planes analytically (a slab test is far cheaper than a BVH walk over their
+  // triangles) and only the meshes' triangles through their own BVH.
   void BuildStatics() {
     bool has_floor = false;
     auto merged = std::make_unique<btTriangleMesh>(true, false);
+    auto ray_mesh = std::make_unique<btTriangleMesh>(true, false);
     auto add = [&](const ShapeDescription& s) {
       const bool floor = s.kind == ShapeKind::kPlane;
       has_floor = has_floor || floor;
       const int e = AddEntity(floor ? EntityKind::kFloor : EntityKind::kStatic, s.model, -1);
       if (!floor) AppendFootprint(s, e, &walls);
-      const int before = merged->getNumTriangles();
       if (AppendTriangles(s, merged.get())) {
         static_triangle_entity.resize(std::size_t(merged->getNumTriangles()), e);
-        (void)before;
+        if (s.kind == ShapeKind::kBox || s.kind == ShapeKind::kPlane) {
+          RayBox box;
+          box.R_SW = s.X_WS.rotation().transpose();
+          box.p_WS = s.X_WS.translation();
+          box.half = s.kind == ShapeKind::kBox
+                         ? Eigen::Vector3d(s.box_size / 2)
+                         : Eigen::Vector3d(s.plane_size.x() > 0 ? s.plane_size.x() / 2 : 50.0,
+                                           s.plane_size.y() > 0 ? s.plane_size.y() / 2 : 50.0, 0.0);
+          box.entity = e;
+          ray_boxes.push_back(box);
+        } else {
+          AppendTriangles(s, ray_mesh.get());
+          ray_triangle_entity.resize(std::size_t(ray_mesh->getNumTriangles()), e);
+        }
         return;
       }
       ray_targets.push_back(AddBody(MakeConvexShape(s), s.X_WS, 0.0, floor ? kGFloor : kGStatic,
@@ -303,6 +319,12 @@ struct TwinWorld::Impl {
       meshes.push_back(std::move(merged));
       static_mesh_body =
           AddBody(std::move(shape), Pose3(), 0.0, kGStatic, kMaskStatic, kMergedStatic);
+    }
+    if (ray_mesh->getNumTriangles() > 0) {
+      auto shape = std::make_unique<btBvhTriangleMeshShape>(ray_mesh.get(), true);
+      ray_mesh_shape = shape.get();
+      meshes.push_back(std::move(ray_mesh));
+      shapes.push_back(std::move(shape));
     }
   }
 
@@ -1142,6 +1164,16 @@ struct TwinWorld::Impl {
   std::vector<int> static_triangle_entity;
   btBvhTriangleMeshShape* static_mesh_shape{nullptr};
   btRigidBody* static_mesh_body{nullptr};
+  // Static boxes and planes (half extent 0 along the normal) for analytic ray tests.
+  struct RayBox {
+    Eigen::Matrix3d R_SW;  // world to shape
+    Eigen::Vector3d p_WS;
+    Eigen::Vector3d half;
+    int entity{-1};
+  };
+  std::vector<RayBox> ray_boxes;
+  btBvhTriangleMeshShape* ray_mesh_shape{nullptr};  // the static meshes only, for rays
+  std::vector<int> ray_triangle_entity;
   struct RayProxy {
     std::unique_ptr<btCollisionObject> proxy;
     const btCollisionObject* source;
@@ -1442,19 +1474,21 @@ class StaticMeshRayCallback : public btTriangleRaycastCallback {
  public:
   StaticMeshRayCallback(const btVector3& from, const btVector3& to, btScalar scale,
                         const btCollisionObject* mesh, TwinRayCallback* out,
-                        const std::function<int(const btCollisionObject*, int)>& entity_of)
+                        const std::vector<int>& triangle_entity)
       : btTriangleRaycastCallback(from, to),
         scale_(scale),
         mesh_(mesh),
         out_(out),
-        entity_of_(entity_of) {}
+        triangle_entity_(triangle_entity) {}
   btScalar reportHit(const btVector3& normal, btScalar fraction, int, int triangle) override {
     const btScalar whole = fraction * scale_;
     if (whole >= out_->m_closestHitFraction) return m_hitFraction;
     out_->m_closestHitFraction = whole;
     out_->m_collisionObject = mesh_;
     out_->normal = normal;
-    out_->entity = entity_of_(mesh_, triangle);
+    out_->entity = triangle >= 0 && std::size_t(triangle) < triangle_entity_.size()
+                       ? triangle_entity_[std::size_t(triangle)]
+                       : -1;
     out_->glass = false;
     return fraction;
   }
@@ -1463,7 +1497,7 @@ class StaticMeshRayCallback : public btTriangleRaycastCallback {
   btScalar scale_;
   const btCollisionObject* mesh_;
   TwinRayCallback* out_;
-  const std::function<int(const btCollisionObject*, int)>& entity_of_;
+  const std::vector<int>& triangle_entity_;
 };
 
 }  // namespace
@@ -1490,12 +1524,52 @@ RayHit TwinWorld::Impl::CastSegment(const Eigen::Vector3d& from, const Eigen::Ve
     btCollisionWorld::rayTestSingle(from_T, to_T, const_cast<btCollisionObject*>(target),
                                     target->getCollisionShape(), target->getWorldTransform(), cb);
   }
-  if (static_mesh_shape != nullptr) {
-    // A hair past the closest hit, so that a wall standing on the floor still wins the tie.
+  // Static boxes and planes: slab tests in each shape's frame, on the ray as a segment t in
+  // [0, 1]. A ray starting inside a box hits its far side (as the triangles' did).
+  const Eigen::Vector3d d = to - from;
+  for (const RayBox& box : ray_boxes) {
+    const Eigen::Vector3d o = box.R_SW * (from - box.p_WS);
+    const Eigen::Vector3d v = box.R_SW * d;
+    double t_in = -std::numeric_limits<double>::infinity();
+    double t_out = std::numeric_limits<double>::infinity();
+    int axis_in = -1, axis_out = -1;
+    bool miss = false;
+    for (int i = 0; i < 3 && !miss; ++i) {
+      if (std::abs(v[i]) < 1e-12) {
+        miss = std::abs(o[i]) > box.half[i] || box.half[i] == 0.0;
+        continue;
+      }
+      double ta = (-box.half[i] - o[i]) / v[i], tb = (box.half[i] - o[i]) / v[i];
+      if (ta > tb) std::swap(ta, tb);
+      if (ta > t_in) {
+        t_in = ta;
+        axis_in = i;
+      }
+      if (tb < t_out) {
+        t_out = tb;
+        axis_out = i;
+      }
+      miss = t_in > t_out;
+    }
+    if (miss) continue;
+    const bool inside = t_in < 0.0;
+    const double t = inside ? t_out : t_in;
+    const int axis = inside ? axis_out : axis_in;
+    if (axis < 0 || t < 0.0 || t >= cb.m_closestHitFraction) continue;
+    // Outward normal of the face the ray meets.
+    const double sign = (v[axis] > 0.0) == inside ? 1.0 : -1.0;
+    cb.m_closestHitFraction = btScalar(t);
+    cb.m_collisionObject = static_mesh_body;
+    cb.normal = ToBt(box.R_SW.row(axis).transpose() * sign);
+    cb.entity = box.entity;
+    cb.glass = false;
+  }
+  if (ray_mesh_shape != nullptr) {
+    // A hair past the closest hit, so that a mesh standing on the floor still wins the tie.
     const btScalar scale = std::min<btScalar>(1.0, cb.m_closestHitFraction * 1.001 + 1e-6);
     const btVector3 b_clipped = a + (b - a) * scale;
-    StaticMeshRayCallback mesh_cb(a, b_clipped, scale, static_mesh_body, &cb, ray_entity_of);
-    static_mesh_shape->performRaycast(&mesh_cb, a, b_clipped);
+    StaticMeshRayCallback mesh_cb(a, b_clipped, scale, static_mesh_body, &cb, ray_triangle_entity);
+    ray_mesh_shape->performRaycast(&mesh_cb, a, b_clipped);
   }
   RayHit hit;
   if (!cb.hasHit()) return hit;
