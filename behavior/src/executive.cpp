@@ -8,6 +8,7 @@
 #include "egress/bt/loggers.h"
 #include "egress/bt/tree.h"
 #include "egress/hsr_interface/error.h"
+#include "egress/perception/door_estimation.h"
 
 namespace egress::behavior {
 
@@ -262,7 +263,15 @@ bool Executive::Step(RobotPort& port) {
     }
   }
 
-  // Act.
+  // Act. A Bug2 detour steers by the latest scan and the tracked people.
+  if (m.motion.bug_active() && snapshot.scan) {
+    std::vector<Eigen::Vector2d> people;
+    for (const auto& p : context_.world.people)
+      people.push_back(p.person.p_MP);
+    m.motion.SetSurroundings(
+        perception::ScanPoints(*snapshot.scan, (Pose3::FromPose2(context_.X_MB) * X_BL).ToPose2()),
+        std::move(people));
+  }
   const Twist2 V_B = m.motion.Update(now, context_.X_MB, snapshot.odometry.V_B);
   port.SendBaseVelocity(V_B);
   if (auto arm = m.motion.TakeArmCommand()) port.SendArmTrajectory(*arm);

@@ -47,10 +47,29 @@ void MotionExecutor::FollowPath(const std::vector<Pose2>& path,
   path_ = path;
   base_failed_ = false;
   base_failure_.clear();
+  bug_.reset();
+}
+
+void MotionExecutor::FollowBug(const Pose2& X_MB, const Eigen::Vector2d& p_MGoal,
+                               const planning::BugConfig& config, Time now) {
+  controller_.Stop();
+  bug_.emplace(X_MB.translation(), p_MGoal, config);
+  bug_last_step_ = now;
+  base_active_ = true;
+  path_ = {X_MB, {p_MGoal.x(), p_MGoal.y(), X_MB.yaw}};
+  base_failed_ = false;
+  base_failure_.clear();
+}
+
+void MotionExecutor::SetSurroundings(std::vector<Eigen::Vector2d> p_MObstacles,
+                                     std::vector<Eigen::Vector2d> p_MPeople) {
+  obstacles_M_ = std::move(p_MObstacles);
+  people_M_ = std::move(p_MPeople);
 }
 
 void MotionExecutor::StopBase() {
   controller_.Stop();
+  bug_.reset();
   base_active_ = false;
   path_.clear();
 }
@@ -74,6 +93,22 @@ void MotionExecutor::MoveArm(const std::vector<std::pair<double, ArmPose>>& knot
 
 Twist2 MotionExecutor::Update(Time now, const Pose2& X_MB, const Twist2& V_B_measured) {
   if (!base_active_) return {};
+  if (bug_) {
+    const double dt = ToSeconds(now - bug_last_step_);
+    bug_last_step_ = now;
+    const planning::BugCommand command = bug_->Step(X_MB, obstacles_M_, people_M_, dt);
+    if (command.mode == planning::BugMode::kReached || command.mode == planning::BugMode::kFailed) {
+      if (command.mode == planning::BugMode::kFailed) {
+        base_failed_ = true;
+        base_failure_ = "detour gave up: " + command.reason;
+      }
+      bug_.reset();
+      base_active_ = false;
+      path_.clear();
+      return {};
+    }
+    return command.V_B;
+  }
   const planning::ControlCommand command = controller_.Update(now, X_MB, V_B_measured);
   if (command.watchdog_tripped) {
     base_active_ = false;

@@ -364,9 +364,11 @@ class ButtonType final : public TaskNode<bt::SyncActionNode> {
   }
 };
 
-// Plans and follows a path to `goal`. A goal or path blocked for now (a person standing on it,
-// the tracker of a blocked path stopping the base) is planned again every `replan_period` for
-// up to `patience` before the node fails.
+// Plans and follows a path to `goal`. When the path ahead becomes blocked (an obstacle the map
+// does not show), it plans again on the updated costmap; when the costmap has no way to the
+// goal, it detours with the Bug2 local planner (round the obstacle's boundary by the laser).
+// A goal someone stands on, or a detour that gives up, is planned again every `replan_period`
+// for up to `patience` before the node fails.
 class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
  public:
   using TaskNode::TaskNode;
@@ -377,11 +379,17 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
   }
   NodeStatus OnStart() override {
     blocked_since_.reset();
+    detour_tried_ = false;
     return Start();
   }
   NodeStatus OnRunning() override {
     if (blocked_since_) {
       if (ToSeconds(ctx_.now - last_try_) < kReplanPeriod) return NodeStatus::kRunning;
+      return Start();
+    }
+    if (!ctx_.motion->bug_active() && PathAheadBlocked()) {
+      ctx_.motion->StopBase();
+      Note("the path ahead is blocked: planning again");
       return Start();
     }
     const NodeStatus s = BaseMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
@@ -391,6 +399,8 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
 
  private:
   static constexpr double kReplanPeriod = 0.5;  // [s]
+  static constexpr double kLookahead = 1.5;     // [m] of the path checked against the costmap
+
   NodeStatus Start() {
     last_try_ = ctx_.now;
     const Pose2 goal = ParsePose2(Input<std::string>("goal"));
@@ -402,6 +412,16 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
       if (blocked_since_) Note("the way is free again");
       blocked_since_.reset();
       return s;
+    }
+    // No path on the costmap, though the goal itself is free: round the obstacle by the laser.
+    if (!detour_tried_ && ctx_.planner->IsValid(goal)) {
+      detour_tried_ = true;
+      planning::BugConfig bug;
+      bug.speed = Input<double>("speed");
+      bug.robot_radius = ctx_.config.footprint_radius;
+      ctx_.motion->FollowBug(ctx_.X_MB, goal.translation(), bug, ctx_.now);
+      Note("no path on the costmap: detouring round the obstacle (Bug2)");
+      return NodeStatus::kRunning;
     }
     return Blocked();
   }
@@ -417,8 +437,47 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
     }
     return NodeStatus::kRunning;
   }
+  // The next kLookahead metres of the path being followed cross lethal or inscribed cost.
+  bool PathAheadBlocked() const {
+    const std::vector<Pose2>& path = ctx_.motion->path();
+    if (path.size() < 2) return false;
+    // From the waypoint segment nearest the robot on.
+    std::size_t next = 1;
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 1; i < path.size(); ++i) {
+      const Eigen::Vector2d a = path[i - 1].translation(), b = path[i].translation();
+      const Eigen::Vector2d ab = b - a;
+      const double t =
+          ab.squaredNorm() > 0
+              ? std::clamp((ctx_.X_MB.translation() - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0)
+              : 0.0;
+      const double d = (a + t * ab - ctx_.X_MB.translation()).norm();
+      if (d < best) {
+        best = d;
+        next = i;
+      }
+    }
+    std::vector<Pose2> ahead{ctx_.X_MB};
+    double length = 0.0;
+    for (std::size_t i = next; i < path.size() && length < kLookahead; ++i) {
+      const Eigen::Vector2d step = path[i].translation() - ahead.back().translation();
+      const double remaining = kLookahead - length;
+      if (step.norm() > remaining) {
+        const Eigen::Vector2d p = ahead.back().translation() + step.normalized() * remaining;
+        ahead.push_back({p.x(), p.y(), path[i].yaw});
+        break;
+      }
+      ahead.push_back(path[i]);
+      length += step.norm();
+    }
+    if (ahead.size() < 2) return false;
+    // Starting inside inflation (e.g. beside a door) is not a new blockage: test from the
+    // first free pose on.
+    return ctx_.planner->IsValid(ctx_.X_MB) && !ctx_.planner->IsPathValid(ahead);
+  }
   std::optional<Time> blocked_since_;
   Time last_try_{};
+  bool detour_tried_{false};
 };
 
 class ApproachButton final : public TaskNode<bt::StatefulActionNode> {

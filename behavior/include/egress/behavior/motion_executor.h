@@ -15,6 +15,7 @@
 #include "egress/hsr_interface/geometry.h"
 #include "egress/hsr_interface/robot_model.h"
 #include "egress/hsr_interface/time.h"
+#include "egress/planning/bug2_navigator.h"
 #include "egress/planning/tracking_controller.h"
 #include "egress/planning/trajectory.h"
 
@@ -40,6 +41,15 @@ class MotionExecutor {
   /// @throws InvalidArgument for fewer than 2 waypoints or non-finite poses.
   void FollowPath(const std::vector<Pose2>& path, const std::vector<bool>& through_door,
                   const ArmPose& arm, Time now);
+  /// Drives the base to `p_MGoal` with the Bug2 local planner instead (head for the goal,
+  /// follow an obstacle's boundary round it, stop for people ahead) — the detour when the
+  /// costmap has no path. It sees what SetSurroundings last gave it.
+  void FollowBug(const Pose2& X_MB, const Eigen::Vector2d& p_MGoal,
+                 const planning::BugConfig& config, Time now);
+  /// The laser's obstacle points and the tracked people (in M) for the Bug2 detour.
+  void SetSurroundings(std::vector<Eigen::Vector2d> p_MObstacles,
+                       std::vector<Eigen::Vector2d> p_MPeople);
+  bool bug_active() const { return bug_.has_value(); }
   /// Stops the base: zero velocity from the next control step.
   void StopBase();
   /// Moves the arm through `knots` (seconds from now, pose). Sent with the next control step.
@@ -78,6 +88,9 @@ class MotionExecutor {
   std::vector<Pose2> path_;
   bool base_failed_{false};
   std::string base_failure_;
+  std::optional<planning::Bug2Navigator> bug_;
+  Time bug_last_step_{};
+  std::vector<Eigen::Vector2d> obstacles_M_, people_M_;
   std::optional<JointTrajectory> pending_arm_;
   std::optional<GripperCommand> pending_gripper_;
   Time arm_done_{};
