@@ -186,6 +186,12 @@ cv::Mat RenderTraceFrame(const TraceFile& trace, std::size_t index, double pixel
              cv::LINE_AA);
   cv::line(image, v(rx, ry), v(rx + radius * std::cos(yaw), ry + radius * std::sin(yaw)),
            cv::Scalar(255, 255, 255), 2, cv::LINE_AA);
+  // The arm: base to palm, seen from above.
+  if (sample.contains("hand") && sample["hand"].is_array() && sample["hand"].size() >= 2) {
+    const cv::Point hand = v(sample["hand"][0], sample["hand"][1]);
+    cv::line(image, v(rx, ry), hand, cv::Scalar(40, 40, 40), 3, cv::LINE_AA);
+    cv::circle(image, hand, 4, cv::Scalar(40, 40, 40), cv::FILLED, cv::LINE_AA);
+  }
   const std::string held = sample.contains("held") && sample["held"].is_string()
                                ? " holding " + sample["held"].get<std::string>()
                                : "";

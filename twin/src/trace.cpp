@@ -168,6 +168,9 @@ void TraceRecorder::Observe(const TwinWorld& world, const TraceAnnotation* annot
     s += Fixed(p.z());
     s += ']';
   }
+  // The arm as the palm's position (a line from the base in the video).
+  const Eigen::Vector3d p_WG = world.palm_pose().translation();
+  s += "],\"hand\":[" + Fixed(p_WG.x()) + ',' + Fixed(p_WG.y()) + ',' + Fixed(p_WG.z());
   s += "],\"held\":";
   if (const auto held = world.held_payload()) {
     quoted(&s, *held);
