@@ -178,16 +178,16 @@ TEST(DoorTraversalTreeTest, GivesUpAfterMaxYields) {
 
 TEST(FetchTreeTest, RetriesAGraspTheGripperDidNotHoldThenDelivers) {
   int holding_checks = 0;
-  ScriptedRun run("fetch_and_deliver.xml", "FetchAndDeliver",
-                  [&](int, const TreeNode& n) {
-                    if (Is(n, "IsHoldingPayload"))
-                      return ++holding_checks >= 2 ? NodeStatus::kSuccess : NodeStatus::kFailure;
-                    if (Is(n, "DetectPayload"))
-                      n.config().blackboard->Set("payload_position",
-                                                 Any(std::string("2.3;1.35;0.86")));
-                    return NodeStatus::kSuccess;
-                  },
-                  {{"payload", "bottle"}, {"pickup", "2.3;2.0;-1.57"}, {"dropoff", "2.5;1.3;0.87"}});
+  ScriptedRun run(
+      "fetch_and_deliver.xml", "FetchAndDeliver",
+      [&](int, const TreeNode& n) {
+        if (Is(n, "IsHoldingPayload"))
+          return ++holding_checks >= 2 ? NodeStatus::kSuccess : NodeStatus::kFailure;
+        if (Is(n, "DetectPayload"))
+          n.config().blackboard->Set("payload_position", Any(std::string("2.3;1.35;0.86")));
+        return NodeStatus::kSuccess;
+      },
+      {{"payload", "bottle"}, {"pickup", "2.3;2.0;-1.57"}, {"dropoff", "2.5;1.3;0.87"}});
   EXPECT_EQ(run.Tick(), NodeStatus::kSuccess);  // the first grasp missed; the second held
   EXPECT_EQ(holding_checks, 2);
   int grasps = 0;

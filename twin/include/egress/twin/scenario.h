@@ -47,7 +47,7 @@ enum class OperatorKind {
 
 /// One door and its operator.
 struct DoorOperatorSpec {
-  std::string door;      ///< SDF model name of the hinged door.
+  std::string door;  ///< SDF model name of the hinged door.
   /// SDF model names of its buttons or plates, all of the operator's kind: one on each side of
   /// the wall is usual for ADA doors (empty for kManual).
   std::vector<std::string> actuators;
