@@ -1153,9 +1153,8 @@ class ReleaseAction : public TaskNode<bt::StatefulActionNode> {
     }
     const auto target = ReleaseTarget();
     if (!target) return NodeStatus::kFailure;
-    const auto [centre, X_MB_stand] = *target;
-    centre_ = centre;
-    approach_ = HorizontalApproach(X_MB_stand, centre_);
+    centre_ = *target;
+    approach_ = HorizontalApproach(ctx_.X_MB, centre_);
     approaches_ = 0;
     return DriveToReach();
   }
@@ -1215,9 +1214,9 @@ class ReleaseAction : public TaskNode<bt::StatefulActionNode> {
   void OnHalted() override { ctx_.motion->StopBase(); }
 
  protected:
-  // Where the payload's centre goes when released [m, M], and the pose the robot approaches
-  // it from; nullopt (with a note) if there is none.
-  virtual std::optional<std::pair<Eigen::Vector3d, Pose2>> ReleaseTarget() = 0;
+  // Where the payload's centre goes when released [m, M] (approached from where the robot is
+  // now); nullopt (with a note) if there is none.
+  virtual std::optional<Eigen::Vector3d> ReleaseTarget() = 0;
   enum class Release { kWait, kNow, kGiveUp };
   // Whether to let go now, the payload being held at `p_M_payload`.
   virtual Release ReadyToRelease(const Eigen::Vector3d& /*p_M_payload*/) { return Release::kNow; }
@@ -1260,8 +1259,8 @@ class PlacePayload final : public ReleaseAction {
   }
 
  private:
-  std::optional<std::pair<Eigen::Vector3d, Pose2>> ReleaseTarget() override {
-    return std::make_pair(ParsePoint3(Input<std::string>("pose")), ctx_.X_MB);
+  std::optional<Eigen::Vector3d> ReleaseTarget() override {
+    return ParsePoint3(Input<std::string>("pose"));
   }
 };
 
@@ -1282,7 +1281,7 @@ class HandOver final : public ReleaseAction {
   }
 
  private:
-  std::optional<std::pair<Eigen::Vector3d, Pose2>> ReleaseTarget() override {
+  std::optional<Eigen::Vector3d> ReleaseTarget() override {
     const Pose2 expected = ParsePose2(Input<std::string>("pose"));
     const auto* recipient = Recipient(expected.translation());
     if (recipient == nullptr) {
@@ -1296,7 +1295,7 @@ class HandOver final : public ReleaseAction {
     const Eigen::Vector2d p = p_MP + to_robot.normalized() * kOfferDistance;
     const Eigen::Vector3d centre(p.x(), p.y(), Input<double>("hand_height"));
     Note(StrCat("holding it out to the responder at ", PoseText({p_MP.x(), p_MP.y(), 0.0})));
-    return std::make_pair(centre, ctx_.X_MB);
+    return centre;
   }
   Release ReadyToRelease(const Eigen::Vector3d& p_M_payload) override {
     const Pose2 expected = ParsePose2(Input<std::string>("pose"));
