@@ -236,6 +236,34 @@ TEST_F(GraspTest, OutsideToleranceTheGraspFails) {
   EXPECT_EQ(CountEvents(*world, "grasp_failed", "bottle"), 1);
 }
 
+TEST(TwinWorldTest, APayloadStartingInsideFurnitureIsABadScenario) {
+  const std::string table =
+      "obstacles: [{name: table, box: [0.6, 0.8, 0.72], x: -1.8, y: 1.2},\n"
+      "            {name: books, box: [0.1, 0.24, 0.07], x: -1.55, y: 1.2, z: 0.755}]\n";
+  // Clear of the books (1 cm behind them): builds, and the bottle stays upright where it is.
+  auto clear = LoadText(LabScenario({0.0, 0.5, 0.0}, table + "payloads: [{name: bottle, kind: "
+                                                             "water_bottle, x: -1.643, y: 1.2, z: "
+                                                             "0.825}]\n"),
+                        WorldsDir() / "lab");
+  TwinWorld world(clear.scenario, clear.world, 1, Hsr());
+  world.StepFor(0.5);
+  EXPECT_NEAR(world.payload_pose("bottle").translation().x(), -1.643, 2e-3);
+  EXPECT_NEAR(world.payload_pose("bottle").translation().z(), 0.825, 2e-3);
+  // 2.5 cm into them: the first physics step would knock it over. A clear error instead.
+  auto inside = LoadText(LabScenario({0.0, 0.5, 0.0}, table + "payloads: [{name: bottle, kind: "
+                                                              "water_bottle, x: -1.608, y: 1.2, z: "
+                                                              "0.825}]\n"),
+                         WorldsDir() / "lab");
+  try {
+    TwinWorld bad(inside.scenario, inside.world, 1, Hsr());
+    ADD_FAILURE() << "a payload inside the books was accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("payload 'bottle'"));
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("inside 'books'"));
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("randomize.payload_xy"));
+  }
+}
+
 TEST(TwinWorldTest, BaseFollowsVelocityWithAccelerationLimitAndStopsAfterTimeout) {
   auto loaded = LoadText(LabScenario({0.0, 0.0, 0.0}), WorldsDir() / "lab");
   TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());

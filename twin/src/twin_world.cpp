@@ -48,6 +48,8 @@ constexpr double kHandMaxWidth = 0.135;     // finger gap when fully open [m]
 constexpr double kHandSpeed = 1.0;          // [rad/s] (URDF limit)
 constexpr double kGraspDepthInPalm = 0.07;  // grasp centre along the palm's approach z [m]
 constexpr double kDegToRad = M_PI / 180.0;
+// A payload may start this deep in what it stands on (contact margins), no deeper [m].
+constexpr double kPayloadStartOverlapTolerance = 0.002;
 
 btVector3 ToBt(const Eigen::Vector3d& v) {
   return {v.x(), v.y(), v.z()};
@@ -549,6 +551,45 @@ struct TwinWorld::Impl {
       p.body->setRollingFriction(0.01);
       payloads.push_back(std::move(p));
     }
+    for (const Payload& p : payloads)
+      CheckPayloadClear(p);
+  }
+
+  // A payload that starts inside furniture, a wall or another payload is thrown out by the first
+  // physics step (a bottle tipped over by the books it overlaps): the scenario's placement, or
+  // its randomization, is wrong, and the run would not test what the scenario says.
+  void CheckPayloadClear(const Payload& p) const {
+    struct Deepest : btCollisionWorld::ContactResultCallback {
+      const Impl* impl{nullptr};
+      const btCollisionObject* self{nullptr};
+      double depth{0.0};
+      int other{-1};
+      btScalar addSingleResult(btManifoldPoint& pt, const btCollisionObjectWrapper* a, int,
+                               int index_a, const btCollisionObjectWrapper* b, int,
+                               int index_b) override {
+        if (-pt.getDistance() > depth) {
+          depth = -pt.getDistance();
+          other = a->getCollisionObject() == self
+                      ? impl->EntityOf(b->getCollisionObject(), index_b)
+                      : impl->EntityOf(a->getCollisionObject(), index_a);
+        }
+        return 0;
+      }
+    } deepest;
+    deepest.impl = this;
+    deepest.self = p.body;
+    deepest.m_collisionFilterGroup = kGPayload;
+    deepest.m_collisionFilterMask = kGStatic | kGDoor | kGPayload;
+    dynamics->contactTest(p.body, deepest);
+    const Eigen::Vector3d p_WP = FromBt(p.body->getWorldTransform()).translation();
+    ThrowUnless(deepest.depth <= kPayloadStartOverlapTolerance, "Invalid scenario '", scenario.name,
+                "', payload '", p.spec.name, "': with seed ", seed, " it starts at (",
+                std::round(p_WP.x() * 1e3) / 1e3, ", ", std::round(p_WP.y() * 1e3) / 1e3, ", ",
+                std::round(p_WP.z() * 1e3) / 1e3, ") inside '",
+                deepest.other >= 0 ? entities[std::size_t(deepest.other)].name : "?", "' (",
+                std::lround(deepest.depth * 1000),
+                " mm deep); move it or narrow "
+                "randomize.payload_xy.");
   }
 
   void BuildPeople() {
