@@ -71,13 +71,22 @@ DoorPass CalcApproachPass(TaskContext& context, const std::string& door) {
   return pass;
 }
 
+bool IsHoldingDoorAside(const TaskContext& context,
+                        const perception::TrackedPersonWithIntent& entry, const std::string& door) {
+  if (entry.intent != perception::PersonIntent::kHoldingDoor || entry.door_id != door) return false;
+  const DoorPass pass = CalcDoorPass(*context.map, door, context.X_MB);
+  const Eigen::Vector2d along(-pass.n_M.y(), pass.n_M.x());
+  const double lateral = std::abs((entry.person.p_MP - pass.centre).dot(along));
+  return lateral >= context.config.footprint_radius + context.config.person_radius;
+}
+
 bool IsDoorZoneOccupied(const TaskContext& context, const std::string& door) {
   const perception::DoorModel* model = context.map->FindDoor(door);
   ThrowUnless(model != nullptr, "unknown door '", door, "' (not in the building map)");
   perception::DoorZone zone{*model, context.config.zone_depth, context.config.person_radius};
   for (const auto& entry : context.world.people) {
     // Someone holding this door open is why the robot may pass, not a reason to wait.
-    if (entry.intent == perception::PersonIntent::kHoldingDoor && entry.door_id == door) continue;
+    if (IsHoldingDoorAside(context, entry, door)) continue;
     if (zone.Contains(entry.person.p_MP)) return true;
     for (const auto& p : entry.person.forecast) {
       if (zone.Contains(p)) return true;
@@ -261,8 +270,7 @@ bool DoorPassable(const TaskContext& ctx, const std::string& door, double margin
   if (!clearance || *clearance < 2 * ctx.config.footprint_radius + margin) return false;
   bool held_by_person = false;
   for (const auto& entry : ctx.world.people) {
-    held_by_person = held_by_person || (entry.door_id == door &&
-                                        entry.intent == perception::PersonIntent::kHoldingDoor);
+    held_by_person = held_by_person || IsHoldingDoorAside(ctx, entry, door);
   }
   for (const auto& d : ctx.world.doors) {
     if (d.model.id != door) continue;
@@ -322,8 +330,7 @@ class IsPersonHoldingDoor final : public TaskNode<bt::ConditionNode> {
   NodeStatus Tick() override {
     const std::string door = Door();
     for (const auto& entry : ctx_.world.people) {
-      if (entry.door_id == door && entry.intent == perception::PersonIntent::kHoldingDoor &&
-          DoorPassable(ctx_, door, 0.0)) {
+      if (IsHoldingDoorAside(ctx_, entry, door) && DoorPassable(ctx_, door, 0.0)) {
         return NodeStatus::kSuccess;
       }
     }

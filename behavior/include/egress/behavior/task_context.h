@@ -112,7 +112,14 @@ DoorPass CalcKnownPass(const TaskContext& context, const std::string& door);
 /// CalcKnownPass, remembering the side the first time (the robot's side now).
 DoorPass CalcApproachPass(TaskContext& context, const std::string& door);
 
-/// True when a person (not one holding this door) is in, or forecast into, the zone of `door`.
+/// True when `entry` holds `door` open standing out of the robot's lane through it: the strip
+/// through the opening's middle, as wide as the footprint plus the person. Someone standing in
+/// that lane blocks the way whatever the tracker reads as their intent (a person stopped in the
+/// doorway face to face with the robot is still, next to an open leaf, and not holding it).
+bool IsHoldingDoorAside(const TaskContext& context,
+                        const perception::TrackedPersonWithIntent& entry, const std::string& door);
+/// True when a person (not one holding this door aside) is in, or forecast into, the zone of
+/// `door`.
 bool IsDoorZoneOccupied(const TaskContext& context, const std::string& door);
 /// Clearance of the door's opening from the latest estimate, or nullopt if never observed.
 std::optional<double> DoorClearance(const TaskContext& context, const std::string& door);
