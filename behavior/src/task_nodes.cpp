@@ -211,6 +211,62 @@ NodeStatus BaseMotionStatus(const TaskContext& ctx,
   return ctx.motion->base_moving() ? NodeStatus::kRunning : NodeStatus::kSuccess;
 }
 
+constexpr double kPathLookahead = 1.5;  // [m] of the path ahead checked against the costmap
+
+// The next kPathLookahead metres of the path being followed cross lethal or inscribed cost.
+bool IsPathAheadBlocked(const TaskContext& ctx) {
+  const std::vector<Pose2>& path = ctx.motion->path();
+  if (path.size() < 2) return false;
+  // From the waypoint segment nearest the robot on.
+  std::size_t next = 1;
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 1; i < path.size(); ++i) {
+    const Eigen::Vector2d a = path[i - 1].translation(), b = path[i].translation();
+    const Eigen::Vector2d ab = b - a;
+    const double t =
+        ab.squaredNorm() > 0
+            ? std::clamp((ctx.X_MB.translation() - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0)
+            : 0.0;
+    const double d = (a + t * ab - ctx.X_MB.translation()).norm();
+    if (d < best) {
+      best = d;
+      next = i;
+    }
+  }
+  std::vector<Pose2> ahead{ctx.X_MB};
+  double length = 0.0;
+  for (std::size_t i = next; i < path.size() && length < kPathLookahead; ++i) {
+    const Eigen::Vector2d step = path[i].translation() - ahead.back().translation();
+    const double remaining = kPathLookahead - length;
+    if (step.norm() > remaining) {
+      const Eigen::Vector2d p = ahead.back().translation() + step.normalized() * remaining;
+      ahead.push_back({p.x(), p.y(), path[i].yaw});
+      break;
+    }
+    ahead.push_back(path[i]);
+    length += step.norm();
+  }
+  if (ahead.size() < 2) return false;
+  // Starting inside inflation (e.g. beside a door) is not a new blockage: test from the
+  // first free pose on.
+  return ctx.planner->IsValid(ctx.X_MB) && !ctx.planner->IsPathValid(ahead);
+}
+
+// BaseMotionStatus for a planned drive: when the path ahead becomes blocked on the costmap (an
+// obstacle the map does not show, seen only once the robot is on its way), plan again to the
+// same end pose instead of driving into it.
+NodeStatus DriveStatus(TaskContext& ctx, const std::function<void(const std::string&)>& note,
+                       bool door_speed = false) {
+  if (ctx.motion->base_moving() && !ctx.motion->bug_active() && IsPathAheadBlocked(ctx)) {
+    const Pose2 goal = ctx.motion->path().back();
+    ctx.motion->StopBase();
+    note("the path ahead is blocked: planning again");
+    const NodeStatus s = StartPath(ctx, goal, "the same pose", note, door_speed);
+    if (s != NodeStatus::kRunning) return s;
+  }
+  return BaseMotionStatus(ctx, note);
+}
+
 // ---- conditions
 
 class IsPathClear final : public TaskNode<bt::ConditionNode> {
@@ -394,7 +450,7 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
       if (ToSeconds(ctx_.now - last_try_) < kReplanPeriod) return NodeStatus::kRunning;
       return Start();
     }
-    if (!ctx_.motion->bug_active() && PathAheadBlocked()) {
+    if (!ctx_.motion->bug_active() && IsPathAheadBlocked(ctx_)) {
       ctx_.motion->StopBase();
       Note("the path ahead is blocked: planning again");
       return Start();
@@ -406,7 +462,6 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
 
  private:
   static constexpr double kReplanPeriod = 0.5;  // [s]
-  static constexpr double kLookahead = 1.5;     // [m] of the path checked against the costmap
 
   NodeStatus Start() {
     last_try_ = ctx_.now;
@@ -443,44 +498,6 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
       return NodeStatus::kFailure;
     }
     return NodeStatus::kRunning;
-  }
-  // The next kLookahead metres of the path being followed cross lethal or inscribed cost.
-  bool PathAheadBlocked() const {
-    const std::vector<Pose2>& path = ctx_.motion->path();
-    if (path.size() < 2) return false;
-    // From the waypoint segment nearest the robot on.
-    std::size_t next = 1;
-    double best = std::numeric_limits<double>::infinity();
-    for (std::size_t i = 1; i < path.size(); ++i) {
-      const Eigen::Vector2d a = path[i - 1].translation(), b = path[i].translation();
-      const Eigen::Vector2d ab = b - a;
-      const double t =
-          ab.squaredNorm() > 0
-              ? std::clamp((ctx_.X_MB.translation() - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0)
-              : 0.0;
-      const double d = (a + t * ab - ctx_.X_MB.translation()).norm();
-      if (d < best) {
-        best = d;
-        next = i;
-      }
-    }
-    std::vector<Pose2> ahead{ctx_.X_MB};
-    double length = 0.0;
-    for (std::size_t i = next; i < path.size() && length < kLookahead; ++i) {
-      const Eigen::Vector2d step = path[i].translation() - ahead.back().translation();
-      const double remaining = kLookahead - length;
-      if (step.norm() > remaining) {
-        const Eigen::Vector2d p = ahead.back().translation() + step.normalized() * remaining;
-        ahead.push_back({p.x(), p.y(), path[i].yaw});
-        break;
-      }
-      ahead.push_back(path[i]);
-      length += step.norm();
-    }
-    if (ahead.size() < 2) return false;
-    // Starting inside inflation (e.g. beside a door) is not a new blockage: test from the
-    // first free pose on.
-    return ctx_.planner->IsValid(ctx_.X_MB) && !ctx_.planner->IsPathValid(ahead);
   }
   std::optional<Time> blocked_since_;
   Time last_try_{};
@@ -527,7 +544,7 @@ class ApproachButton final : public TaskNode<bt::StatefulActionNode> {
                      [this](const std::string& s) { Note(s); });
   }
   NodeStatus OnRunning() override {
-    return BaseMotionStatus(ctx_, [this](const std::string& s) { Note(s); });
+    return DriveStatus(ctx_, [this](const std::string& s) { Note(s); });
   }
   void OnHalted() override { ctx_.motion->StopBase(); }
 };
@@ -765,7 +782,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     const auto note = [this](const std::string& t) { Note(t); };
     switch (phase_) {
       case Phase::kToEntry: {
-        const NodeStatus s = BaseMotionStatus(ctx_, note);
+        const NodeStatus s = DriveStatus(ctx_, note, true);
         if (s != NodeStatus::kSuccess) return s;
         phase_ = Phase::kWaiting;
         waiting_since_ = ctx_.now;
