@@ -32,6 +32,7 @@ struct TrialResult {
   double time{0.0};                 ///< Time to goal, else the run's end [s].
   double min_person_distance{std::numeric_limits<double>::infinity()};  ///< [m]
   int person_contacts{0};
+  int static_contacts{0};  ///< The robot touching walls or furniture (not a failure; a bump).
   int presses{0};
   std::vector<double> preemption_latencies;        ///< [s] person seen in the zone -> stop.
   std::vector<double> preemption_total_latencies;  ///< [s] person in the zone (truth) -> stop.
@@ -51,6 +52,8 @@ struct ScenarioSummary {
   std::optional<double> median_time;  ///< Of the successful trials [s].
   double min_person_distance{std::numeric_limits<double>::infinity()};
   int person_contacts{0};
+  int static_contacts{0};
+  int trials_with_static_contacts{0};
   std::map<std::string, int> failure_reasons;
   std::vector<std::uint64_t> failed_seeds;
   std::vector<double> times;

@@ -91,6 +91,7 @@ TrialResult RunBrainTrial(const std::string& scenario_path, std::uint64_t seed) 
   r.time = m.time_to_goal.value_or(m.end_time);
   r.min_person_distance = m.min_person_distance;
   r.person_contacts = m.contacts.count("person") ? m.contacts.at("person") : 0;
+  r.static_contacts = m.contacts.count("static") ? m.contacts.at("static") : 0;
   for (const auto& [door, n] : m.button_presses)
     r.presses += n;
   for (const auto& [known, commanded] : brain->preemptions()) {
@@ -117,6 +118,7 @@ nlohmann::json ToJson(const TrialResult& r) {
                                       ? nlohmann::json(r.min_person_distance)
                                       : nlohmann::json(nullptr)},
           {"person_contacts", r.person_contacts},
+          {"static_contacts", r.static_contacts},
           {"presses", r.presses},
           {"preemption_latencies", r.preemption_latencies},
           {"preemption_total_latencies", r.preemption_total_latencies},
@@ -136,6 +138,7 @@ TrialResult TrialFromJson(const nlohmann::json& j) {
                               ? std::numeric_limits<double>::infinity()
                               : j.at("min_person_distance").get<double>();
   r.person_contacts = j.at("person_contacts").get<int>();
+  r.static_contacts = j.at("static_contacts").get<int>();
   r.presses = j.at("presses").get<int>();
   r.preemption_latencies = j.at("preemption_latencies").get<std::vector<double>>();
   r.preemption_total_latencies = j.at("preemption_total_latencies").get<std::vector<double>>();
@@ -159,6 +162,8 @@ std::vector<ScenarioSummary> Summarize(const std::vector<TrialResult>& trials) {
     ++s.trials;
     s.successes += t.success ? 1 : 0;
     s.person_contacts += t.person_contacts;
+    s.static_contacts += t.static_contacts;
+    s.trials_with_static_contacts += t.static_contacts > 0 ? 1 : 0;
     s.min_person_distance = std::min(s.min_person_distance, t.min_person_distance);
     if (t.success) s.times.push_back(t.time);
     if (!t.success) s.failed_seeds.push_back(t.seed);
@@ -179,8 +184,8 @@ std::vector<ScenarioSummary> Summarize(const std::vector<TrialResult>& trials) {
 
 std::string FormatSummaryTable(const std::vector<ScenarioSummary>& summaries) {
   std::ostringstream out;
-  out << fmt::format("{:<28} {:>6} {:>5} {:>7}  {:<15} {:>8} {:>9} {:>8}  {}\n", "scenario",
-                     "trials", "ok", "rate", "95% Wilson", "median", "closest", "contacts",
+  out << fmt::format("{:<28} {:>6} {:>5} {:>7}  {:<15} {:>8} {:>9} {:>8} {:>6}  {}\n", "scenario",
+                     "trials", "ok", "rate", "95% Wilson", "median", "closest", "contacts", "bumps",
                      "failure reasons");
   int trials = 0, successes = 0;
   for (const ScenarioSummary& s : summaries) {
@@ -188,12 +193,12 @@ std::string FormatSummaryTable(const std::vector<ScenarioSummary>& summaries) {
     for (const auto& [reason, n] : s.failure_reasons)
       reasons += fmt::format("{}{} x{}", reasons.empty() ? "" : ", ", reason, n);
     out << fmt::format(
-        "{:<28} {:>6} {:>5} {:>6.1f}%  [{:>5.1f}, {:>5.1f}] {:>7} {:>9} {:>8}  {}\n",
+        "{:<28} {:>6} {:>5} {:>6.1f}%  [{:>5.1f}, {:>5.1f}] {:>7} {:>9} {:>8} {:>6}  {}\n",
         s.name.substr(0, 28), s.trials, s.successes, 100.0 * s.successes / std::max(1, s.trials),
         100 * s.rate.low, 100 * s.rate.high,
         s.median_time ? fmt::format("{:.1f} s", *s.median_time) : "-",
         std::isfinite(s.min_person_distance) ? fmt::format("{:.2f} m", s.min_person_distance) : "-",
-        s.person_contacts, reasons.empty() ? "-" : reasons);
+        s.person_contacts, s.trials_with_static_contacts, reasons.empty() ? "-" : reasons);
     trials += s.trials;
     successes += s.successes;
   }
@@ -402,17 +407,18 @@ void RunBatch(const BatchOptions& o) {
   std::filesystem::create_directories(dir);
   {
     std::ofstream csv(csv_path);
-    csv << "scenario,name,seed,success,time_s,min_person_distance_m,person_contacts,presses,"
-           "failed,wall_s\n";
+    csv << "scenario,name,seed,success,time_s,min_person_distance_m,person_contacts,"
+           "static_contacts,presses,failed,wall_s\n";
     for (const auto& r : results) {
       std::string failed;
       for (const auto& f : r.failed)
         failed += (failed.empty() ? "" : ";") + f;
       csv << fmt::format(
-          "{},\"{}\",{},{},{:.2f},{},{},{},\"{}\",{:.2f}\n", r.scenario, r.name, r.seed,
+          "{},\"{}\",{},{},{:.2f},{},{},{},{},\"{}\",{:.2f}\n", r.scenario, r.name, r.seed,
           r.success ? 1 : 0, r.time,
           std::isfinite(r.min_person_distance) ? fmt::format("{:.3f}", r.min_person_distance) : "",
-          r.person_contacts, r.presses, r.error.empty() ? failed : r.error, r.wall_time);
+          r.person_contacts, r.static_contacts, r.presses, r.error.empty() ? failed : r.error,
+          r.wall_time);
     }
     if (!csv) throw CommandFailed(fmt::format("cannot write '{}'", csv_path.string()));
   }
@@ -427,6 +433,8 @@ void RunBatch(const BatchOptions& o) {
          {"wilson95", {s.rate.low, s.rate.high}},
          {"median_time", s.median_time ? nlohmann::json(*s.median_time) : nlohmann::json(nullptr)},
          {"person_contacts", s.person_contacts},
+         {"static_contacts", s.static_contacts},
+         {"trials_with_static_contacts", s.trials_with_static_contacts},
          {"failure_reasons", s.failure_reasons},
          {"failed_seeds", s.failed_seeds}});
   }

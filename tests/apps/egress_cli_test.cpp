@@ -370,6 +370,9 @@ TEST(EgressCliTest, SimBatchPrintsTheTableAndWritesTheSameResultsForAnyJobCount)
   };
   EXPECT_EQ(trials("one"), trials("two"));
   EXPECT_EQ(trials("one").size(), 2u);
+  // Bumps into walls or furniture are counted per trial (not a failure, but reported).
+  EXPECT_THAT(two.output, HasSubstr("bumps"));
+  EXPECT_TRUE(trials("one")[0].contains("static_contacts"));
   std::ifstream csv(dir / "one" / "trials.csv");
   int lines = 0;
   for (std::string line; std::getline(csv, line);)
