@@ -304,6 +304,9 @@ constexpr double kLeafClearance = 0.15;  // [m] kept between the footprint and a
 // back check), and at most about the second: the hold window starts in between.
 constexpr double kOperatorMinOpeningTime = 3.0;
 constexpr double kOperatorOpeningTime = 4.0;
+// [rad/s] The fastest a low-energy operator may close its door (A156.19: no less than 3 s from
+// 90° to 10°).
+constexpr double kOperatorMaxClosingRate = (80.0 * M_PI / 180.0) / 3.0;
 
 // Far enough past the door line that the closing leaf cannot reach the footprint.
 double ExitDistance(const TaskContext& ctx, const std::string& door) {
@@ -361,7 +364,19 @@ bool DoorPassable(const TaskContext& ctx, const std::string& door, double margin
     const double to_clear =
         std::max(0.0, (ctx.X_MB.translation() - pass.centre).dot(pass.n_M) + beyond);
     const double needed = to_clear / ctx.motion->trajectory_config().door_speed;
-    if (open_for + needed > window) return false;
+    // A leaf that opens towards the robot closes across the robot's side of the line, reaching
+    // the lane through the clear opening only once it has swung down to the lane's edge: time the
+    // robot still has after the window ends, at the fastest closing an operator may have.
+    double grace = 0.0;
+    if (opens_towards_robot) {
+      const double w = ctx.map->FindDoor(door)->width();
+      const double lane_edge =
+          w * (1.0 + std::cos(d.state.angle)) / 2 - ctx.config.footprint_radius;
+      const double hit_angle =
+          std::atan2(ctx.config.footprint_radius + kLeafClearance, std::max(lane_edge, 1e-3));
+      grace = std::max(0.0, d.state.angle - hit_angle) / kOperatorMaxClosingRate;
+    }
+    if (open_for + needed > window + grace) return false;
   }
   return true;
 }

@@ -228,6 +228,26 @@ TEST_F(GraspTest, InsideToleranceTheBottleIsHeldAndLiftedAndReleasedOntoTheTable
   EXPECT_NEAR(world->payload_pose("bottle").translation().z(), 0.856, 0.02);
 }
 
+TEST_F(GraspTest, AHeldBottleTuckedOverTheBaseDoesNotPushTheRobot) {
+  auto world = MakeWorld(0.0);
+  ReachAndClose(world.get());
+  ASSERT_EQ(world->held_payload(), "bottle");
+  const Pose2 before = world->robot_pose();
+  // The HSR's "go" pose: the hand (and the bottle in it) over the base.
+  WholeBodyVector tucked = grasp_;
+  tucked[kArmLift] = 0.0;
+  tucked[kArmFlex] = 0.0;
+  tucked[kArmRoll] = -M_PI / 2;
+  tucked[kWristFlex] = -M_PI / 2;
+  tucked[kWristRoll] = 0.0;
+  world->SetArmTrajectory(ArmThrough({{4.0, tucked}}));
+  world->StepFor(6.0);
+  EXPECT_EQ(world->held_payload(), "bottle");
+  const Pose2 after = world->robot_pose();
+  EXPECT_LT((after.translation() - before.translation()).norm(), 0.01);
+  EXPECT_LT(std::abs(after.yaw - before.yaw), 0.01);
+}
+
 TEST_F(GraspTest, OutsideToleranceTheGraspFails) {
   auto world = MakeWorld(0.07);  // the fingers close 7 cm short of the bottle
   ReachAndClose(world.get());

@@ -963,7 +963,10 @@ struct TwinWorld::Impl {
           held = int(i);
           dynamics->removeRigidBody(p.body);
           MakeKinematic(p.body);
-          dynamics->addRigidBody(p.body, kGPayload, kMaskPayload & ~kGArm);
+          // Held, it moves with the hand: not against the arm, nor the robot's own body (the
+          // twin's body is one 1 m cylinder the tucked hand sits over; a kinematic payload
+          // inside it would launch the base).
+          dynamics->addRigidBody(p.body, kGPayload, kMaskPayload & ~kGArm & ~kGBase);
           hand_q = std::max(
               hand_q, kHandTouching + (kHandOpen - kHandTouching) * p.diameter / kHandMaxWidth);
           AddEvent("grasp", p.spec.name, "held");
