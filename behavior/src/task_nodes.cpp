@@ -322,8 +322,8 @@ double EntryDistance(const TaskContext& ctx, const std::string& door, const Door
   return std::max(ctx.config.door_entry_distance, ExitDistance(ctx, door));
 }
 
-// The leaf leaves room for the footprint (plus `margin`), is not closing, and — unless a person
-// holds it — an operator's hold window leaves time to drive clear of the leaf's sweep.
+}  // namespace
+
 bool DoorPassable(const TaskContext& ctx, const std::string& door, double margin) {
   const auto clearance = DoorClearance(ctx, door);
   if (!clearance || *clearance < 2 * ctx.config.footprint_radius + margin) return false;
@@ -380,6 +380,8 @@ bool DoorPassable(const TaskContext& ctx, const std::string& door, double margin
   }
   return true;
 }
+
+namespace {
 
 class IsDoorOpen final : public TaskNode<bt::ConditionNode> {
  public:

@@ -91,6 +91,44 @@ TEST_F(DoorZoneRulesTest, AStillPersonInTheZoneOccupiesItAndOneFarAwayDoesNot) {
   EXPECT_TRUE(IsDoorZoneOccupied(context_, "lab_door"));
 }
 
+// A door held open out of the robot's sight (steady at 80°, no press of ours), seen open for
+// `open_for`; the robot 1 m before the line on `side` (+1: north, the side the leaf opens into).
+class DoorWindowTest : public DoorZoneRulesTest {
+ protected:
+  DoorWindowTest() : model_(RobotModel::LoadDefault()), motion_(model_) {
+    context_.motion = &motion_;
+  }
+  bool PassableAfter(double open_for, double side) {
+    context_.now = Time{} + SecondsToDuration(100.0);
+    context_.X_MB = {0.0, 3.0 + side * 1.0, side > 0 ? -M_PI / 2 : M_PI / 2};
+    context_.door_approach_side.clear();
+    context_.door_open_since["lab_door"] = context_.now - SecondsToDuration(open_for);
+    perception::TrackedDoor door;
+    door.model = map_.doors[0];
+    door.state.observed = true;
+    door.state.angle = 80.0 * M_PI / 180.0;
+    door.state.clearance_width = door.model.ClearanceWidth(door.state.angle);
+    door.state.motion = perception::DoorMotion::kHeldOpen;
+    context_.world.doors = {door};
+    return DoorPassable(context_, "lab_door", 0.0);
+  }
+  RobotModel model_;
+  MotionExecutor motion_;
+};
+
+TEST_F(DoorWindowTest, ALeafOpeningTowardsTheRobotLeavesItTheTimeItTakesToCloseOnItsLane) {
+  // From the swing side the robot has 1.365 m to go (to just past the line): 3.4 s at 0.4 m/s.
+  // Open 7 s, 10.4 s in all: past a 10 s window, but the leaf, closing at most 80° in 3 s, takes
+  // over a second to come down from 80° to the lane through the opening.
+  EXPECT_TRUE(PassableAfter(7.0, +1.0));
+  // Open 8 s: it would still be in the lane when the leaf reaches it.
+  EXPECT_FALSE(PassableAfter(8.0, +1.0));
+  // From the other side the leaf closes towards the far side, where the robot must get beyond
+  // its sweep: no such grace. Open 7 s leaves too little time; 2 s enough.
+  EXPECT_FALSE(PassableAfter(7.0, -1.0));
+  EXPECT_TRUE(PassableAfter(2.0, -1.0));
+}
+
 TEST_F(DoorZoneRulesTest, AnUnknownDoorIsAClearError) {
   EXPECT_THROW(IsDoorZoneOccupied(context_, "door_z"), InvalidArgument);
 }

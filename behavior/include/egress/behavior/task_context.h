@@ -121,6 +121,12 @@ bool IsHoldingDoorAside(const TaskContext& context,
 /// True when a person (not one holding this door aside) is in, or forecast into, the zone of
 /// `door`.
 bool IsDoorZoneOccupied(const TaskContext& context, const std::string& door);
+/// The leaf leaves room for the footprint (plus `margin`) [m], is not closing, and — unless a
+/// person holds it aside — the operator's hold window (from the robot's own press, or from when
+/// it was first seen open) leaves time to drive clear of the leaf: past the line for a leaf that
+/// opens towards the robot (which then still has the time the closing leaf takes to reach its
+/// lane), beyond the sweep on the far side otherwise. Needs `context.motion` (door speed).
+bool DoorPassable(const TaskContext& context, const std::string& door, double margin);
 /// Clearance of the door's opening from the latest estimate, or nullopt if never observed.
 std::optional<double> DoorClearance(const TaskContext& context, const std::string& door);
 
