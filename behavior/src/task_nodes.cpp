@@ -299,7 +299,8 @@ class IsPathClear final : public TaskNode<bt::ConditionNode> {
   NodeStatus last_{NodeStatus::kIdle};
 };
 
-constexpr double kLeafClearance = 0.15;  // [m] kept between the footprint and a leaf's sweep
+constexpr double kDoorSeenRecentlySec = 0.5;  // [s] a door estimate this fresh is "now"
+constexpr double kLeafClearance = 0.15;       // [m] kept between the footprint and a leaf's sweep
 // [s] A low-energy ADA operator takes at least this long to open (ANSI A156.19: >= 3 s to the
 // back check), and at most about the second: the hold window starts in between.
 constexpr double kOperatorMinOpeningTime = 3.0;
@@ -349,8 +350,11 @@ bool DoorPassable(const TaskContext& ctx, const std::string& door, double margin
     // person passing in front of the leaf resets).
     const auto since = ctx.door_open_since.find(door);
     double open_for = since != ctx.door_open_since.end() ? ToSeconds(ctx.now - since->second) : 0.0;
-    // Still open well past an operator's window: someone or something out of sight holds it.
-    if (!ours && open_for > window + ctx.config.door_hold_margin) continue;
+    // Still open well past an operator's window: someone or something out of sight holds it —
+    // if it is seen so now. An estimate not refreshed for a while (the leaf out of the laser's
+    // view from a button's standoff) says only what the door was.
+    const bool seen_now = ToSeconds(ctx.now - d.state.stamp) <= kDoorSeenRecentlySec;
+    if (!ours && seen_now && open_for > window + ctx.config.door_hold_margin) continue;
     if (ours && (since == ctx.door_open_since.end() ||
                  ToSeconds(since->second - operated->second) > kOperatorOpeningTime)) {
       open_for = std::max(open_for, since_press - kOperatorMinOpeningTime);

@@ -98,7 +98,7 @@ class DoorWindowTest : public DoorZoneRulesTest {
   DoorWindowTest() : model_(RobotModel::LoadDefault()), motion_(model_) {
     context_.motion = &motion_;
   }
-  bool PassableAfter(double open_for, double side) {
+  bool PassableAfter(double open_for, double side, double estimate_age = 0.0) {
     context_.now = Time{} + SecondsToDuration(100.0);
     context_.X_MB = {0.0, 3.0 + side * 1.0, side > 0 ? -M_PI / 2 : M_PI / 2};
     context_.door_approach_side.clear();
@@ -109,6 +109,7 @@ class DoorWindowTest : public DoorZoneRulesTest {
     door.state.angle = 80.0 * M_PI / 180.0;
     door.state.clearance_width = door.model.ClearanceWidth(door.state.angle);
     door.state.motion = perception::DoorMotion::kHeldOpen;
+    door.state.stamp = context_.now - SecondsToDuration(estimate_age);
     context_.world.doors = {door};
     return DoorPassable(context_, "lab_door", 0.0);
   }
@@ -127,6 +128,13 @@ TEST_F(DoorWindowTest, ALeafOpeningTowardsTheRobotLeavesItTheTimeItTakesToCloseO
   // its sweep: no such grace. Open 7 s leaves too little time; 2 s enough.
   EXPECT_FALSE(PassableAfter(7.0, -1.0));
   EXPECT_TRUE(PassableAfter(2.0, -1.0));
+}
+
+TEST_F(DoorWindowTest, ADoorSeenOpenLongPastTheWindowIsHeldButOnlyIfSeenSoNow) {
+  // Open 15 s, past the 10 s window and its 2 s margin: someone out of sight holds it...
+  EXPECT_TRUE(PassableAfter(15.0, -1.0));
+  // ...unless that is what the door was 5 s ago, the last time the laser saw the leaf.
+  EXPECT_FALSE(PassableAfter(15.0, -1.0, 5.0));
 }
 
 TEST_F(DoorZoneRulesTest, AnUnknownDoorIsAClearError) {
