@@ -67,6 +67,8 @@ TEST(ScenarioTest, ErrorsNameFileLineAndField) {
                       "    trigger: {event: opened}\n"),
               "trigger.event", "button_pressed:<door>");
   ExpectError("world: [lab.sdf\n", "bad.yaml:", "not valid YAML");
+  ExpectError(Minimal("randomize: {hold_angle_deg: [30, 120]}\n"), "randomize.hold_angle_deg",
+              "(0, 90]");
 }
 
 TEST(ScenarioTest, ValidationAgainstTheWorldNamesTheField) {

@@ -1,5 +1,8 @@
 #include "egress/twin/twin_world.h"
 
+#include <algorithm>
+#include <fstream>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -124,6 +127,29 @@ TEST(TwinWorldTest, APersonHoldsTheDoorOpenThenItCloses) {
   world.StepFor(released + 8.0 - world.time());
   EXPECT_EQ(CountEvents(world, "person_released_door"), 1);
   EXPECT_LT(world.door_angle(0), 5 * kDeg);
+}
+
+TEST(TwinWorldTest, TheHoldAngleIsRandomizedBySeedWithinItsRange) {
+  std::ifstream in(WorldsDir() / "lab/lab_hold_door.yaml");
+  std::string yaml((std::istreambuf_iterator<char>(in)), {});
+  yaml += "randomize:\n  hold_angle_deg: [30, 60]\n";
+  const auto loaded = LoadText(yaml, WorldsDir() / "lab");
+  std::vector<double> held;
+  for (std::uint64_t seed : {1u, 2u, 3u}) {
+    TwinWorld world(loaded.scenario, loaded.world, seed, Hsr());
+    world.StepFor(9.0);
+    ASSERT_EQ(CountEvents(world, "person_holding_door"), 1) << "seed " << seed;
+    held.push_back(world.door_angle(0));
+    EXPECT_GE(held.back(), 28 * kDeg) << "seed " << seed;
+    EXPECT_LE(held.back(), 62 * kDeg) << "seed " << seed;
+    // The same seed holds it at the same angle.
+    TwinWorld again(loaded.scenario, loaded.world, seed, Hsr());
+    again.StepFor(9.0);
+    EXPECT_DOUBLE_EQ(again.door_angle(0), held.back());
+  }
+  EXPECT_GT(
+      *std::max_element(held.begin(), held.end()) - *std::min_element(held.begin(), held.end()),
+      2 * kDeg);
 }
 
 TEST(TwinWorldTest, PeopleCrossAnOpenDoorBothWaysWithoutOverlap) {

@@ -514,13 +514,18 @@ Scenario Parse(const YAML::Node& root, const FieldReader& r,
     const std::string f = "randomize";
     r.CheckKeys(rnd, f,
                 {"robot_dx", "robot_dy", "robot_dyaw", "payload_xy", "hold_open_s",
-                 "person_delay_s", "person_speed_scale"});
+                 "hold_angle_deg", "person_delay_s", "person_speed_scale"});
     auto& z = s.randomize;
     if (rnd["robot_dx"]) z.robot_dx = r.ReadRange(rnd["robot_dx"], f + ".robot_dx");
     if (rnd["robot_dy"]) z.robot_dy = r.ReadRange(rnd["robot_dy"], f + ".robot_dy");
     if (rnd["robot_dyaw"]) z.robot_dyaw = r.ReadRange(rnd["robot_dyaw"], f + ".robot_dyaw");
     if (rnd["payload_xy"]) z.payload_xy = r.NonNegative(rnd["payload_xy"], f + ".payload_xy");
     if (rnd["hold_open_s"]) z.hold_open_s = r.ReadRange(rnd["hold_open_s"], f + ".hold_open_s");
+    if (rnd["hold_angle_deg"]) {
+      z.hold_angle_deg = r.ReadRange(rnd["hold_angle_deg"], f + ".hold_angle_deg");
+      if (!(z.hold_angle_deg.min > 0 && z.hold_angle_deg.max <= 90))
+        r.Fail(rnd["hold_angle_deg"], f + ".hold_angle_deg", "must lie in (0, 90] degrees");
+    }
     if (rnd["person_delay_s"])
       z.person_delay_s = r.ReadRange(rnd["person_delay_s"], f + ".person_delay_s");
     if (rnd["person_speed_scale"]) {

@@ -594,6 +594,8 @@ struct TwinWorld::Impl {
 
   void BuildPeople() {
     std::mt19937_64 rng(DeriveSeed(seed, 4));
+    // Its own stream: a scenario without the range draws exactly what it drew before.
+    std::mt19937_64 hold_rng(DeriveSeed(seed, 5));
     const auto& r = scenario.randomize;
     for (const auto& spec : scenario.people) {
       const int count = spec.behavior == PersonBehavior::kEvacuate ? spec.count : 1;
@@ -620,6 +622,8 @@ struct TwinWorld::Impl {
         p.trigger_delay = r.person_delay_s.Sample(rng) + (count > 1 ? 0.3 * k : 0.0);
         p.door = spec.door.empty() ? -1 : FindDoor(spec.door);
         p.hold_angle = spec.hold_angle_deg * kDegToRad;
+        if (spec.behavior == PersonBehavior::kHoldDoor && r.hold_angle_deg.max > 0.0)
+          p.hold_angle = r.hold_angle_deg.Sample(hold_rng) * kDegToRad;
         p.hold_duration = spec.hold_duration;
         p.state.position = p.walker.position;
         BuildRoute(spec, &p);
