@@ -158,8 +158,8 @@ struct RandomizeSpec {
   double payload_xy{0.0};                ///< Payload xy jitter half-width [m].
   Range hold_open_s;                     ///< Overrides doors' hold time when non-zero.
   Range hold_angle_deg;  ///< Overrides hold_door people's hold angle when non-zero [deg].
-  Range person_delay_s;                  ///< Added to each person's trigger.
-  Range person_speed_scale{1.0, 1.0};    ///< Multiplies sampled speeds.
+  Range person_delay_s;  ///< Added to each person's trigger.
+  Range person_speed_scale{1.0, 1.0};  ///< Multiplies sampled speeds.
 };
 
 /// The robot brain's task in a scenario. The twin does not read it (it knows nothing of the
