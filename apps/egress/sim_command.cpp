@@ -59,6 +59,7 @@ struct SimOptions {
   std::string mp4;
   bool overwrite{false};
   bool quiet{false};
+  bool no_octomap{false};
 };
 
 void RefuseOverwrite(const std::string& path, bool overwrite) {
@@ -112,8 +113,9 @@ void RunSim(const SimOptions& o) {
   const std::string driver = o.driver != "auto" ? o.driver : (scenario.mission ? "brain" : "idle");
   twin::RunOptions options;
   if (driver == "brain") {
-    static const behavior::ExecutiveConfig kDefaults;
-    brain = MakeScenarioExecutive(scenario, world_description, world, model, kDefaults);
+    behavior::ExecutiveConfig config;
+    config.use_octomap = !o.no_octomap;
+    brain = MakeScenarioExecutive(scenario, world_description, world, model, config);
     options.control_period = 1.0 / 100.0;
     controller = [&brain](RobotPort& port) { return brain->Step(port); };
     // The video shows the running action, the planned path and, once a second, the costmap
@@ -218,6 +220,8 @@ void AddSimCommand(CLI::App& app) {
   sim->add_option("--video,--mp4", o->mp4, "render the run to this top-down MP4");
   sim->add_flag("--overwrite", o->overwrite, "replace existing output files");
   sim->add_flag("-q,--quiet", o->quiet, "print only the verdict");
+  sim->add_flag("--no-octomap", o->no_octomap,
+                "disconnect the brain's 3D obstacle map (the base laser alone), for comparison");
   sim->callback([o] { RunSim(*o); });
   AddSimBatchCommand(*sim_group);
 

@@ -17,6 +17,12 @@ void ExecutiveConfig::Validate() const {
       tick_rate_hz > 0 && control_rate_hz >= tick_rate_hz,
       "ExecutiveConfig: rates must be positive and the control rate at least the tick rate");
   tasks.Validate();
+  octomap.Validate();
+  ThrowUnless(octomap_known_radius >= 0 && octomap_person_radius >= 0 && octomap_self_margin >= 0,
+              "ExecutiveConfig: octomap_known_radius, octomap_person_radius and "
+              "octomap_self_margin must be >= 0");
+  ThrowUnless(held_payload_radius > 0 && held_payload_length > 0,
+              "ExecutiveConfig: held_payload_radius and held_payload_length must be > 0");
   trajectory.Validate();
   controller.Validate();
   planner.Validate();
@@ -80,6 +86,9 @@ struct Executive::Impl {
   std::optional<Pose3> X_BC;
   CameraIntrinsics intrinsics;
   bool finished{false};
+  std::optional<perception::OccupancyMap3D> octomap;
+  std::vector<PlacedShape> body;              // the robot's outline in B
+  std::map<std::string, double> leaf_angles;  // per door: the leaf as the costmap has it
   std::map<std::string, bool> zone_occupied;  // per door, at the last control step
   std::optional<double> occupied_known_at;    // when perception first showed a person there
 
@@ -104,7 +113,9 @@ Executive::Executive(std::shared_ptr<const RobotModel> model, MissionMap map, Mi
   costmap_ = std::make_unique<perception::Costmap2D>(m.map.grid, m.config.costmap);
   planning::BasePlannerConfig planner_config = m.config.planner;
   planner_config.footprint_radius = m.config.costmap.robot_radius + m.config.path_clearance;
-  m.planner = std::make_unique<planning::BasePlanner>(*costmap_, nullptr, planner_config);
+  if (m.config.use_octomap) m.octomap.emplace(m.config.octomap);
+  m.planner = std::make_unique<planning::BasePlanner>(
+      *costmap_, m.octomap ? m.octomap->tree() : nullptr, planner_config);
   for (const auto& doorway : m.map.doorways) {
     costmap_->AddDoorway(doorway);
     m.planner->AddDoor({doorway.id, doorway.p_MHinge, doorway.p_MLatch});
@@ -134,6 +145,82 @@ Executive::Executive(std::shared_ptr<const RobotModel> model, MissionMap map, Mi
 }
 
 Executive::~Executive() = default;
+
+const perception::OccupancyMap3D* Executive::octomap() const {
+  return impl_->octomap ? &*impl_->octomap : nullptr;
+}
+
+const std::vector<PlacedShape>& Executive::body_shapes() const {
+  return impl_->body;
+}
+
+void Executive::UpdateBody(const SensorSnapshot& snapshot) {
+  Impl& m = *impl_;
+  std::vector<std::pair<std::string, double>> q;
+  for (std::string_view joint : WholeBodyJointNames()) {
+    if (auto value = snapshot.joints.Position(joint)) q.emplace_back(joint, *value);
+  }
+  for (std::string_view joint : {"head_pan_joint", "head_tilt_joint"}) {
+    if (auto value = snapshot.joints.Position(joint)) q.emplace_back(joint, *value);
+  }
+  m.body = m.model->CalcCollisionShapesInBase(q);
+  if (context_.holding_object) {
+    // The payload hangs between the fingers, ahead of the palm along its approach axis.
+    const Pose3 X_BG = m.model->CalcLinkPoseInBase("hand_palm_link", q);
+    CollisionShape payload;
+    payload.link = "hand_palm_link";
+    payload.name = "held_payload";
+    payload.kind = CollisionShape::Kind::kCylinder;
+    payload.size = {m.config.held_payload_radius, m.config.held_payload_radius,
+                    m.config.held_payload_length};
+    payload.X_LS = Pose3(Eigen::Vector3d(0, 0, 0.06));
+    m.body.push_back({payload, Pose3((X_BG * payload.X_LS).translation())});
+  }
+  m.planner->SetBodyShapes(m.body);
+}
+
+void Executive::InsertDepth(const DepthImage& depth, const Pose3& X_MC) {
+  Impl& m = *impl_;
+  const Pose3 X_BM = Pose3::FromPose2(context_.X_MB).Inverse();
+  const auto& cfg = m.config;
+  std::vector<Eigen::Vector2d> people;
+  for (const auto& p : context_.world.people)
+    people.push_back(p.person.p_MP);
+  const auto keep = [&](const Eigen::Vector3d& p_MQ) {
+    if (p_MQ.z() < cfg.octomap.min_obstacle_height || p_MQ.z() > cfg.octomap.max_obstacle_height)
+      return false;  // the floor, or above the robot
+    const Eigen::Vector2d p = p_MQ.head<2>();
+    for (const auto& p_MP : people) {
+      if ((p - p_MP).norm() < cfg.octomap_person_radius) return false;
+    }
+    // A leaf is the door layer's: anywhere it can swing, at any angle the estimate lags behind.
+    for (const auto& door : m.map.doorways) {
+      if ((p - door.p_MHinge).norm() < door.width() + 0.1) return false;
+    }
+    const Eigen::Vector3d p_BQ = X_BM * p_MQ;
+    for (const PlacedShape& s : m.body) {
+      if (s.shape.Contains(s.X_BS.Inverse() * p_BQ, cfg.octomap_self_margin)) return false;
+    }
+    return !costmap_->IsNearSensedObstacle(p, cfg.octomap_known_radius);
+  };
+  m.octomap->InsertDepthImage(depth, m.intrinsics, X_MC, keep);
+  costmap_->SetProjectedObstacles(m.octomap->ProjectObstacles());
+}
+
+void Executive::UpdateDoorLeaves() {
+  Impl& m = *impl_;
+  // The leaf at its estimated angle, so paths keep out of it; re-marked when it moved by more
+  // than a degree (each change recomputes the inflation round the door).
+  constexpr double kLeafUpdateRad = 0.0175;
+  for (const auto& d : context_.world.doors) {
+    if (!d.state.observed) continue;
+    auto it = m.leaf_angles.find(d.model.id);
+    if (it != m.leaf_angles.end() && std::abs(it->second - d.state.angle) < kLeafUpdateRad)
+      continue;
+    costmap_->SetDoorLeafAngle(d.model.id, d.state.angle);
+    m.leaf_angles[d.model.id] = d.state.angle;
+  }
+}
 
 std::string Executive::active_action() const {
   const bt::TreeNode* node = impl_->log->running();
@@ -172,6 +259,8 @@ bool Executive::Step(RobotPort& port) {
   const Pose3 X_MB3 = Pose3::FromPose2(context_.X_MB);
 
   // Perceive.
+  context_.holding_object = snapshot.gripper.holding_object;
+  UpdateBody(snapshot);
   if (snapshot.depth) {
     m.depth = snapshot.depth;
     m.X_BC = snapshot.X_BC;
@@ -180,6 +269,7 @@ bool Executive::Step(RobotPort& port) {
       context_.depth = snapshot.depth;
       context_.X_MC = X_MB3 * *m.X_BC;
       context_.depth_intrinsics = snapshot.depth_intrinsics;
+      if (m.octomap) InsertDepth(*snapshot.depth, context_.X_MC);
     }
   }
   const Pose3& X_BL = m.model->laser_pose();
@@ -203,9 +293,10 @@ bool Executive::Step(RobotPort& port) {
         snapshot.detections, cv::Size(m.intrinsics.width, m.intrinsics.height), *m.depth,
         m.intrinsics, X_MB3 * *m.X_BC, Pose3::FromPose2(X_MB_capture) * *m.X_BC);
   }
-  context_.world =
-      m.perception.Snapshot(now, context_.X_MB, Eigen::Matrix3d::Zero(), costmap_.get());
-  context_.holding_object = snapshot.gripper.holding_object;
+  context_.world = m.perception.Snapshot(
+      now, context_.X_MB, m.localizer ? m.localizer->Covariance() : Eigen::Matrix3d::Zero().eval(),
+      costmap_.get(), m.octomap ? m.octomap->tree() : nullptr);
+  UpdateDoorLeaves();
   // Each door's current opening starts when it is first seen wide enough to pass, and ends
   // when it is seen closed or closing (a dip in the estimate, e.g. a person in front of the
   // leaf, does not end it).

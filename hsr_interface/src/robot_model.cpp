@@ -1,5 +1,6 @@
 #include "egress/hsr_interface/robot_model.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -104,6 +105,7 @@ struct RobotModel::Impl {
   Eigen::Vector3d p_GF{Eigen::Vector3d::Zero()};
   Pose3 X_BL;
   double footprint_radius{RobotModel::kDefaultFootprintRadius};
+  std::vector<CollisionShape> collision_shapes;
 
   [[noreturn]] void Fail(const std::string& what) const {
     throw LoadError(StrCat("Cannot load robot model from '", source, "': ", what));
@@ -193,6 +195,51 @@ struct RobotModel::Impl {
       if (info.mimic_leader && !joints.contains(*info.mimic_leader)) {
         Fail(StrCat("joint '", joint_name, "' mimics '", *info.mimic_leader,
                     "', which is not in the model."));
+      }
+    }
+  }
+
+  // Primitive <collision> elements of every link reachable from the root; meshes are skipped.
+  void ReadCollisionShapes(const urdf::ModelInterface& model) {
+    std::vector<urdf::LinkSharedPtr> links;
+    model.getLinks(links);
+    std::sort(links.begin(), links.end(),
+              [](const auto& a, const auto& b) { return a->name < b->name; });
+    for (const auto& link : links) {
+      if (link->name != kRootLink && !parent_joint_of_link.contains(link->name)) continue;
+      for (const auto& collision : link->collision_array) {
+        if (!collision || !collision->geometry) continue;
+        CollisionShape shape;
+        shape.link = link->name;
+        shape.name = collision->name;
+        shape.X_LS = ToPose3(collision->origin);
+        const std::string what =
+            StrCat("link '", link->name, "' collision '", collision->name, "'");
+        switch (collision->geometry->type) {
+          case urdf::Geometry::BOX: {
+            const auto& box = static_cast<const urdf::Box&>(*collision->geometry);
+            shape.kind = CollisionShape::Kind::kBox;
+            shape.size = {box.dim.x, box.dim.y, box.dim.z};
+            break;
+          }
+          case urdf::Geometry::CYLINDER: {
+            const auto& c = static_cast<const urdf::Cylinder&>(*collision->geometry);
+            shape.kind = CollisionShape::Kind::kCylinder;
+            shape.size = {c.radius, c.radius, c.length};
+            break;
+          }
+          case urdf::Geometry::SPHERE: {
+            const auto& sphere = static_cast<const urdf::Sphere&>(*collision->geometry);
+            shape.kind = CollisionShape::Kind::kSphere;
+            shape.size = Eigen::Vector3d::Constant(sphere.radius);
+            break;
+          }
+          default:
+            continue;  // meshes: the robot's outline is given by primitives
+        }
+        if (!shape.size.allFinite() || !(shape.size.minCoeff() > 0.0))
+          Fail(StrCat(what, " has a non-positive or non-finite size."));
+        collision_shapes.push_back(std::move(shape));
       }
     }
   }
@@ -367,6 +414,7 @@ RobotModel RobotModel::LoadFromString(const std::string& urdf_xml, std::string_v
       break;
     }
   }
+  impl->ReadCollisionShapes(*model);
   return RobotModel(std::move(impl));
 }
 
@@ -490,6 +538,61 @@ Pose3 RobotModel::CalcHeadCameraPose(double arm_lift, const HeadConfiguration& h
 
 const Pose3& RobotModel::laser_pose() const {
   return impl_->X_BL;
+}
+
+double CollisionShape::BoundingRadius() const {
+  switch (kind) {
+    case Kind::kBox:
+      return size.norm() / 2;
+    case Kind::kCylinder:
+      return std::hypot(size.x(), size.z() / 2);
+    case Kind::kSphere:
+      return size.x();
+  }
+  return 0.0;
+}
+
+bool CollisionShape::Contains(const Eigen::Vector3d& p_SQ, double margin) const {
+  switch (kind) {
+    case Kind::kBox:
+      return (p_SQ.cwiseAbs() - size / 2).maxCoeff() <= margin;
+    case Kind::kCylinder:
+      return p_SQ.head<2>().norm() <= size.x() + margin &&
+             std::abs(p_SQ.z()) <= size.z() / 2 + margin;
+    case Kind::kSphere:
+      return p_SQ.norm() <= size.x() + margin;
+  }
+  return false;
+}
+
+const std::vector<CollisionShape>& RobotModel::collision_shapes() const {
+  return impl_->collision_shapes;
+}
+
+std::vector<PlacedShape> RobotModel::CalcCollisionShapesInBase(
+    const std::vector<std::pair<std::string, double>>& joint_positions, bool skip_fingers) const {
+  std::map<std::string, double, std::less<>> q;
+  for (const auto& [joint, value] : joint_positions) {
+    ThrowUnless(impl_->joints.contains(joint), "Unknown joint '", joint, "' in robot model '",
+                impl_->name, "'.");
+    ThrowUnless(std::isfinite(value), "Invalid joint position: '", joint, "' (", value,
+                ") must be finite.");
+    q[joint] = value;
+  }
+  std::vector<PlacedShape> out;
+  std::map<std::string, Pose3, std::less<>> link_poses;
+  for (const CollisionShape& shape : impl_->collision_shapes) {
+    if (skip_fingers && shape.link.starts_with("hand_") &&
+        (shape.link.find("proximal") != std::string::npos ||
+         shape.link.find("distal") != std::string::npos)) {
+      continue;
+    }
+    auto it = link_poses.find(shape.link);
+    if (it == link_poses.end())
+      it = link_poses.emplace(shape.link, impl_->LinkPoseInBase(shape.link, q)).first;
+    out.push_back({shape, it->second * shape.X_LS});
+  }
+  return out;
 }
 
 Pose3 RobotModel::CalcLinkPoseInBase(

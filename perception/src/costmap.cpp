@@ -139,6 +139,26 @@ void Costmap2D::SetProjectedObstacles(const std::vector<Eigen::Vector2d>& p_MObs
   if (x1 >= x0) RecomputeWindow(x0, y0, x1, y1);
 }
 
+bool Costmap2D::IsNearSensedObstacle(const Eigen::Vector2d& p_MQ, double radius) const {
+  const auto c = geometry_.CellOf(p_MQ);
+  if (!c) return false;
+  const int n = int(std::ceil(radius / geometry_.resolution));
+  const double r2 = std::pow(radius / geometry_.resolution, 2);
+  for (int dy = -n; dy <= n; ++dy) {
+    for (int dx = -n; dx <= n; ++dx) {
+      const int x = c->x() + dx, y = c->y() + dy;
+      if (dx * dx + dy * dy > r2 || x < 0 || y < 0 || x >= geometry_.width ||
+          y >= geometry_.height) {
+        continue;
+      }
+      const std::size_t i = geometry_.Index(x, y);
+      if (static_[i] == kLethalCost || obstacle_[i] == kLethalCost || leaves_[i] == kLethalCost)
+        return true;
+    }
+  }
+  return false;
+}
+
 void Costmap2D::ClearObstacles() {
   std::fill(obstacle_.begin(), obstacle_.end(), kFreeCost);
   RecomputeWindow(0, 0, geometry_.width - 1, geometry_.height - 1);

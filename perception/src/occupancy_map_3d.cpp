@@ -22,8 +22,8 @@ OccupancyMap3D::OccupancyMap3D(OccupancyMap3DConfig config)
 }
 
 std::size_t OccupancyMap3D::InsertDepthImage(const DepthImage& depth,
-                                             const CameraIntrinsics& intrinsics,
-                                             const Pose3& X_MC) {
+                                             const CameraIntrinsics& intrinsics, const Pose3& X_MC,
+                                             const PointFilter& keep) {
   depth.Validate();
   intrinsics.Validate();
   ThrowUnless(depth.width == intrinsics.width && depth.height == intrinsics.height,
@@ -44,7 +44,7 @@ std::size_t OccupancyMap3D::InsertDepthImage(const DepthImage& depth,
       const Eigen::Vector3d p_MQ = X_MC * intrinsics.Unproject(u + 0.5, v + 0.5, z);
       const Eigen::Vector3d ray_M = p_MQ - p_MC;
       const double distance = ray_M.norm();
-      if (mark && distance <= config_.max_range) {
+      if (mark && distance <= config_.max_range && (!keep || keep(p_MQ))) {
         octomap::OcTreeKey key;
         if (tree_->coordToKeyChecked(p_MQ.x(), p_MQ.y(), p_MQ.z(), key)) {
           occupied.insert(key);

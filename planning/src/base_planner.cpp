@@ -6,6 +6,9 @@
 #include <queue>
 
 #include <fcl/geometry/octree/octree.h>
+#include <fcl/geometry/shape/box.h>
+#include <fcl/geometry/shape/cylinder.h>
+#include <fcl/geometry/shape/sphere.h>
 #include <fcl/narrowphase/collision.h>
 #include <ompl/base/objectives/PathLengthOptimizationObjective.h>
 #include <ompl/base/objectives/StateCostIntegralObjective.h>
@@ -109,23 +112,71 @@ class FootprintValidityChecker final : public ob::StateValidityChecker {
       }
     }
     if (octree_ == nullptr) return true;
-    fcl::Transform3d X_MCyl = fcl::Transform3d::Identity();
-    X_MCyl.translation() = Eigen::Vector3d(X_MB.x, X_MB.y, config_.robot_height / 2);
-    fcl::CollisionObjectd robot(cylinder_, X_MCyl);
     fcl::CollisionObjectd world(std::shared_ptr<fcl::CollisionGeometryd>(
         const_cast<fcl::OcTree<double>*>(octree_), [](fcl::CollisionGeometryd*) {}));
     fcl::CollisionRequestd request;
+    const Pose3 X_MB3 = Pose3::FromPose2(X_MB);
+    auto collides = [&](const std::shared_ptr<fcl::CollisionGeometryd>& geometry,
+                        const Pose3& X_MS) {
+      fcl::Transform3d X = fcl::Transform3d::Identity();
+      X.linear() = X_MS.rotation();
+      X.translation() = X_MS.translation();
+      fcl::CollisionObjectd object(geometry, X);
+      fcl::CollisionResultd result;
+      return fcl::collide(&object, &world, request, result) > 0;
+    };
+    if (body_.empty()) {
+      if (collides(cylinder_, X_MB3 * Pose3(Eigen::Vector3d(0, 0, config_.robot_height / 2))))
+        return false;
+    } else if (collides(body_bound_, X_MB3 * X_BBound_)) {
+      // Near a 3D obstacle: the shapes themselves decide.
+      for (const auto& [geometry, X_BS] : body_) {
+        if (collides(geometry, X_MB3 * X_BS)) return false;
+      }
+    }
     fcl::CollisionResultd result;
-    if (fcl::collide(&robot, &world, request, result) > 0) return false;
     if (box_) {
       fcl::Transform3d X_MBox = fcl::Transform3d::Identity();
       X_MBox.linear() = Eigen::AngleAxisd(X_MB.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
       X_MBox.translation() = Pose3::FromPose2(X_MB) * config_.carry->p_BBox;
       fcl::CollisionObjectd carried(box_, X_MBox);
-      fcl::CollisionResultd box_result;
-      if (fcl::collide(&carried, &world, request, box_result) > 0) return false;
+      if (fcl::collide(&carried, &world, request, result) > 0) return false;
     }
     return true;
+  }
+
+  // All or nothing: a bad shape leaves the body as it was.
+  void SetBody(const std::vector<PlacedShape>& shapes) {
+    std::vector<std::pair<std::shared_ptr<fcl::CollisionGeometryd>, Pose3>> body;
+    double radius = 0.0, z_low = 0.0, z_high = 0.0;
+    for (const PlacedShape& placed : shapes) {
+      const CollisionShape& s = placed.shape;
+      ThrowUnless(placed.X_BS.IsFinite() && s.size.allFinite() && s.size.minCoeff() > 0.0,
+                  "BasePlanner::SetBodyShapes: shape '", s.name, "' of link '", s.link,
+                  "' has a non-finite pose or a non-positive size");
+      std::shared_ptr<fcl::CollisionGeometryd> geometry;
+      switch (s.kind) {
+        case CollisionShape::Kind::kBox:
+          geometry = std::make_shared<fcl::Boxd>(s.size);
+          break;
+        case CollisionShape::Kind::kCylinder:
+          geometry = std::make_shared<fcl::Cylinderd>(s.size.x(), s.size.z());
+          break;
+        case CollisionShape::Kind::kSphere:
+          geometry = std::make_shared<fcl::Sphered>(s.size.x());
+          break;
+      }
+      const Eigen::Vector3d p = placed.X_BS.translation();
+      const double r = s.BoundingRadius();
+      radius = std::max(radius, p.head<2>().norm() + r);
+      z_low = body.empty() ? p.z() - r : std::min(z_low, p.z() - r);
+      z_high = body.empty() ? p.z() + r : std::max(z_high, p.z() + r);
+      body.emplace_back(std::move(geometry), placed.X_BS);
+    }
+    body_ = std::move(body);
+    if (body_.empty()) return;
+    body_bound_ = std::make_shared<fcl::Cylinderd>(radius, std::max(z_high - z_low, 1e-3));
+    X_BBound_ = Pose3(Eigen::Vector3d(0, 0, (z_low + z_high) / 2));
   }
 
  private:
@@ -134,6 +185,9 @@ class FootprintValidityChecker final : public ob::StateValidityChecker {
   const BasePlannerConfig& config_;
   std::shared_ptr<fcl::Cylinderd> cylinder_;
   std::shared_ptr<fcl::Boxd> box_;
+  std::vector<std::pair<std::shared_ptr<fcl::CollisionGeometryd>, Pose3>> body_;  // shapes in B
+  std::shared_ptr<fcl::CollisionGeometryd> body_bound_;  // a cylinder round all of them
+  Pose3 X_BBound_;
 };
 
 // Costmap cost as a state cost, for the optional clearance term of the objective.
@@ -372,6 +426,10 @@ void BasePlanner::AddDoor(const PlannerDoor& door) {
       door.p_MA.allFinite() && door.p_MB.allFinite() && (door.p_MB - door.p_MA).norm() > 0.1,
       "Invalid door '", door.id, "': jambs must be finite and at least 0.1 m apart.");
   impl_->doors.push_back(door);
+}
+
+void BasePlanner::SetBodyShapes(std::vector<PlacedShape> shapes) {
+  impl_->checker->SetBody(shapes);
 }
 
 bool BasePlanner::IsValid(const Pose2& X_MB) const {

@@ -158,6 +158,59 @@ TEST_F(RobotModelTest, SensorMountsAndFootprint) {
   EXPECT_LT(X_BC_down.rotation().col(2).z(), -0.4);
 }
 
+TEST_F(RobotModelTest, CollisionShapesComeFromTheUrdfAndFollowTheJoints) {
+  const auto& shapes = model().collision_shapes();
+  auto find = [&](const std::vector<PlacedShape>& placed, const std::string& name) {
+    for (const auto& p : placed) {
+      if (p.shape.name == name) return p;
+    }
+    ADD_FAILURE() << "no collision '" << name << "'";
+    return PlacedShape{};
+  };
+  bool has_base = false, has_finger = false;
+  for (const auto& s : shapes) {
+    has_base = has_base || (s.name == "base_body" && s.kind == CollisionShape::Kind::kCylinder &&
+                            s.size.x() == 0.215 && s.size.z() == 0.24);
+    has_finger = has_finger || s.link == "hand_l_distal_link";
+  }
+  EXPECT_TRUE(has_base);
+  EXPECT_TRUE(has_finger);
+
+  const auto low = model().CalcCollisionShapesInBase({});
+  const auto high = model().CalcCollisionShapesInBase({{"arm_lift_joint", 0.3}});
+  for (const auto& p : low)
+    EXPECT_EQ(p.shape.link.find("distal"), std::string::npos) << "fingers are skipped";
+  EXPECT_EQ(model().CalcCollisionShapesInBase({}, false).size(), shapes.size());
+  // The base stays put, the torso rises with half the lift (mimic joint), the arm with all of it.
+  EXPECT_NEAR(find(low, "base_body").X_BS.translation().z(), 0.13, 1e-9);
+  EXPECT_NEAR(find(high, "base_body").X_BS.translation().z(), 0.13, 1e-9);
+  EXPECT_NEAR(find(high, "torso_column").X_BS.translation().z() -
+                  find(low, "torso_column").X_BS.translation().z(),
+              0.15, 1e-9);
+  EXPECT_NEAR(find(high, "hand_body").X_BS.translation().z() -
+                  find(low, "hand_body").X_BS.translation().z(),
+              0.3, 1e-9);
+  // Flexing the arm forward carries the hand out in front of the base.
+  const auto forward = model().CalcCollisionShapesInBase({{"arm_flex_joint", -kPi / 2}});
+  EXPECT_GT(find(forward, "hand_body").X_BS.translation().x(), 0.5);
+  EXPECT_NEAR(find(low, "base_body").shape.BoundingRadius(), std::hypot(0.215, 0.12), 1e-12);
+  CollisionShape box;
+  box.kind = CollisionShape::Kind::kBox;
+  box.size = {0.2, 0.4, 0.6};
+  EXPECT_TRUE(box.Contains({0.09, -0.19, 0.29}));
+  EXPECT_FALSE(box.Contains({0.11, 0.0, 0.0}));
+  EXPECT_TRUE(box.Contains({0.11, 0.0, 0.0}, 0.02));
+  CollisionShape cylinder;
+  cylinder.kind = CollisionShape::Kind::kCylinder;
+  cylinder.size = {0.1, 0.1, 0.4};
+  EXPECT_TRUE(cylinder.Contains({0.07, 0.07, 0.19}));
+  EXPECT_FALSE(cylinder.Contains({0.08, 0.08, 0.0}));
+  EXPECT_FALSE(cylinder.Contains({0.0, 0.0, 0.21}));
+  EXPECT_THROW(model().CalcCollisionShapesInBase({{"no_such_joint", 0.0}}), InvalidArgument);
+  EXPECT_THROW(model().CalcCollisionShapesInBase({{"arm_lift_joint", std::nan("")}}),
+               InvalidArgument);
+}
+
 TEST_F(RobotModelTest, RejectsNonFiniteConfigurations) {
   WholeBodyVector q = WholeBodyVector::Zero();
   q[kArmFlex] = std::nan("");

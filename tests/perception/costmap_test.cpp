@@ -121,6 +121,23 @@ TEST(CostmapTest, ProjectedObstaclesAndFootprint) {
   EXPECT_EQ(costmap.FootprintCost({0.1, 0.1, 0.0}), kUnknownCost);  // leaves the map
 }
 
+TEST(CostmapTest, SensedObstaclesAreTheMapTheLaserAndLeavesNotTheProjection) {
+  const OccupancyGrid walls =
+      OccupancyGrid::FromBoxes({{{5.0, 2.25, 0.0}, {0.1, 4.5}}}, {0, 0}, {10, 10}, 0.05);
+  Costmap2D costmap(walls);
+  costmap.AddDoorway({"office", {5.0, 4.5}, {5.0, 5.5}, -1.0, 0.3});
+  EXPECT_TRUE(costmap.IsNearSensedObstacle({5.1, 2.0}, 0.1));  // the map's wall
+  EXPECT_FALSE(costmap.IsNearSensedObstacle({5.3, 2.0}, 0.1));
+  costmap.SetProjectedObstacles({{3.0, 3.0}});
+  EXPECT_FALSE(costmap.IsNearSensedObstacle({3.0, 3.0}, 0.1));       // projected: not sensed
+  costmap.UpdateWithScan(SingleReturn(0.0, 1.0f), {1.0, 8.0, 0.0});  // a return at (2, 8)
+  EXPECT_TRUE(costmap.IsNearSensedObstacle({2.08, 8.0}, 0.15));
+  EXPECT_FALSE(costmap.IsNearSensedObstacle({2.3, 8.0}, 0.15));
+  costmap.SetDoorLeafAngle("office", 0.0);
+  EXPECT_TRUE(costmap.IsNearSensedObstacle({5.05, 5.0}, 0.1));
+  EXPECT_FALSE(costmap.IsNearSensedObstacle({-1.0, -1.0}, 0.1));  // outside the map
+}
+
 TEST(CostmapTest, MalformedInputIsRejectedWithoutCrashing) {
   Costmap2D costmap(EmptyMap());
   LaserScan empty = testing::MakeScan(2);

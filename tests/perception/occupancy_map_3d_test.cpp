@@ -72,6 +72,28 @@ TEST(OccupancyMap3DTest, OverheadObstaclesAreNotProjected) {
   EXPECT_TRUE(map.ProjectObstacles().empty());
 }
 
+TEST(OccupancyMap3DTest, AFilterKeepsPointsFromMarkingButNotFromCarving) {
+  const CameraIntrinsics K = CameraIntrinsics::FromHorizontalFov(80, 60, 1.047);
+  const Pose3 X_MC = ForwardCamera();
+  OccupancyMap3D map;
+  // The face 2 m ahead, with its left half (y > 0) refused, e.g. a tracked person there.
+  const std::size_t inserted =
+      map.InsertDepthImage(RenderFace(K, X_MC, 2.0, -0.3, 0.3, 0.4, 0.8), K, X_MC,
+                           [](const Eigen::Vector3d& p_MQ) { return p_MQ.y() < 0.0; });
+  EXPECT_GT(inserted, 30u);
+  EXPECT_TRUE(OccupiedAtFace(map, -0.2, 0.6));
+  EXPECT_FALSE(OccupiedAtFace(map, 0.2, 0.6));
+  const octomap::OcTreeNode* carved = map.tree()->search(0.5, 0.0, 0.9);
+  ASSERT_NE(carved, nullptr);
+  EXPECT_FALSE(map.tree()->isNodeOccupied(carved));
+  // A filter that refuses everything marks nothing.
+  OccupancyMap3D none;
+  EXPECT_EQ(none.InsertDepthImage(RenderFace(K, X_MC, 2.0, -0.3, 0.3, 0.4, 0.8), K, X_MC,
+                                  [](const Eigen::Vector3d&) { return false; }),
+            0u);
+  EXPECT_TRUE(none.ProjectObstacles().empty());
+}
+
 TEST(OccupancyMap3DTest, MalformedInput) {
   const CameraIntrinsics K = CameraIntrinsics::FromHorizontalFov(80, 60, 1.047);
   OccupancyMap3D map;

@@ -131,6 +131,46 @@ TEST_F(BasePlannerTest, OctomapObstaclesTheLaserMissesAreAvoided) {
   }
 }
 
+TEST_F(BasePlannerTest, TheRobotsOwnOutlineDecidesUnderOverhangs) {
+  // A shelf board at 0.8 m whose edge is at x = 3.0 (it reaches over x 3.0..3.6).
+  auto octree = std::make_shared<octomap::OcTree>(0.05);
+  for (double x = 3.0; x <= 3.6; x += 0.05) {
+    for (double y = 2.2; y <= 4.2; y += 0.05)
+      octree->updateNode(x, y, 0.8, true);
+  }
+  octree->updateInnerOccupancy();
+  BasePlanner planner = MakePlanner(octree);
+  const RobotModel model = RobotModel::LoadDefault();
+  const auto tucked = model.CalcCollisionShapesInBase(
+      {{"arm_roll_joint", -M_PI / 2}, {"wrist_flex_joint", -M_PI / 2}});
+  // A payload carried in front at the shelf's height, 0.45 m ahead of the base's centre.
+  auto carrying = tucked;
+  CollisionShape bottle;
+  bottle.name = "payload";
+  bottle.kind = CollisionShape::Kind::kCylinder;
+  bottle.size = {0.04, 0.04, 0.22};
+  carrying.push_back({bottle, Pose3(Eigen::Vector3d(0.45, 0.0, 0.8))});
+
+  // Base centre 0.3 m short of the edge, facing it: the default cylinder and the tucked robot
+  // clear the board; the payload held out in front does not, unless the robot faces away.
+  const Pose2 facing{2.7, 3.2, 0.0}, away{2.7, 3.2, M_PI};
+  EXPECT_TRUE(planner.IsValid(facing));
+  planner.SetBodyShapes(tucked);
+  EXPECT_TRUE(planner.IsValid(facing));
+  EXPECT_FALSE(planner.IsValid({3.3, 3.2, 0.0})) << "the torso and head reach the board";
+  planner.SetBodyShapes(carrying);
+  EXPECT_FALSE(planner.IsValid(facing));
+  EXPECT_TRUE(planner.IsValid(away));
+  // Far from the board the bounding check alone passes.
+  EXPECT_TRUE(planner.IsValid({1.5, 3.0, 0.0}));
+  planner.SetBodyShapes({});
+  EXPECT_TRUE(planner.IsValid(facing)) << "an empty body falls back to the cylinder";
+
+  auto broken = tucked;
+  broken[0].shape.size.x() = std::nan("");
+  EXPECT_THROW(planner.SetBodyShapes(broken), InvalidArgument);
+}
+
 TEST_F(BasePlannerTest, AnUpdatedCostmapInvalidatesThePathForReplanning) {
   const BasePlanner planner = MakePlanner();
   const PlanResult result = planner.Plan({6.0, 4.0, 0.0}, {8.0, 4.0, 0.0});

@@ -3,6 +3,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "egress/hsr_interface/error.h"
 #include "twin_test_util.h"
 
 namespace egress::twin {
@@ -50,6 +51,45 @@ TEST(ScenarioJudgeTest, ThroughAnOpenDoorEveryPredicatePasses) {
   EXPECT_THAT(table, HasSubstr("SUCCESS"));
   EXPECT_THAT(table, HasSubstr("PASS  door_open_when_crossed:lab_door"));
   EXPECT_THAT(VerdictToJson(v), HasSubstr("\"success\":true"));
+}
+
+// A table top at 0.74 m over the robot's way north: the body (up to 1 m) runs into it; the
+// leg stands clear of the way. no_contact_with names what was touched.
+TEST(ScenarioJudgeTest, ContactWithANamedObstacleFailsItsPredicate) {
+  const std::string yaml =
+      "world: lab.sdf\nrobot:\n  start: {x: 0.0, y: -0.5, yaw_deg: 90}\n"
+      "obstacles:\n"
+      "  - {name: top, box: [1.0, 0.6, 0.04], x: 0.0, y: 1.0, z: 0.74}\n"
+      "  - {name: leg, cylinder: [0.02, 0.72], x: 0.46, y: 0.74}\n"
+      "success: [{no_contact_with: top}, {no_contact_with: leg}]\n";
+  auto loaded = LoadText(yaml, WorldsDir() / "lab");
+  loaded.scenario.ValidateAgainst(loaded.world);
+  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+  ScenarioJudge judge;
+  while (world.time() < 6.0) {
+    world.SetBaseVelocity({0.3, 0.0, 0.0});
+    world.Step();
+    judge.Observe(world);
+  }
+  const Verdict v = judge.Finish(world);
+  EXPECT_FALSE(v.success);
+  ASSERT_EQ(v.predicates.size(), 3u);  // and within_time_limit
+  EXPECT_EQ(v.predicates[0].name, "no_contact_with:top");
+  EXPECT_FALSE(v.predicates[0].passed);
+  EXPECT_EQ(v.predicates[1].name, "no_contact_with:leg");
+  EXPECT_TRUE(v.predicates[1].passed);
+  EXPECT_GE(v.metrics.contacts_with.at("top"), 1);
+
+  auto unknown = LoadText(
+      "world: lab.sdf\nrobot:\n  start: {x: 0.0, y: -0.5}\nsuccess: [{no_contact_with: shelf}]\n",
+      WorldsDir() / "lab");
+  try {
+    unknown.scenario.ValidateAgainst(unknown.world);
+    FAIL() << "an unknown model was accepted";
+  } catch (const LoadError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("success[0].no_contact_with"));
+    EXPECT_THAT(e.what(), HasSubstr("shelf"));
+  }
 }
 
 TEST(ScenarioJudgeTest, AgainstAClosedDoorTheRobotIsStoppedAndFails) {

@@ -249,6 +249,9 @@ PredicateSpec ParsePredicate(const FieldReader& r, const YAML::Node& node,
              : key == "button_pressed"         ? K::kButtonPressed
                                                : K::kButtonNotPressed;
     p.door = r.String(value, sub);
+  } else if (key == "no_contact_with") {
+    p.kind = K::kNoContactWith;
+    p.model = r.String(value, sub);
   } else if (key == "payload_held") {
     p.kind = K::kPayloadHeld;
     p.payload = r.String(value, sub);
@@ -266,7 +269,7 @@ PredicateSpec ParsePredicate(const FieldReader& r, const YAML::Node& node,
                "' is not a predicate (reach_goal, cross_door, "
                "door_open_when_crossed, button_pressed, button_not_pressed, "
                "payload_held, payload_delivered, no_person_contact, no_door_strike, "
-               "within_time_limit)");
+               "no_contact_with, within_time_limit)");
   }
   return p;
 }
@@ -621,6 +624,8 @@ std::string ToString(const PredicateSpec& p) {
       return "no_person_contact";
     case K::kNoDoorStrike:
       return "no_door_strike";
+    case K::kNoContactWith:
+      return "no_contact_with:" + p.model;
     case K::kWithinTimeLimit:
       return "within_time_limit";
   }
@@ -668,6 +673,16 @@ void Scenario::ValidateAgainst(const WorldDescription& world) const {
         found = found || pl.name == p.payload;
       if (!found)
         throw LoadError(StrCat(where, ": field 'success[", i, "]': no payload '", p.payload, "'"));
+    }
+    if (!p.model.empty()) {
+      bool found = !world.ShapesOfModel(p.model).empty();
+      for (const auto& o : obstacles)
+        found = found || o.model == p.model;
+      if (!found) {
+        throw LoadError(StrCat(where, ": field 'success[", i, "].no_contact_with': neither world ",
+                               world_file.string(), " nor the scenario's obstacles have a model '",
+                               p.model, "'"));
+      }
     }
   }
 }

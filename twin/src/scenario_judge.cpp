@@ -99,6 +99,7 @@ Verdict ScenarioJudge::Finish(const TwinWorld& world) const {
     if (e.kind != "contact") continue;
     const std::string kind = e.detail.substr(0, e.detail.find(' '));
     ++m.contacts[kind];
+    ++m.contacts_with[e.subject];
   }
   m.presses_per_traversal =
       m.crossings.empty() ? double(presses) : double(presses) / double(m.crossings.size());
@@ -172,6 +173,12 @@ Verdict ScenarioJudge::Finish(const TwinWorld& world) const {
         const int n = m.contacts.count("door") ? m.contacts.at("door") : 0;
         r.passed = n == 0;
         r.detail = std::to_string(n) + " leaf contact(s)";
+        break;
+      }
+      case K::kNoContactWith: {
+        const int n = m.contacts_with.count(p.model) ? m.contacts_with.at(p.model) : 0;
+        r.passed = n == 0;
+        r.detail = std::to_string(n) + " contact(s)";
         break;
       }
       case K::kWithinTimeLimit:

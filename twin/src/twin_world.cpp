@@ -1115,7 +1115,10 @@ struct TwinWorld::Impl {
           return 0;
         }
       };
-      for (btRigidBody* arm : {hand_body, forearm_body}) {
+      // What the hand holds is part of the robot's outline while carried.
+      std::vector<btRigidBody*> parts{hand_body, forearm_body};
+      if (held >= 0) parts.push_back(payloads[held].body);
+      for (btRigidBody* arm : parts) {
         Collector collector;
         collector.impl = this;
         collector.m_collisionFilterGroup = kGArm;
@@ -1137,14 +1140,23 @@ struct TwinWorld::Impl {
       if (touching.count({a, b})) continue;
       const Entity& ea = entities[a];
       const Entity& eb = entities[b];
-      const bool robot_a = ea.kind == EntityKind::kRobotBase || ea.kind == EntityKind::kRobotArm;
-      const bool robot_b = eb.kind == EntityKind::kRobotBase || eb.kind == EntityKind::kRobotArm;
-      if (robot_a == robot_b) continue;  // only robot–world contacts are recorded
+      const auto carried = [&](const Entity& e) {
+        return e.kind == EntityKind::kPayload && payloads[e.index].held;
+      };
+      const auto robot = [&](const Entity& e) {
+        return e.kind == EntityKind::kRobotBase || e.kind == EntityKind::kRobotArm || carried(e);
+      };
+      const bool robot_a = robot(ea);
+      if (robot_a == robot(eb)) continue;  // only robot–world contacts are recorded
       const Entity& other = robot_a ? eb : ea;
       const Entity& part = robot_a ? ea : eb;
       if (other.kind == EntityKind::kFloor) continue;
-      if (other.kind == EntityKind::kPayload && payloads[other.index].held) continue;
-      AddEvent("contact", other.name, StrCat(ToString(other.kind), " by ", part.name));
+      // A carried payload touching furniture is not a bump of the robot's body (it is how a
+      // payload is set down), but it names what it touched.
+      const std::string kind = carried(part) && other.kind == EntityKind::kStatic
+                                   ? std::string("carried")
+                                   : std::string(ToString(other.kind));
+      AddEvent("contact", other.name, StrCat(kind, " by ", part.name));
     }
     touching = std::move(now_touching);
   }

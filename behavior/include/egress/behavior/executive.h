@@ -22,6 +22,7 @@
 #include "egress/bt/status.h"
 #include "egress/hsr_interface/robot_port.h"
 #include "egress/perception/costmap.h"
+#include "egress/perception/occupancy_map_3d.h"
 #include "egress/perception/particle_filter_localizer.h"
 #include "egress/perception/world_state.h"
 #include "egress/planning/base_planner.h"
@@ -48,6 +49,22 @@ struct ExecutiveConfig {
     return c;
   }();
   double initial_pose_sigma{0.05};  ///< Spread of the initial pose estimate [m and rad].
+  /// The head depth camera's 3D obstacle map (OctoMap): what the base laser misses (table
+  /// tops, shelves, overhangs) is projected into the costmap and checked by the planner with
+  /// FCL against the robot's 3D outline. False disconnects it: the laser alone.
+  bool use_octomap{true};
+  perception::OccupancyMap3DConfig octomap;
+  /// Depth points this close to what the costmap already knows (the map's walls, laser
+  /// returns, door leaves) are left to it: the 3D map adds only what the laser misses, and
+  /// people and leaves seen by both leave no stale voxels behind [m].
+  double octomap_known_radius{0.15};
+  /// Depth points within this of a tracked person's centre are that person [m].
+  double octomap_person_radius{0.5};
+  /// Depth points within the robot's own outline grown by this are the robot (arm, payload) [m].
+  double octomap_self_margin{0.06};
+  /// A held payload's outline for collision checks: a vertical cylinder at the palm [m].
+  double held_payload_radius{0.05};
+  double held_payload_length{0.26};
   planning::BasePlannerConfig planner = [] {
     planning::BasePlannerConfig c;
     c.deterministic = true;  // a twin run must be a pure function of its seed
@@ -90,12 +107,24 @@ class Executive {
   std::string active_action() const;
   const Pose2& X_MB() const { return context_.X_MB; }
   const perception::Costmap2D& costmap() const { return *costmap_; }
+  /// The head camera's 3D obstacle map, or nullptr when config.use_octomap is false.
+  const perception::OccupancyMap3D* octomap() const;
+  /// The robot's 3D outline in B the planner checks (measured arm, held payload).
+  const std::vector<PlacedShape>& body_shapes() const;
   const TaskContext& context() const { return context_; }
   /// Time of the first tick at which an IsPathClear check failed after having passed, and of
   /// the first zero-velocity / retract command after it, per event [s] (preemption latency).
   const std::vector<std::pair<double, double>>& preemptions() const { return preemptions_; }
 
  private:
+  // The robot's 3D outline from the measured joints (and a held payload), for the planner.
+  void UpdateBody(const SensorSnapshot& snapshot);
+  // One depth image into the 3D map (the floor, people, leaves and the robot itself left out)
+  // and the map's projection into the costmap.
+  void InsertDepth(const DepthImage& depth, const Pose3& X_MC);
+  // The estimated door leaves into the costmap.
+  void UpdateDoorLeaves();
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
   TaskContext context_;

@@ -62,6 +62,28 @@ struct HeadConfiguration {
   double tilt{0.0};
 };
 
+/// One collision primitive of a link, from a URDF <collision> element (meshes are not kept:
+/// the shipped model describes its outline with primitives).
+struct CollisionShape {
+  enum class Kind { kBox, kCylinder, kSphere };
+  std::string link;  ///< The link it is fixed to.
+  std::string name;  ///< The <collision> element's name (may be empty).
+  Kind kind{Kind::kBox};
+  /// Box: full extents; cylinder: (radius, radius, length along its z); sphere: (r, r, r) [m].
+  Eigen::Vector3d size{Eigen::Vector3d::Zero()};
+  Pose3 X_LS;  ///< Shape frame S in the link frame L.
+  /// Radius of the smallest sphere about S's origin that holds the shape [m].
+  double BoundingRadius() const;
+  /// Whether point p_SQ (in S) lies inside the shape grown by `margin` [m].
+  bool Contains(const Eigen::Vector3d& p_SQ, double margin = 0.0) const;
+};
+
+/// A collision shape placed in the base frame B.
+struct PlacedShape {
+  CollisionShape shape;
+  Pose3 X_BS;  ///< Shape frame S in B.
+};
+
 /// The HSR's kinematics. Immutable after loading; all Calc methods are const and thread-safe.
 class RobotModel {
  public:
@@ -127,6 +149,17 @@ class RobotModel {
   Pose3 CalcHeadCameraPose(double arm_lift, const HeadConfiguration& head) const;
   /// Pose of the base laser frame L in B.
   const Pose3& laser_pose() const;
+
+  /// The collision primitives of every link (URDF order of links, then of elements).
+  const std::vector<CollisionShape>& collision_shapes() const;
+  /// Every collision primitive placed in B for the named joint positions (as for
+  /// CalcLinkPoseInBase: joints not given are at 0, mimic joints follow their leader). With
+  /// `skip_fingers`, the finger links (hand_*_proximal/distal) are left out: they fold inside
+  /// the hand's outline and a grasp opens them round the payload.
+  /// @throws InvalidArgument for an unknown joint or a non-finite position.
+  std::vector<PlacedShape> CalcCollisionShapesInBase(
+      const std::vector<std::pair<std::string, double>>& joint_positions,
+      bool skip_fingers = true) const;
 
   /// Pose of any link in B for the named joint positions (joints not given are at 0; mimic
   /// joints follow their leader). @throws InvalidArgument for an unknown link or joint name.

@@ -58,6 +58,9 @@ class Costmap2D {
   void UpdateWithScan(const LaserScan& scan, const Pose2& X_ML);
   /// Replaces the projected 3D obstacles (points in M).
   void SetProjectedObstacles(const std::vector<Eigen::Vector2d>& p_MObstacles);
+  /// Whether a cell of the static map, the laser's obstacle layer or a door leaf within
+  /// `radius` of p_MQ is lethal: something the costmap knows without the projection layer.
+  bool IsNearSensedObstacle(const Eigen::Vector2d& p_MQ, double radius) const;
   /// Clears the obstacle layer (e.g. after relocalization).
   void ClearObstacles();
 

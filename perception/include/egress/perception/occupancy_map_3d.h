@@ -4,6 +4,7 @@
 /// laser misses (table tops, overhangs), with a projection into the costmap and the tree itself
 /// for FCL collision checks.
 
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -33,11 +34,15 @@ class OccupancyMap3D {
  public:
   explicit OccupancyMap3D(OccupancyMap3DConfig config = {});
 
+  /// Which points may mark their voxel (p_MQ in M); the rays still carve free space.
+  using PointFilter = std::function<bool(const Eigen::Vector3d& p_MQ)>;
+
   /// Inserts a depth image seen from camera pose X_MC (optical frame: z forward). Invalid
-  /// pixels (NaN, 0) are skipped. Returns the number of points inserted.
+  /// pixels (NaN, 0) are skipped; with `keep`, only the points it accepts are marked (the
+  /// robot's own body, tracked people, the floor). Returns the number of points inserted.
   /// @throws InvalidArgument if the image and intrinsics disagree or the pose is not finite.
   std::size_t InsertDepthImage(const DepthImage& depth, const CameraIntrinsics& intrinsics,
-                               const Pose3& X_MC);
+                               const Pose3& X_MC, const PointFilter& keep = {});
   /// Centres (x, y) of occupied voxels whose z lies within the obstacle band.
   std::vector<Eigen::Vector2d> ProjectObstacles() const;
   bool IsOccupied(const Eigen::Vector3d& p_MQ) const;

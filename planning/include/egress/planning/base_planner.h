@@ -3,9 +3,10 @@
 /// BasePlanner: OMPL planning of the omnidirectional base over SE(2).
 ///  - Validity (FootprintValidityChecker): the round footprint touches no obstacle of the
 ///    costmap (the centre cell's cost is below kInscribedCost, which encodes the robot radius)
-///    and, when an OctoMap is given, an FCL cylinder of the footprint does not collide with it;
-///    when carrying, the arm's swept box is checked too. Motions are checked at the costmap's
-///    cell size.
+///    and, when an OctoMap is given, the robot's 3D outline (SetBodyShapes: base, torso at its
+///    lift, the arm as posed, a held payload; by default an FCL cylinder of the footprint) does
+///    not collide with it; when carrying, the arm's swept box is checked too. Motions are checked
+///    at the costmap's cell size.
 ///  - Planner by name (RRTConnect default; RRTstar, PRMstar, BITstar, InformedRRTstar use the
 ///    time budget to improve), objective path length plus optional costmap cost; shortcutting
 ///    and smoothing, then a check that the simplified path is still valid.
@@ -26,6 +27,7 @@
 
 #include "egress/hsr_interface/clock.h"
 #include "egress/hsr_interface/geometry.h"
+#include "egress/hsr_interface/robot_model.h"
 #include "egress/perception/costmap.h"
 
 namespace egress::planning {
@@ -95,6 +97,12 @@ class BasePlanner {
   BasePlanner(BasePlanner&&) noexcept;
   BasePlanner& operator=(BasePlanner&&) noexcept;
   void AddDoor(const PlannerDoor& door);
+  /// The robot's 3D outline for the OctoMap check, as shapes in B (RobotModel's collision
+  /// shapes at the current arm pose, plus a held payload). Empty (the default): the config's
+  /// footprint cylinder of robot_height. A pose is valid when no shape touches an occupied
+  /// voxel; a bounding cylinder is tested first, so poses far from 3D obstacles cost one check.
+  /// @throws InvalidArgument for a non-finite shape pose or size.
+  void SetBodyShapes(std::vector<PlacedShape> shapes);
 
   PlanResult Plan(const Pose2& X_MB_start, const Pose2& X_MB_goal) const;
   /// Whether the footprint at X_MB is collision-free (costmap and OctoMap).

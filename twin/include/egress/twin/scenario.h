@@ -141,11 +141,13 @@ struct PredicateSpec {
                            ///< its centre at least `min_z` high (on a table, not the floor).
     kNoPersonContact,      ///< No robot–person contact.
     kNoDoorStrike,         ///< The robot's body or arm never touched a door leaf.
+    kNoContactWith,        ///< Neither the robot nor what it holds ever touched `model`.
     kWithinTimeLimit,      ///< Finished before the time limit (always checked).
   };
   Kind kind{Kind::kReachGoal};
   std::string door;
   std::string payload;
+  std::string model;  ///< A world model or scenario obstacle, for kNoContactWith.
   Eigen::Vector2d target{Eigen::Vector2d::Zero()};
   double radius{0.3};
   double min_z{-1e9};  ///< [m] for kPayloadDelivered

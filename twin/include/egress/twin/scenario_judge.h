@@ -31,8 +31,10 @@ struct RunMetrics {
   std::optional<double> time_to_goal;                                   ///< [s]
   double path_length{0.0};                                              ///< [m]
   double min_person_distance{std::numeric_limits<double>::infinity()};  ///< Surface gap [m]
-  double time_in_personal_space{0.0};            ///< [s] with a surface gap < 1.2 m
-  std::map<std::string, int> contacts;           ///< By kind: person, static, door, payload
+  double time_in_personal_space{0.0};   ///< [s] with a surface gap < 1.2 m
+  std::map<std::string, int> contacts;  ///< By kind: person, static, door, payload, carried
+  /// By the model touched (the robot's body or arm, or the payload it holds).
+  std::map<std::string, int> contacts_with;
   std::map<std::string, double> door_wait_time;  ///< Per door [s]
   std::map<std::string, int> button_presses;     ///< Per door
   std::vector<DoorCrossing> crossings;
