@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "egress/behavior/grasp_monitor.h"
 #include "egress/behavior/task_nodes.h"
 #include "egress/bt/clock.h"
 #include "egress/bt/factory.h"
@@ -17,6 +18,8 @@ void ExecutiveConfig::Validate() const {
       tick_rate_hz > 0 && control_rate_hz >= tick_rate_hz,
       "ExecutiveConfig: rates must be positive and the control rate at least the tick rate");
   tasks.Validate();
+  arm.Validate();
+  grasp.Validate();
   octomap.Validate();
   ThrowUnless(octomap_known_radius >= 0 && octomap_person_radius >= 0 && octomap_self_margin >= 0,
               "ExecutiveConfig: octomap_known_radius, octomap_person_radius and "
@@ -86,6 +89,7 @@ struct Executive::Impl {
   std::optional<Pose3> X_BC;
   CameraIntrinsics intrinsics;
   bool finished{false};
+  GraspMonitor grasp;
   std::optional<perception::OccupancyMap3D> octomap;
   std::vector<PlacedShape> body;              // the robot's outline in B
   std::map<std::string, double> leaf_angles;  // per door: the leaf as the costmap has it
@@ -97,7 +101,8 @@ struct Executive::Impl {
         map(std::move(mp)),
         config(std::move(c)),
         perception(map.doors, config.perception),
-        motion(*model, config.trajectory, config.controller) {}
+        motion(*model, config.trajectory, config.controller, config.arm),
+        grasp(config.grasp) {}
 };
 
 Executive::Executive(std::shared_ptr<const RobotModel> model, MissionMap map, MissionTree tree,
@@ -213,8 +218,19 @@ void Executive::UpdateDoorLeaves() {
   // than a degree (each change recomputes the inflation round the door).
   constexpr double kLeafUpdateRad = 0.0175;
   for (const auto& d : context_.world.doors) {
-    if (!d.state.observed) continue;
     auto it = m.leaf_angles.find(d.model.id);
+    // Only a leaf seen lately: an old estimate (the leaf out of the laser's view, e.g. from a
+    // button's standoff beside the door) may have the leaf where it no longer is, across the
+    // very pose the robot lines up at.
+    const bool fresh =
+        d.state.observed && ToSeconds(context_.now - d.state.stamp) <= m.config.door_leaf_max_age;
+    if (!fresh) {
+      if (it != m.leaf_angles.end()) {
+        costmap_->SetDoorLeafAngle(d.model.id, std::nullopt);
+        m.leaf_angles.erase(it);
+      }
+      continue;
+    }
     if (it != m.leaf_angles.end() && std::abs(it->second - d.state.angle) < kLeafUpdateRad)
       continue;
     costmap_->SetDoorLeafAngle(d.model.id, d.state.angle);
@@ -258,8 +274,19 @@ bool Executive::Step(RobotPort& port) {
   }
   const Pose3 X_MB3 = Pose3::FromPose2(context_.X_MB);
 
+  // Proprioception: the arm's joints (arm motions end when they arrive) and the gripper's
+  // angle and effort (whether it holds something).
+  ArmPose arm;
+  bool arm_measured = true;
+  for (std::size_t j = 0; j < arm.size(); ++j) {
+    const auto q = snapshot.joints.Position(kArmJointNames[j]);
+    arm_measured = arm_measured && q.has_value();
+    if (q) arm[j] = *q;
+  }
+  if (arm_measured) m.motion.SetMeasuredArm(arm);
+  m.grasp.Update(snapshot.gripper);
+  context_.holding_object = m.grasp.holding();
   // Perceive.
-  context_.holding_object = snapshot.gripper.holding_object;
   UpdateBody(snapshot);
   if (snapshot.depth) {
     m.depth = snapshot.depth;
@@ -366,7 +393,10 @@ bool Executive::Step(RobotPort& port) {
   const Twist2 V_B = m.motion.Update(now, context_.X_MB, snapshot.odometry.V_B);
   port.SendBaseVelocity(V_B);
   if (auto arm = m.motion.TakeArmCommand()) port.SendArmTrajectory(*arm);
-  if (auto gripper = m.motion.TakeGripperCommand()) port.SendGripperCommand(*gripper);
+  if (auto gripper = m.motion.TakeGripperCommand()) {
+    m.grasp.OnCommand(*gripper);
+    port.SendGripperCommand(*gripper);
+  }
   return !m.finished;
 }
 

@@ -1,6 +1,7 @@
 #include "egress/behavior/motion_executor.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "egress/hsr_interface/error.h"
 
@@ -17,10 +18,34 @@ WholeBodyVector WithArm(const WholeBodyVector& q, const ArmPose& arm) {
   return out;
 }
 
+void ArmMotionConfig::Validate() const {
+  ThrowUnless(tolerance > 0 && std::isfinite(tolerance), "ArmMotionConfig: tolerance (", tolerance,
+              ") must be > 0");
+  ThrowUnless(timeout > 0 && std::isfinite(timeout), "ArmMotionConfig: timeout (", timeout,
+              ") must be > 0");
+}
+
 MotionExecutor::MotionExecutor(const RobotModel& model, planning::TrajectoryConfig trajectory,
-                               planning::ControllerConfig controller)
-    : model_(model), trajectory_config_(trajectory), controller_(controller) {
+                               planning::ControllerConfig controller, ArmMotionConfig arm)
+    : model_(model), trajectory_config_(trajectory), controller_(controller), arm_config_(arm) {
   trajectory_config_.Validate();
+  arm_config_.Validate();
+}
+
+std::pair<std::size_t, double> MotionExecutor::ArmError() const {
+  std::pair<std::size_t, double> worst{0, 0.0};
+  if (!measured_arm_) return worst;
+  for (std::size_t j = 0; j < arm_target_.size(); ++j) {
+    const double error = std::abs((*measured_arm_)[j] - arm_target_[j]);
+    if (error > worst.second) worst = {j, error};
+  }
+  return worst;
+}
+
+bool MotionExecutor::arm_moving(Time now) const {
+  if (now < arm_done_) return true;
+  if (arm_failed() || arm_settled_ || !measured_arm_) return false;
+  return ArmError().second > arm_config_.tolerance;
 }
 
 void MotionExecutor::FollowPath(const std::vector<Pose2>& path,
@@ -77,9 +102,12 @@ void MotionExecutor::StopBase() {
 void MotionExecutor::MoveArm(const std::vector<std::pair<double, ArmPose>>& knots, Time now) {
   ThrowUnless(!knots.empty(), "MoveArm: no knots");
   JointTrajectory trajectory;
-  trajectory.joint_names = {"arm_lift_joint", "arm_flex_joint", "arm_roll_joint",
-                            "wrist_flex_joint", "wrist_roll_joint"};
+  trajectory.joint_names.assign(kArmJointNames.begin(), kArmJointNames.end());
+  double previous_t = 0.0;
   for (const auto& [t, arm] : knots) {
+    ThrowUnless(std::isfinite(t) && t >= previous_t, "MoveArm: knot times must be finite and ",
+                "non-decreasing");
+    previous_t = t;
     JointTrajectoryPoint point;
     point.positions.assign(arm.begin(), arm.end());
     point.time_from_start = SecondsToDuration(t);
@@ -89,9 +117,21 @@ void MotionExecutor::MoveArm(const std::vector<std::pair<double, ArmPose>>& knot
   pending_arm_ = std::move(trajectory);
   arm_done_ = now + SecondsToDuration(knots.back().first);
   arm_target_ = knots.back().second;
+  arm_failure_.clear();
+  arm_settled_ = false;
 }
 
 Twist2 MotionExecutor::Update(Time now, const Pose2& X_MB, const Twist2& V_B_measured) {
+  if (measured_arm_ && !arm_failed() && !arm_settled_ && now >= arm_done_) {
+    const auto [joint, error] = ArmError();
+    if (error <= arm_config_.tolerance) {
+      arm_settled_ = true;
+    } else if (ToSeconds(now - arm_done_) > arm_config_.timeout) {
+      arm_failure_ = StrCat("the arm did not reach its target: ", kArmJointNames[joint], " at ",
+                            (*measured_arm_)[joint], ", target ", arm_target_[joint], " (",
+                            arm_config_.timeout, " s past the motion's end)");
+    }
+  }
   if (!base_active_) return {};
   if (bug_) {
     const double dt = ToSeconds(now - bug_last_step_);

@@ -211,6 +211,18 @@ NodeStatus BaseMotionStatus(const TaskContext& ctx,
   return ctx.motion->base_moving() ? NodeStatus::kRunning : NodeStatus::kSuccess;
 }
 
+// The arm motion under way: running while the joints travel, failure (with the joint that
+// stopped short) when they did not arrive in time, success once they are at the target.
+NodeStatus ArmMotionStatus(const TaskContext& ctx,
+                           const std::function<void(const std::string&)>& note) {
+  if (ctx.motion->arm_moving(ctx.now)) return NodeStatus::kRunning;
+  if (ctx.motion->arm_failed()) {
+    note(ctx.motion->arm_failure());
+    return NodeStatus::kFailure;
+  }
+  return NodeStatus::kSuccess;
+}
+
 constexpr double kPathLookahead = 1.5;  // [m] of the path ahead checked against the costmap
 
 // The next kPathLookahead metres of the path being followed cross lethal or inscribed cost.
@@ -662,7 +674,10 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
       if (ctx_.motion->base_moving()) return NodeStatus::kRunning;
       return AlignOrOperate();
     }
-    if (ctx_.motion->arm_moving(ctx_.now)) return NodeStatus::kRunning;
+    if (const NodeStatus arm = ArmMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+        arm != NodeStatus::kSuccess) {
+      return arm;
+    }
     // A press (or wave) restarts the operator's hold window of an open door.
     if (ctx_.door_open_since.count(door_) > 0) ctx_.door_open_since[door_] = ctx_.now;
     return NodeStatus::kSuccess;
@@ -810,7 +825,10 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
         [[fallthrough]];
       }
       case Phase::kWaiting: {
-        if (ctx_.motion->arm_moving(ctx_.now)) return NodeStatus::kRunning;
+        if (const NodeStatus arm = ArmMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+            arm != NodeStatus::kSuccess) {
+          return arm;
+        }
         if (!DoorPassable(ctx_, door_, 0.0)) {
           if (ToSeconds(ctx_.now - waiting_since_) > Input<double>("wait_timeout")) {
             Note("the door did not open in time");
@@ -1143,7 +1161,10 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
         return NodeStatus::kRunning;
       }
       case Phase::kReach: {
-        if (ctx_.motion->arm_moving(ctx_.now)) return NodeStatus::kRunning;
+        if (const NodeStatus arm = ArmMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+            arm != NodeStatus::kSuccess) {
+          return arm;
+        }
         GripperCommand close;
         close.mode = GripperCommand::Mode::kGrasp;
         close.effort = 10.0;
@@ -1154,12 +1175,21 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
       }
       case Phase::kClose: {
         if (ToSeconds(ctx_.now - closing_since_) < 1.5) return NodeStatus::kRunning;
-        ctx_.motion->MoveArm({{1.0, lifted_}}, ctx_.now);
+        // Lift, then fold the arm over the base at that height: the hand rises on its arc,
+        // clear of what the payload stood among (a straight tuck in joint space would lower
+        // the lift while folding and drag the payload through it). The tuck that follows only
+        // lowers the lift.
+        ArmPose folded = kTuckedArm;
+        folded[0] = lifted_[0];
+        ctx_.motion->MoveArm({{1.0, lifted_}, {1.0 + ctx_.config.arm_tuck_time, folded}}, ctx_.now);
         phase_ = Phase::kLift;
         return NodeStatus::kRunning;
       }
       case Phase::kLift: {
-        if (ctx_.motion->arm_moving(ctx_.now)) return NodeStatus::kRunning;
+        if (const NodeStatus arm = ArmMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+            arm != NodeStatus::kSuccess) {
+          return arm;
+        }
         if (!ctx_.holding_object) {
           Note("the gripper closed on nothing");
           return NodeStatus::kFailure;
@@ -1226,7 +1256,10 @@ class ReleaseAction : public TaskNode<bt::StatefulActionNode> {
         return NodeStatus::kRunning;
       }
       case Phase::kReach: {
-        if (ctx_.motion->arm_moving(ctx_.now)) return NodeStatus::kRunning;
+        if (const NodeStatus arm = ArmMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+            arm != NodeStatus::kSuccess) {
+          return arm;
+        }
         const Release release = ReadyToRelease(centre_);
         if (release == Release::kGiveUp) return NodeStatus::kFailure;  // still holding it
         if (release == Release::kWait) return NodeStatus::kRunning;
@@ -1245,7 +1278,10 @@ class ReleaseAction : public TaskNode<bt::StatefulActionNode> {
         return NodeStatus::kRunning;
       }
       case Phase::kWithdraw: {
-        if (ctx_.motion->arm_moving(ctx_.now)) return NodeStatus::kRunning;
+        if (const NodeStatus arm = ArmMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+            arm != NodeStatus::kSuccess) {
+          return arm;
+        }
         if (ctx_.holding_object) {
           Note("the payload is still in the gripper");
           return NodeStatus::kFailure;

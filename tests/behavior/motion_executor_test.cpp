@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "egress/hsr_interface/error.h"
+
 namespace egress::behavior {
 namespace {
 
@@ -66,6 +68,65 @@ TEST(MotionExecutorTest, StoppingOrAPathEndsTheDetour) {
   motion.FollowPath({{0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}}, {false}, kTuckedArm, Time{});
   EXPECT_FALSE(motion.bug_active());
   EXPECT_TRUE(motion.base_moving());
+}
+
+}  // namespace
+}  // namespace egress::behavior
+
+namespace egress::behavior {
+namespace {
+
+Time At(double t) {
+  return Time{} + SecondsToDuration(t);
+}
+
+// An arm motion ends when the measured joints arrive, not when its planned time is up; one
+// that never arrives fails after the timeout, naming the joint.
+TEST(MotionExecutorTest, ArmMotionsEndWhenTheMeasuredJointsArrive) {
+  const RobotModel model = RobotModel::LoadDefault();
+  MotionExecutor motion(model);
+  motion.SetMeasuredArm(kTuckedArm);
+  ArmPose raised = kTuckedArm;
+  raised[0] = 0.4;  // arm_lift: 0.4 m at 0.2 m/s needs 2 s, though asked for in 1 s
+  motion.MoveArm({{1.0, raised}}, At(0.0));
+  const auto command = motion.TakeArmCommand();
+  ASSERT_TRUE(command.has_value());
+  EXPECT_NEAR(ToSeconds(motion.arm_done() - At(0.0)), 1.0, 1e-9);
+  EXPECT_TRUE(motion.arm_moving(At(0.9)));
+  motion.Update(At(1.0), {}, {});
+  EXPECT_TRUE(motion.arm_moving(At(1.0))) << "the planned time is up but the joints are not there";
+  // Past the planned end but still on the way: moving.
+  ArmPose halfway = raised;
+  halfway[0] = 0.3;
+  motion.SetMeasuredArm(halfway);
+  motion.Update(At(3.0), {}, {});
+  EXPECT_TRUE(motion.arm_moving(At(3.0)));
+  EXPECT_FALSE(motion.arm_failed());
+  motion.SetMeasuredArm(raised);
+  motion.Update(At(3.1), {}, {});
+  EXPECT_FALSE(motion.arm_moving(At(3.1)));
+  EXPECT_FALSE(motion.arm_failed());
+
+  // Blocked at 0.1 m: failure once the timeout is past, with the joint named.
+  motion.MoveArm({{1.0, kTuckedArm}}, At(4.0));
+  ArmPose stuck = kTuckedArm;
+  stuck[0] = 0.1;
+  motion.SetMeasuredArm(stuck);
+  const double end = ToSeconds(motion.arm_done());
+  motion.Update(At(end + 2.9), {}, {});
+  EXPECT_TRUE(motion.arm_moving(At(end + 2.9)));
+  motion.Update(At(end + 3.1), {}, {});
+  EXPECT_FALSE(motion.arm_moving(At(end + 3.1)));
+  ASSERT_TRUE(motion.arm_failed());
+  EXPECT_NE(motion.arm_failure().find("arm_lift_joint"), std::string::npos);
+  // A new motion clears the failure.
+  motion.MoveArm({{1.0, stuck}}, At(20.0));
+  EXPECT_FALSE(motion.arm_failed());
+
+  ArmMotionConfig bad;
+  bad.timeout = -1.0;
+  EXPECT_THROW(MotionExecutor(model, {}, {}, bad), InvalidArgument);
+  EXPECT_THROW(motion.MoveArm({{2.0, raised}, {1.0, kTuckedArm}}, At(30.0)), InvalidArgument);
 }
 
 }  // namespace

@@ -54,7 +54,7 @@ TEST(OdometryTest, Validation) {
 }
 
 TEST(GripperStateTest, Validation) {
-  GripperState gripper{Time{0}, 0.5, 10.0, true};
+  GripperState gripper{Time{0}, 0.5, 10.0};
   EXPECT_NO_THROW(gripper.Validate());
   gripper.effort = -1.0;
   EXPECT_THAT(ErrorOf(gripper), HasSubstr("effort"));

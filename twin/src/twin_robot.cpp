@@ -109,7 +109,6 @@ SensorSnapshot TwinRobot::DoSense() {
   s.gripper.stamp = world_->now();
   s.gripper.hand_motor_position = world_->hand_motor_position();
   s.gripper.effort = world_->gripper_effort();
-  s.gripper.holding_object = world_->held_payload().has_value();
   return s;
 }
 

@@ -1374,6 +1374,8 @@ double TwinWorld::hand_motor_position() const {
   return impl_->hand_q;
 }
 double TwinWorld::gripper_effort() const {
+  // The fingers squeeze what they hold with the commanded force; closed on nothing, or open,
+  // the motor rests.
   return impl_->held >= 0 ? std::max(impl_->gripper_command.effort, 1.0) : 0.0;
 }
 std::optional<std::string> TwinWorld::held_payload() const {

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "egress/behavior/grasp_monitor.h"
 #include "egress/behavior/mission_map.h"
 #include "egress/behavior/motion_executor.h"
 #include "egress/behavior/task_context.h"
@@ -35,6 +36,8 @@ struct ExecutiveConfig {
   TaskConfig tasks;
   planning::TrajectoryConfig trajectory;
   planning::ControllerConfig controller;
+  ArmMotionConfig arm;       ///< When an arm motion is done (measured joints) or failed.
+  GraspMonitorConfig grasp;  ///< When the gripper holds something (its angle and effort).
   perception::PerceptionConfig perception;
   perception::CostmapConfig costmap;
   /// Paths keep this much more than the footprint's radius from obstacles: string-pulled paths
@@ -62,6 +65,8 @@ struct ExecutiveConfig {
   double octomap_person_radius{0.5};
   /// Depth points within the robot's own outline grown by this are the robot (arm, payload) [m].
   double octomap_self_margin{0.06};
+  /// A door's leaf is in the costmap while its angle estimate is at most this old [s].
+  double door_leaf_max_age{0.5};
   /// A held payload's outline for collision checks: a vertical cylinder at the palm [m].
   double held_payload_radius{0.05};
   double held_payload_length{0.26};

@@ -9,6 +9,7 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "egress/hsr_interface/command_types.h"
@@ -24,6 +25,10 @@ namespace egress::behavior {
 /// arm_lift [m], arm_flex, arm_roll, wrist_flex, wrist_roll [rad].
 using ArmPose = std::array<double, 5>;
 
+/// The URDF names of ArmPose's joints, in its order.
+inline constexpr std::array<std::string_view, 5> kArmJointNames{
+    "arm_lift_joint", "arm_flex_joint", "arm_roll_joint", "wrist_flex_joint", "wrist_roll_joint"};
+
 /// The arm folded over the base: nothing sticks out of the footprint.
 inline constexpr ArmPose kTuckedArm{0.0, 0.0, -1.5707963267948966, -1.5707963267948966, 0.0};
 
@@ -31,10 +36,20 @@ inline constexpr ArmPose kTuckedArm{0.0, 0.0, -1.5707963267948966, -1.5707963267
 ArmPose ArmOf(const WholeBodyVector& q);
 WholeBodyVector WithArm(const WholeBodyVector& q, const ArmPose& arm);
 
+/// How an arm motion is judged complete: by the measured joints, not the clock.
+struct ArmMotionConfig {
+  /// Done when every arm joint is within this of its target [m or rad].
+  double tolerance{0.02};
+  /// Failed when the joints are not there this long after the motion's planned end [s].
+  double timeout{3.0};
+  /// @throws InvalidArgument naming the field.
+  void Validate() const;
+};
+
 class MotionExecutor {
  public:
   MotionExecutor(const RobotModel& model, planning::TrajectoryConfig trajectory = {},
-                 planning::ControllerConfig controller = {});
+                 planning::ControllerConfig controller = {}, ArmMotionConfig arm = {});
 
   /// Follows `path` (X_MB waypoints, the first one the current pose); `through_door[i]` marks
   /// segment i as a door crossing (0.4 m/s). The arm holds `arm`.
@@ -53,7 +68,11 @@ class MotionExecutor {
   /// Stops the base: zero velocity from the next control step.
   void StopBase();
   /// Moves the arm through `knots` (seconds from now, pose). Sent with the next control step.
+  /// The arm's own controller rate-limits each joint: a knot asked for too soon is reached
+  /// late, and arm_moving() waits for it.
   void MoveArm(const std::vector<std::pair<double, ArmPose>>& knots, Time now);
+  /// The arm joints as measured (joint states), each control step.
+  void SetMeasuredArm(const ArmPose& arm) { measured_arm_ = arm; }
 
   const planning::TrajectoryConfig& trajectory_config() const { return trajectory_config_; }
   bool base_moving() const { return base_active_; }
@@ -62,12 +81,19 @@ class MotionExecutor {
   /// The last base motion ended by the watchdog (tracking error beyond its limits).
   bool base_failed() const { return base_failed_; }
   const std::string& base_failure() const { return base_failure_; }
-  bool arm_moving(Time now) const { return now < arm_done_; }
+  /// The arm motion is under way: before its planned end, or after it while the measured
+  /// joints are not yet at the target (until the timeout). Without measurements, the clock.
+  bool arm_moving(Time now) const;
+  /// The last arm motion did not reach its target within the timeout (see arm_failure()).
+  bool arm_failed() const { return !arm_failure_.empty(); }
+  /// Which joint stopped where, against which target.
+  const std::string& arm_failure() const { return arm_failure_; }
+  /// The planned end of the last arm motion.
   Time arm_done() const { return arm_done_; }
   /// The arm pose the last arm motion ends in.
   const ArmPose& arm_target() const { return arm_target_; }
 
-  /// One control step: the base twist to send (zero when idle).
+  /// One control step: the base twist to send (zero when idle); checks the arm's timeout.
   Twist2 Update(Time now, const Pose2& X_MB, const Twist2& V_B_measured);
   /// The arm trajectory to send, once.
   std::optional<JointTrajectory> TakeArmCommand();
@@ -95,6 +121,12 @@ class MotionExecutor {
   std::optional<GripperCommand> pending_gripper_;
   Time arm_done_{};
   ArmPose arm_target_{kTuckedArm};
+  ArmMotionConfig arm_config_;
+  std::optional<ArmPose> measured_arm_;
+  std::string arm_failure_;
+  bool arm_settled_{false};  // the measured joints reached the target after the planned end
+  // The measured joint farthest from the target: its index and error.
+  std::pair<std::size_t, double> ArmError() const;
 };
 
 }  // namespace egress::behavior

@@ -45,7 +45,6 @@ struct GripperState {
   Time stamp{};
   double hand_motor_position{0.0};  ///< hand_motor_joint angle [rad]; larger is more open.
   double effort{0.0};               ///< Grip force [N], >= 0.
-  bool holding_object{false};       ///< The fingers stopped on an object while closing.
   void Validate() const;
 };
 
