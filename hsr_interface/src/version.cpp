@@ -2,6 +2,8 @@
 
 #include <Eigen/Core>
 
+#include "egress_revision.h"  // generated at build time: EGRESS_GIT_REVISION
+
 #ifndef EGRESS_VERSION
 #error "EGRESS_VERSION must be defined by the build"
 #endif
