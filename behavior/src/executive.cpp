@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "egress/behavior/door_rules.h"
 #include "egress/behavior/grasp_monitor.h"
 #include "egress/behavior/task_nodes.h"
 #include "egress/bt/clock.h"

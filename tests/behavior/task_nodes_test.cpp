@@ -1,9 +1,9 @@
-// The task nodes' shared door-zone rules (task_context.h): who occupies a door's zone, and who
+// The task nodes' shared door-zone rules (door_rules.h): who occupies a door's zone, and who
 // holds a door open out of the robot's way.
 
 #include <gtest/gtest.h>
 
-#include "egress/behavior/task_context.h"
+#include "egress/behavior/door_rules.h"
 #include "egress/hsr_interface/error.h"
 
 namespace egress::behavior {

@@ -5,10 +5,12 @@
 /// world state, actions start motions on the MotionExecutor and watch them finish; halting an
 /// action stops its motion in the same tick.
 ///
-/// Registered now: IsPathClear, IsDoorOpen, IsPersonHoldingDoor, IsHoldingPayload, ButtonType,
-/// NavigateTo, ApproachButton, PressButton, WaveAtPlate, TraverseDoor, RetractToSafe,
-/// WaitForClear, DetectPayload, GraspPayload. Not yet: PlacePayload, HandOver (a tree using them
-/// fails to load with an unknown-node error naming the file and line).
+/// The nodes live in families, one file each in behavior/src/: conditions (IsPathClear,
+/// IsDoorOpen, IsPersonHoldingDoor, IsHoldingPayload), navigation (NavigateTo, RetractToSafe,
+/// WaitForClear), doors (ButtonType, ApproachButton, PressButton, WaveAtPlate, TraverseDoor; the
+/// door rules they share are egress/behavior/door_rules.h) and manipulation (DetectPayload,
+/// GraspPayload, PlacePayload, HandOver). A tree naming any other node fails to load with an
+/// unknown-node error naming the file and line.
 
 #include "egress/behavior/task_context.h"
 #include "egress/bt/factory.h"

@@ -1,0 +1,48 @@
+#pragma once
+/// @file
+/// Door rules: the geometry of a door as the robot approaches it, who is in its zone, and
+/// whether its leaf and its operator's hold window leave the robot time to pass. Shared by the
+/// executive (door zones for the preemption figure) and the door task nodes.
+
+#include <optional>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "egress/behavior/task_context.h"
+
+namespace egress::behavior {
+
+/// Geometry of one door as the robot approaches it.
+struct DoorPass {
+  Eigen::Vector2d centre;  ///< Middle of the opening [m].
+  Eigen::Vector2d n_M;     ///< Unit normal of the door line pointing to the robot's side.
+  double width{0.0};
+};
+/// @throws InvalidArgument for an unknown door id.
+DoorPass CalcDoorPass(const MissionMap& map, const std::string& door, const Pose2& X_MB);
+/// The same, with the normal pointing to the side the robot approached the door from, if the
+/// context remembers one (else the side it is on now).
+DoorPass CalcKnownPass(const TaskContext& context, const std::string& door);
+/// CalcKnownPass, remembering the side the first time (the robot's side now).
+DoorPass CalcApproachPass(TaskContext& context, const std::string& door);
+
+/// True when `entry` holds `door` open standing out of the robot's lane through it: the strip
+/// through the opening's middle, as wide as the footprint plus the person. Someone standing in
+/// that lane blocks the way whatever the tracker reads as their intent (a person stopped in the
+/// doorway face to face with the robot is still, next to an open leaf, and not holding it).
+bool IsHoldingDoorAside(const TaskContext& context,
+                        const perception::TrackedPersonWithIntent& entry, const std::string& door);
+/// True when a person (not one holding this door aside) is in, or forecast into, the zone of
+/// `door`.
+bool IsDoorZoneOccupied(const TaskContext& context, const std::string& door);
+/// The leaf leaves room for the footprint (plus `margin`) [m], is not closing, and — unless a
+/// person holds it aside — the operator's hold window (from the robot's own press, or from when
+/// it was first seen open) leaves time to drive clear of the leaf: past the line for a leaf that
+/// opens towards the robot (which then still has the time the closing leaf takes to reach its
+/// lane), beyond the sweep on the far side otherwise. Needs `context.motion` (door speed).
+bool DoorPassable(const TaskContext& context, const std::string& door, double margin);
+/// Clearance of the door's opening from the latest estimate, or nullopt if never observed.
+std::optional<double> DoorClearance(const TaskContext& context, const std::string& door);
+
+}  // namespace egress::behavior

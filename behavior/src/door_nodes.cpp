@@ -1,0 +1,362 @@
+#include "task_node_support.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace egress::behavior::detail {
+namespace {
+
+class ButtonType final : public TaskNode<bt::SyncActionNode> {
+ public:
+  using TaskNode::TaskNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("door", "door id"),
+            OutputPort<std::string>("type", "push_button or proximity_plate")};
+  }
+  NodeStatus Tick() override {
+    const MapActuator* actuator = ctx_.map->FindActuatorOf(Door(), ctx_.X_MB.translation());
+    if (actuator == nullptr) {
+      Note("door has no actuator on this side");
+      return NodeStatus::kFailure;
+    }
+    this->SetOutput("type", std::string(actuator->type == planning::ButtonType::kPushButton
+                                            ? "push_button"
+                                            : "proximity_plate"));
+    return NodeStatus::kSuccess;
+  }
+};
+
+class ApproachButton final : public TaskNode<bt::StatefulActionNode> {
+ public:
+  using TaskNode::TaskNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("door", "door whose actuator to stand off")};
+  }
+  NodeStatus OnStart() override {
+    const std::string door = Door();
+    const MapActuator* actuator = ctx_.map->FindActuatorOf(door, ctx_.X_MB.translation());
+    if (actuator == nullptr) {
+      Note("door has no actuator on this side");
+      return NodeStatus::kFailure;
+    }
+    CalcApproachPass(ctx_, door);  // remember which side is "before" the door
+    ButtonPlan plan;
+    plan.actuator = actuator->id;
+    plan.type = actuator->type;
+    plan.targets = planning::MakeButtonTargets(actuator->p_M, actuator->n_M, actuator->type,
+                                               ctx_.config.buttons);
+    // Whole-body IK from the standoff with the arm tucked picks where the base stands.
+    planning::IkConfig ik = ctx_.config.ik;
+    ik.fingertip = actuator->type == planning::ButtonType::kPushButton;
+    ik.use_base = true;
+    WholeBodyVector q0 = WholeBodyVector::Zero();
+    q0[kBaseX] = plan.targets.X_MB_standoff.x;
+    q0[kBaseY] = plan.targets.X_MB_standoff.y;
+    q0[kBaseYaw] = plan.targets.X_MB_standoff.yaw;
+    q0 = WithArm(q0, kTuckedArm);
+    const planning::IkResult solution =
+        planning::DlsIkSolver(*ctx_.model, ik).Solve(plan.targets.approach, q0);
+    plan.X_MB_standoff = solution.converged
+                             ? Pose2{solution.q[kBaseX], solution.q[kBaseY], solution.q[kBaseYaw]}
+                             : plan.targets.X_MB_standoff;
+    if (solution.converged) plan.approach_arm = ArmOf(solution.q);
+    if (!solution.converged) Note("whole-body IK did not converge; using the nominal standoff");
+    ctx_.button_plans[door] = plan;
+    return StartPath(ctx_, plan.X_MB_standoff, StrCat("the ", actuator->id, " standoff"),
+                     [this](const std::string& s) { Note(s); });
+  }
+  NodeStatus OnRunning() override {
+    return DriveStatus(ctx_, [this](const std::string& s) { Note(s); });
+  }
+  void OnHalted() override { ctx_.motion->StopBase(); }
+};
+
+// The base pose relative to the actuator's wall, corrected by the laser: the distance to the
+// wall straight ahead, measured, against the distance the believed pose predicts. Pressing a
+// 4 mm button stroke needs the wall's distance to a few millimetres; the localizer's estimate
+// is good to a few centimetres. Along the wall nothing changes (the button is 10 cm wide).
+Pose2 WallAlignedPose(const TaskContext& ctx, const MapActuator& actuator,
+                      const std::function<void(const std::string&)>& note) {
+  if (!ctx.scan) return ctx.X_MB;
+  const Eigen::Vector2d n = actuator.n_M.head<2>().normalized();
+  const Eigen::Vector2d t(-n.y(), n.x());
+  const Eigen::Vector2d p_MWall = actuator.p_M.head<2>() - n * actuator.protrusion;
+  const Pose2 X_ML = ctx.X_MB * ctx.X_BL;
+  std::vector<double> distances;
+  const LaserScan& scan = *ctx.scan;
+  for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
+    const double r = scan.ranges[i];
+    if (!std::isfinite(r) || r < scan.range_min || r > 2.0) continue;
+    const double a = scan.angle_min + double(i) * scan.angle_increment;
+    const Eigen::Vector2d p_M = X_ML * Eigen::Vector2d(r * std::cos(a), r * std::sin(a));
+    // Near the wall plane, within 0.4 m of the actuator along the wall.
+    if (std::abs((p_M - p_MWall).dot(n)) > 0.15 || std::abs((p_M - p_MWall).dot(t)) > 0.4) continue;
+    distances.push_back((X_ML.translation() - p_M).dot(n));
+  }
+  if (distances.size() < 5) return ctx.X_MB;
+  auto middle = distances.begin() + std::ptrdiff_t(distances.size() / 2);
+  std::nth_element(distances.begin(), middle, distances.end());
+  const double expected = (X_ML.translation() - p_MWall).dot(n);
+  const double error = *middle - expected;
+  Pose2 corrected = ctx.X_MB;
+  corrected.x += n.x() * error;
+  corrected.y += n.y() * error;
+  note(StrCat("wall ", std::round(*middle * 1000) / 1000, " m ahead by laser, ",
+              std::round(error * 1000), " mm off the estimate"));
+  return corrected;
+}
+
+// Presses (push button) or waves (proximity plate): one arm motion, RUNNING until it ends.
+class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
+ public:
+  ActuatorAction(const std::string& name, NodeConfig config, TaskContext* context,
+                 planning::ButtonType type)
+      : TaskNode(name, std::move(config), context), type_(type) {}
+  NodeStatus OnStart() override {
+    door_ = Door();
+    const auto it = ctx_.button_plans.find(door_);
+    if (it == ctx_.button_plans.end() || it->second.type != type_) {
+      Note("no standoff for this actuator: ApproachButton must run first");
+      return NodeStatus::kFailure;
+    }
+    alignments_ = 0;
+    arm_started_ = false;
+    return AlignOrOperate();
+  }
+  NodeStatus OnRunning() override {
+    if (!arm_started_) {
+      if (ctx_.motion->base_failed()) {
+        Note("could not square up to the actuator: " + ctx_.motion->base_failure());
+        return NodeStatus::kFailure;
+      }
+      if (ctx_.motion->base_moving()) return NodeStatus::kRunning;
+      return AlignOrOperate();
+    }
+    if (const NodeStatus arm = ArmMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+        arm != NodeStatus::kSuccess) {
+      return arm;
+    }
+    // A press (or wave) restarts the operator's hold window of an open door.
+    if (ctx_.door_open_since.count(door_) > 0) ctx_.door_open_since[door_] = ctx_.now;
+    return NodeStatus::kSuccess;
+  }
+  void OnHalted() override { ctx_.motion->StopBase(); }  // the arm is tucked by whoever runs next
+
+ private:
+  static constexpr double kAlignTolerance = 0.01;  // [m] base off its standoff along the normal
+  static constexpr int kMaxAlignments = 2;
+
+  // The base squares up to the planned standoff (by the laser's wall distance) first, then the
+  // arm presses or waves.
+  NodeStatus AlignOrOperate() {
+    const ButtonPlan& plan = ctx_.button_plans.at(door_);
+    const MapActuator& actuator = *ctx_.map->FindActuator(plan.actuator);
+    const Pose2 X_MB = WallAlignedPose(ctx_, actuator, [this](const std::string& t) { Note(t); });
+    const Eigen::Vector2d n = actuator.n_M.head<2>().normalized();
+    const double off = (X_MB.translation() - plan.X_MB_standoff.translation()).dot(n);
+    if (std::abs(off) > kAlignTolerance && alignments_ < kMaxAlignments) {
+      ++alignments_;
+      const Pose2 target{ctx_.X_MB.x - n.x() * off, ctx_.X_MB.y - n.y() * off,
+                         plan.X_MB_standoff.yaw};
+      ctx_.motion->FollowPath({ctx_.X_MB, target}, {false}, ctx_.motion->arm_target(), ctx_.now);
+      Note(StrCat("squaring up: ", std::round(off * 1000), " mm off the standoff"));
+      return NodeStatus::kRunning;
+    }
+    return Operate(plan, X_MB);
+  }
+
+  NodeStatus Operate(const ButtonPlan& plan, const Pose2& X_MB) {
+    const bool push = type_ == planning::ButtonType::kPushButton;
+    // The hand reaches the actuator's approach pose then; the press or wave follows.
+    ctx_.door_operated_at[door_] = ctx_.now + SecondsToDuration(ctx_.config.press_reach_time);
+    const auto approach = SolveArm(ctx_, X_MB, plan.targets.approach, plan.approach_arm, push);
+    if (!approach) {
+      Note("the actuator is out of the arm's reach from here");
+      return NodeStatus::kFailure;
+    }
+    const TaskConfig& c = ctx_.config;
+    if (push) {
+      planning::IkTarget press = plan.targets.press;
+      press.approach_M.reset();  // the arm alone cannot also hold the approach axis exactly
+      const auto pressed = SolveArm(ctx_, X_MB, press, *approach, true);
+      if (!pressed) {
+        Note("the press point is out of the arm's reach from here");
+        return NodeStatus::kFailure;
+      }
+      ctx_.motion->MoveArm({{c.press_reach_time, *approach},
+                            {c.press_reach_time + c.press_time, *pressed},
+                            {c.press_reach_time + 2 * c.press_time, *approach}},
+                           ctx_.now);
+      Note("pressing the push button");
+    } else {
+      ctx_.motion->MoveArm(
+          {{c.press_reach_time, *approach}, {c.press_reach_time + c.wave_hold_time, *approach}},
+          ctx_.now);
+      Note("waving at the proximity plate");
+    }
+    arm_started_ = true;
+    return NodeStatus::kRunning;
+  }
+
+  planning::ButtonType type_;
+  std::string door_;
+  int alignments_{0};
+  bool arm_started_{false};
+};
+
+class PressButton final : public ActuatorAction {
+ public:
+  PressButton(const std::string& name, NodeConfig config, TaskContext* context)
+      : ActuatorAction(name, std::move(config), context, planning::ButtonType::kPushButton) {}
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("door", "door whose push button to press")};
+  }
+};
+
+class WaveAtPlate final : public ActuatorAction {
+ public:
+  WaveAtPlate(const std::string& name, NodeConfig config, TaskContext* context)
+      : ActuatorAction(name, std::move(config), context, planning::ButtonType::kProximityPlate) {}
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("door", "door whose proximity plate to wave at")};
+  }
+};
+
+// Drives through a door in two legs: to the entry pose on the door's axis (the arm tucking on
+// the way), where the laser sees through the opening; then, once the leaf leaves room for the
+// footprint, through the doorway to the exit pose. Both legs run at the door speed: the ADA
+// hold window is short.
+class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
+ public:
+  using TaskNode::TaskNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("door", "door to drive through"),
+            InputPort<double>("speed", 0.4, "speed through the doorway [m/s]"),
+            InputPort<double>("wait_timeout", 8.0, "how long to wait for the leaf to open [s]")};
+  }
+  NodeStatus OnStart() override {
+    door_ = Door();
+    pass_ = CalcApproachPass(ctx_, door_);
+    if (!ArmAt(ctx_.motion->arm_target(), kTuckedArm) || ctx_.motion->arm_moving(ctx_.now)) {
+      ctx_.motion->MoveArm({{ctx_.config.arm_tuck_time, kTuckedArm}}, ctx_.now);
+    }
+    yaw_ = std::atan2(-pass_.n_M.y(), -pass_.n_M.x());  // facing through the door
+    entry_distance_ = EntryDistance(ctx_, door_, pass_);
+    const Eigen::Vector2d entry = pass_.centre + pass_.n_M * entry_distance_;
+    const Eigen::Vector2d offset = ctx_.X_MB.translation() - pass_.centre;
+    const double lateral = std::abs(offset.dot(Eigen::Vector2d(-pass_.n_M.y(), pass_.n_M.x())));
+    phase_ = Phase::kWaiting;
+    waiting_since_ = ctx_.now;
+    if (lateral > 0.05 || offset.dot(pass_.n_M) > entry_distance_ + 0.05) {
+      // Straight when the costmap allows (the usual case), else round what is in the way.
+      const Pose2 X_MB_entry{entry.x(), entry.y(), yaw_};
+      // On the side the leaf opens into, out beyond its sweep first, then across to the axis: a
+      // straight line from beside the hinge (a button's standoff) would cut the opening leaf.
+      std::vector<Pose2> line_up{ctx_.X_MB};
+      const double out = offset.dot(pass_.n_M);
+      if (entry_distance_ > ctx_.config.door_entry_distance && out < entry_distance_ - 0.05) {
+        const Eigen::Vector2d p = ctx_.X_MB.translation() + pass_.n_M * (entry_distance_ - out);
+        line_up.push_back({p.x(), p.y(), yaw_});
+      }
+      line_up.push_back(X_MB_entry);
+      if (ctx_.planner->IsPathValid(line_up)) {
+        ctx_.motion->FollowPath(line_up, std::vector<bool>(line_up.size() - 1, true), kTuckedArm,
+                                ctx_.now);
+        Note("lining up on the door's axis");
+      } else {
+        const NodeStatus s = StartPath(
+            ctx_, X_MB_entry, "the door's axis", [this](const std::string& t) { Note(t); }, true);
+        if (s != NodeStatus::kRunning) return s;
+      }
+      phase_ = Phase::kToEntry;
+    }
+    return OnRunning();
+  }
+  NodeStatus OnRunning() override {
+    const auto note = [this](const std::string& t) { Note(t); };
+    switch (phase_) {
+      case Phase::kToEntry: {
+        const NodeStatus s = DriveStatus(ctx_, note, true);
+        if (s != NodeStatus::kSuccess) return s;
+        phase_ = Phase::kWaiting;
+        waiting_since_ = ctx_.now;
+        [[fallthrough]];
+      }
+      case Phase::kWaiting: {
+        if (const NodeStatus arm = ArmMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+            arm != NodeStatus::kSuccess) {
+          return arm;
+        }
+        if (!DoorPassable(ctx_, door_, 0.0)) {
+          if (ToSeconds(ctx_.now - waiting_since_) > Input<double>("wait_timeout")) {
+            Note("the door did not open in time");
+            return NodeStatus::kFailure;
+          }
+          return NodeStatus::kRunning;  // the leaf is still opening
+        }
+        // Through the middle of the clear opening, between the latch jamb and the leaf.
+        const Eigen::Vector2d centre = ClearOpeningCentre();
+        const Eigen::Vector2d exit = centre - pass_.n_M * ExitDistance(ctx_, door_);
+        const Eigen::Vector2d offset = ctx_.X_MB.translation() - centre;
+        std::vector<Pose2> path{ctx_.X_MB};
+        std::vector<bool> through;
+        if (offset.dot(pass_.n_M) > 0.1) {  // square up on the opening's centre line first
+          const Eigen::Vector2d in = centre + pass_.n_M * std::min(offset.dot(pass_.n_M), 0.4);
+          path.push_back({in.x(), in.y(), yaw_});
+          through.push_back(true);
+        }
+        path.push_back({exit.x(), exit.y(), yaw_});
+        through.push_back(true);
+        ctx_.motion->FollowPath(path, through, kTuckedArm, ctx_.now);
+        Note(StrCat("door open: driving through at ", Input<double>("speed"), " m/s"));
+        phase_ = Phase::kThrough;
+        return NodeStatus::kRunning;
+      }
+      case Phase::kThrough: {
+        const NodeStatus s = BaseMotionStatus(ctx_, note);
+        if (s == NodeStatus::kSuccess) {
+          Note("through the door");
+          ctx_.door_approach_side.erase(door_);  // a later traversal may come the other way
+        }
+        return s;
+      }
+    }
+    return NodeStatus::kFailure;
+  }
+  void OnHalted() override { ctx_.motion->StopBase(); }
+
+ private:
+  Eigen::Vector2d ClearOpeningCentre() const {
+    const perception::DoorModel& door = *ctx_.map->FindDoor(door_);
+    double angle = M_PI / 2;
+    for (const auto& d : ctx_.world.doors) {
+      if (d.model.id == door_ && d.state.observed) angle = std::min(d.state.angle, M_PI / 2);
+    }
+    constexpr double kLeafHalfThickness = 0.03;  // [m] with a margin
+    const double w = door.width();
+    const double clear_from = std::min(w, w * std::cos(angle) + kLeafHalfThickness);
+    const Eigen::Vector2d along = (door.p_MLatch - door.p_MHinge) / w;
+    return door.p_MHinge + along * (clear_from + w) / 2;
+  }
+
+  enum class Phase { kToEntry, kWaiting, kThrough };
+  std::string door_;
+  DoorPass pass_;
+  double entry_distance_{0.0};
+  double yaw_{0.0};
+  Phase phase_{Phase::kWaiting};
+  Time waiting_since_{};
+};
+
+}  // namespace
+
+void RegisterDoorNodes(bt::BehaviorTreeFactory& factory, TaskContext* context) {
+  Register<ButtonType>(factory, "ButtonType", context);
+  Register<ApproachButton>(factory, "ApproachButton", context);
+  Register<PressButton>(factory, "PressButton", context);
+  Register<WaveAtPlate>(factory, "WaveAtPlate", context);
+  Register<TraverseDoor>(factory, "TraverseDoor", context);
+}
+
+}  // namespace egress::behavior::detail

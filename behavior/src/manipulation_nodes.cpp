@@ -1,0 +1,463 @@
+#include "task_node_support.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace egress::behavior::detail {
+namespace {
+
+// "x;y;z" → point. @throws InvalidArgument naming the text.
+Eigen::Vector3d ParsePoint3(std::string_view text) {
+  const Pose2 xy = ParsePose2(text);  // x;y;z parses as x;y;yaw
+  return {xy.x, xy.y, xy.yaw};
+}
+
+// Waits (up to `timeout`) for the perception pipeline to confirm a payload of the class, and
+// writes its position.
+class DetectPayload final : public TaskNode<bt::StatefulActionNode> {
+ public:
+  using TaskNode::TaskNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("kind", "bottle or flashlight"),
+            InputPort<double>("timeout", 4.0, "how long to look [s]"),
+            OutputPort<std::string>("pose", "payload position x;y;z in the map")};
+  }
+  NodeStatus OnStart() override {
+    started_ = ctx_.now;
+    return OnRunning();
+  }
+  NodeStatus OnRunning() override {
+    const std::string kind = Input<std::string>("kind");
+    const perception::TrackedObject* best = nullptr;
+    for (const auto& object : ctx_.world.payloads) {
+      if (object.label != kind) continue;
+      if (best == nullptr || (object.p_MO.head<2>() - ctx_.X_MB.translation()).norm() <
+                                 (best->p_MO.head<2>() - ctx_.X_MB.translation()).norm()) {
+        best = &object;
+      }
+    }
+    if (best != nullptr) {
+      this->SetOutput("pose", StrCat(best->p_MO.x(), ";", best->p_MO.y(), ";", best->p_MO.z()));
+      Note(StrCat("found a ", kind, " at (", std::round(best->p_MO.x() * 100) / 100, ", ",
+                  std::round(best->p_MO.y() * 100) / 100, ", ",
+                  std::round(best->p_MO.z() * 100) / 100, ")"));
+      return NodeStatus::kSuccess;
+    }
+    if (ToSeconds(ctx_.now - started_) > Input<double>("timeout")) {
+      Note(StrCat("no ", kind, " in sight"));
+      return NodeStatus::kFailure;
+    }
+    return NodeStatus::kRunning;
+  }
+  void OnHalted() override {}
+
+ private:
+  Time started_{};
+};
+
+constexpr double kGraspDepthInPalm = 0.07;  // grasp centre ahead of the palm [m]
+constexpr double kPreGraspOffset = 0.12;    // pre-grasp / pre-place this far short [m]
+constexpr double kHandError = 0.005;        // [m] a grasp or release this close is good
+
+// The palm target that holds a grasp centre `p_M`, approached along the unit `approach_M`.
+planning::IkTarget PalmTarget(const Eigen::Vector3d& p_M, const Eigen::Vector3d& approach_M) {
+  return {p_M - approach_M * kGraspDepthInPalm, approach_M};
+}
+
+// Where the base stands, and the arm there, for the hand to hold a grasp centre `p_M`
+// approached horizontally along `approach_M` (whole-body IK from 0.6 m short); nullopt if out
+// of reach.
+struct HandReach {
+  Pose2 X_MB;
+  ArmPose arm;
+};
+std::optional<HandReach> SolveHandReach(const TaskContext& ctx, const Eigen::Vector3d& p_M,
+                                        const Eigen::Vector3d& approach_M) {
+  static constexpr ArmPose kReachArm{0.2, -1.0, 0.0, -0.5, 0.0};
+  const Eigen::Vector2d a = approach_M.head<2>();
+  const Eigen::Vector2d base = p_M.head<2>() - a * 0.6;
+  WholeBodyVector q0 = WholeBodyVector::Zero();
+  q0[kBaseX] = base.x();
+  q0[kBaseY] = base.y();
+  q0[kBaseYaw] = std::atan2(a.y(), a.x());
+  q0 = WithArm(q0, kReachArm);
+  planning::IkConfig ik = ctx.config.ik;
+  ik.fingertip = false;
+  ik.use_base = true;
+  const planning::IkResult r =
+      planning::DlsIkSolver(*ctx.model, ik).Solve(PalmTarget(p_M, approach_M), q0);
+  if (!r.converged) return std::nullopt;
+  return HandReach{{r.q[kBaseX], r.q[kBaseY], r.q[kBaseYaw]}, ArmOf(r.q)};
+}
+
+// The unit horizontal direction from the robot to `p_M` (the robot's heading if it is there).
+Eigen::Vector3d HorizontalApproach(const Pose2& X_MB, const Eigen::Vector3d& p_M) {
+  Eigen::Vector2d a = p_M.head<2>() - X_MB.translation();
+  if (a.norm() < 1e-6) a = Eigen::Vector2d(std::cos(X_MB.yaw), std::sin(X_MB.yaw));
+  a.normalize();
+  return {a.x(), a.y(), 0.0};
+}
+
+// How far a payload's centre stands above the surface it rests on [m]: a bottle upright, a
+// flashlight lying; unknown kinds get a middle value.
+double PayloadCentreHeight(std::string_view kind) {
+  if (kind == perception::labels::kBottle) return 0.105;
+  if (kind == perception::labels::kFlashlight) return 0.021;
+  return 0.05;
+}
+
+// The highest depth point standing out of the surface the payload rests on (`surface_z`) in the
+// corridor the hand sweeps horizontally towards a grasp centre `p_M` along `approach_M` (from
+// the pre-grasp to just before the payload, within a hand's width of the line), or nullopt if
+// there is none.
+std::optional<double> ClutterTopBeforeGrasp(const TaskContext& ctx, const Eigen::Vector3d& p_M,
+                                            const Eigen::Vector3d& approach_M,
+                                            double payload_radius, double surface_z) {
+  if (!ctx.depth) return std::nullopt;
+  constexpr double kHandHalfWidth = 0.07;  // [m] fingers open, with a margin
+  constexpr double kFlat = 0.02;           // [m] bumps lower than this are the surface
+  const DepthImage& depth = *ctx.depth;
+  const CameraIntrinsics& K = ctx.depth_intrinsics;
+  const Eigen::Vector2d a = approach_M.head<2>().normalized();
+  std::optional<double> top;
+  for (int v = 0; v < depth.height; ++v) {
+    for (int u = 0; u < depth.width; ++u) {
+      if (!depth.IsValidAt(u, v)) continue;
+      const double z = depth.At(u, v);
+      const Eigen::Vector3d p =
+          ctx.X_MC * Eigen::Vector3d((u + 0.5 - K.cx) / K.fx * z, (v + 0.5 - K.cy) / K.fy * z, z);
+      const Eigen::Vector2d d = p.head<2>() - p_M.head<2>();
+      const double along = d.dot(a);
+      const double lateral = (d - along * a).norm();
+      if (along > -(payload_radius + 0.01) || along < -(kPreGraspOffset + 0.1) ||
+          lateral > kHandHalfWidth || p.z() < surface_z + kFlat) {
+        continue;
+      }
+      top = top ? std::max(*top, p.z()) : p.z();
+    }
+  }
+  return top;
+}
+
+// Grasps a payload seen at `pose`: the base goes where whole-body IK puts it (palm level,
+// approaching horizontally from the robot's side), the arm reaches a pre-grasp 12 cm short, then
+// the grasp, the gripper closes, and the arm lifts 10 cm. Success when the gripper holds it.
+class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
+ public:
+  using TaskNode::TaskNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("pose", "payload position x;y;z"),
+            InputPort<std::string>("kind", "", "bottle or flashlight (how it stands)")};
+  }
+  NodeStatus OnStart() override {
+    const Eigen::Vector3d p_seen = ParsePoint3(Input<std::string>("pose"));
+    approach_ = HorizontalApproach(ctx_.X_MB, p_seen);
+    // The camera sees the near surface; the centre is a radius further.
+    centre_ = p_seen + approach_ * kPayloadRadius;
+    // Something low in front of it (books, a box): grasp higher, so the hand passes above it.
+    const double surface_z = centre_.z() - PayloadCentreHeight(Input<std::string>("kind"));
+    if (const auto top = ClutterTopBeforeGrasp(ctx_, centre_, approach_, kPayloadRadius, surface_z);
+        top && *top + kHandBelowGrasp > centre_.z()) {
+      const double raised = std::min(*top + kHandBelowGrasp, centre_.z() + kMaxGraspRaise);
+      Note(StrCat("something in front of it up to ", std::round(*top * 100) / 100, " m: grasping ",
+                  std::round((raised - centre_.z()) * 100), " cm higher"));
+      centre_.z() = raised;
+    }
+    const auto reach = SolveHandReach(ctx_, centre_, approach_);
+    if (!reach) {
+      Note("no whole-body reach for the grasp");
+      return NodeStatus::kFailure;
+    }
+    grasp_arm_ = reach->arm;
+    X_MB_grasp_ = reach->X_MB;
+    GripperCommand open;
+    open.mode = GripperCommand::Mode::kOpen;
+    ctx_.motion->SetGripper(open);
+    phase_ = Phase::kToBase;
+    return StartPath(ctx_, X_MB_grasp_, "the grasp pose",
+                     [this](const std::string& t) { Note(t); });
+  }
+  NodeStatus OnRunning() override {
+    switch (phase_) {
+      case Phase::kToBase: {
+        const NodeStatus s = BaseMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+        if (s != NodeStatus::kSuccess) return s;
+        // Arm-only from where the base stopped.
+        const auto grasp = SolveArm(ctx_, ctx_.X_MB, PalmTarget(centre_, approach_), grasp_arm_,
+                                    false, kHandError);
+        const auto pre =
+            SolveArm(ctx_, ctx_.X_MB, PalmTarget(centre_ - approach_ * kPreGraspOffset, approach_),
+                     grasp ? *grasp : grasp_arm_, false, kHandError);
+        if (!grasp || !pre) {
+          Note("the payload is out of the arm's reach from here");
+          return NodeStatus::kFailure;
+        }
+        ctx_.motion->MoveArm({{2.0, *pre}, {3.5, *grasp}}, ctx_.now);
+        lifted_ = *grasp;
+        lifted_[0] += 0.10;  // arm_lift
+        phase_ = Phase::kReach;
+        Note("reaching for the payload");
+        return NodeStatus::kRunning;
+      }
+      case Phase::kReach: {
+        if (const NodeStatus arm = ArmMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+            arm != NodeStatus::kSuccess) {
+          return arm;
+        }
+        GripperCommand close;
+        close.mode = GripperCommand::Mode::kGrasp;
+        close.effort = 10.0;
+        ctx_.motion->SetGripper(close);
+        closing_since_ = ctx_.now;
+        phase_ = Phase::kClose;
+        return NodeStatus::kRunning;
+      }
+      case Phase::kClose: {
+        if (ToSeconds(ctx_.now - closing_since_) < 1.5) return NodeStatus::kRunning;
+        // Lift, then fold the arm over the base at that height: the hand rises on its arc,
+        // clear of what the payload stood among (a straight tuck in joint space would lower
+        // the lift while folding and drag the payload through it). The tuck that follows only
+        // lowers the lift.
+        ArmPose folded = kTuckedArm;
+        folded[0] = lifted_[0];
+        ctx_.motion->MoveArm({{1.0, lifted_}, {1.0 + ctx_.config.arm_tuck_time, folded}}, ctx_.now);
+        phase_ = Phase::kLift;
+        return NodeStatus::kRunning;
+      }
+      case Phase::kLift: {
+        if (const NodeStatus arm = ArmMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+            arm != NodeStatus::kSuccess) {
+          return arm;
+        }
+        if (!ctx_.holding_object) {
+          Note("the gripper closed on nothing");
+          return NodeStatus::kFailure;
+        }
+        Note("holding the payload");
+        return NodeStatus::kSuccess;
+      }
+    }
+    return NodeStatus::kFailure;
+  }
+  void OnHalted() override { ctx_.motion->StopBase(); }
+
+ private:
+  static constexpr double kPayloadRadius = 0.03;   // [m] a bottle's, about
+  static constexpr double kHandBelowGrasp = 0.06;  // [m] the hand's lowest point, with margin
+  static constexpr double kMaxGraspRaise = 0.06;   // [m] still on the payload's body
+  enum class Phase { kToBase, kReach, kClose, kLift };
+  Phase phase_{Phase::kToBase};
+  Eigen::Vector3d approach_{Eigen::Vector3d::UnitX()};
+  Eigen::Vector3d centre_{Eigen::Vector3d::Zero()};
+  ArmPose grasp_arm_{kTuckedArm}, lifted_{kTuckedArm};
+  Pose2 X_MB_grasp_;
+  Time closing_since_{};
+};
+
+// Lets go of the held payload where the hand takes it: the base goes where whole-body IK puts
+// it, the arm carries the payload in from 12 cm short (and a little higher), waits until
+// ReadyToRelease, opens the gripper, draws back and tucks. Success when the gripper is empty.
+class ReleaseAction : public TaskNode<bt::StatefulActionNode> {
+ public:
+  using TaskNode::TaskNode;
+  NodeStatus OnStart() override {
+    if (!ctx_.holding_object) {
+      Note("not holding a payload");
+      return NodeStatus::kFailure;
+    }
+    const auto target = ReleaseTarget();
+    if (!target) return NodeStatus::kFailure;
+    centre_ = *target;
+    approach_ = HorizontalApproach(ctx_.X_MB, centre_);
+    approaches_ = 0;
+    return DriveToReach();
+  }
+  NodeStatus OnRunning() override {
+    switch (phase_) {
+      case Phase::kToBase: {
+        const NodeStatus s = BaseMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+        if (s != NodeStatus::kSuccess) return s;
+        const auto at = SolveArm(ctx_, ctx_.X_MB, PalmTarget(centre_, approach_), release_arm_,
+                                 false, kHandError);
+        const Eigen::Vector3d p_pre =
+            centre_ - approach_ * kPreGraspOffset + Eigen::Vector3d(0, 0, kPreReleaseRise);
+        const auto pre = SolveArm(ctx_, ctx_.X_MB, PalmTarget(p_pre, approach_),
+                                  at ? *at : release_arm_, false, kHandError);
+        if (!at || !pre) {
+          // The base stopped a little off the planned pose: plan the reach again from here.
+          Note("the release point is out of the arm's reach from here");
+          return approaches_ < kMaxApproaches ? DriveToReach() : NodeStatus::kFailure;
+        }
+        pre_arm_ = *pre;
+        ctx_.motion->MoveArm({{2.0, *pre}, {3.5, *at}}, ctx_.now);
+        phase_ = Phase::kReach;
+        waiting_since_ = ctx_.now;
+        return NodeStatus::kRunning;
+      }
+      case Phase::kReach: {
+        if (const NodeStatus arm = ArmMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+            arm != NodeStatus::kSuccess) {
+          return arm;
+        }
+        const Release release = ReadyToRelease(centre_);
+        if (release == Release::kGiveUp) return NodeStatus::kFailure;  // still holding it
+        if (release == Release::kWait) return NodeStatus::kRunning;
+        GripperCommand open;
+        open.mode = GripperCommand::Mode::kOpen;
+        ctx_.motion->SetGripper(open);
+        opened_at_ = ctx_.now;
+        phase_ = Phase::kOpen;
+        return NodeStatus::kRunning;
+      }
+      case Phase::kOpen: {
+        if (ToSeconds(ctx_.now - opened_at_) < kOpenTime) return NodeStatus::kRunning;
+        ctx_.motion->MoveArm({{1.5, pre_arm_}, {1.5 + ctx_.config.arm_tuck_time, kTuckedArm}},
+                             ctx_.now);
+        phase_ = Phase::kWithdraw;
+        return NodeStatus::kRunning;
+      }
+      case Phase::kWithdraw: {
+        if (const NodeStatus arm = ArmMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+            arm != NodeStatus::kSuccess) {
+          return arm;
+        }
+        if (ctx_.holding_object) {
+          Note("the payload is still in the gripper");
+          return NodeStatus::kFailure;
+        }
+        Note("let go of the payload");
+        return NodeStatus::kSuccess;
+      }
+    }
+    return NodeStatus::kFailure;
+  }
+  void OnHalted() override { ctx_.motion->StopBase(); }
+
+ protected:
+  // Where the payload's centre goes when released [m, M] (approached from where the robot is
+  // now); nullopt (with a note) if there is none.
+  virtual std::optional<Eigen::Vector3d> ReleaseTarget() = 0;
+  enum class Release { kWait, kNow, kGiveUp };
+  // Whether to let go now, the payload being held at `p_M_payload`.
+  virtual Release ReadyToRelease(const Eigen::Vector3d& /*p_M_payload*/) { return Release::kNow; }
+  Time waiting_since() const { return waiting_since_; }
+
+ private:
+  static constexpr double kPreReleaseRise = 0.05;  // [m] the payload comes in from above
+  static constexpr int kMaxApproaches = 3;
+
+  NodeStatus DriveToReach() {
+    ++approaches_;
+    const auto reach = SolveHandReach(ctx_, centre_, approach_);
+    if (!reach) {
+      Note("no whole-body reach for the release point");
+      return NodeStatus::kFailure;
+    }
+    release_arm_ = reach->arm;
+    phase_ = Phase::kToBase;
+    const NodeStatus s =
+        StartPath(ctx_, reach->X_MB, "the release pose", [this](const std::string& t) { Note(t); });
+    return s == NodeStatus::kSuccess ? OnRunning() : s;  // already there: reach now
+  }
+  int approaches_{0};
+  static constexpr double kOpenTime = 1.0;  // [s] for the fingers to open
+  enum class Phase { kToBase, kReach, kOpen, kWithdraw };
+  Phase phase_{Phase::kToBase};
+  Eigen::Vector3d centre_{Eigen::Vector3d::Zero()};
+  Eigen::Vector3d approach_{Eigen::Vector3d::UnitX()};
+  ArmPose release_arm_{kTuckedArm}, pre_arm_{kTuckedArm};
+  Time waiting_since_{}, opened_at_{};
+};
+
+// Places the held payload on a surface: `pose` is where its centre goes (the surface height
+// plus half the payload's height plus a centimetre or so, which it drops).
+class PlacePayload final : public ReleaseAction {
+ public:
+  using ReleaseAction::ReleaseAction;
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("pose", "payload centre x;y;z in the map when let go [m]")};
+  }
+
+ private:
+  std::optional<Eigen::Vector3d> ReleaseTarget() override {
+    return ParsePoint3(Input<std::string>("pose"));
+  }
+};
+
+// Hands the held payload to a responder standing near `pose`: the robot holds it out at
+// hand height toward the nearest person tracked within `search_radius` of it and lets go once
+// that person stands within `reach` of the payload (the twin has no hands: there the payload
+// drops at the person's feet; on the robot a wrist-force pull would be the cue).
+class HandOver final : public ReleaseAction {
+ public:
+  using ReleaseAction::ReleaseAction;
+  static PortsList ProvidedPorts() {
+    return {
+        InputPort<std::string>("pose", "where the responder is expected x;y[;yaw]"),
+        InputPort<double>("search_radius", 1.5, "person this close to pose is the recipient [m]"),
+        InputPort<double>("hand_height", 0.9, "payload held out at this height [m]"),
+        InputPort<double>("reach", 0.8, "recipient this close to the payload takes it [m]"),
+        InputPort<double>("timeout", 20.0, "how long to hold it out [s]")};
+  }
+
+ private:
+  std::optional<Eigen::Vector3d> ReleaseTarget() override {
+    const Pose2 expected = ParsePose2(Input<std::string>("pose"));
+    const auto* recipient = Recipient(expected.translation());
+    if (recipient == nullptr) {
+      Note("no responder in sight near " + PoseText(expected));
+      return std::nullopt;
+    }
+    // Held out half-way between a comfortable standoff and the person.
+    const Eigen::Vector2d p_MP = recipient->person.p_MP;
+    Eigen::Vector2d to_robot = ctx_.X_MB.translation() - p_MP;
+    if (to_robot.norm() < 1e-6) to_robot = Eigen::Vector2d::UnitX();
+    const Eigen::Vector2d p = p_MP + to_robot.normalized() * kOfferDistance;
+    const Eigen::Vector3d centre(p.x(), p.y(), Input<double>("hand_height"));
+    Note(StrCat("holding it out to the responder at ", PoseText({p_MP.x(), p_MP.y(), 0.0})));
+    return centre;
+  }
+  Release ReadyToRelease(const Eigen::Vector3d& p_M_payload) override {
+    const Pose2 expected = ParsePose2(Input<std::string>("pose"));
+    const auto* recipient = Recipient(expected.translation());
+    if (recipient != nullptr &&
+        (recipient->person.p_MP - p_M_payload.head<2>()).norm() < Input<double>("reach")) {
+      Note(StrCat("the responder is within reach (at ",
+                  PoseText({recipient->person.p_MP.x(), recipient->person.p_MP.y(), 0.0}),
+                  "): letting go"));
+      return Release::kNow;
+    }
+    if (ToSeconds(ctx_.now - waiting_since()) > Input<double>("timeout")) {
+      Note("nobody took the payload in time");
+      return Release::kGiveUp;
+    }
+    return Release::kWait;
+  }
+  const perception::TrackedPersonWithIntent* Recipient(const Eigen::Vector2d& expected) const {
+    const perception::TrackedPersonWithIntent* best = nullptr;
+    double best_distance = Input<double>("search_radius");
+    for (const auto& entry : ctx_.world.people) {
+      const double d = (entry.person.p_MP - expected).norm();
+      if (d <= best_distance) {
+        best = &entry;
+        best_distance = d;
+      }
+    }
+    return best;
+  }
+  static constexpr double kOfferDistance =
+      0.3;  // [m] payload from the person (as tracked: its near side)
+};
+
+}  // namespace
+
+void RegisterManipulationNodes(bt::BehaviorTreeFactory& factory, TaskContext* context) {
+  Register<DetectPayload>(factory, "DetectPayload", context);
+  Register<GraspPayload>(factory, "GraspPayload", context);
+  Register<PlacePayload>(factory, "PlacePayload", context);
+  Register<HandOver>(factory, "HandOver", context);
+}
+
+}  // namespace egress::behavior::detail

@@ -1,0 +1,187 @@
+#include "task_node_support.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace egress::behavior::detail {
+
+bool ArmAt(const ArmPose& a, const ArmPose& b) {
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    if (std::abs(a[i] - b[i]) > kArmTolerance) return false;
+  }
+  return true;
+}
+
+std::string PoseText(const Pose2& X) {
+  return StrCat(std::round(X.x * 100) / 100, ", ", std::round(X.y * 100) / 100);
+}
+
+// Starts a base motion along a planned path; RUNNING until it ends.
+// Plans from the robot to `goal` on the costmap and starts following the path; `door_speed`
+// runs every segment at the door speed (a door approach inside the hold window).
+NodeStatus StartPath(TaskContext& ctx, const Pose2& goal, const std::string& what,
+                     const std::function<void(const std::string&)>& note, bool door_speed) {
+  planning::PlanResult plan = ctx.planner->Plan(ctx.X_MB, goal);
+  if (plan.status == planning::PlanStatus::kStartInCollision) {
+    // The robot stands where the costmap says it cannot (inflation around a leaf, a person seen
+    // close by, an obstacle it brushed): step to the nearest free pose — never across an
+    // obstacle cell — preferring the goal's direction, and plan from there.
+    const Eigen::Vector2d towards = (goal.translation() - ctx.X_MB.translation()).normalized();
+    const double heading = std::atan2(towards.y(), towards.x());
+    const perception::Costmap2D& costmap = *ctx.world.costmap;
+    bool escaped = false;
+    for (double step = 0.05; step <= 0.6 && !escaped; step += 0.05) {
+      for (int k = 0; k < 16 && !escaped; ++k) {
+        // 0, +22.5°, -22.5°, +45°, ... around the goal's direction.
+        const double a = heading + (k % 2 == 0 ? 1 : -1) * ((k + 1) / 2) * M_PI / 8;
+        const Eigen::Vector2d d(std::cos(a), std::sin(a));
+        const Eigen::Vector2d p = ctx.X_MB.translation() + d * step;
+        const Pose2 escape{p.x(), p.y(), ctx.X_MB.yaw};
+        if (!ctx.planner->IsValid(escape)) continue;
+        bool crosses = false;
+        for (double s = 0.02; s < step && !crosses; s += 0.02)
+          crosses = costmap.CostAt(ctx.X_MB.translation() + d * s) >= perception::kLethalCost;
+        if (crosses) continue;
+        planning::PlanResult rest = ctx.planner->Plan(escape, goal);
+        if (!rest.ok()) continue;
+        rest.path.insert(rest.path.begin(), ctx.X_MB);
+        rest.length += step;
+        plan = rest;
+        escaped = true;
+      }
+    }
+  }
+  if (!plan.ok()) {
+    note(StrCat("no path to ", what, " (", PoseText(goal), "): ", plan.message));
+    return NodeStatus::kFailure;
+  }
+  const std::vector<bool> through(plan.path.size() > 0 ? plan.path.size() - 1 : 0, door_speed);
+  if (plan.path.size() < 2 ||
+      (plan.path.back().translation() - ctx.X_MB.translation()).norm() < 0.01) {
+    return NodeStatus::kSuccess;  // already there
+  }
+  // The base is holonomic: turn from the start yaw to the goal yaw evenly along the path
+  // rather than through the planner's intermediate headings.
+  std::vector<Pose2> path = plan.path;
+  path.front().yaw = ctx.X_MB.yaw;
+  const double turn = std::remainder(goal.yaw - ctx.X_MB.yaw, 2 * M_PI);
+  double travelled = 0.0;
+  for (std::size_t i = 1; i < path.size(); ++i) {
+    travelled += (path[i].translation() - path[i - 1].translation()).norm();
+    const double fraction = plan.length > 0 ? std::min(1.0, travelled / plan.length) : 1.0;
+    path[i].yaw = ctx.X_MB.yaw + turn * fraction;
+  }
+  ctx.motion->FollowPath(path, through, ctx.motion->arm_target(), ctx.now);
+  note(StrCat("driving to ", what, " (", PoseText(goal), ", ", std::round(plan.length * 100) / 100,
+              " m)"));
+  return NodeStatus::kRunning;
+}
+
+NodeStatus BaseMotionStatus(const TaskContext& ctx,
+                            const std::function<void(const std::string&)>& note) {
+  if (ctx.motion->base_failed()) {
+    note("stopped: " + ctx.motion->base_failure());
+    return NodeStatus::kFailure;
+  }
+  return ctx.motion->base_moving() ? NodeStatus::kRunning : NodeStatus::kSuccess;
+}
+
+// The arm motion under way: running while the joints travel, failure (with the joint that
+// stopped short) when they did not arrive in time, success once they are at the target.
+NodeStatus ArmMotionStatus(const TaskContext& ctx,
+                           const std::function<void(const std::string&)>& note) {
+  if (ctx.motion->arm_moving(ctx.now)) return NodeStatus::kRunning;
+  if (ctx.motion->arm_failed()) {
+    note(ctx.motion->arm_failure());
+    return NodeStatus::kFailure;
+  }
+  return NodeStatus::kSuccess;
+}
+
+// The next kPathLookahead metres of the path being followed cross lethal or inscribed cost.
+bool IsPathAheadBlocked(const TaskContext& ctx) {
+  const std::vector<Pose2>& path = ctx.motion->path();
+  if (path.size() < 2) return false;
+  // From the waypoint segment nearest the robot on.
+  std::size_t next = 1;
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 1; i < path.size(); ++i) {
+    const Eigen::Vector2d a = path[i - 1].translation(), b = path[i].translation();
+    const Eigen::Vector2d ab = b - a;
+    const double t =
+        ab.squaredNorm() > 0
+            ? std::clamp((ctx.X_MB.translation() - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0)
+            : 0.0;
+    const double d = (a + t * ab - ctx.X_MB.translation()).norm();
+    if (d < best) {
+      best = d;
+      next = i;
+    }
+  }
+  std::vector<Pose2> ahead{ctx.X_MB};
+  double length = 0.0;
+  for (std::size_t i = next; i < path.size() && length < kPathLookahead; ++i) {
+    const Eigen::Vector2d step = path[i].translation() - ahead.back().translation();
+    const double remaining = kPathLookahead - length;
+    if (step.norm() > remaining) {
+      const Eigen::Vector2d p = ahead.back().translation() + step.normalized() * remaining;
+      ahead.push_back({p.x(), p.y(), path[i].yaw});
+      break;
+    }
+    ahead.push_back(path[i]);
+    length += step.norm();
+  }
+  if (ahead.size() < 2) return false;
+  // Starting inside inflation (e.g. beside a door) is not a new blockage: test from the
+  // first free pose on.
+  return ctx.planner->IsValid(ctx.X_MB) && !ctx.planner->IsPathValid(ahead);
+}
+
+// BaseMotionStatus for a planned drive: when the path ahead becomes blocked on the costmap (an
+// obstacle the map does not show, seen only once the robot is on its way), plan again to the
+// same end pose instead of driving into it.
+NodeStatus DriveStatus(TaskContext& ctx, const std::function<void(const std::string&)>& note,
+                       bool door_speed) {
+  if (ctx.motion->base_moving() && !ctx.motion->bug_active() && IsPathAheadBlocked(ctx)) {
+    const Pose2 goal = ctx.motion->path().back();
+    ctx.motion->StopBase();
+    note("the path ahead is blocked: planning again");
+    const NodeStatus s = StartPath(ctx, goal, "the same pose", note, door_speed);
+    if (s != NodeStatus::kRunning) return s;
+  }
+  return BaseMotionStatus(ctx, note);
+}
+
+// Arm-only IK at the current base pose (the base stays where it stopped). A solve that ends
+// within `accept_error` of the target counts (0: only a converged one; DLS with the paper's
+// damping creeps over the last millimetres, which a grasp does not need).
+std::optional<ArmPose> SolveArm(const TaskContext& ctx, const Pose2& X_MB,
+                                const planning::IkTarget& target, const ArmPose& from,
+                                bool fingertip, double accept_error) {
+  planning::IkConfig ik = ctx.config.ik;
+  ik.fingertip = fingertip;
+  ik.use_base = false;
+  WholeBodyVector q = WholeBodyVector::Zero();
+  q[kBaseX] = X_MB.x;
+  q[kBaseY] = X_MB.y;
+  q[kBaseYaw] = X_MB.yaw;
+  q = WithArm(q, from);
+  const planning::DlsIkSolver solver(*ctx.model, ik);
+  const auto good = [&](const planning::IkResult& r) {
+    return r.converged || (r.position_error <= accept_error &&
+                           r.orientation_error <= ctx.config.ik.orientation_tolerance);
+  };
+  planning::IkResult r = solver.Solve(target, q);
+  if (!good(r) && target.approach_M) {
+    // With the base a little off its planned pose the arm alone may not hold the approach
+    // axis too: the position is what presses.
+    planning::IkTarget position_only = target;
+    position_only.approach_M.reset();
+    r = solver.Solve(position_only, q);
+  }
+  if (!good(r)) return std::nullopt;
+  return ArmOf(r.q);
+}
+
+}  // namespace egress::behavior::detail

@@ -1,0 +1,110 @@
+#pragma once
+// Internal to behavior/src: what the task-node families share — the TaskNode base, motion and
+// path helpers, arm IK at a fixed base, the door constants — and each family's registration.
+// Not installed; the public face is egress/behavior/task_nodes.h.
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <type_traits>
+
+#include "egress/behavior/door_rules.h"
+#include "egress/behavior/task_context.h"
+#include "egress/behavior/task_nodes.h"
+#include "egress/bt/factory.h"
+#include "egress/hsr_interface/error.h"
+
+namespace egress::behavior::detail {
+
+using bt::InputPort;
+using bt::NodeConfig;
+using bt::NodeStatus;
+using bt::OutputPort;
+using bt::PortsList;
+using NoteFn = std::function<void(const std::string&)>;
+
+inline constexpr double kArmTolerance = 0.02;        ///< [rad or m] the arm counts as at a pose
+inline constexpr double kPathLookahead = 1.5;        ///< [m] of the path ahead checked for blockage
+inline constexpr double kDoorSeenRecentlySec = 0.5;  // [s] a door estimate this fresh is "now"
+inline constexpr double kLeafClearance = 0.15;  // [m] kept between the footprint and a leaf's sweep
+// [s] A low-energy ADA operator takes at least this long to open (ANSI A156.19: >= 3 s to the
+// back check), and at most about the second: the hold window starts in between.
+inline constexpr double kOperatorMinOpeningTime = 3.0;
+inline constexpr double kOperatorOpeningTime = 4.0;
+// [rad/s] The fastest a low-energy operator may close its door (A156.19: no less than 3 s from
+// 90° to 10°).
+inline constexpr double kOperatorMaxClosingRate = (80.0 * M_PI / 180.0) / 3.0;
+
+bool ArmAt(const ArmPose& a, const ArmPose& b);
+std::string PoseText(const Pose2& X);
+
+// Base for the nodes: access to the context and typed inputs that fail the node loudly.
+template <typename Base>
+class TaskNode : public Base {
+ public:
+  TaskNode(const std::string& name, NodeConfig config, TaskContext* context)
+      : Base(name, std::move(config)), ctx_(*context) {}
+
+ protected:
+  template <typename T>
+  T Input(std::string_view port) const {
+    auto value = this->template GetInput<T>(port);
+    if (!value) throw InvalidArgument(value.error());
+    return *value;
+  }
+  std::string Door() const { return Input<std::string>("door"); }
+  void Note(const std::string& text) const {
+    ctx_.Note(StrCat(this->name().empty() ? this->registration_id() : this->name(), ": ", text));
+  }
+  TaskContext& ctx_;
+};
+
+/// Plans from the robot to `goal` on the costmap and starts following the path; `door_speed`
+/// runs every segment at the door speed (a door approach inside the hold window). RUNNING while
+/// the base moves, SUCCESS if already there, FAILURE (noted) without a path.
+NodeStatus StartPath(TaskContext& ctx, const Pose2& goal, const std::string& what,
+                     const NoteFn& note, bool door_speed = false);
+/// The base motion under way: RUNNING, SUCCESS when it ended, FAILURE (noted) when the
+/// watchdog stopped it.
+NodeStatus BaseMotionStatus(const TaskContext& ctx, const NoteFn& note);
+/// The arm motion under way: RUNNING while the joints travel, FAILURE (the joint that stopped
+/// short, noted) when they did not arrive in time, SUCCESS once they are at the target.
+NodeStatus ArmMotionStatus(const TaskContext& ctx, const NoteFn& note);
+/// The next kPathLookahead metres of the path being followed cross lethal or inscribed cost.
+bool IsPathAheadBlocked(const TaskContext& ctx);
+/// BaseMotionStatus for a planned drive that plans again when the path ahead becomes blocked.
+NodeStatus DriveStatus(TaskContext& ctx, const NoteFn& note, bool door_speed = false);
+/// Arm-only IK at a fixed base pose; `accept_error` [m] accepts a solve that ends this close.
+std::optional<ArmPose> SolveArm(const TaskContext& ctx, const Pose2& X_MB,
+                                const planning::IkTarget& target, const ArmPose& from,
+                                bool fingertip, double accept_error = 0.0);
+/// Far enough past the door line that the closing leaf cannot reach the footprint [m].
+double ExitDistance(const TaskContext& ctx, const std::string& door);
+/// How far before the door line the robot lines up and waits [m].
+double EntryDistance(const TaskContext& ctx, const std::string& door, const DoorPass& pass);
+
+/// Registers node type T under `id` with its ports; its nodes share `context`.
+template <typename T>
+void Register(bt::BehaviorTreeFactory& factory, const std::string& id, TaskContext* context) {
+  bt::NodeManifest manifest;
+  manifest.id = id;
+  if constexpr (std::is_base_of_v<bt::ConditionNode, T>) {
+    manifest.kind = bt::NodeKind::kCondition;
+  } else {
+    manifest.kind = bt::NodeKind::kAction;
+  }
+  manifest.ports = T::ProvidedPorts();
+  factory.RegisterBuilder(std::move(manifest), [context](const std::string& name, NodeConfig c) {
+    return std::make_unique<T>(name, std::move(c), context);
+  });
+}
+
+// Each family registers its own nodes (condition_nodes.cpp, navigation_nodes.cpp,
+// door_nodes.cpp, manipulation_nodes.cpp).
+void RegisterConditionNodes(bt::BehaviorTreeFactory& factory, TaskContext* context);
+void RegisterNavigationNodes(bt::BehaviorTreeFactory& factory, TaskContext* context);
+void RegisterDoorNodes(bt::BehaviorTreeFactory& factory, TaskContext* context);
+void RegisterManipulationNodes(bt::BehaviorTreeFactory& factory, TaskContext* context);
+
+}  // namespace egress::behavior::detail
