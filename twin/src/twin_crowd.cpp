@@ -1,0 +1,229 @@
+#include "twin_world_impl.h"
+
+namespace egress::twin {
+
+void TwinWorld::Impl::BuildPeople() {
+  std::mt19937_64 rng(DeriveSeed(seed, 4));
+  // Its own stream: a scenario without the range draws exactly what it drew before.
+  std::mt19937_64 hold_rng(DeriveSeed(seed, 5));
+  const auto& r = scenario.randomize;
+  for (const auto& spec : scenario.people) {
+    const int count = spec.behavior == PersonBehavior::kEvacuate ? spec.count : 1;
+    const int columns = int(std::ceil(std::sqrt(double(count))));
+    for (int k = 0; k < count; ++k) {
+      Person p;
+      p.state.name = count == 1 ? spec.name : spec.name + "_" + std::to_string(k);
+      p.state.behavior = spec.behavior;
+      p.state.radius = spec.radius;
+      p.state.phase = "waiting";
+      // A group stands in a grid around its start, 2.2 radii apart.
+      Eigen::Vector2d offset = Eigen::Vector2d::Zero();
+      if (count > 1) {
+        offset = Eigen::Vector2d((k % columns) - (columns - 1) / 2.0,
+                                 (k / columns) - (columns - 1) / 2.0) *
+                 2.2 * spec.radius;
+      }
+      p.walker.position = spec.start + offset;
+      p.walker.radius = spec.radius;
+      p.walker.desired_speed = 0.0;
+      p.walker.target = p.walker.position;
+      p.speed = spec.speed.Sample(rng) * r.person_speed_scale.Sample(rng);
+      p.trigger = spec.trigger;
+      p.trigger_delay = r.person_delay_s.Sample(rng) + (count > 1 ? 0.3 * k : 0.0);
+      p.door = spec.door.empty() ? -1 : FindDoor(spec.door);
+      p.hold_angle = spec.hold_angle_deg * kDegToRad;
+      if (spec.behavior == PersonBehavior::kHoldDoor && r.hold_angle_deg.max > 0.0)
+        p.hold_angle = r.hold_angle_deg.Sample(hold_rng) * kDegToRad;
+      p.hold_duration = spec.hold_duration;
+      p.state.position = p.walker.position;
+      BuildRoute(spec, &p);
+      const int e = AddEntity(EntityKind::kPerson, p.state.name, int(people.size()));
+      const Pose3 X_W(
+          Eigen::Vector3d(p.walker.position.x(), p.walker.position.y(), kPersonHeight / 2));
+      p.body =
+          AddBody(std::make_unique<btCapsuleShapeZ>(spec.radius, kPersonHeight - 2 * spec.radius),
+                  X_W, 0.0, kGPerson, kMaskPerson, e);
+      MakeKinematic(p.body);
+      people.push_back(std::move(p));
+      states_cache.push_back(people.back().state);
+    }
+  }
+}
+
+int TwinWorld::Impl::FindDoor(const std::string& name) const {
+  for (std::size_t i = 0; i < world.doors.size(); ++i) {
+    if (world.doors[i].name == name) return int(i);
+  }
+  return -1;
+}
+
+void TwinWorld::Impl::BuildRoute(const PersonSpec& spec, Person* p) {
+  const Eigen::Vector2d start = p->walker.position;
+  auto through_door = [&](int door_index) {
+    const Door& d = doors[door_index];
+    const double side = (start - d.centre).dot(d.normal) >= 0 ? 1.0 : -1.0;
+    // People keep right: wait and leave kKeepRight to the right of the doorway's axis, so two
+    // walkers crossing in opposite directions do not meet head-on at its ends.
+    const Eigen::Vector2d heading = -d.normal * side;
+    const Eigen::Vector2d right(heading.y(), -heading.x());
+    p->route.push_back(d.centre - heading * 1.0 + right * kKeepRight);
+    p->wait_before_waypoint = int(p->route.size());
+    p->route.push_back(d.centre);
+    p->route.push_back(d.centre + heading * 1.0 + right * kKeepRight);
+  };
+  switch (spec.behavior) {
+    case PersonBehavior::kCrossDoorway:
+    case PersonBehavior::kEvacuate:
+      for (const auto& v : spec.via)
+        p->route.push_back(v);
+      through_door(p->door);
+      p->route.push_back(spec.goal);
+      break;
+    case PersonBehavior::kHoldDoor: {
+      const Door& d = doors[p->door];
+      const double side = (start - d.centre).dot(d.normal) >= 0 ? 1.0 : -1.0;
+      // Beside the hinge jamb on the person's side, out of the doorway.
+      p->route.push_back(d.desc->p_WH.head<2>() - d.along * 0.45 + d.normal * side * 0.45);
+      break;
+    }
+    case PersonBehavior::kWalkPast:
+    case PersonBehavior::kApproachAndWait:
+      for (const auto& v : spec.via)
+        p->route.push_back(v);
+      p->route.push_back(spec.goal);
+      break;
+  }
+}
+
+void TwinWorld::Impl::UpdatePeople() {
+  const Pose2 X_WB = RobotPose();
+  for (auto& p : people) {
+    if (!p.state.started) {
+      bool go = false;
+      switch (p.trigger.kind) {
+        case TriggerSpec::Kind::kImmediately:
+          go = time >= p.trigger_delay;
+          break;
+        case TriggerSpec::Kind::kAtTime:
+          go = time >= p.trigger.value + p.trigger_delay;
+          break;
+        case TriggerSpec::Kind::kRobotWithin:
+          go = (X_WB.translation() - p.walker.position).norm() <= p.trigger.value;
+          break;
+        case TriggerSpec::Kind::kEvent:
+          go = HasEvent(p.trigger.event);
+          break;
+      }
+      if (go) {
+        p.state.started = true;
+        p.state.phase = "walking";
+        AddEvent("person_started", p.state.name);
+      }
+      continue;
+    }
+    if (p.state.phase == "holding") {
+      if (time - p.hold_started >= p.hold_duration) {
+        p.state.phase = "walking";
+        AddEvent("person_released_door", p.state.name, doors[p.door].desc->name);
+        const PersonSpec* spec = FindSpec(p.state.name);
+        if (spec != nullptr && (spec->goal - p.walker.position).norm() > 0.3)
+          p.route.push_back(spec->goal);
+      }
+      continue;
+    }
+    if (p.state.phase == "standing") {
+      if (p.state.behavior == PersonBehavior::kApproachAndWait && p.wait_started >= 0 &&
+          time - p.wait_started >= p.hold_duration && p.hold_duration > 0) {
+        p.state.phase = "done";
+      }
+      continue;
+    }
+    if (p.route.empty()) {
+      p.walker.desired_speed = 0.0;
+      if (p.state.behavior == PersonBehavior::kHoldDoor && p.hold_started < 0) {
+        p.state.phase = "holding";
+        p.hold_started = time;
+        AddEvent("person_holding_door", p.state.name, doors[p.door].desc->name);
+      } else if (p.state.phase != "done") {
+        p.state.phase = p.state.behavior == PersonBehavior::kApproachAndWait ? "standing" : "done";
+        if (p.wait_started < 0) p.wait_started = time;
+      }
+      continue;
+    }
+    // Wait in front of a door that is not open enough.
+    p.walker.target = p.route.front();
+    p.walker.final_target = p.route.size() == 1;
+    p.walker.desired_speed = p.speed;
+    if (p.door >= 0 && p.wait_before_waypoint >= 0 && PendingDoorWaypoint(p) &&
+        (doors[p.door].angle < config.door_crossed_open_angle_deg * kDegToRad || DoorwayTaken(p))) {
+      p.state.phase = "waiting_for_door";
+      p.walker.desired_speed = 0.0;
+    } else if (p.state.phase == "waiting_for_door") {
+      p.state.phase = "walking";
+    }
+    // Pushed against a jamb (a social-force local minimum, e.g. after making way for the
+    // robot), a walker heading for the doorway steps back onto the door's axis and goes again.
+    const bool heading_for_doorway =
+        p.door >= 0 && p.reached == p.wait_before_waypoint && p.state.phase == "walking";
+    p.stuck_for = heading_for_doorway && p.walker.velocity.norm() < 0.05 ? p.stuck_for + dt : 0.0;
+    if (p.stuck_for > kStuckSec && !p.realigned) {
+      const Door& d = doors[std::size_t(p.door)];
+      const double side = (p.walker.position - d.centre).dot(d.normal) >= 0 ? 1.0 : -1.0;
+      p.route.insert(p.route.begin(), d.centre + d.normal * side * 0.8);
+      --p.reached;  // the doorway centre stays the next waypoint after this one
+      p.realigned = true;
+      p.stuck_for = 0.0;
+      p.walker.target = p.route.front();
+      p.walker.final_target = false;
+    }
+    const double reached_radius = p.route.size() == 1 ? 0.25 : 0.4;
+    if ((p.walker.position - p.route.front()).norm() < reached_radius &&
+        p.state.phase != "waiting_for_door") {
+      p.route.erase(p.route.begin());
+      ++p.reached;
+    }
+  }
+  // Social forces: the robot is a disc to avoid; door leaves are walls.
+  std::vector<Walker> walkers;
+  walkers.reserve(people.size());
+  for (const auto& p : people)
+    walkers.push_back(p.walker);
+  std::vector<WallSegment> all_walls = walls;
+  for (const auto& d : doors) {
+    all_walls.push_back({d.desc->p_WH.head<2>(), d.desc->CalcFreeEdge(d.angle).head<2>()});
+  }
+  const Twist2 V_B = RobotVelocity();
+  const Eigen::Vector2d v_W = X_WB.rotation() * Eigen::Vector2d(V_B.vx, V_B.vy);
+  const std::vector<DiscObstacle> discs = {{X_WB.translation(), v_W, robot_radius}};
+  // Standing people do not integrate (they would drift under wall forces).
+  sfm.Step(&walkers, discs, all_walls, dt);
+  for (std::size_t i = 0; i < people.size(); ++i) {
+    Person& p = people[i];
+    if (!p.state.started) continue;
+    p.walker = walkers[i];
+    p.state.position = p.walker.position;
+    p.state.velocity = p.walker.velocity;
+    const btTransform T(btQuaternion::getIdentity(),
+                        btVector3(p.walker.position.x(), p.walker.position.y(), kPersonHeight / 2));
+    p.body->getMotionState()->setWorldTransform(T);
+    p.body->setWorldTransform(T);
+  }
+}
+
+bool TwinWorld::Impl::DoorwayTaken(const Person& me) const {
+  const Door& d = doors[me.door];
+  for (const auto& other : people) {
+    if (&other == &me || !other.state.started) continue;
+    if ((other.walker.position - d.centre).norm() < 0.9) return true;
+  }
+  return false;
+}
+
+const PersonSpec* TwinWorld::Impl::FindSpec(const std::string& person_name) const {
+  for (const auto& s : scenario.people) {
+    if (person_name == s.name || person_name.rfind(s.name + "_", 0) == 0) return &s;
+  }
+  return nullptr;
+}
+
+}  // namespace egress::twin

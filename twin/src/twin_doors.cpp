@@ -1,0 +1,144 @@
+#include "twin_world_impl.h"
+
+namespace egress::twin {
+
+void TwinWorld::Impl::BuildDoors() {
+  std::mt19937_64 rng(DeriveSeed(seed, 1));
+  const double hold_override = scenario.randomize.hold_open_s.Sample(rng);
+  for (std::size_t i = 0; i < world.doors.size(); ++i) {
+    const DoorDescription& d = world.doors[i];
+    Door door;
+    door.desc = &d;
+    for (const auto& spec : scenario.doors) {
+      if (spec.door == d.name) door.spec = spec;
+    }
+    if (door.spec && scenario.randomize.hold_open_s.max > 0.0) {
+      door.spec->timing.hold_open_s = hold_override;
+    }
+    const bool glass = door.spec && door.spec->glass;
+    const int e = AddEntity(EntityKind::kDoor, d.name, int(i), glass);
+    door.leaf = AddBody(std::make_unique<btBoxShape>(ToBt(d.leaf_size / 2)), d.X_WL, d.mass, kGDoor,
+                        kMaskDoor, e);
+    door.leaf->setFlags(door.leaf->getFlags() | BT_DISABLE_WORLD_GRAVITY);
+    door.leaf->setGravity(btVector3(0, 0, 0));
+    door.leaf->setActivationState(DISABLE_DEACTIVATION);
+    door.leaf->setFriction(0.3);
+    const Eigen::Vector3d pivot_L = d.X_WL.rotation().transpose() * (d.p_WH - d.X_WL.translation());
+    const Eigen::Vector3d axis_L = d.X_WL.rotation().transpose() * d.axis_W;
+    auto hinge = std::make_unique<btHingeConstraint>(*door.leaf, ToBt(pivot_L), ToBt(axis_L));
+    // Which sign of Bullet's hinge angle opens the door: probe with a small opening.
+    const btTransform closed = ToBt(d.X_WL);
+    const btTransform probe = ToBt(d.CalcLeafPose(0.1));
+    const btTransform fixed = hinge->getBFrame();
+    const double a0 = hinge->getHingeAngle(closed * hinge->getAFrame(), fixed);
+    const double a1 = hinge->getHingeAngle(probe * hinge->getAFrame(), fixed);
+    door.motor_sign = a1 > a0 ? 1.0 : -1.0;
+    if (door.motor_sign > 0)
+      hinge->setLimit(a0, a0 + d.max_open_angle, 0.9, 0.3, 0.5);
+    else
+      hinge->setLimit(a0 - d.max_open_angle, a0, 0.9, 0.3, 0.5);
+    door.hinge = hinge.get();
+    dynamics->addConstraint(hinge.get(), true);
+    constraints.push_back(std::move(hinge));
+    door.reach = d.LeafReach();
+    const Eigen::Vector3d edge = d.CalcFreeEdge(0.0);
+    door.along = (edge - d.p_WH).head<2>().normalized();
+    door.centre = d.p_WH.head<2>() + door.along * door.reach / 2;
+    door.normal = Eigen::Vector2d(-door.along.y(), door.along.x());
+    if (door.spec) {
+      door.op.emplace(door.spec->timing, d.max_open_angle);
+      for (const auto& actuator : door.spec->actuators) {
+        const ShapeDescription& a = *world.ShapesOfModel(actuator).front();
+        ActuatorBox box{a.X_WS, a.box_size};
+        if (door.spec->kind == OperatorKind::kPushButton) {
+          door.buttons.emplace_back(box, door.spec->button_stroke, door.spec->button_spring_force,
+                                    door.spec->button_max_force);
+        } else if (door.spec->kind == OperatorKind::kProximityPlate) {
+          door.plates.emplace_back(box, door.spec->proximity_range);
+        }
+      }
+    }
+    doors.push_back(std::move(door));
+  }
+}
+
+void TwinWorld::Impl::UpdateActuators() {
+  const std::vector<Eigen::Vector3d> hand_points = {fingertip, palm.translation()};
+  for (std::size_t i = 0; i < doors.size(); ++i) {
+    Door& d = doors[i];
+    const std::string* triggered = nullptr;  // the actuator that opened the door this step
+    for (std::size_t k = 0; k < d.buttons.size(); ++k) {
+      const auto result = d.buttons[k].Update(fingertip);
+      if (result == PushButton::Result::kPressed) {
+        triggered = &d.spec->actuators[k];
+      } else if (result == PushButton::Result::kOverForce) {
+        AddEvent("button_overforce", d.desc->name, StrCat(d.buttons[k].force(), " N"));
+      }
+    }
+    for (std::size_t k = 0; k < d.plates.size(); ++k) {
+      if (d.plates[k].Update(hand_points)) triggered = &d.spec->actuators[k];
+    }
+    if (d.spec && d.next_open_at < d.spec->open_at.size() &&
+        time >= d.spec->open_at[d.next_open_at]) {
+      ++d.next_open_at;
+      AddEvent("door_triggered", d.desc->name, "scheduled");
+      d.op->Trigger(time);
+    }
+    if (triggered != nullptr) {
+      ++d.presses;
+      AddEvent("button_pressed", d.desc->name, *triggered);
+      d.op->Trigger(time);
+    }
+  }
+}
+
+double TwinWorld::Impl::MeasureDoorAngle(const Door& d) const {
+  const Eigen::Matrix3d R =
+      FromBt(d.leaf->getWorldTransform()).rotation() * d.desc->X_WL.rotation().transpose();
+  const double about_axis = std::atan2(R(1, 0), R(0, 0)) * (d.desc->axis_W.z() > 0 ? 1.0 : -1.0);
+  return std::max(0.0, d.desc->open_sign * about_axis);
+}
+
+void TwinWorld::Impl::UpdateDoors() {
+  for (std::size_t i = 0; i < doors.size(); ++i) {
+    Door& d = doors[i];
+    d.angle = MeasureDoorAngle(d);
+    const double stall_impulse = (d.spec ? d.spec->timing.stall_force : 67.0) * d.reach * dt;
+    if (d.op) {
+      const double rate = d.op->Update(time, d.angle);
+      d.hinge->enableAngularMotor(true, d.motor_sign * rate, stall_impulse);
+      if (d.op->phase() != d.last_phase) {
+        AddEvent(StrCat("door_", ToString(d.op->phase())), d.desc->name);
+        d.last_phase = d.op->phase();
+      }
+    } else {
+      // A manual door with a closer: gently back to closed (≥ 5 s from 90° to 12°).
+      const double closer_rate = d.angle > AdaDoorOperator::kClosedAngle ? -0.25 : 0.0;
+      d.hinge->enableAngularMotor(true, d.motor_sign * closer_rate, 15.0 * d.reach * dt);
+    }
+    const btVector3 axis = ToBt(d.desc->axis_W * d.desc->open_sign);
+    const double omega = d.leaf->getAngularVelocity().dot(axis);
+    btVector3 torque = -d.desc->damping * omega * axis;
+    // People holding this door push it towards their hold angle.
+    for (const auto& p : people) {
+      if (p.state.phase != "holding" || p.door != int(i)) continue;
+      const double max_torque = config.person_hold_force * d.reach;
+      const double tau =
+          std::clamp(1000.0 * (p.hold_angle - d.angle) - 100.0 * omega, -max_torque, max_torque);
+      torque += tau * axis;
+    }
+    d.leaf->applyTorque(torque);
+    const double open_threshold = config.door_crossed_open_angle_deg * kDegToRad;
+    if (!d.reported_open && d.angle >= open_threshold) {
+      d.reported_open = true;
+      d.reported_closed = false;
+      AddEvent("door_opened", d.desc->name);
+    } else if (!d.reported_closed && d.angle <= AdaDoorOperator::kClosedAngle) {
+      d.reported_closed = true;
+      d.reported_open = false;
+      AddEvent("door_closed", d.desc->name);
+    }
+  }
+}
+
+}  // namespace egress::twin

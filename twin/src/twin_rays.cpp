@@ -1,0 +1,206 @@
+#include "twin_world_impl.h"
+
+#include <BulletCollision/NarrowPhaseCollision/btRaycastCallback.h>
+
+namespace egress::twin {
+
+namespace {
+
+class TwinRayCallback : public btCollisionWorld::RayResultCallback {
+ public:
+  TwinRayCallback(const btVector3& dir, GlassMode mode, double glass_max_incidence,
+                  const std::function<bool(int)>& is_glass,
+                  const std::function<int(const btCollisionObject*, int)>& entity_of)
+      : dir_(dir.normalized()),
+        mode_(mode),
+        glass_max_incidence_(glass_max_incidence),
+        is_glass_(is_glass),
+        entity_of_(entity_of) {}
+
+  btScalar addSingleResult(btCollisionWorld::LocalRayResult& r, bool normal_in_world) override {
+    const btVector3 n =
+        normal_in_world ? r.m_hitNormalLocal
+                        : r.m_collisionObject->getWorldTransform().getBasis() * r.m_hitNormalLocal;
+    const int entity =
+        entity_of_(r.m_collisionObject,
+                   r.m_localShapeInfo != nullptr ? r.m_localShapeInfo->m_triangleIndex : -1);
+    const bool glass = is_glass_(entity);
+    if (glass && (mode_ == GlassMode::kTransparent ||
+                  (mode_ == GlassMode::kLaser &&
+                   std::abs(n.normalized().dot(dir_)) < std::cos(glass_max_incidence_)))) {
+      return m_closestHitFraction;  // the ray passes through the glass
+    }
+    m_closestHitFraction = r.m_hitFraction;
+    m_collisionObject = r.m_collisionObject;
+    normal = n;
+    this->entity = entity;
+    this->glass = glass;
+    return r.m_hitFraction;
+  }
+
+  btVector3 normal{0, 0, 0};
+  int entity{-1};
+  bool glass{false};
+
+ private:
+  btVector3 dir_;
+  GlassMode mode_;
+  double glass_max_incidence_;  // [rad]; its cosine is needed only on a glass hit
+  const std::function<bool(int)>& is_glass_;
+  const std::function<int(const btCollisionObject*, int)>& entity_of_;
+};
+
+// The static triangle mesh's hits, passed on to the twin's ray callback. The mesh may be cast on
+// a piece [0, scale] of the twin's ray; fractions are rescaled to the whole ray.
+class StaticMeshRayCallback : public btTriangleRaycastCallback {
+ public:
+  StaticMeshRayCallback(const btVector3& from, const btVector3& to, btScalar scale,
+                        const btCollisionObject* mesh, TwinRayCallback* out,
+                        const std::vector<int>& triangle_entity)
+      : btTriangleRaycastCallback(from, to),
+        scale_(scale),
+        mesh_(mesh),
+        out_(out),
+        triangle_entity_(triangle_entity) {}
+  btScalar reportHit(const btVector3& normal, btScalar fraction, int, int triangle) override {
+    const btScalar whole = fraction * scale_;
+    if (whole >= out_->m_closestHitFraction) return m_hitFraction;
+    out_->m_closestHitFraction = whole;
+    out_->m_collisionObject = mesh_;
+    out_->normal = normal;
+    out_->entity = triangle >= 0 && std::size_t(triangle) < triangle_entity_.size()
+                       ? triangle_entity_[std::size_t(triangle)]
+                       : -1;
+    out_->glass = false;
+    return fraction;
+  }
+
+ private:
+  btScalar scale_;
+  const btCollisionObject* mesh_;
+  TwinRayCallback* out_;
+  const std::vector<int>& triangle_entity_;
+};
+
+}  // namespace
+
+RayHit TwinWorld::Impl::CastSegment(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
+                                    GlassMode mode, double glass_max_incidence) const {
+  const btVector3 a = ToBt(from), b = ToBt(to);
+  TwinRayCallback cb(b - a, mode, glass_max_incidence, ray_is_glass, ray_entity_of);
+  // Bullet's ray tests, object by object rather than through the broadphase: first the cheap
+  // targets (the ground plane, and every other target whose bounding box the ray still crosses
+  // before its closest hit so far), then the static triangle mesh on the ray clipped just past
+  // that hit: the mesh's BVH walk costs in proportion to the ray's length. Dynamic bodies are
+  // cast as triangle proxies of their shapes (see BuildRayProxies): Bullet's triangle ray test
+  // is exact and much cheaper than its iterative convex cast.
+  const btTransform from_T(btMatrix3x3::getIdentity(), a), to_T(btMatrix3x3::getIdentity(), b);
+  for (std::size_t i = 0; i < ray_targets.size(); ++i) {
+    const btCollisionObject* target = ray_targets[i];
+    btVector3 normal;
+    btScalar param = cb.m_closestHitFraction;
+    const bool plane = target->getCollisionShape()->getShapeType() == STATIC_PLANE_PROXYTYPE;
+    if (!plane &&
+        !btRayAabb(a, b, ray_target_aabbs[i].first, ray_target_aabbs[i].second, param, normal))
+      continue;
+    btCollisionWorld::rayTestSingle(from_T, to_T, const_cast<btCollisionObject*>(target),
+                                    target->getCollisionShape(), target->getWorldTransform(), cb);
+  }
+  // Static boxes and planes: slab tests in each shape's frame, on the ray as a segment t in
+  // [0, 1]. A ray starting inside a box hits its far side (as the triangles' did).
+  const Eigen::Vector3d d = to - from;
+  for (const RayBox& box : ray_boxes) {
+    const Eigen::Vector3d o = box.R_SW * (from - box.p_WS);
+    const Eigen::Vector3d v = box.R_SW * d;
+    double t_in = -std::numeric_limits<double>::infinity();
+    double t_out = std::numeric_limits<double>::infinity();
+    int axis_in = -1, axis_out = -1;
+    bool miss = false;
+    for (int i = 0; i < 3 && !miss; ++i) {
+      if (std::abs(v[i]) < 1e-12) {
+        miss = std::abs(o[i]) > box.half[i] || box.half[i] == 0.0;
+        continue;
+      }
+      double ta = (-box.half[i] - o[i]) / v[i], tb = (box.half[i] - o[i]) / v[i];
+      if (ta > tb) std::swap(ta, tb);
+      if (ta > t_in) {
+        t_in = ta;
+        axis_in = i;
+      }
+      if (tb < t_out) {
+        t_out = tb;
+        axis_out = i;
+      }
+      miss = t_in > t_out;
+    }
+    if (miss) continue;
+    const bool inside = t_in < 0.0;
+    const double t = inside ? t_out : t_in;
+    const int axis = inside ? axis_out : axis_in;
+    if (axis < 0 || t < 0.0 || t >= cb.m_closestHitFraction) continue;
+    // Outward normal of the face the ray meets.
+    const double sign = (v[axis] > 0.0) == inside ? 1.0 : -1.0;
+    cb.m_closestHitFraction = btScalar(t);
+    cb.m_collisionObject = static_mesh_body;
+    cb.normal = ToBt(box.R_SW.row(axis).transpose() * sign);
+    cb.entity = box.entity;
+    cb.glass = false;
+  }
+  if (ray_mesh_shape != nullptr) {
+    // A hair past the closest hit, so that a mesh standing on the floor still wins the tie.
+    const btScalar scale = std::min<btScalar>(1.0, cb.m_closestHitFraction * 1.001 + 1e-6);
+    const btVector3 b_clipped = a + (b - a) * scale;
+    StaticMeshRayCallback mesh_cb(a, b_clipped, scale, static_mesh_body, &cb, ray_triangle_entity);
+    ray_mesh_shape->performRaycast(&mesh_cb, a, b_clipped);
+  }
+  RayHit hit;
+  if (!cb.hasHit()) return hit;
+  hit.hit = true;
+  hit.distance = cb.m_closestHitFraction * (to - from).norm();
+  hit.point = from + cb.m_closestHitFraction * (to - from);
+  hit.normal = FromBt(cb.normal).normalized();
+  hit.entity = cb.entity;
+  hit.glass = cb.glass;
+  return hit;
+}
+
+RayHit TwinWorld::CastRay(const Eigen::Vector3d& from, const Eigen::Vector3d& to, GlassMode mode,
+                          double glass_max_incidence) const {
+  // The sensors see doors, people and payloads where they are now.
+  if (impl_->ray_proxies_stale) impl_->SyncRayProxies();
+  // Cast near first, then the rest: most rays indoors hit within a few metres, and a hit in the
+  // near piece skips the far piece's walk of the BVH.
+  constexpr double kNearSegment = 3.0;  // [m]
+  const double length = (to - from).norm();
+  if (length > 1.5 * kNearSegment) {
+    const Eigen::Vector3d mid = from + (to - from) * (kNearSegment / length);
+    RayHit near = impl_->CastSegment(from, mid, mode, glass_max_incidence);
+    if (near.hit) return near;
+    RayHit far = impl_->CastSegment(mid, to, mode, glass_max_incidence);
+    if (far.hit) far.distance += kNearSegment;
+    return far;
+  }
+  return impl_->CastSegment(from, to, mode, glass_max_incidence);
+}
+
+EntityKind TwinWorld::entity_kind(int entity) const {
+  return impl_->entities.at(std::size_t(entity)).kind;
+}
+const std::string& TwinWorld::entity_name(int entity) const {
+  return impl_->entities.at(std::size_t(entity)).name;
+}
+
+const Scenario& TwinWorld::scenario() const {
+  return impl_->scenario;
+}
+const WorldDescription& TwinWorld::world() const {
+  return impl_->world;
+}
+const TwinConfig& TwinWorld::config() const {
+  return impl_->config;
+}
+std::uint64_t TwinWorld::seed() const {
+  return impl_->seed;
+}
+
+}  // namespace egress::twin

@@ -1,0 +1,133 @@
+#include "twin_world_impl.h"
+
+namespace egress::twin {
+
+void TwinWorld::Impl::BuildStatics() {
+  bool has_floor = false;
+  auto merged = std::make_unique<btTriangleMesh>(true, false);
+  auto ray_mesh = std::make_unique<btTriangleMesh>(true, false);
+  auto add = [&](const ShapeDescription& s) {
+    const bool floor = s.kind == ShapeKind::kPlane;
+    has_floor = has_floor || floor;
+    const int e = AddEntity(floor ? EntityKind::kFloor : EntityKind::kStatic, s.model, -1);
+    if (!floor) AppendFootprint(s, e, &walls);
+    if (AppendTriangles(s, merged.get())) {
+      static_triangle_entity.resize(std::size_t(merged->getNumTriangles()), e);
+      if (s.kind == ShapeKind::kBox || s.kind == ShapeKind::kPlane) {
+        RayBox box;
+        box.R_SW = s.X_WS.rotation().transpose();
+        box.p_WS = s.X_WS.translation();
+        box.half = s.kind == ShapeKind::kBox
+                       ? Eigen::Vector3d(s.box_size / 2)
+                       : Eigen::Vector3d(s.plane_size.x() > 0 ? s.plane_size.x() / 2 : 50.0,
+                                         s.plane_size.y() > 0 ? s.plane_size.y() / 2 : 50.0, 0.0);
+        box.entity = e;
+        ray_boxes.push_back(box);
+      } else {
+        AppendTriangles(s, ray_mesh.get());
+        ray_triangle_entity.resize(std::size_t(ray_mesh->getNumTriangles()), e);
+      }
+      return;
+    }
+    ray_targets.push_back(AddBody(MakeConvexShape(s), s.X_WS, 0.0, floor ? kGFloor : kGStatic,
+                                  floor ? kMaskFloor : kMaskStatic, e));
+  };
+  for (const auto& s : world.shapes)
+    add(s);
+  for (const auto& s : scenario.obstacles)
+    add(s);
+  if (!has_floor) {
+    ShapeDescription ground;
+    ground.model = "ground_plane";
+    ground.kind = ShapeKind::kPlane;
+    add(ground);
+  }
+  if (merged->getNumTriangles() > 0) {
+    auto shape = std::make_unique<btBvhTriangleMeshShape>(merged.get(), true);
+    static_mesh_shape = shape.get();
+    meshes.push_back(std::move(merged));
+    static_mesh_body =
+        AddBody(std::move(shape), Pose3(), 0.0, kGStatic, kMaskStatic, kMergedStatic);
+  }
+  if (ray_mesh->getNumTriangles() > 0) {
+    auto shape = std::make_unique<btBvhTriangleMeshShape>(ray_mesh.get(), true);
+    ray_mesh_shape = shape.get();
+    meshes.push_back(std::move(ray_mesh));
+    shapes.push_back(std::move(shape));
+  }
+}
+
+void TwinWorld::Impl::AddRayProxy(const btCollisionObject* source,
+                                  const std::vector<btVector3>& triangles_local) {
+  auto mesh = std::make_unique<btTriangleMesh>(true, false);
+  for (std::size_t i = 0; i + 2 < triangles_local.size(); i += 3) {
+    mesh->addTriangle(triangles_local[i], triangles_local[i + 1], triangles_local[i + 2]);
+  }
+  auto shape = std::make_unique<btBvhTriangleMeshShape>(mesh.get(), true);
+  auto proxy = std::make_unique<btCollisionObject>();
+  proxy->setCollisionShape(shape.get());
+  proxy->setUserIndex(source->getUserIndex());
+  proxy->setWorldTransform(source->getWorldTransform());
+  ray_targets.push_back(proxy.get());
+  ray_proxies.push_back({std::move(proxy), source});
+  meshes.push_back(std::move(mesh));
+  shapes.push_back(std::move(shape));
+}
+
+std::vector<btVector3> TwinWorld::Impl::BoxTriangles(const btVector3& h) {
+  auto corner = [&](int i) {
+    return btVector3((i & 1) ? h.x() : -h.x(), (i & 2) ? h.y() : -h.y(), (i & 4) ? h.z() : -h.z());
+  };
+  static constexpr int kFaces[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1},
+                                       {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
+  std::vector<btVector3> t;
+  for (const auto& f : kFaces) {
+    for (int k : {f[0], f[1], f[2], f[0], f[2], f[3]})
+      t.push_back(corner(k));
+  }
+  return t;
+}
+
+std::vector<btVector3> TwinWorld::Impl::PrismTriangles(double radius, double half_length,
+                                                       int axis) {
+  constexpr int kSides = 16;
+  const double r = radius / std::cos(M_PI / kSides);
+  auto point = [&](int k, double h) {
+    const double a = 2 * M_PI * k / kSides;
+    const double u = r * std::cos(a), v = r * std::sin(a);
+    return axis == 0 ? btVector3(h, u, v) : btVector3(u, v, h);
+  };
+  std::vector<btVector3> t;
+  const btVector3 top = axis == 0 ? btVector3(half_length, 0, 0) : btVector3(0, 0, half_length);
+  for (int k = 0; k < kSides; ++k) {
+    const btVector3 a0 = point(k, -half_length), a1 = point(k + 1, -half_length);
+    const btVector3 b0 = point(k, half_length), b1 = point(k + 1, half_length);
+    for (const auto& p : {a0, a1, b1, a0, b1, b0, top, b0, b1, -top, a1, a0})
+      t.push_back(p);
+  }
+  return t;
+}
+
+void TwinWorld::Impl::BuildRayProxies() {
+  for (const auto& d : doors)
+    AddRayProxy(d.leaf, BoxTriangles(ToBt(d.desc->leaf_size / 2)));
+  for (const auto& p : people)
+    AddRayProxy(p.body, PrismTriangles(p.state.radius, kPersonHeight / 2, 2));
+  for (const auto& p : payloads) {
+    AddRayProxy(p.body, p.spec.kind == PayloadKind::kWaterBottle ? PrismTriangles(0.033, 0.105, 2)
+                                                                 : PrismTriangles(0.02, 0.1, 0));
+  }
+}
+
+void TwinWorld::Impl::SyncRayProxies() const {
+  ray_proxies_stale = false;
+  for (auto& [proxy, source] : ray_proxies)
+    proxy->setWorldTransform(source->getWorldTransform());
+  ray_target_aabbs.resize(ray_targets.size());
+  for (std::size_t i = 0; i < ray_targets.size(); ++i) {
+    ray_targets[i]->getCollisionShape()->getAabb(
+        ray_targets[i]->getWorldTransform(), ray_target_aabbs[i].first, ray_target_aabbs[i].second);
+  }
+}
+
+}  // namespace egress::twin
