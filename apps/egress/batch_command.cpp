@@ -24,11 +24,11 @@
 #include <nlohmann/json.hpp>
 
 #include "batch.h"
+#include "brain_trial.h"
 #include "commands.h"
 #include "egress/hsr_interface/error.h"
 #include "egress/twin/sdf_world_loader.h"
 #include "egress/twin/twin_run.h"
-#include "sdf_map.h"
 
 namespace egress::apps {
 
@@ -49,35 +49,28 @@ TrialResult RunBrainTrial(const std::string& scenario_path, std::uint64_t seed) 
   const twin::Scenario scenario = twin::LoadScenario(scenario_path);
   const twin::WorldDescription description = twin::LoadSdfWorld(scenario.world_file);
   auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
-  twin::TwinWorld world(scenario, description, seed, model);
-  twin::TwinRobot robot(&world);
-  const behavior::ExecutiveConfig config;
-  auto brain = MakeScenarioExecutive(scenario, description, world, model, config);
-  twin::RunOptions options;
-  options.control_period = 0.01;
-  options.record_trace = false;
+  BrainTrialOptions options;
+  options.run.record_trace = false;
   // Ground truth for the preemption latency: when a person (not one holding the door) really
   // entered a door zone. Only this trial harness reads it; the brain sees sensors only.
-  const behavior::MissionMap& map = *brain->context().map;
   std::vector<double> entered_at;
   bool inside_before = false;
-  const twin::RunResult run = twin::RunScenario(
-      robot,
-      [&](RobotPort& port) {
-        bool inside = false;
-        for (const auto& door : map.doors) {
-          const perception::DoorZone zone{door, brain->context().config.zone_depth,
-                                          brain->context().config.person_radius};
-          for (const auto& person : world.people()) {
-            if (person.started && person.phase != "holding" && zone.Contains(person.position))
-              inside = true;
-          }
-        }
-        if (inside && !inside_before) entered_at.push_back(world.time());
-        inside_before = inside;
-        return brain->Step(port);
-      },
-      options);
+  options.after_step = [&](const twin::TwinWorld& world, const behavior::Executive& brain) {
+    bool inside = false;
+    for (const auto& door : brain.context().map->doors) {
+      const perception::DoorZone zone{door, brain.context().config.zone_depth,
+                                      brain.context().config.person_radius};
+      for (const auto& person : world.people()) {
+        if (person.started && person.phase != "holding" && zone.Contains(person.position))
+          inside = true;
+      }
+    }
+    if (inside && !inside_before) entered_at.push_back(world.time());
+    inside_before = inside;
+  };
+  const BrainTrial trial = RunBrainTrial(scenario, description, seed, model, options);
+  const twin::RunResult& run = trial.result;
+  const behavior::Executive* brain = trial.brain.get();
   TrialResult r;
   r.scenario = scenario_path;
   r.name =

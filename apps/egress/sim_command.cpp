@@ -16,11 +16,11 @@
 #include <fmt/format.h>
 
 #include "batch.h"
+#include "brain_trial.h"
 #include "commands.h"
 #include "egress/hsr_interface/error.h"
 #include "egress/twin/sdf_world_loader.h"
 #include "egress/twin/twin_run.h"
-#include "sdf_map.h"
 #include "trace_render.h"
 
 namespace egress::apps {
@@ -106,36 +106,13 @@ void RunSim(const SimOptions& o) {
   const twin::WorldDescription world_description = twin::LoadSdfWorld(scenario.world_file);
   const std::uint64_t seed = o.seed.value_or(scenario.seed);
   auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
-  twin::TwinWorld world(scenario, world_description, seed, model);
-  twin::TwinRobot robot(&world);
-  twin::Controller controller;
-  std::unique_ptr<behavior::Executive> brain;
   const std::string driver = o.driver != "auto" ? o.driver : (scenario.mission ? "brain" : "idle");
-  twin::RunOptions options;
-  if (driver == "brain") {
-    behavior::ExecutiveConfig config;
-    config.use_octomap = !o.no_octomap;
-    brain = MakeScenarioExecutive(scenario, world_description, world, model, config);
-    options.control_period = 1.0 / 100.0;
-    controller = [&brain](RobotPort& port) { return brain->Step(port); };
-    // The video shows the running action, the planned path and, once a second, the costmap
-    // (the map frame is W here: the brain starts from the twin's start pose).
-    options.annotate = [&brain, &world, next_costmap = 0.0]() mutable {
-      twin::TraceAnnotation note;
-      note.label = brain->active_action();
-      for (const Pose2& X : brain->context().motion->path())
-        note.path.push_back(X.translation());
-      if (world.time() + 1e-9 >= next_costmap) {
-        next_costmap = world.time() + kCostmapSnapshotPeriodSec;
-        note.costmap = CostmapLayer(brain->costmap());
-      }
-      return note;
-    };
-  } else if (driver == "idle") {
+  twin::Controller controller;
+  if (driver == "idle") {
     controller = twin::IdleController();
-  } else if (o.driver == "dead-reckoning") {
+  } else if (driver == "dead-reckoning") {
     controller = DeadReckoningController(scenario);
-  } else {
+  } else if (driver != "brain") {
     throw CommandFailed(
         fmt::format("--driver '{}': expected auto, brain, idle or dead-reckoning", o.driver));
   }
@@ -149,10 +126,41 @@ void RunSim(const SimOptions& o) {
     fmt::print("seed      {}   driver {}   time limit {:.0f} s\n", seed, driver,
                scenario.time_limit);
   }
+  twin::RunOptions options;
   options.duration = o.duration;
   if (!o.quiet && ::isatty(::fileno(stderr))) options.on_progress = ProgressBar;
   const auto started = std::chrono::steady_clock::now();
-  const twin::RunResult result = twin::RunScenario(robot, controller, options);
+  std::unique_ptr<twin::TwinWorld> world_owner;
+  std::unique_ptr<behavior::Executive> brain;
+  twin::RunResult result;
+  if (driver == "brain") {
+    BrainTrialOptions trial_options;
+    trial_options.config.use_octomap = !o.no_octomap;
+    trial_options.run = options;
+    // The video shows the running action, the planned path and, once a second, the costmap
+    // (the map frame is W here: the brain starts from the twin's start pose).
+    trial_options.annotate = [next_costmap = 0.0](const twin::TwinWorld& world,
+                                                  const behavior::Executive& b) mutable {
+      twin::TraceAnnotation note;
+      note.label = b.active_action();
+      for (const Pose2& X : b.context().motion->path())
+        note.path.push_back(X.translation());
+      if (world.time() + 1e-9 >= next_costmap) {
+        next_costmap = world.time() + kCostmapSnapshotPeriodSec;
+        note.costmap = CostmapLayer(b.costmap());
+      }
+      return note;
+    };
+    BrainTrial trial = RunBrainTrial(scenario, world_description, seed, model, trial_options);
+    world_owner = std::move(trial.world);
+    brain = std::move(trial.brain);
+    result = std::move(trial.result);
+  } else {
+    world_owner = std::make_unique<twin::TwinWorld>(scenario, world_description, seed, model);
+    twin::TwinRobot robot(world_owner.get());
+    result = twin::RunScenario(robot, controller, options);
+  }
+  const twin::TwinWorld& world = *world_owner;
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   if (!o.quiet) {

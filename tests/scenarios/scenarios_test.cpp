@@ -11,9 +11,9 @@
 
 #include <gtest/gtest.h>
 
+#include "brain_trial.h"
 #include "egress/twin/sdf_world_loader.h"
 #include "egress/twin/twin_run.h"
-#include "sdf_map.h"
 
 namespace egress {
 namespace {
@@ -38,52 +38,35 @@ BrainRun RunWithBrain(const std::filesystem::path& file, std::uint64_t seed,
   const twin::Scenario scenario = twin::LoadScenario(file);
   const twin::WorldDescription description = twin::LoadSdfWorld(scenario.world_file);
   auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
-  BrainRun run;
-  run.world = std::make_unique<twin::TwinWorld>(scenario, description, seed, model);
-  twin::TwinRobot robot(run.world.get());
-  run.brain = apps::MakeScenarioExecutive(scenario, description, *run.world, model, config);
-  twin::RunOptions options;
-  options.control_period = 0.01;
-  options.record_trace = false;
+  apps::BrainTrialOptions options;
+  options.config = config;
+  options.run.record_trace = false;
   const bool debug = std::getenv("EGRESS_SCENARIO_DEBUG") != nullptr;
   double last = -1.0;
-  run.result = twin::RunScenario(
-      robot,
-      [&](RobotPort& port) {
-        const bool more = run.brain->Step(port);
-        if (debug && run.world->time() - last >= 0.25) {
-          last = run.world->time();
-          const auto f = run.world->fingertip_position();
-          const auto b = run.world->robot_pose();
-          const auto e = run.brain->X_MB();
-          std::printf(
-              "%6.2f tip %.3f %.3f %.3f base %.3f %.3f %.3f belief %.3f %.3f %.3f "
-              "door %.2f %s\n",
-              run.world->time(), f.x(), f.y(), f.z(), b.x, b.y, b.yaw, e.x, e.y, e.yaw,
-              run.world->door_angle(0), run.brain->active_action().c_str());
-          for (const auto& p : run.world->people()) {
-            std::printf("         TRUE %s at %.2f %.2f phase %s\n", p.name.c_str(), p.position.x(),
-                        p.position.y(), p.phase.c_str());
-          }
-          for (const auto& p : run.brain->context().world.people) {
-            std::printf("         person %d at %.2f %.2f v %.2f %.2f intent %d door %s\n",
-                        p.person.id, p.person.p_MP.x(), p.person.p_MP.y(), p.person.v_MP.x(),
-                        p.person.v_MP.y(), int(p.intent), p.door_id.c_str());
-          }
-          for (const auto& d : run.brain->context().world.doors) {
-            const auto since = run.brain->context().door_open_since.find(d.model.id);
-            std::printf(
-                "         door %s observed %d angle %.2f clearance %.2f motion %d open since "
-                "%.2f\n",
-                d.model.id.c_str(), int(d.state.observed), d.state.angle, d.state.clearance_width,
-                int(d.state.motion),
-                since == run.brain->context().door_open_since.end() ? -1.0
-                                                                    : ToSeconds(since->second));
-          }
-        }
-        return more;
-      },
-      options);
+  options.after_step = [&](const twin::TwinWorld& world, const behavior::Executive& brain) {
+    if (!debug || world.time() - last < 0.25) return;
+    last = world.time();
+    const auto f = world.fingertip_position();
+    const auto b = world.robot_pose();
+    const auto e = brain.X_MB();
+    std::printf("%6.2f tip %.3f %.3f %.3f base %.3f %.3f %.3f belief %.3f %.3f %.3f door %.2f %s\n",
+                world.time(), f.x(), f.y(), f.z(), b.x, b.y, b.yaw, e.x, e.y, e.yaw,
+                world.door_angle(0), brain.active_action().c_str());
+    for (const auto& p : world.people()) {
+      std::printf("         TRUE %s at %.2f %.2f phase %s\n", p.name.c_str(), p.position.x(),
+                  p.position.y(), p.phase.c_str());
+    }
+    for (const auto& p : brain.context().world.people) {
+      std::printf("         person %d at %.2f %.2f v %.2f %.2f intent %d door %s\n", p.person.id,
+                  p.person.p_MP.x(), p.person.p_MP.y(), p.person.v_MP.x(), p.person.v_MP.y(),
+                  int(p.intent), p.door_id.c_str());
+    }
+  };
+  apps::BrainTrial trial = apps::RunBrainTrial(scenario, description, seed, model, options);
+  BrainRun run;
+  run.world = std::move(trial.world);
+  run.brain = std::move(trial.brain);
+  run.result = std::move(trial.result);
   if (debug) {
     for (const auto& d : run.brain->decisions())
       std::printf("  %7.2f  %s\n", d.time, d.text.c_str());

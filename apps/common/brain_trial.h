@@ -1,0 +1,67 @@
+#pragma once
+/// @file
+/// A twin scenario run by the robot brain: the building map the brain gets (the world's floor plan
+/// and doors, the scenario's actuators), the executive built for the scenario's mission, and one
+/// RunBrainTrial that `egress sim run`, `egress sim batch` and the scenario tests all use. The
+/// control period is the executive's own (ExecutiveConfig::control_rate_hz).
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+
+#include "egress/behavior/executive.h"
+#include "egress/behavior/mission_map.h"
+#include "egress/twin/scenario.h"
+#include "egress/twin/twin_run.h"
+#include "egress/twin/twin_world.h"
+#include "egress/twin/world_description.h"
+
+namespace egress::apps {
+
+/// The building map the robot brain gets for a twin scenario: the world's floor plan and doors
+/// (RasterizeSdfWorld) and the scenario's door actuators (their SDF boxes, face on the side of
+/// the door line they stand on). The scenario's extra obstacles, people and payloads are not in
+/// it: the robot perceives them. @throws InvalidArgument for an actuator without a shape.
+behavior::MissionMap BuildMissionMap(const twin::WorldDescription& world,
+                                     const twin::Scenario& scenario, double resolution = 0.05);
+
+}  // namespace egress::apps
+
+namespace egress::apps {
+
+/// The robot brain for a twin run of `scenario`: its mission tree and blackboard, the building
+/// map, and as the initial pose the twin's start (what an operator's initial pose estimate
+/// gives a real robot; after that the brain localizes on odometry alone).
+/// @throws InvalidArgument / LogicError naming the file for a scenario without a mission, a bad
+/// tree or an unknown node.
+std::unique_ptr<behavior::Executive> MakeScenarioExecutive(const twin::Scenario& scenario,
+                                                           const twin::WorldDescription& world,
+                                                           const twin::TwinWorld& twin_world,
+                                                           std::shared_ptr<const RobotModel> model,
+                                                           const behavior::ExecutiveConfig& config);
+
+struct BrainTrialOptions {
+  behavior::ExecutiveConfig config;
+  /// How the twin runs (duration, trace, progress); its control_period is replaced by the
+  /// executive's 1 / config.control_rate_hz.
+  twin::RunOptions run;
+  /// Called after every control step (ground-truth probes, debugging output).
+  std::function<void(const twin::TwinWorld&, const behavior::Executive&)> after_step;
+  /// What each trace sample shows of the brain (the running action, its path, the costmap).
+  std::function<twin::TraceAnnotation(const twin::TwinWorld&, const behavior::Executive&)> annotate;
+};
+
+/// The twin, the brain and the judge's verdict of one trial.
+struct BrainTrial {
+  std::unique_ptr<twin::TwinWorld> world;
+  std::unique_ptr<behavior::Executive> brain;
+  twin::RunResult result;
+};
+
+/// Runs `scenario` with `seed`, driven by the brain, to the end of its mission or time limit.
+/// @throws what the scenario, world, tree or executive throw, naming the file or field.
+BrainTrial RunBrainTrial(const twin::Scenario& scenario, const twin::WorldDescription& world,
+                         std::uint64_t seed, std::shared_ptr<const RobotModel> model,
+                         const BrainTrialOptions& options = {});
+
+}  // namespace egress::apps
