@@ -1,5 +1,6 @@
 #include "egress/behavior/executive.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "egress/behavior/door_rules.h"
@@ -110,6 +111,15 @@ Executive::Executive(std::shared_ptr<const RobotModel> model, MissionMap map, Mi
                      const Pose2& X_MB_initial, ExecutiveConfig config) {
   ThrowUnless(model != nullptr, "Executive: no robot model");
   ThrowUnless(X_MB_initial.IsFinite(), "Executive: the initial pose must be finite");
+  // The robot's geometry comes from its description (the URDF), not from the configs' defaults:
+  // the footprint every module plans and checks with, and the robot's height.
+  const double footprint = model->footprint_radius();
+  config.tasks.footprint_radius = footprint;
+  config.costmap.robot_radius = footprint;
+  double top = 0.0;
+  for (const PlacedShape& s : model->CalcCollisionShapesInBase({}))
+    top = std::max(top, s.X_BS.translation().z() + s.shape.BoundingRadius());
+  if (top > 0.0) config.planner.robot_height = top;
   config.Validate();
   config.localizer.Validate();
   map.Validate();

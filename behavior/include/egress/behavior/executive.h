@@ -30,6 +30,9 @@
 
 namespace egress::behavior {
 
+/// The executive's parameters. The robot's own geometry is not among them: the footprint
+/// radius (tasks, costmap, planner) and the robot's height come from the RobotModel the
+/// executive is given (its URDF), whatever these fields hold.
 struct ExecutiveConfig {
   double tick_rate_hz{10.0};      ///< Behavior-tree ticks (the paper's 10 Hz).
   double control_rate_hz{100.0};  ///< Controller steps; Step() is called at this rate.
