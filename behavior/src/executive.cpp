@@ -26,6 +26,9 @@ void ExecutiveConfig::Validate() const {
   ThrowUnless(octomap_known_radius >= 0 && octomap_person_radius >= 0 && octomap_self_margin >= 0,
               "ExecutiveConfig: octomap_known_radius, octomap_person_radius and "
               "octomap_self_margin must be >= 0");
+  ThrowUnless(detection_merge_iou > 0 && detection_merge_iou <= 1,
+              "ExecutiveConfig: detection_merge_iou must be in (0, 1]");
+  ThrowUnless(door_leaf_max_age >= 0, "ExecutiveConfig: door_leaf_max_age must be >= 0");
   ThrowUnless(held_payload_radius > 0 && held_payload_length > 0,
               "ExecutiveConfig: held_payload_radius and held_payload_length must be > 0");
   trajectory.Validate();
@@ -92,6 +95,7 @@ struct Executive::Impl {
   CameraIntrinsics intrinsics;
   bool finished{false};
   GraspMonitor grasp;
+  std::unique_ptr<perception::Detector> detector;  // on colour images, when set
   std::optional<perception::OccupancyMap3D> octomap;
   std::vector<PlacedShape> body;              // the robot's outline in B
   std::map<std::string, double> leaf_angles;  // per door: the leaf as the costmap has it
@@ -161,6 +165,28 @@ Executive::Executive(std::shared_ptr<const RobotModel> model, MissionMap map, Mi
 }
 
 Executive::~Executive() = default;
+
+void Executive::SetDetector(std::unique_ptr<perception::Detector> detector) {
+  impl_->detector = std::move(detector);
+}
+
+std::vector<Detection2D> Executive::Detect(const SensorSnapshot& snapshot) {
+  Impl& m = *impl_;
+  if (!m.detector || !snapshot.color) return snapshot.detections;
+  const ColorImage& image = *snapshot.color;
+  perception::CameraFrame frame;
+  frame.stamp = image.stamp;
+  frame.frame_id = image.frame_id;
+  // A view of the port's buffer, not a copy: the detector only reads it.
+  frame.image =
+      cv::Mat(image.height, image.width, CV_8UC3, const_cast<std::uint8_t*>(image.bgr.data()));
+  frame.upstream = snapshot.detections;
+  std::vector<Detection2D> found = m.detector->Detect(frame);
+  for (Detection2D& d : found)
+    d.stamp = image.stamp;
+  if (snapshot.detections.empty()) return found;
+  return perception::MergeDetections({snapshot.detections, found}, m.config.detection_merge_iou);
+}
 
 const perception::OccupancyMap3D* Executive::octomap() const {
   return impl_->octomap ? &*impl_->octomap : nullptr;
@@ -322,14 +348,15 @@ bool Executive::Step(RobotPort& port) {
   pose_history_.emplace_back(now, context_.X_MB);
   while (!pose_history_.empty() && ToSeconds(now - pose_history_.front().first) > kPoseHistorySec)
     pose_history_.pop_front();
-  if (!snapshot.detections.empty() && m.depth && m.X_BC) {
+  const std::vector<Detection2D> detections = Detect(snapshot);
+  if (!detections.empty() && m.depth && m.X_BC) {
     Pose2 X_MB_capture = context_.X_MB;
     for (const auto& [t, X] : pose_history_) {
-      if (t <= snapshot.detections.front().stamp) X_MB_capture = X;
+      if (t <= detections.front().stamp) X_MB_capture = X;
     }
-    m.perception.ProcessCameraFrame(
-        snapshot.detections, cv::Size(m.intrinsics.width, m.intrinsics.height), *m.depth,
-        m.intrinsics, X_MB3 * *m.X_BC, Pose3::FromPose2(X_MB_capture) * *m.X_BC);
+    m.perception.ProcessCameraFrame(detections, cv::Size(m.intrinsics.width, m.intrinsics.height),
+                                    *m.depth, m.intrinsics, X_MB3 * *m.X_BC,
+                                    Pose3::FromPose2(X_MB_capture) * *m.X_BC);
   }
   context_.world = m.perception.Snapshot(
       now, context_.X_MB, m.localizer ? m.localizer->Covariance() : Eigen::Matrix3d::Zero().eval(),

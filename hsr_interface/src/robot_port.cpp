@@ -16,6 +16,7 @@ void SensorSnapshot::Validate() const {
     ThrowUnless(X_BC.has_value(), "Invalid SensorSnapshot: a depth image needs X_BC.");
   }
   if (X_BC) ThrowUnless(X_BC->IsFinite(), "Invalid SensorSnapshot: X_BC must be finite.");
+  if (color) color->Validate();
   for (const auto& detection : detections)
     detection.Validate();
   odometry.Validate();

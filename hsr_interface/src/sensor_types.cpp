@@ -105,4 +105,12 @@ void Detection2D::Validate() const {
   ThrowUnless(!frame_id.empty(), "Invalid Detection2D '", label, "': frame_id must not be empty.");
 }
 
+void ColorImage::Validate() const {
+  ThrowUnless(width > 0 && height > 0, "Invalid ColorImage: size ", width, "x", height,
+              " must be positive.");
+  ThrowUnless(bgr.size() == std::size_t(width) * std::size_t(height) * 3u,
+              "Invalid ColorImage: ", bgr.size(), " bytes for ", width, "x", height,
+              " BGR pixels (expected ", std::size_t(width) * std::size_t(height) * 3u, ").");
+}
+
 }  // namespace egress

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include <gtest/gtest.h>
+#include <opencv2/core.hpp>
 
 #include "egress/hsr_interface/error.h"
 
@@ -55,6 +56,94 @@ TEST(ExecutiveTest, TheFootprintComesFromTheRobotDescription) {
   const Executive blind(std::make_shared<const RobotModel>(RobotModel::LoadDefault()), EmptyRoom(),
                         GoTo(), {2.0, 3.0, 0.0}, laser_only);
   EXPECT_EQ(blind.octomap(), nullptr);
+}
+
+// A robot that gives colour images and depth, no detections of its own (a real robot without
+// an on-board detector): a fixed pose, a flat wall 1.5 m ahead of the camera.
+class ImageOnlyRobot final : public RobotPort {
+ public:
+  explicit ImageOnlyRobot(const RobotModel& model) : X_BC_(model.CalcHeadCameraPose(0.0, {})) {}
+  const Clock& clock() const override { return clock_; }
+  void Advance() { clock_.AdvanceBy(SecondsToDuration(0.1)); }
+
+ private:
+  SensorSnapshot DoSense() override {
+    SensorSnapshot s;
+    s.stamp = clock_.Now();
+    s.depth_intrinsics = CameraIntrinsics::FromHorizontalFov(64, 48, 1.0);
+    DepthImage depth;
+    depth.stamp = s.stamp;
+    depth.width = 64;
+    depth.height = 48;
+    depth.depth.assign(64 * 48, 1.5f);
+    s.depth = depth;
+    s.X_BC = X_BC_;
+    ColorImage color;
+    color.stamp = s.stamp;
+    color.width = 64;
+    color.height = 48;
+    color.bgr.assign(64 * 48 * 3, 0);
+    color.bgr[0] = 200;  // a mark the detector checks it sees
+    s.color = color;
+    s.odometry.stamp = s.stamp;
+    s.joints.stamp = s.stamp;
+    s.gripper.stamp = s.stamp;
+    return s;
+  }
+  void DoSendBaseVelocity(const Twist2&) override {}
+  void DoSendArmTrajectory(const JointTrajectory&) override {}
+  void DoSendGripperCommand(const GripperCommand&) override {}
+  SimClock clock_;
+  Pose3 X_BC_;
+};
+
+// A detector stage that finds a bottle in the middle of every image it is given, and records
+// what it was given.
+class CentreBottleDetector final : public perception::Detector {
+ public:
+  explicit CentreBottleDetector(int* calls) : calls_(calls) {}
+  std::vector<Detection2D> Detect(const perception::CameraFrame& frame) override {
+    EXPECT_EQ(frame.image.cols, 64);
+    EXPECT_EQ(frame.image.rows, 48);
+    EXPECT_EQ(frame.image.at<cv::Vec3b>(0, 0)[0], 200);
+    ++*calls_;
+    Detection2D d;
+    d.label = "bottle";
+    d.confidence = 0.9;
+    d.box = {28, 18, 36, 30};
+    d.stamp = frame.stamp;
+    return {d};
+  }
+
+ private:
+  int* calls_;
+};
+
+TEST(ExecutiveTest, ColourImagesGoThroughTheDetectorStage) {
+  const auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
+  ImageOnlyRobot robot(*model);
+  Executive brain(model, EmptyRoom(), GoTo(), {2.0, 3.0, 0.0}, {});
+  int calls = 0;
+  brain.SetDetector(std::make_unique<CentreBottleDetector>(&calls));
+  for (int i = 0; i < 6; ++i) {
+    brain.Step(robot);
+    robot.Advance();
+  }
+  EXPECT_EQ(calls, 6);
+  // The detector's bottle, placed with the depth image, is a confirmed payload in the belief.
+  ASSERT_EQ(brain.context().world.payloads.size(), 1u);
+  const Eigen::Vector3d p_MP = brain.context().world.payloads[0].p_MO;
+  EXPECT_GT(p_MP.x(), 2.0 + 1.0);  // ahead of the robot, about 1.5 m from the camera
+  EXPECT_NEAR(p_MP.y(), 3.0, 0.3);
+
+  // Without a detector the images are ignored: nothing is found.
+  ImageOnlyRobot other(*model);
+  Executive blind(model, EmptyRoom(), GoTo(), {2.0, 3.0, 0.0}, {});
+  for (int i = 0; i < 6; ++i) {
+    blind.Step(other);
+    other.Advance();
+  }
+  EXPECT_TRUE(blind.context().world.payloads.empty());
 }
 
 TEST(ExecutiveTest, BadConfigurationsAreRefusedNamingTheField) {

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "egress/hsr_interface/error.h"
+#include "egress/hsr_interface/robot_port.h"
 
 namespace egress {
 namespace {
@@ -119,6 +120,28 @@ TEST(Detection2DTest, Validation) {
   detection.box.u_max = 30.0;
   detection.label.clear();
   EXPECT_THAT(ErrorOf(detection), HasSubstr("label"));
+}
+
+}  // namespace
+}  // namespace egress
+
+namespace egress {
+namespace {
+
+TEST(ColorImageTest, SizeAndBufferMustAgree) {
+  ColorImage image;
+  image.width = 4;
+  image.height = 2;
+  image.bgr.assign(4 * 2 * 3, 0);
+  EXPECT_NO_THROW(image.Validate());
+  image.bgr.pop_back();
+  EXPECT_THROW(image.Validate(), InvalidArgument);
+  image.bgr.clear();
+  image.width = 0;
+  EXPECT_THROW(image.Validate(), InvalidArgument);
+  SensorSnapshot snapshot;
+  snapshot.color = image;
+  EXPECT_THROW(snapshot.Validate(), InvalidArgument);
 }
 
 }  // namespace

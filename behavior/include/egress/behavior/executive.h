@@ -23,6 +23,7 @@
 #include "egress/bt/status.h"
 #include "egress/hsr_interface/robot_port.h"
 #include "egress/perception/costmap.h"
+#include "egress/perception/detection.h"
 #include "egress/perception/occupancy_map_3d.h"
 #include "egress/perception/particle_filter_localizer.h"
 #include "egress/perception/world_state.h"
@@ -68,6 +69,8 @@ struct ExecutiveConfig {
   double octomap_person_radius{0.5};
   /// Depth points within the robot's own outline grown by this are the robot (arm, payload) [m].
   double octomap_self_margin{0.06};
+  /// The detector stage's boxes and the port's own are merged above this overlap (IoU).
+  double detection_merge_iou{0.5};
   /// A door's leaf is in the costmap while its angle estimate is at most this old [s].
   double door_leaf_max_age{0.5};
   /// A held payload's outline for collision checks: a vertical cylinder at the palm [m].
@@ -111,6 +114,10 @@ class Executive {
 
   bt::NodeStatus status() const { return status_; }
   const std::vector<Decision>& decisions() const { return decisions_; }
+  /// Runs `detector` on every colour image the port gives (a robot that sends images, not
+  /// detections); its boxes join the port's own detections. Without one, colour images are
+  /// ignored. The executive owns it from here.
+  void SetDetector(std::unique_ptr<perception::Detector> detector);
   /// The running action's name (instance name, else its type), or empty.
   std::string active_action() const;
   const Pose2& X_MB() const { return context_.X_MB; }
@@ -132,6 +139,8 @@ class Executive {
   void InsertDepth(const DepthImage& depth, const Pose3& X_MC);
   // The estimated door leaves into the costmap.
   void UpdateDoorLeaves();
+  // The port's detections, plus the detector stage's on a colour image when there is one.
+  std::vector<Detection2D> Detect(const SensorSnapshot& snapshot);
 
   struct Impl;
   std::unique_ptr<Impl> impl_;

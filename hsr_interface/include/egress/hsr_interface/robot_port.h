@@ -22,11 +22,14 @@ namespace egress {
 /// Everything the robot brain reads in one cycle. Sensors run at their own rates: an empty
 /// optional or list means that sensor produced nothing new since the previous Sense().
 struct SensorSnapshot {
-  Time stamp{};                         ///< Robot clock time at which the snapshot was taken.
-  std::optional<LaserScan> scan;        ///< Latest base laser sweep (frame L).
-  std::optional<DepthImage> depth;      ///< Latest head depth image (frame C).
-  CameraIntrinsics depth_intrinsics;    ///< Intrinsics of `depth` (and of detections' image).
-  std::optional<Pose3> X_BC;            ///< Camera pose in the base at `depth`'s capture time.
+  Time stamp{};                       ///< Robot clock time at which the snapshot was taken.
+  std::optional<LaserScan> scan;      ///< Latest base laser sweep (frame L).
+  std::optional<DepthImage> depth;    ///< Latest head depth image (frame C).
+  CameraIntrinsics depth_intrinsics;  ///< Intrinsics of `depth` (and of detections' image).
+  std::optional<Pose3> X_BC;          ///< Camera pose in the base at `depth`'s capture time.
+  /// Latest head colour image, from a robot that gives images rather than detections (the
+  /// executive's detector stage runs on it); the twin leaves it empty and gives `detections`.
+  std::optional<ColorImage> color;
   std::vector<Detection2D> detections;  ///< Detections produced since the previous Sense().
   Odometry odometry;                    ///< Latest wheel odometry.
   JointState joints;                    ///< Latest joint states (arm, head, gripper).

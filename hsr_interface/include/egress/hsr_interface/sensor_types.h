@@ -6,6 +6,7 @@
 /// boundary rather than deep inside perception.
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -91,6 +92,18 @@ struct PixelBox {
 };
 
 /// One labelled box from a 2D detector, in the image of the camera frame_id.
+/// A colour image from the head RGB-D camera, 8-bit BGR, row-major (OpenCV's layout; ROS 2's
+/// sensor_msgs/Image with encoding "bgr8"). Same optical frame C as the depth image.
+struct ColorImage {
+  std::string frame_id{frames::kHeadCamera};
+  Time stamp{};  ///< Capture time.
+  int width{0};
+  int height{0};
+  std::vector<std::uint8_t> bgr;  ///< width * height * 3 bytes.
+  /// @throws InvalidArgument for a non-positive size or a buffer that does not match it.
+  void Validate() const;
+};
+
 struct Detection2D {
   std::string label;       ///< Class label, e.g. "person", "push_button", "bottle".
   double confidence{0.0};  ///< In [0, 1].
