@@ -4,6 +4,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <memory>
@@ -13,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "egress/behavior/task_nodes.h"
 #include "egress/bt/factory.h"
 #include "egress/bt/loggers.h"
 
@@ -320,6 +322,26 @@ void AddBtCommand(CLI::App& app) {
       ->required();
   trace->add_option("--btlog", options->btlog, "also write a Groot2 .btlog of the run");
   trace->add_flag("--json", options->json, "print the trace as JSON");
+  auto* model = bt_app->add_subcommand(
+      "model",
+      "Print the TreeNodesModel of egress's task nodes (Groot2's palette), from their "
+      "registrations");
+  auto model_out = std::make_shared<std::string>();
+  auto model_overwrite = std::make_shared<bool>(false);
+  model->add_option("--out", *model_out, "write it to this file instead of printing it");
+  model->add_flag("--overwrite", *model_overwrite, "replace an existing --out file");
+  model->callback([model_out, model_overwrite] {
+    const std::string xml = behavior::TaskNodesModelXml();
+    if (model_out->empty()) {
+      std::cout << xml;
+      return;
+    }
+    if (std::filesystem::exists(*model_out) && !*model_overwrite)
+      throw CommandFailed(*model_out + " exists (pass --overwrite to replace it)");
+    std::ofstream out(*model_out);
+    out << xml;
+    if (!out) throw CommandFailed("cannot write '" + *model_out + "'");
+  });
   validate->callback([options] {
     if (RunValidate(*options) != 0) throw CommandFailed("");
   });

@@ -13,8 +13,10 @@ class IsPathClear final : public TaskNode<bt::ConditionNode> {
  public:
   using TaskNode::TaskNode;
   static PortsList ProvidedPorts() {
-    return {InputPort<std::string>("door", "door whose zone must be free of people"),
-            InputPort<double>("clear_for", 1.0, "seconds the zone must have been clear [s]")};
+    return {InputPort<std::string>(
+                "door", "door whose zone must be free of people now and over the forecast"),
+            InputPort<double>("clear_for", 1.0,
+                              "seconds the zone must have been clear (hysteresis) [s]")};
   }
   NodeStatus Tick() override {
     const std::string door = Door();
@@ -44,7 +46,8 @@ class IsDoorOpen final : public TaskNode<bt::ConditionNode> {
   using TaskNode::TaskNode;
   static PortsList ProvidedPorts() {
     return {InputPort<std::string>("door", "door id"),
-            InputPort<double>("margin", 0.1, "clearance beyond the footprint [m]")};
+            InputPort<double>("margin", 0.1,
+                              "clearance beyond the robot's footprint the opening must leave [m]")};
   }
   NodeStatus Tick() override {
     return DoorPassable(ctx_, Door(), Input<double>("margin")) ? NodeStatus::kSuccess
@@ -55,7 +58,10 @@ class IsDoorOpen final : public TaskNode<bt::ConditionNode> {
 class IsPersonHoldingDoor final : public TaskNode<bt::ConditionNode> {
  public:
   using TaskNode::TaskNode;
-  static PortsList ProvidedPorts() { return {InputPort<std::string>("door", "door id")}; }
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>(
+        "door", "door id: a person stands still at the leaf and it is open enough")};
+  }
   NodeStatus Tick() override {
     const std::string door = Door();
     for (const auto& entry : ctx_.world.people) {
@@ -71,7 +77,8 @@ class IsHoldingPayload final : public TaskNode<bt::ConditionNode> {
  public:
   using TaskNode::TaskNode;
   static PortsList ProvidedPorts() {
-    return {InputPort<std::string>("payload", "", "payload class; empty: any")};
+    return {
+        InputPort<std::string>("payload", "", "payload class (bottle, flashlight); empty: any")};
   }
   NodeStatus Tick() override {
     return ctx_.holding_object ? NodeStatus::kSuccess : NodeStatus::kFailure;

@@ -12,7 +12,8 @@ class ButtonType final : public TaskNode<bt::SyncActionNode> {
   using TaskNode::TaskNode;
   static PortsList ProvidedPorts() {
     return {InputPort<std::string>("door", "door id"),
-            OutputPort<std::string>("type", "push_button or proximity_plate")};
+            OutputPort<std::string>(
+                "type", "push_button or proximity_plate: sets the end-effector travel")};
   }
   NodeStatus Tick() override {
     const MapActuator* actuator = ctx_.map->FindActuatorOf(Door(), ctx_.X_MB.translation());
@@ -31,7 +32,7 @@ class ApproachButton final : public TaskNode<bt::StatefulActionNode> {
  public:
   using TaskNode::TaskNode;
   static PortsList ProvidedPorts() {
-    return {InputPort<std::string>("door", "door whose actuator to stand off")};
+    return {InputPort<std::string>("door", "door whose actuator to stand off (base facing it)")};
   }
   NodeStatus OnStart() override {
     const std::string door = Door();
@@ -210,7 +211,8 @@ class PressButton final : public ActuatorAction {
   PressButton(const std::string& name, NodeConfig config, TaskContext* context)
       : ActuatorAction(name, std::move(config), context, planning::ButtonType::kPushButton) {}
   static PortsList ProvidedPorts() {
-    return {InputPort<std::string>("door", "door whose push button to press")};
+    return {InputPort<std::string>(
+        "door", "door whose push button to press (fingertip past the face by the stroke)")};
   }
 };
 
@@ -219,7 +221,8 @@ class WaveAtPlate final : public ActuatorAction {
   WaveAtPlate(const std::string& name, NodeConfig config, TaskContext* context)
       : ActuatorAction(name, std::move(config), context, planning::ButtonType::kProximityPlate) {}
   static PortsList ProvidedPorts() {
-    return {InputPort<std::string>("door", "door whose proximity plate to wave at")};
+    return {InputPort<std::string>(
+        "door", "door whose proximity plate to wave at (palm within its range, no contact)")};
   }
 };
 
@@ -232,8 +235,8 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
   using TaskNode::TaskNode;
   static PortsList ProvidedPorts() {
     return {InputPort<std::string>("door", "door to drive through"),
-            InputPort<double>("speed", 0.4, "speed through the doorway [m/s]"),
-            InputPort<double>("wait_timeout", 8.0, "how long to wait for the leaf to open [s]")};
+            InputPort<double>("wait_timeout", 8.0,
+                              "how long to wait for the leaf to open before failing [s]")};
   }
   NodeStatus OnStart() override {
     door_ = Door();
@@ -309,7 +312,8 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
         path.push_back({exit.x(), exit.y(), yaw_});
         through.push_back(true);
         ctx_.motion->FollowPath(path, through, kTuckedArm, ctx_.now);
-        Note(StrCat("door open: driving through at ", Input<double>("speed"), " m/s"));
+        Note(StrCat("door open: driving through at ", ctx_.motion->trajectory_config().door_speed,
+                    " m/s"));
         phase_ = Phase::kThrough;
         return NodeStatus::kRunning;
       }

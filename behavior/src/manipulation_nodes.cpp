@@ -21,7 +21,7 @@ class DetectPayload final : public TaskNode<bt::StatefulActionNode> {
   using TaskNode::TaskNode;
   static PortsList ProvidedPorts() {
     return {InputPort<std::string>("kind", "bottle or flashlight"),
-            InputPort<double>("timeout", 4.0, "how long to look [s]"),
+            InputPort<double>("timeout", 4.0, "how long to look before failing [s]"),
             OutputPort<std::string>("pose", "payload position x;y;z in the map")};
   }
   NodeStatus OnStart() override {
@@ -377,7 +377,9 @@ class PlacePayload final : public ReleaseAction {
  public:
   using ReleaseAction::ReleaseAction;
   static PortsList ProvidedPorts() {
-    return {InputPort<std::string>("pose", "payload centre x;y;z in the map when let go [m]")};
+    return {InputPort<std::string>("pose",
+                                   "payload centre x;y;z in the map when let go [m]: the surface "
+                                   "height plus half the payload's height plus a centimetre")};
   }
 
  private:

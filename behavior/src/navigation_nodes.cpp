@@ -17,7 +17,8 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
   using TaskNode::TaskNode;
   static PortsList ProvidedPorts() {
     return {InputPort<std::string>("goal", "goal pose x;y;yaw"),
-            InputPort<double>("speed", 0.2, "cruise speed [m/s]"),
+            InputPort<double>("detour_speed", 0.2,
+                              "speed of the Bug2 detour when the costmap has no path [m/s]"),
             InputPort<double>("patience", 15.0, "how long to keep re-planning a blocked goal [s]")};
   }
   NodeStatus OnStart() override {
@@ -59,7 +60,7 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
     if (!detour_tried_ && ctx_.planner->IsValid(goal)) {
       detour_tried_ = true;
       planning::BugConfig bug;
-      bug.speed = Input<double>("speed");
+      bug.speed = Input<double>("detour_speed");
       bug.robot_radius = ctx_.config.footprint_radius;
       ctx_.motion->FollowBug(ctx_.X_MB, goal.translation(), bug, ctx_.now);
       Note("no path on the costmap: detouring round the obstacle (Bug2)");

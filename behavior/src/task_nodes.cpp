@@ -36,6 +36,16 @@ Pose2 ParsePose2(std::string_view text) {
   return X;
 }
 
+std::string TaskNodesModelXml() {
+  // Registration needs only the node types' ports; no node is built, so no context.
+  bt::BehaviorTreeFactory factory;
+  detail::RegisterConditionNodes(factory, nullptr);
+  detail::RegisterNavigationNodes(factory, nullptr);
+  detail::RegisterDoorNodes(factory, nullptr);
+  detail::RegisterManipulationNodes(factory, nullptr);
+  return factory.WriteTreeNodesModelXml(false);
+}
+
 void RegisterTaskNodes(bt::BehaviorTreeFactory& factory, TaskContext* context) {
   ThrowUnless(context != nullptr && context->map != nullptr && context->model != nullptr &&
                   context->motion != nullptr && context->planner != nullptr,

@@ -20,6 +20,10 @@ namespace egress::behavior {
 /// Registers the task nodes; `context` must outlive every tree created from `factory`.
 void RegisterTaskNodes(bt::BehaviorTreeFactory& factory, TaskContext* context);
 
+/// The task nodes' TreeNodesModel (Groot2's palette; behavior/trees/egress_nodes.xml), written
+/// from their registrations: `egress bt model` prints it.
+std::string TaskNodesModelXml();
+
 /// "x;y;yaw" → pose. @throws InvalidArgument naming the text.
 Pose2 ParsePose2(std::string_view text);
 
