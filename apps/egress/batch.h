@@ -34,6 +34,7 @@ struct TrialResult {
   int person_contacts{0};
   int static_contacts{0};  ///< The robot touching walls or furniture (not a failure; a bump).
   int presses{0};
+  int relocalizations{0};  ///< Precise acts that waited for an uncertain pose to settle.
   std::vector<double> preemption_latencies;        ///< [s] person seen in the zone -> stop.
   std::vector<double> preemption_total_latencies;  ///< [s] person in the zone (truth) -> stop.
   double wall_time{0.0};                           ///< [s]
@@ -54,6 +55,7 @@ struct ScenarioSummary {
   int person_contacts{0};
   int static_contacts{0};
   int trials_with_static_contacts{0};
+  int trials_with_relocalizations{0};
   std::map<std::string, int> failure_reasons;
   std::vector<std::uint64_t> failed_seeds;
   std::vector<double> times;

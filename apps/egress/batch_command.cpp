@@ -87,6 +87,7 @@ TrialResult RunBrainTrial(const std::string& scenario_path, std::uint64_t seed) 
   r.static_contacts = m.contacts.count("static") ? m.contacts.at("static") : 0;
   for (const auto& [door, n] : m.button_presses)
     r.presses += n;
+  r.relocalizations = brain->relocalizations();
   for (const auto& [known, commanded] : brain->preemptions()) {
     r.preemption_latencies.push_back(commanded - known);
     // The person's true entry before this stop (none: the forecast saw them coming).
@@ -113,6 +114,7 @@ nlohmann::json ToJson(const TrialResult& r) {
           {"person_contacts", r.person_contacts},
           {"static_contacts", r.static_contacts},
           {"presses", r.presses},
+          {"relocalizations", r.relocalizations},
           {"preemption_latencies", r.preemption_latencies},
           {"preemption_total_latencies", r.preemption_total_latencies},
           {"wall_time", r.wall_time},
@@ -133,6 +135,7 @@ TrialResult TrialFromJson(const nlohmann::json& j) {
   r.person_contacts = j.at("person_contacts").get<int>();
   r.static_contacts = j.at("static_contacts").get<int>();
   r.presses = j.at("presses").get<int>();
+  r.relocalizations = j.value("relocalizations", 0);
   r.preemption_latencies = j.at("preemption_latencies").get<std::vector<double>>();
   r.preemption_total_latencies = j.at("preemption_total_latencies").get<std::vector<double>>();
   r.wall_time = j.at("wall_time").get<double>();
@@ -157,6 +160,7 @@ std::vector<ScenarioSummary> Summarize(const std::vector<TrialResult>& trials) {
     s.person_contacts += t.person_contacts;
     s.static_contacts += t.static_contacts;
     s.trials_with_static_contacts += t.static_contacts > 0 ? 1 : 0;
+    s.trials_with_relocalizations += t.relocalizations > 0 ? 1 : 0;
     s.min_person_distance = std::min(s.min_person_distance, t.min_person_distance);
     if (t.success) s.times.push_back(t.time);
     if (!t.success) s.failed_seeds.push_back(t.seed);
@@ -401,17 +405,17 @@ void RunBatch(const BatchOptions& o) {
   {
     std::ofstream csv(csv_path);
     csv << "scenario,name,seed,success,time_s,min_person_distance_m,person_contacts,"
-           "static_contacts,presses,failed,wall_s\n";
+           "static_contacts,presses,relocalizations,failed,wall_s\n";
     for (const auto& r : results) {
       std::string failed;
       for (const auto& f : r.failed)
         failed += (failed.empty() ? "" : ";") + f;
       csv << fmt::format(
-          "{},\"{}\",{},{},{:.2f},{},{},{},{},\"{}\",{:.2f}\n", r.scenario, r.name, r.seed,
+          "{},\"{}\",{},{},{:.2f},{},{},{},{},{},\"{}\",{:.2f}\n", r.scenario, r.name, r.seed,
           r.success ? 1 : 0, r.time,
           std::isfinite(r.min_person_distance) ? fmt::format("{:.3f}", r.min_person_distance) : "",
-          r.person_contacts, r.static_contacts, r.presses, r.error.empty() ? failed : r.error,
-          r.wall_time);
+          r.person_contacts, r.static_contacts, r.presses, r.relocalizations,
+          r.error.empty() ? failed : r.error, r.wall_time);
     }
     if (!csv) throw CommandFailed(fmt::format("cannot write '{}'", csv_path.string()));
   }
@@ -428,6 +432,7 @@ void RunBatch(const BatchOptions& o) {
          {"person_contacts", s.person_contacts},
          {"static_contacts", s.static_contacts},
          {"trials_with_static_contacts", s.trials_with_static_contacts},
+         {"trials_with_relocalizations", s.trials_with_relocalizations},
          {"failure_reasons", s.failure_reasons},
          {"failed_seeds", s.failed_seeds}});
   }

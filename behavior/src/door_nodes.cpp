@@ -123,6 +123,7 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
     }
     alignments_ = 0;
     arm_started_ = false;
+    gate_.Reset();
     return AlignOrOperate();
   }
   NodeStatus OnRunning() override {
@@ -145,12 +146,16 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
   void OnHalted() override { ctx_.motion->StopBase(); }  // the arm is tucked by whoever runs next
 
  private:
+  RelocalizeGate gate_;
   static constexpr double kAlignTolerance = 0.01;  // [m] base off its standoff along the normal
   static constexpr int kMaxAlignments = 2;
 
   // The base squares up to the planned standoff (by the laser's wall distance) first, then the
   // arm presses or waves.
   NodeStatus AlignOrOperate() {
+    if (gate_.Check(ctx_, "operating the actuator", [this](const std::string& t) { Note(t); }) ==
+        NodeStatus::kRunning)
+      return NodeStatus::kRunning;
     const ButtonPlan& plan = ctx_.button_plans.at(door_);
     const MapActuator& actuator = *ctx_.map->FindActuator(plan.actuator);
     const Pose2 X_MB = WallAlignedPose(ctx_, actuator, [this](const std::string& t) { Note(t); });
@@ -239,6 +244,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
                               "how long to wait for the leaf to open before failing [s]")};
   }
   NodeStatus OnStart() override {
+    gate_.Reset();
     door_ = Door();
     pass_ = CalcApproachPass(ctx_, door_);
     if (!ArmAt(ctx_.motion->arm_target(), kTuckedArm) || ctx_.motion->arm_moving(ctx_.now)) {
@@ -287,6 +293,9 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
         [[fallthrough]];
       }
       case Phase::kWaiting: {
+        if (gate_.Check(ctx_, "driving through the door",
+                        [this](const std::string& t) { Note(t); }) == NodeStatus::kRunning)
+          return NodeStatus::kRunning;
         if (const NodeStatus arm = ArmMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
             arm != NodeStatus::kSuccess) {
           return arm;
@@ -331,6 +340,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
   void OnHalted() override { ctx_.motion->StopBase(); }
 
  private:
+  RelocalizeGate gate_;
   Eigen::Vector2d ClearOpeningCentre() const {
     const perception::DoorModel& door = *ctx_.map->FindDoor(door_);
     double angle = M_PI / 2;

@@ -152,6 +152,7 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
             InputPort<std::string>("kind", "", "bottle or flashlight (how it stands)")};
   }
   NodeStatus OnStart() override {
+    gate_.Reset();
     const Eigen::Vector3d p_seen = ParsePoint3(Input<std::string>("pose"));
     approach_ = HorizontalApproach(ctx_.X_MB, p_seen);
     // The camera sees the near surface; the centre is a radius further.
@@ -184,6 +185,9 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
       case Phase::kToBase: {
         const NodeStatus s = BaseMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
         if (s != NodeStatus::kSuccess) return s;
+        if (gate_.Check(ctx_, "grasping", [this](const std::string& t) { Note(t); }) ==
+            NodeStatus::kRunning)
+          return NodeStatus::kRunning;
         // Arm-only from where the base stopped.
         const auto grasp = SolveArm(ctx_, ctx_.X_MB, PalmTarget(centre_, approach_), grasp_arm_,
                                     false, kHandError);
@@ -244,6 +248,7 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
   void OnHalted() override { ctx_.motion->StopBase(); }
 
  private:
+  RelocalizeGate gate_;
   static constexpr double kPayloadRadius = 0.03;   // [m] a bottle's, about
   static constexpr double kHandBelowGrasp = 0.06;  // [m] the hand's lowest point, with margin
   static constexpr double kMaxGraspRaise = 0.06;   // [m] still on the payload's body

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/Eigenvalues>
+
 namespace egress::behavior::detail {
 
 bool ArmAt(const ArmPose& a, const ArmPose& b) {
@@ -182,6 +184,36 @@ std::optional<ArmPose> SolveArm(const TaskContext& ctx, const Pose2& X_MB,
   }
   if (!good(r)) return std::nullopt;
   return ArmOf(r.q);
+}
+
+double PositionSigma(const TaskContext& ctx) {
+  const Eigen::Matrix2d C = ctx.world.X_MB_covariance.topLeftCorner<2, 2>();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(C);
+  return std::sqrt(std::max(0.0, eigen.eigenvalues().maxCoeff()));
+}
+
+NodeStatus RelocalizeGate::Check(TaskContext& ctx, const std::string& act, const NoteFn& note) {
+  const double sigma = PositionSigma(ctx);
+  const double limit = ctx.config.precise_pose_sigma;
+  if (!waiting_since_) {
+    if (sigma <= limit) return NodeStatus::kSuccess;
+    waiting_since_ = ctx.now;
+    ++ctx.relocalizations;
+    ctx.motion->StopBase();
+    note(StrCat("the pose is uncertain (", std::round(sigma * 1000), " mm): re-localizing before ",
+                act));
+    return NodeStatus::kRunning;
+  }
+  if (sigma <= limit) {
+    note(StrCat("re-localized (", std::round(sigma * 1000), " mm)"));
+    waiting_since_.reset();
+    return NodeStatus::kSuccess;
+  }
+  if (ToSeconds(ctx.now - *waiting_since_) < ctx.config.relocalize_timeout)
+    return NodeStatus::kRunning;
+  note(StrCat("the pose stayed uncertain (", std::round(sigma * 1000), " mm): ", act, " anyway"));
+  waiting_since_.reset();
+  return NodeStatus::kSuccess;
 }
 
 }  // namespace egress::behavior::detail

@@ -84,6 +84,25 @@ double ExitDistance(const TaskContext& ctx, const std::string& door);
 /// How far before the door line the robot lines up and waits [m].
 double EntryDistance(const TaskContext& ctx, const std::string& door, const DoorPass& pass);
 
+/// The localizer's position standard deviation: the square root of the largest eigenvalue of
+/// the xy block of the belief's covariance [m].
+double PositionSigma(const TaskContext& ctx);
+
+/// Holds a precise act until the pose is certain enough: when PositionSigma exceeds
+/// config.precise_pose_sigma, the base stands still while the localizer corrects on scans of
+/// the walls and door around it, until it is below again or config.relocalize_timeout passed.
+class RelocalizeGate {
+ public:
+  /// A new act: forget any earlier wait.
+  void Reset() { waiting_since_.reset(); }
+  /// RUNNING while re-localizing; SUCCESS when the pose is good enough (or the wait timed out,
+  /// noted). Counts each wait in ctx.relocalizations.
+  NodeStatus Check(TaskContext& ctx, const std::string& act, const NoteFn& note);
+
+ private:
+  std::optional<Time> waiting_since_;
+};
+
 /// Registers node type T under `id` with its ports; its nodes share `context`.
 template <typename T>
 void Register(bt::BehaviorTreeFactory& factory, const std::string& id, TaskContext* context) {

@@ -13,6 +13,8 @@ void TaskConfig::Validate() const {
               "TaskConfig: distances must be positive");
   ThrowUnless(arm_tuck_time > 0 && press_reach_time > 0 && press_time > 0 && wave_hold_time >= 0,
               "TaskConfig: motion times must be positive");
+  ThrowUnless(precise_pose_sigma > 0 && relocalize_timeout >= 0,
+              "TaskConfig: precise_pose_sigma must be > 0 and relocalize_timeout >= 0");
   ik.Validate();
 }
 

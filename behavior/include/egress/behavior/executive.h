@@ -127,6 +127,8 @@ class Executive {
   /// The robot's 3D outline in B the planner checks (measured arm, held payload).
   const std::vector<PlacedShape>& body_shapes() const;
   const TaskContext& context() const { return context_; }
+  /// How often a precise act re-localized first (TaskConfig::precise_pose_sigma).
+  int relocalizations() const { return context_.relocalizations; }
   /// Time of the first tick at which an IsPathClear check failed after having passed, and of
   /// the first zero-velocity / retract command after it, per event [s] (preemption latency).
   const std::vector<std::pair<double, double>>& preemptions() const { return preemptions_; }

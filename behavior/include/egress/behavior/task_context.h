@@ -44,6 +44,12 @@ struct TaskConfig {
     return c;
   }();
   planning::IkConfig ik;  ///< For button presses (fingertip for push buttons).
+  /// Precise acts (pressing or waving, grasping, lining up on a door) start only when the
+  /// localizer's position standard deviation is at most this; above it the robot stands and
+  /// re-localizes first [m].
+  double precise_pose_sigma{0.02};
+  /// ... for at most this long, then acts anyway (noted) [s].
+  double relocalize_timeout{3.0};
   void Validate() const;
 };
 
@@ -90,6 +96,8 @@ struct TaskContext {
   /// Per door: when the robot's hand last reached its actuator to press or wave (the operator's
   /// hold window starts soon after, whether or not the door is seen opening).
   std::map<std::string, Time> door_operated_at;
+  /// How often a precise act waited for the pose to settle (re-localized) first.
+  int relocalizations{0};
   /// A standby retreat is under way: it is finished before the robot resumes.
   bool retreating{false};
   std::vector<std::string> notes;  ///< The nodes' reasons, for the run log.
