@@ -199,6 +199,21 @@ struct RobotModel::Impl {
     }
   }
 
+  // Named joint positions as a map. @throws InvalidArgument for an unknown joint or a
+  // non-finite position.
+  std::map<std::string, double, std::less<>> JointMap(
+      const std::vector<std::pair<std::string, double>>& joint_positions) const {
+    std::map<std::string, double, std::less<>> q;
+    for (const auto& [joint, value] : joint_positions) {
+      ThrowUnless(joints.contains(joint), "Unknown joint '", joint, "' in robot model '", name,
+                  "'.");
+      ThrowUnless(std::isfinite(value), "Invalid joint position: '", joint, "' (", value,
+                  ") must be finite.");
+      q[joint] = value;
+    }
+    return q;
+  }
+
   // Primitive <collision> elements of every link reachable from the root; meshes are skipped.
   void ReadCollisionShapes(const urdf::ModelInterface& model) {
     std::vector<urdf::LinkSharedPtr> links;
@@ -571,14 +586,7 @@ const std::vector<CollisionShape>& RobotModel::collision_shapes() const {
 
 std::vector<PlacedShape> RobotModel::CalcCollisionShapesInBase(
     const std::vector<std::pair<std::string, double>>& joint_positions, bool skip_fingers) const {
-  std::map<std::string, double, std::less<>> q;
-  for (const auto& [joint, value] : joint_positions) {
-    ThrowUnless(impl_->joints.contains(joint), "Unknown joint '", joint, "' in robot model '",
-                impl_->name, "'.");
-    ThrowUnless(std::isfinite(value), "Invalid joint position: '", joint, "' (", value,
-                ") must be finite.");
-    q[joint] = value;
-  }
+  const auto q = impl_->JointMap(joint_positions);
   std::vector<PlacedShape> out;
   std::map<std::string, Pose3, std::less<>> link_poses;
   for (const CollisionShape& shape : impl_->collision_shapes) {
@@ -598,14 +606,7 @@ std::vector<PlacedShape> RobotModel::CalcCollisionShapesInBase(
 Pose3 RobotModel::CalcLinkPoseInBase(
     std::string_view link_name,
     const std::vector<std::pair<std::string, double>>& joint_positions) const {
-  std::map<std::string, double, std::less<>> q;
-  for (const auto& [joint, value] : joint_positions) {
-    ThrowUnless(impl_->joints.contains(joint), "Unknown joint '", joint, "' in robot model '",
-                impl_->name, "'.");
-    ThrowUnless(std::isfinite(value), "Invalid joint position: '", joint, "' (", value,
-                ") must be finite.");
-    q[joint] = value;
-  }
+  const auto q = impl_->JointMap(joint_positions);
   return impl_->LinkPoseInBase(link_name, q);
 }
 
