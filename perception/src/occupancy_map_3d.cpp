@@ -12,6 +12,9 @@ void OccupancyMap3DConfig::Validate() const {
   ThrowUnless(max_range > 0.0, "Invalid OccupancyMap3DConfig: max_range must be > 0.");
   ThrowUnless(pixel_stride >= 1, "Invalid OccupancyMap3DConfig: pixel_stride (", pixel_stride,
               ") must be >= 1.");
+  ThrowUnless(prob_hit > 0.5 && prob_hit < 1.0 && prob_miss > 0.0 && prob_miss < 0.5,
+              "Invalid OccupancyMap3DConfig: prob_hit must be in (0.5, 1) and prob_miss in "
+              "(0, 0.5).");
   ThrowUnless(max_obstacle_height > min_obstacle_height,
               "Invalid OccupancyMap3DConfig: max_obstacle_height must exceed min_obstacle_height.");
 }
@@ -19,6 +22,8 @@ void OccupancyMap3DConfig::Validate() const {
 OccupancyMap3D::OccupancyMap3D(OccupancyMap3DConfig config)
     : config_(config), tree_(std::make_shared<octomap::OcTree>(config.resolution)) {
   config_.Validate();
+  tree_->setProbHit(config_.prob_hit);
+  tree_->setProbMiss(config_.prob_miss);
 }
 
 std::size_t OccupancyMap3D::InsertDepthImage(const DepthImage& depth,
@@ -75,14 +80,17 @@ std::vector<Eigen::Vector2d> OccupancyMap3D::ProjectObstacles() const {
     if (!tree_->isNodeOccupied(*it)) continue;
     const double z = it.getZ();
     if (z < config_.min_obstacle_height || z > config_.max_obstacle_height) continue;
-    // A coarse leaf covers several voxels: emit each.
+    // The leaf's whole footprint, not its centre: a point at the centre of a 5 cm voxel may lie
+    // 2.5 cm inside the obstacle's true edge, and the costmap cell it falls in adds its own
+    // rounding. Its corners and centres at voxel spacing mark every cell the leaf overlaps
+    // (a coarse leaf covers several voxels).
     const double size = it.getSize();
     const int n = std::max(1, static_cast<int>(std::round(size / config_.resolution)));
-    const double x0 = it.getX() - size / 2 + config_.resolution / 2,
-                 y0 = it.getY() - size / 2 + config_.resolution / 2;
-    for (int i = 0; i < n; ++i) {
-      for (int j = 0; j < n; ++j)
-        points.emplace_back(x0 + i * config_.resolution, y0 + j * config_.resolution);
+    const double x0 = it.getX() - size / 2, y0 = it.getY() - size / 2;
+    const double step = config_.resolution / 2;
+    for (int i = 0; i <= 2 * n; ++i) {
+      for (int j = 0; j <= 2 * n; ++j)
+        points.emplace_back(x0 + i * step, y0 + j * step);
     }
   }
   return points;

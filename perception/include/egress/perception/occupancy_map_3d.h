@@ -20,11 +20,16 @@ namespace egress::perception {
 /// to clearing_range. Carving the whole frustum at 5 cm costs ~30 ms per 80x60 frame; bounded
 /// like this an insert stays near 2 ms, and space is cleared as the robot comes near it.
 struct OccupancyMap3DConfig {
-  double resolution{0.05};           ///< Voxel size [m].
-  double max_range{4.0};             ///< Returns beyond this are ignored [m].
-  double clearing_range{1.5};        ///< Rays carve free space up to this distance [m].
-  int clearing_stride{4};            ///< Carve along every n-th pixel's ray in u and v.
-  int pixel_stride{1};               ///< Mark every n-th pixel in u and v.
+  double resolution{0.05};     ///< Voxel size [m].
+  double max_range{4.0};       ///< Returns beyond this are ignored [m].
+  double clearing_range{1.5};  ///< Rays carve free space up to this distance [m].
+  int clearing_stride{4};      ///< Carve along every n-th pixel's ray in u and v.
+  int pixel_stride{1};         ///< Mark every n-th pixel in u and v.
+  /// OctoMap's sensor model. A miss (a ray through a voxel) counts less than OctoMap's default
+  /// 0.4: rays that graze an obstacle's edge at a shallow angle pass through its edge voxels
+  /// often, and would wear a table top's edge away as the robot drives along it.
+  double prob_hit{0.7};
+  double prob_miss{0.45};
   double min_obstacle_height{0.05};  ///< Projection band in M's z [m]: the floor is below it,
   double max_obstacle_height{1.5};   ///< and what the robot passes under is above it.
   void Validate() const;
@@ -43,7 +48,8 @@ class OccupancyMap3D {
   /// @throws InvalidArgument if the image and intrinsics disagree or the pose is not finite.
   std::size_t InsertDepthImage(const DepthImage& depth, const CameraIntrinsics& intrinsics,
                                const Pose3& X_MC, const PointFilter& keep = {});
-  /// Centres (x, y) of occupied voxels whose z lies within the obstacle band.
+  /// Points (x, y) covering the footprint of every occupied voxel whose z lies within the
+  /// obstacle band (its corners and centre, at half-voxel spacing), for the costmap.
   std::vector<Eigen::Vector2d> ProjectObstacles() const;
   bool IsOccupied(const Eigen::Vector3d& p_MQ) const;
   /// The OctoMap (shared so that FCL can hold it).
