@@ -12,6 +12,8 @@ void OccupancyMap3DConfig::Validate() const {
   ThrowUnless(max_range > 0.0, "Invalid OccupancyMap3DConfig: max_range must be > 0.");
   ThrowUnless(pixel_stride >= 1, "Invalid OccupancyMap3DConfig: pixel_stride (", pixel_stride,
               ") must be >= 1.");
+  ThrowUnless(occupied_threshold > 0.5 && occupied_threshold < 1.0,
+              "Invalid OccupancyMap3DConfig: occupied_threshold must be in (0.5, 1).");
   ThrowUnless(prob_hit > 0.5 && prob_hit < 1.0 && prob_miss > 0.0 && prob_miss < 0.5,
               "Invalid OccupancyMap3DConfig: prob_hit must be in (0.5, 1) and prob_miss in "
               "(0, 0.5).");
@@ -24,6 +26,7 @@ OccupancyMap3D::OccupancyMap3D(OccupancyMap3DConfig config)
   config_.Validate();
   tree_->setProbHit(config_.prob_hit);
   tree_->setProbMiss(config_.prob_miss);
+  tree_->setOccupancyThres(config_.occupied_threshold);
 }
 
 std::size_t OccupancyMap3D::InsertDepthImage(const DepthImage& depth,

@@ -45,9 +45,13 @@ TEST(OccupancyMap3DTest, SyntheticBoxIsOccupiedAndTheSpaceBeforeItFree) {
   const Pose3 X_MC = ForwardCamera();
   OccupancyMap3D map;
   // A table-like face 2 m ahead, 0.4-0.8 m high: above the base laser's scan plane.
+  // Seen in three frames (a static obstacle): occupied.
   const std::size_t inserted =
       map.InsertDepthImage(RenderFace(K, X_MC, 2.0, -0.3, 0.3, 0.4, 0.8), K, X_MC);
   EXPECT_GT(inserted, 100u);
+  EXPECT_FALSE(OccupiedAtFace(map, 0.0, 0.6)) << "one sighting is not yet an obstacle";
+  for (int frame = 0; frame < 2; ++frame)
+    map.InsertDepthImage(RenderFace(K, X_MC, 2.0, -0.3, 0.3, 0.4, 0.8), K, X_MC);
   EXPECT_TRUE(OccupiedAtFace(map, 0.0, 0.6));
   EXPECT_FALSE(map.IsOccupied({0.5, 0.0, 0.9}));  // along the rays, within clearing_range: free
   const octomap::OcTreeNode* carved = map.tree()->search(0.5, 0.0, 0.9);
@@ -67,7 +71,8 @@ TEST(OccupancyMap3DTest, OverheadObstaclesAreNotProjected) {
   OccupancyMap3DConfig config;
   config.max_obstacle_height = 1.5;
   OccupancyMap3D map(config);
-  map.InsertDepthImage(RenderFace(K, X_MC, 2.0, -0.3, 0.3, 1.6, 1.9), K, X_MC);  // above the robot
+  for (int frame = 0; frame < 3; ++frame)  // above the robot
+    map.InsertDepthImage(RenderFace(K, X_MC, 2.0, -0.3, 0.3, 1.6, 1.9), K, X_MC);
   EXPECT_TRUE(OccupiedAtFace(map, 0.0, 1.7));
   EXPECT_TRUE(map.ProjectObstacles().empty());
 }
@@ -77,10 +82,12 @@ TEST(OccupancyMap3DTest, AFilterKeepsPointsFromMarkingButNotFromCarving) {
   const Pose3 X_MC = ForwardCamera();
   OccupancyMap3D map;
   // The face 2 m ahead, with its left half (y > 0) refused, e.g. a tracked person there.
+  const auto left_refused = [](const Eigen::Vector3d& p_MQ) { return p_MQ.y() < 0.0; };
   const std::size_t inserted =
-      map.InsertDepthImage(RenderFace(K, X_MC, 2.0, -0.3, 0.3, 0.4, 0.8), K, X_MC,
-                           [](const Eigen::Vector3d& p_MQ) { return p_MQ.y() < 0.0; });
+      map.InsertDepthImage(RenderFace(K, X_MC, 2.0, -0.3, 0.3, 0.4, 0.8), K, X_MC, left_refused);
   EXPECT_GT(inserted, 30u);
+  for (int frame = 0; frame < 2; ++frame)
+    map.InsertDepthImage(RenderFace(K, X_MC, 2.0, -0.3, 0.3, 0.4, 0.8), K, X_MC, left_refused);
   EXPECT_TRUE(OccupiedAtFace(map, -0.2, 0.6));
   EXPECT_FALSE(OccupiedAtFace(map, 0.2, 0.6));
   const octomap::OcTreeNode* carved = map.tree()->search(0.5, 0.0, 0.9);
@@ -92,6 +99,23 @@ TEST(OccupancyMap3DTest, AFilterKeepsPointsFromMarkingButNotFromCarving) {
                                   [](const Eigen::Vector3d&) { return false; }),
             0u);
   EXPECT_TRUE(none.ProjectObstacles().empty());
+}
+
+// Someone walking past, seen in one frame at each place, leaves no obstacle behind; the same
+// thing standing still for three frames is one.
+TEST(OccupancyMap3DTest, WhatIsSeenOnceOrTwiceIsNoObstacle) {
+  const CameraIntrinsics K = CameraIntrinsics::FromHorizontalFov(80, 60, 1.047);
+  const Pose3 X_MC = ForwardCamera();
+  OccupancyMap3D map;
+  for (double y : {-1.0, -0.6, -0.2, 0.2, 0.6})  // 0.4 m on per frame
+    map.InsertDepthImage(RenderFace(K, X_MC, 3.0, y - 0.15, y + 0.15, 0.3, 1.4), K, X_MC);
+  EXPECT_TRUE(map.ProjectObstacles().empty());
+  for (int frame = 0; frame < 3; ++frame)
+    map.InsertDepthImage(RenderFace(K, X_MC, 3.0, 0.45, 0.75, 0.3, 1.4), K, X_MC);
+  EXPECT_FALSE(map.ProjectObstacles().empty());
+  OccupancyMap3DConfig bad;
+  bad.occupied_threshold = 0.4;
+  EXPECT_THROW(OccupancyMap3D{bad}, InvalidArgument);
 }
 
 TEST(OccupancyMap3DTest, MalformedInput) {

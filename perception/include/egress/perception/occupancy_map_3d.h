@@ -30,6 +30,10 @@ struct OccupancyMap3DConfig {
   /// often, and would wear a table top's edge away as the robot drives along it.
   double prob_hit{0.7};
   double prob_miss{0.45};
+  /// A voxel is an obstacle (projected, and for FCL) only at this occupancy: three hits in a
+  /// row. Something seen once or twice — a person walking past before the tracker has them,
+  /// whose voxels no later ray may ever clear — never becomes a wall nobody can see.
+  double occupied_threshold{0.9};
   double min_obstacle_height{0.05};  ///< Projection band in M's z [m]: the floor is below it,
   double max_obstacle_height{1.5};   ///< and what the robot passes under is above it.
   void Validate() const;
