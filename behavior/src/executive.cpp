@@ -99,6 +99,7 @@ struct Executive::Impl {
   std::optional<perception::OccupancyMap3D> octomap;
   std::vector<PlacedShape> body;              // the robot's outline in B
   std::map<std::string, double> leaf_angles;  // per door: the leaf as the costmap has it
+  std::vector<Eigen::Vector2d> projected;     // the 3D map's projection the costmap has
   std::map<std::string, bool> zone_occupied;  // per door, at the last control step
   std::optional<double> occupied_known_at;    // when perception first showed a person there
 
@@ -228,6 +229,15 @@ void Executive::InsertDepth(const DepthImage& depth, const Pose3& X_MC) {
   std::vector<Eigen::Vector2d> people;
   for (const auto& p : context_.world.people)
     people.push_back(p.person.p_MP);
+  // The robot's shapes as seen from each (S from B), and a radius round the base beyond which
+  // no point can be the robot.
+  std::vector<std::pair<const CollisionShape*, Pose3>> self;
+  double self_reach = 0.0;
+  for (const PlacedShape& s : m.body) {
+    self.emplace_back(&s.shape, s.X_BS.Inverse());
+    self_reach = std::max(self_reach, s.X_BS.translation().head<2>().norm() +
+                                          s.shape.BoundingRadius() + cfg.octomap_self_margin);
+  }
   const auto keep = [&](const Eigen::Vector3d& p_MQ) {
     if (p_MQ.z() < cfg.octomap.min_obstacle_height || p_MQ.z() > cfg.octomap.max_obstacle_height)
       return false;  // the floor, or above the robot
@@ -240,13 +250,20 @@ void Executive::InsertDepth(const DepthImage& depth, const Pose3& X_MC) {
       if ((p - door.p_MHinge).norm() < door.width() + 0.1) return false;
     }
     const Eigen::Vector3d p_BQ = X_BM * p_MQ;
-    for (const PlacedShape& s : m.body) {
-      if (s.shape.Contains(s.X_BS.Inverse() * p_BQ, cfg.octomap_self_margin)) return false;
+    if (p_BQ.head<2>().norm() < self_reach) {
+      for (const auto& [shape, X_SB] : self) {
+        if (shape->Contains(X_SB * p_BQ, cfg.octomap_self_margin)) return false;
+      }
     }
     return !costmap_->IsNearSensedObstacle(p, cfg.octomap_known_radius);
   };
   m.octomap->InsertDepthImage(depth, m.intrinsics, X_MC, keep);
-  costmap_->SetProjectedObstacles(m.octomap->ProjectObstacles());
+  // The costmap recomputes its inflation round whatever changed: only when something did.
+  std::vector<Eigen::Vector2d> projected = m.octomap->ProjectObstacles();
+  if (projected != m.projected) {
+    costmap_->SetProjectedObstacles(projected);
+    m.projected = std::move(projected);
+  }
 }
 
 void Executive::UpdateDoorLeaves() {

@@ -247,7 +247,12 @@ struct BasePlanner::Impl {
       ompl::RNG::setSeed(seed);
     });
     if (!clock) clock = std::make_shared<SteadyClock>();
-    if (octomap) fcl_octree = std::make_unique<fcl::OcTree<double>>(octomap);
+    if (octomap) {
+      fcl_octree = std::make_unique<fcl::OcTree<double>>(octomap);
+      // Below the tree's occupancy threshold a node holds nothing to collide with: FCL may skip
+      // it whole (its default, 0, makes it descend into every node the shape overlaps).
+      fcl_octree->setFreeThres(octomap->getOccupancyThres());
+    }
     const auto& g = costmap.geometry();
     space = std::make_shared<ob::SE2StateSpace>();
     ob::RealVectorBounds bounds(2);
