@@ -14,6 +14,11 @@
 namespace egress::behavior {
 namespace {
 
+const ExecutiveConfig& Defaults() {
+  static const ExecutiveConfig config;
+  return config;
+}
+
 MissionMap EmptyRoom() {
   MissionMap map;
   map.grid = perception::OccupancyGrid::FromBoxes(
@@ -122,7 +127,7 @@ class CentreBottleDetector final : public perception::Detector {
 TEST(ExecutiveTest, ColourImagesGoThroughTheDetectorStage) {
   const auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
   ImageOnlyRobot robot(*model);
-  Executive brain(model, EmptyRoom(), GoTo(), {2.0, 3.0, 0.0}, {});
+  Executive brain(model, EmptyRoom(), GoTo(), {2.0, 3.0, 0.0}, Defaults());
   int calls = 0;
   brain.SetDetector(std::make_unique<CentreBottleDetector>(&calls));
   for (int i = 0; i < 6; ++i) {
@@ -138,7 +143,7 @@ TEST(ExecutiveTest, ColourImagesGoThroughTheDetectorStage) {
 
   // Without a detector the images are ignored: nothing is found.
   ImageOnlyRobot other(*model);
-  Executive blind(model, EmptyRoom(), GoTo(), {2.0, 3.0, 0.0}, {});
+  Executive blind(model, EmptyRoom(), GoTo(), {2.0, 3.0, 0.0}, Defaults());
   for (int i = 0; i < 6; ++i) {
     blind.Step(other);
     other.Advance();
