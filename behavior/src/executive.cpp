@@ -97,7 +97,9 @@ struct Executive::Impl {
   GraspMonitor grasp;
   std::unique_ptr<perception::Detector> detector;  // on colour images, when set
   std::optional<perception::OccupancyMap3D> octomap;
-  std::vector<PlacedShape> body;              // the robot's outline in B
+  std::vector<PlacedShape> body;  // the robot's outline in B
+  std::optional<std::vector<std::pair<std::string, double>>> body_joints;  // `body` is for these
+  bool body_holding{false};
   std::map<std::string, double> leaf_angles;  // per door: the leaf as the costmap has it
   std::vector<Eigen::Vector2d> projected;     // the 3D map's projection the costmap has
   std::map<std::string, bool> zone_occupied;  // per door, at the last control step
@@ -206,6 +208,10 @@ void Executive::UpdateBody(const SensorSnapshot& snapshot) {
   for (std::string_view joint : {"head_pan_joint", "head_tilt_joint"}) {
     if (auto value = snapshot.joints.Position(joint)) q.emplace_back(joint, *value);
   }
+  // Each control step, but the outline changes only when a joint or the grip does.
+  if (m.body_joints && *m.body_joints == q && m.body_holding == context_.holding_object) return;
+  m.body_joints = q;
+  m.body_holding = context_.holding_object;
   m.body = m.model->CalcCollisionShapesInBase(q);
   if (context_.holding_object) {
     // The payload hangs between the fingers, ahead of the palm along its approach axis.
