@@ -7,6 +7,10 @@
 namespace egress::behavior::detail {
 namespace {
 
+// Points along the press stroke the arm is solved for (pre-press to press): the fingertip
+// stays on the button's normal instead of a joint-space curve.
+constexpr int kPressStrokeKnots = 4;
+
 class ButtonType final : public TaskNode<bt::SyncActionNode> {
  public:
   using TaskNode::TaskNode;
@@ -55,13 +59,13 @@ class ApproachButton final : public TaskNode<bt::StatefulActionNode> {
     q0[kBaseX] = plan.targets.X_MB_standoff.x;
     q0[kBaseY] = plan.targets.X_MB_standoff.y;
     q0[kBaseYaw] = plan.targets.X_MB_standoff.yaw;
-    q0 = WithArm(q0, kTuckedArm);
+    q0 = WithArm(q0, TuckedArm(*ctx_.model));
     const planning::IkResult solution =
         planning::DlsIkSolver(*ctx_.model, ik).Solve(plan.targets.approach, q0);
     plan.X_MB_standoff = solution.converged
                              ? Pose2{solution.q[kBaseX], solution.q[kBaseY], solution.q[kBaseYaw]}
                              : plan.targets.X_MB_standoff;
-    if (solution.converged) plan.approach_arm = ArmOf(solution.q);
+    plan.approach_arm = solution.converged ? ArmOf(solution.q) : TuckedArm(*ctx_.model);
     if (!solution.converged) Note("whole-body IK did not converge; using the nominal standoff");
     ctx_.button_plans[door] = plan;
     return StartPath(ctx_, plan.X_MB_standoff, StrCat("the ", actuator->id, " standoff"),
@@ -185,15 +189,20 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
     if (push) {
       planning::IkTarget press = plan.targets.press;
       press.approach_M.reset();  // the arm alone cannot also hold the approach axis exactly
-      const auto pressed = SolveArm(ctx_, X_MB, press, *approach, true);
-      if (!pressed) {
+      const auto stroke = SolveArmLine(ctx_, X_MB, plan.targets.approach, press, *approach, true,
+                                       kPressStrokeKnots);
+      if (!stroke) {
         Note("the press point is out of the arm's reach from here");
         return NodeStatus::kFailure;
       }
-      ctx_.motion->MoveArm({{c.press_reach_time, *approach},
-                            {c.press_reach_time + c.press_time, *pressed},
-                            {c.press_reach_time + 2 * c.press_time, *approach}},
-                           ctx_.now);
+      // In along the button's normal, out the same way.
+      std::vector<std::pair<double, ArmPose>> knots{{c.press_reach_time, *approach}};
+      const double dt = c.press_time / kPressStrokeKnots;
+      for (int i = 0; i < kPressStrokeKnots; ++i)
+        knots.emplace_back(c.press_reach_time + (i + 1) * dt, (*stroke)[std::size_t(i)]);
+      for (int i = kPressStrokeKnots - 2; i >= -1; --i)
+        knots.emplace_back(knots.back().first + dt, i >= 0 ? (*stroke)[std::size_t(i)] : *approach);
+      ctx_.motion->MoveArm(knots, ctx_.now);
       Note("pressing the push button");
     } else {
       ctx_.motion->MoveArm(
@@ -247,8 +256,9 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     gate_.Reset();
     door_ = Door();
     pass_ = CalcApproachPass(ctx_, door_);
-    if (!ArmAt(ctx_.motion->arm_target(), kTuckedArm) || ctx_.motion->arm_moving(ctx_.now)) {
-      ctx_.motion->MoveArm({{ctx_.config.arm_tuck_time, kTuckedArm}}, ctx_.now);
+    if (!ArmAt(ctx_.motion->arm_target(), TuckedArm(*ctx_.model)) ||
+        ctx_.motion->arm_moving(ctx_.now)) {
+      ctx_.motion->MoveArm({{ctx_.config.arm_tuck_time, TuckedArm(*ctx_.model)}}, ctx_.now);
     }
     yaw_ = std::atan2(-pass_.n_M.y(), -pass_.n_M.x());  // facing through the door
     entry_distance_ = EntryDistance(ctx_, door_, pass_);
@@ -270,8 +280,8 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
       }
       line_up.push_back(X_MB_entry);
       if (ctx_.planner->IsPathValid(line_up)) {
-        ctx_.motion->FollowPath(line_up, std::vector<bool>(line_up.size() - 1, true), kTuckedArm,
-                                ctx_.now);
+        ctx_.motion->FollowPath(line_up, std::vector<bool>(line_up.size() - 1, true),
+                                TuckedArm(*ctx_.model), ctx_.now);
         Note("lining up on the door's axis");
       } else {
         const NodeStatus s = StartPath(
@@ -320,7 +330,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
         }
         path.push_back({exit.x(), exit.y(), yaw_});
         through.push_back(true);
-        ctx_.motion->FollowPath(path, through, kTuckedArm, ctx_.now);
+        ctx_.motion->FollowPath(path, through, TuckedArm(*ctx_.model), ctx_.now);
         Note(StrCat("door open: driving through at ", ctx_.motion->trajectory_config().door_speed,
                     " m/s"));
         phase_ = Phase::kThrough;

@@ -224,7 +224,7 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
         // clear of what the payload stood among (a straight tuck in joint space would lower
         // the lift while folding and drag the payload through it). The tuck that follows only
         // lowers the lift.
-        ArmPose folded = kTuckedArm;
+        ArmPose folded = TuckedArm(*ctx_.model);
         folded[0] = lifted_[0];
         ctx_.motion->MoveArm({{1.0, lifted_}, {1.0 + ctx_.config.arm_tuck_time, folded}}, ctx_.now);
         phase_ = Phase::kLift;
@@ -256,7 +256,7 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
   Phase phase_{Phase::kToBase};
   Eigen::Vector3d approach_{Eigen::Vector3d::UnitX()};
   Eigen::Vector3d centre_{Eigen::Vector3d::Zero()};
-  ArmPose grasp_arm_{kTuckedArm}, lifted_{kTuckedArm};
+  ArmPose grasp_arm_{}, lifted_{};  // set before use
   Pose2 X_MB_grasp_;
   Time closing_since_{};
 };
@@ -318,8 +318,8 @@ class ReleaseAction : public TaskNode<bt::StatefulActionNode> {
       }
       case Phase::kOpen: {
         if (ToSeconds(ctx_.now - opened_at_) < kOpenTime) return NodeStatus::kRunning;
-        ctx_.motion->MoveArm({{1.5, pre_arm_}, {1.5 + ctx_.config.arm_tuck_time, kTuckedArm}},
-                             ctx_.now);
+        ctx_.motion->MoveArm(
+            {{1.5, pre_arm_}, {1.5 + ctx_.config.arm_tuck_time, TuckedArm(*ctx_.model)}}, ctx_.now);
         phase_ = Phase::kWithdraw;
         return NodeStatus::kRunning;
       }
@@ -372,7 +372,7 @@ class ReleaseAction : public TaskNode<bt::StatefulActionNode> {
   Phase phase_{Phase::kToBase};
   Eigen::Vector3d centre_{Eigen::Vector3d::Zero()};
   Eigen::Vector3d approach_{Eigen::Vector3d::UnitX()};
-  ArmPose release_arm_{kTuckedArm}, pre_arm_{kTuckedArm};
+  ArmPose release_arm_{}, pre_arm_{};  // set before use
   Time waiting_since_{}, opened_at_{};
 };
 

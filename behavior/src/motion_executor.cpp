@@ -11,6 +11,10 @@ ArmPose ArmOf(const WholeBodyVector& q) {
   return {q[kArmLift], q[kArmFlex], q[kArmRoll], q[kWristFlex], q[kWristRoll]};
 }
 
+ArmPose TuckedArm(const RobotModel& model) {
+  return ArmOf(model.tucked_configuration());
+}
+
 WholeBodyVector WithArm(const WholeBodyVector& q, const ArmPose& arm) {
   WholeBodyVector out = q;
   for (int i = 0; i < 5; ++i)
@@ -28,6 +32,7 @@ void ArmMotionConfig::Validate() const {
 MotionExecutor::MotionExecutor(const RobotModel& model, planning::TrajectoryConfig trajectory,
                                planning::ControllerConfig controller, ArmMotionConfig arm)
     : model_(model), trajectory_config_(trajectory), controller_(controller), arm_config_(arm) {
+  arm_target_ = TuckedArm(model_);
   trajectory_config_.Validate();
   arm_config_.Validate();
 }

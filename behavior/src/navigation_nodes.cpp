@@ -93,8 +93,9 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
   }
   NodeStatus OnStart() override {
     ctx_.motion->StopBase();
-    if (!ArmAt(ctx_.motion->arm_target(), kTuckedArm) || ctx_.motion->arm_moving(ctx_.now)) {
-      ctx_.motion->MoveArm({{ctx_.config.arm_tuck_time, kTuckedArm}}, ctx_.now);
+    if (!ArmAt(ctx_.motion->arm_target(), TuckedArm(*ctx_.model)) ||
+        ctx_.motion->arm_moving(ctx_.now)) {
+      ctx_.motion->MoveArm({{ctx_.config.arm_tuck_time, TuckedArm(*ctx_.model)}}, ctx_.now);
       Note("tucking the arm");
     }
     if (Input<bool>("back_off") && ctx_.last_safe &&
@@ -117,8 +118,8 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
       }
       if ((path.back().translation() - ctx_.last_safe->translation()).norm() > 0.05)
         path.push_back(*ctx_.last_safe);
-      ctx_.motion->FollowPath(path, std::vector<bool>(path.size() - 1, false), kTuckedArm,
-                              ctx_.now);
+      ctx_.motion->FollowPath(path, std::vector<bool>(path.size() - 1, false),
+                              TuckedArm(*ctx_.model), ctx_.now);
       ctx_.retreating = true;
       Note(StrCat("backing off to the last safe waypoint (", PoseText(*ctx_.last_safe), ")"));
     }

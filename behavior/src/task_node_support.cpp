@@ -186,6 +186,25 @@ std::optional<ArmPose> SolveArm(const TaskContext& ctx, const Pose2& X_MB,
   return ArmOf(r.q);
 }
 
+std::optional<std::vector<ArmPose>> SolveArmLine(const TaskContext& ctx, const Pose2& X_MB,
+                                                 const planning::IkTarget& from_target,
+                                                 const planning::IkTarget& to_target,
+                                                 const ArmPose& from, bool fingertip, int steps) {
+  ThrowUnless(steps >= 1, "SolveArmLine: steps (", steps, ") must be >= 1.");
+  std::vector<ArmPose> knots;
+  ArmPose seed = from;
+  for (int i = 1; i <= steps; ++i) {
+    planning::IkTarget point = to_target;
+    const double f = double(i) / steps;
+    point.p_MT = (1.0 - f) * from_target.p_MT + f * to_target.p_MT;
+    const auto arm = SolveArm(ctx, X_MB, point, seed, fingertip);
+    if (!arm) return std::nullopt;
+    knots.push_back(*arm);
+    seed = *arm;
+  }
+  return knots;
+}
+
 double PositionSigma(const TaskContext& ctx) {
   const Eigen::Matrix2d C = ctx.world.X_MB_covariance.topLeftCorner<2, 2>();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(C);

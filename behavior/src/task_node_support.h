@@ -79,6 +79,14 @@ NodeStatus DriveStatus(TaskContext& ctx, const NoteFn& note, bool door_speed = f
 std::optional<ArmPose> SolveArm(const TaskContext& ctx, const Pose2& X_MB,
                                 const planning::IkTarget& target, const ArmPose& from,
                                 bool fingertip, double accept_error = 0.0);
+/// Arm-only IK for `steps` points evenly along the straight line from `from_target` (where the
+/// arm `from` already is) to `to_target`, each solved warm from the one before: knots that keep
+/// a press on the button's normal instead of the curve a joint-space move would draw. nullopt
+/// if a point is out of reach.
+std::optional<std::vector<ArmPose>> SolveArmLine(const TaskContext& ctx, const Pose2& X_MB,
+                                                 const planning::IkTarget& from_target,
+                                                 const planning::IkTarget& to_target,
+                                                 const ArmPose& from, bool fingertip, int steps);
 /// Far enough past the door line that the closing leaf cannot reach the footprint [m].
 double ExitDistance(const TaskContext& ctx, const std::string& door);
 /// How far before the door line the robot lines up and waits [m].

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include <console_bridge/console.h>
+#include <tinyxml2.h>
 #include <urdf_parser/urdf_parser.h>
 
 #include "egress/hsr_interface/error.h"
@@ -106,9 +107,50 @@ struct RobotModel::Impl {
   Pose3 X_BL;
   double footprint_radius{RobotModel::kDefaultFootprintRadius};
   std::vector<CollisionShape> collision_shapes;
+  std::map<std::string, WholeBodyVector, std::less<>> named_configurations;
 
   [[noreturn]] void Fail(const std::string& what) const {
     throw LoadError(StrCat("Cannot load robot model from '", source, "': ", what));
+  }
+
+  // Root-level <group_state> elements (SRDF's vocabulary), which urdfdom does not read.
+  void ReadNamedConfigurations(const std::string& urdf_xml) {
+    tinyxml2::XMLDocument doc;
+    if (doc.Parse(urdf_xml.c_str(), urdf_xml.size()) != tinyxml2::XML_SUCCESS)
+      Fail(StrCat("XML error: ", doc.ErrorStr()));
+    const tinyxml2::XMLElement* robot = doc.RootElement();
+    for (const auto* state = robot->FirstChildElement("group_state"); state != nullptr;
+         state = state->NextSiblingElement("group_state")) {
+      const std::string at = StrCat("<group_state> at line ", state->GetLineNum());
+      const char* name = state->Attribute("name");
+      if (name == nullptr || *name == '\0') Fail(StrCat(at, " has no name."));
+      if (named_configurations.count(name) != 0)
+        Fail(StrCat(at, ": a configuration named '", name, "' is given twice."));
+      WholeBodyVector q = WholeBodyVector::Zero();
+      for (int i = kArmLift; i < kNumWholeBodyJoints; ++i)
+        q[i] = std::clamp(0.0, limits[i].lower, limits[i].upper);
+      for (const auto* joint = state->FirstChildElement("joint"); joint != nullptr;
+           joint = joint->NextSiblingElement("joint")) {
+        const std::string where =
+            StrCat(at, " ('", name, "'), <joint> at line ", joint->GetLineNum());
+        const char* joint_name = joint->Attribute("name");
+        if (joint_name == nullptr) Fail(StrCat(where, " has no name."));
+        int index = -1;
+        for (int i = kArmLift; i < kNumWholeBodyJoints; ++i)
+          if (kWholeBodyJointNames[i] == joint_name) index = i;
+        if (index < 0)
+          Fail(StrCat(where, ": '", joint_name, "' is not an arm joint of the whole-body chain."));
+        double value = 0.0;
+        if (joint->QueryDoubleAttribute("value", &value) != tinyxml2::XML_SUCCESS ||
+            !std::isfinite(value))
+          Fail(StrCat(where, ": value must be a finite number."));
+        if (value < limits[index].lower || value > limits[index].upper)
+          Fail(StrCat(where, ": value ", value, " is outside ", joint_name, "'s limits [",
+                      limits[index].lower, ", ", limits[index].upper, "]."));
+        q[index] = value;
+      }
+      named_configurations.emplace(name, q);
+    }
   }
 
   // Joints from the root down to `link`, in order.
@@ -430,7 +472,33 @@ RobotModel RobotModel::LoadFromString(const std::string& urdf_xml, std::string_v
     }
   }
   impl->ReadCollisionShapes(*model);
+  impl->ReadNamedConfigurations(urdf_xml);
   return RobotModel(std::move(impl));
+}
+
+WholeBodyVector RobotModel::NamedConfiguration(std::string_view name) const {
+  const auto it = impl_->named_configurations.find(name);
+  if (it == impl_->named_configurations.end()) {
+    std::string known;
+    for (const auto& n : named_configurations())
+      known += (known.empty() ? "" : ", ") + n;
+    throw InvalidArgument(StrCat("Robot model '", impl_->name, "' has no configuration named '",
+                                 name, "' (it has: ", known.empty() ? "none" : known, ")."));
+  }
+  return it->second;
+}
+
+std::vector<std::string> RobotModel::named_configurations() const {
+  std::vector<std::string> names;
+  for (const auto& [name, q] : impl_->named_configurations)
+    names.push_back(name);
+  return names;
+}
+
+WholeBodyVector RobotModel::tucked_configuration() const {
+  if (impl_->named_configurations.count(kTuckedConfigurationName) != 0)
+    return NamedConfiguration(kTuckedConfigurationName);
+  return ClampToLimits(WholeBodyVector::Zero());
 }
 
 const std::string& RobotModel::name() const {

@@ -65,7 +65,7 @@ TEST(MotionExecutorTest, StoppingOrAPathEndsTheDetour) {
   EXPECT_FALSE(motion.bug_active());
   EXPECT_FALSE(motion.base_moving());
   motion.FollowBug({0.0, 0.0, 0.0}, {4.0, 0.0}, planning::BugConfig{}, Time{});
-  motion.FollowPath({{0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}}, {false}, kTuckedArm, Time{});
+  motion.FollowPath({{0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}}, {false}, TuckedArm(model), Time{});
   EXPECT_FALSE(motion.bug_active());
   EXPECT_TRUE(motion.base_moving());
 }
@@ -85,8 +85,8 @@ Time At(double t) {
 TEST(MotionExecutorTest, ArmMotionsEndWhenTheMeasuredJointsArrive) {
   const RobotModel model = RobotModel::LoadDefault();
   MotionExecutor motion(model);
-  motion.SetMeasuredArm(kTuckedArm);
-  ArmPose raised = kTuckedArm;
+  motion.SetMeasuredArm(TuckedArm(model));
+  ArmPose raised = TuckedArm(model);
   raised[0] = 0.4;  // arm_lift: 0.4 m at 0.2 m/s needs 2 s, though asked for in 1 s
   motion.MoveArm({{1.0, raised}}, At(0.0));
   const auto command = motion.TakeArmCommand();
@@ -108,8 +108,8 @@ TEST(MotionExecutorTest, ArmMotionsEndWhenTheMeasuredJointsArrive) {
   EXPECT_FALSE(motion.arm_failed());
 
   // Blocked at 0.1 m: failure once the timeout is past, with the joint named.
-  motion.MoveArm({{1.0, kTuckedArm}}, At(4.0));
-  ArmPose stuck = kTuckedArm;
+  motion.MoveArm({{1.0, TuckedArm(model)}}, At(4.0));
+  ArmPose stuck = TuckedArm(model);
   stuck[0] = 0.1;
   motion.SetMeasuredArm(stuck);
   const double end = ToSeconds(motion.arm_done());
@@ -126,7 +126,7 @@ TEST(MotionExecutorTest, ArmMotionsEndWhenTheMeasuredJointsArrive) {
   ArmMotionConfig bad;
   bad.timeout = -1.0;
   EXPECT_THROW(MotionExecutor(model, {}, {}, bad), InvalidArgument);
-  EXPECT_THROW(motion.MoveArm({{2.0, raised}, {1.0, kTuckedArm}}, At(30.0)), InvalidArgument);
+  EXPECT_THROW(motion.MoveArm({{2.0, raised}, {1.0, TuckedArm(model)}}, At(30.0)), InvalidArgument);
 }
 
 }  // namespace

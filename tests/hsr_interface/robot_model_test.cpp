@@ -301,6 +301,56 @@ TEST(RobotModelLoadTest, FootprintRadiusFollowsTheBaseCylinder) {
   EXPECT_DOUBLE_EQ(RobotModel::LoadFromString(xml, "wide.urdf").footprint_radius(), 0.25);
 }
 
+TEST(RobotModelLoadTest, TheTuckedPoseComesFromTheUrdf) {
+  const RobotModel model = RobotModel::LoadDefault();
+  EXPECT_THAT(model.named_configurations(), ::testing::ElementsAre("tucked"));
+  const WholeBodyVector tucked = model.tucked_configuration();
+  EXPECT_DOUBLE_EQ(tucked[kArmRoll], -std::numbers::pi / 2);
+  EXPECT_DOUBLE_EQ(tucked[kWristFlex], -std::numbers::pi / 2);
+  EXPECT_EQ(tucked, model.NamedConfiguration("tucked"));
+  // Nothing of the tucked arm sticks out of the footprint.
+  const Eigen::Vector3d p_BG = model.CalcPalmPose(tucked).translation();
+  EXPECT_LT(p_BG.head<2>().norm(), model.footprint_radius());
+  try {
+    model.NamedConfiguration("ready");
+    FAIL() << "expected InvalidArgument";
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("'ready'"));
+    EXPECT_THAT(e.what(), HasSubstr("tucked"));
+  }
+  // Another value in the file is another tucked pose.
+  std::string xml = DefaultUrdfText();
+  xml = ReplaceAll(xml, R"(<joint name="arm_lift_joint" value="0.0"/>)",
+                   R"(<joint name="arm_lift_joint" value="0.1"/>)");
+  EXPECT_DOUBLE_EQ(RobotModel::LoadFromString(xml, "t.urdf").tucked_configuration()[kArmLift], 0.1);
+}
+
+TEST(RobotModelLoadTest, AUrdfWithoutNamedConfigurationsTucksAtZero) {
+  std::string xml = DefaultUrdfText();
+  xml = ReplaceAll(xml, R"(<group_state name="tucked" group="arm">)",
+                   R"(<group_state name="home" group="arm">)");
+  const RobotModel model = RobotModel::LoadFromString(xml, "t.urdf");
+  EXPECT_EQ(model.tucked_configuration(), model.ClampToLimits(WholeBodyVector::Zero()));
+}
+
+TEST(RobotModelLoadTest, BadNamedConfigurationsAreNamed) {
+  const std::string xml = DefaultUrdfText();
+  std::string message = LoadErrorOf(ReplaceAll(xml, R"(<joint name="arm_flex_joint" value="0.0"/>)",
+                                               R"(<joint name="elbow" value="0.0"/>)"));
+  EXPECT_THAT(message, HasSubstr("test.urdf"));
+  EXPECT_THAT(message, HasSubstr("'elbow'"));
+  EXPECT_THAT(message, ::testing::ContainsRegex("line [0-9]+"));
+  message = LoadErrorOf(ReplaceAll(xml, R"(<joint name="arm_lift_joint" value="0.0"/>)",
+                                   R"(<joint name="arm_lift_joint" value="2.0"/>)"));
+  EXPECT_THAT(message, HasSubstr("outside arm_lift_joint's limits"));
+  message = LoadErrorOf(ReplaceAll(xml, R"(<joint name="arm_lift_joint" value="0.0"/>)",
+                                   R"(<joint name="arm_lift_joint" value="low"/>)"));
+  EXPECT_THAT(message, HasSubstr("finite number"));
+  message = LoadErrorOf(ReplaceAll(xml, R"(<group_state name="tucked" group="arm">)",
+                                   R"(<group_state group="arm">)"));
+  EXPECT_THAT(message, HasSubstr("has no name"));
+}
+
 TEST(RobotModelLoadTest, CopiesAreIndependentAndEqual) {
   const RobotModel a = RobotModel::LoadDefault();
   RobotModel b = a;

@@ -38,6 +38,22 @@ TEST(PushButtonTest, NearMissesDoNotPress) {
   EXPECT_EQ(Poke(&b, 1.0, 1.06, 0.005, 200), PushButton::Result::kNone);  // above it
 }
 
+// A finger that pushes on past the cap's centre (toward the wall behind it) keeps the cap
+// pressed: one press, not a release and a second press as it goes deeper and comes back.
+TEST(PushButtonTest, PushingPastTheCentreKeepsOnePress) {
+  PushButton b(WallButton(), 0.004, 5.0, 1000.0);
+  int presses = 0;
+  for (int i = 0; i <= 300; ++i) {  // in to the wall plane behind the button (2 cm), and out
+    const double y = i <= 150 ? 2.88 + 0.07 * i / 150 : 2.95 - 0.07 * (i - 150) / 150;
+    presses += b.Update({1.0, y, 1.0}) == PushButton::Result::kPressed;
+    if (i == 150) {
+      EXPECT_NEAR(b.travel(), 0.02, 1e-9);  // the whole cap's depth
+    }
+  }
+  EXPECT_EQ(presses, 1);
+  EXPECT_EQ(b.travel(), 0.0);  // released once out
+}
+
 TEST(PushButtonTest, AJabPastTheBottomIsRefusedAsOverForce) {
   PushButton b(WallButton(), 0.004, 5.0, 22.0);
   // 5 cm approach + 8 mm in two steps: the first sample inside is already past the bottom.

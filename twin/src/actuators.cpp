@@ -42,19 +42,20 @@ PushButton::Result PushButton::Update(const Eigen::Vector3d& p_WF) {
   for (int i = 0; i < 3; ++i) {
     if (i != k && std::abs(p_AF[i]) > half[i]) over_face = false;
   }
-  const double depth = half[k] - std::abs(p_AF[k]);  // > 0 once past the face
-  if (depth <= 0.0 || !over_face) {
-    // Outside: remember the side, release the cap.
-    if (depth <= 0.0) side_ = p_AF[k] >= 0 ? 1 : -1;
+  // Travel: how far past the face on the side the finger came from. A finger that goes on
+  // past the cap's centre pushes the cap further in (to the bottom, then into the wall behind);
+  // it does not come out of the back: travel counts from that one face, not the nearer one.
+  const double s_k = p_AF[k];
+  const bool in_front = side_ == 0 ? std::abs(s_k) >= half[k] : side_ * s_k >= half[k];
+  if (std::abs(s_k) >= half[k] && (side_ == 0 || in_front)) side_ = s_k >= 0 ? 1 : -1;
+  if (!over_face || in_front || side_ == 0) {
+    // Outside (or never seen outside: started inside the button): the cap is released.
     travel_ = 0.0;
     force_ = 0.0;
     latched_ = false;
     return Result::kNone;
   }
-  if (side_ != 0 && (p_AF[k] >= 0 ? 1 : -1) != side_) {
-    // Came through the far side (e.g. from inside the wall): not a press.
-    return Result::kNone;
-  }
+  const double depth = half[k] - side_ * s_k;
   travel_ = depth;
   force_ = CalcForce(depth);
   if (latched_) {

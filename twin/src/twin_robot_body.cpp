@@ -22,11 +22,11 @@ void TwinWorld::Impl::BuildRobot() {
   base->setAngularFactor(btVector3(0, 0, 1));
   base->setActivationState(DISABLE_DEACTIVATION);
   base->setFriction(0.0);
-  // Arm at the HSR's "go" pose (tucked): flex 0, roll −π/2, wrist −π/2.
-  arm_q = {{"arm_lift_joint", 0.0},       {"arm_flex_joint", 0.0},
-           {"arm_roll_joint", -M_PI / 2}, {"wrist_flex_joint", -M_PI / 2},
-           {"wrist_roll_joint", 0.0},     {"head_pan_joint", 0.0},
-           {"head_tilt_joint", 0.0}};
+  // Arm at the robot description's tucked ("go") pose.
+  const WholeBodyVector tucked = model->tucked_configuration();
+  arm_q = {{"head_pan_joint", 0.0}, {"head_tilt_joint", 0.0}};
+  for (int i = kArmLift; i < kNumWholeBodyJoints; ++i)
+    arm_q[std::string(WholeBodyJointNames()[i])] = tucked[i];
   for (auto& [name, q] : arm_q) {
     const JointLimits lim = model->GetJointLimits(name);
     q = std::clamp(q, lim.lower, lim.upper);

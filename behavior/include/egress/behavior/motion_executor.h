@@ -29,12 +29,13 @@ using ArmPose = std::array<double, 5>;
 inline constexpr std::array<std::string_view, 5> kArmJointNames{
     "arm_lift_joint", "arm_flex_joint", "arm_roll_joint", "wrist_flex_joint", "wrist_roll_joint"};
 
-/// The arm folded over the base: nothing sticks out of the footprint.
-inline constexpr ArmPose kTuckedArm{0.0, 0.0, -1.5707963267948966, -1.5707963267948966, 0.0};
-
 /// The arm joints of a whole-body vector, and back.
 ArmPose ArmOf(const WholeBodyVector& q);
 WholeBodyVector WithArm(const WholeBodyVector& q, const ArmPose& arm);
+
+/// The arm folded over the base, nothing outside the footprint: the robot description's
+/// tucked configuration (RobotModel::tucked_configuration).
+ArmPose TuckedArm(const RobotModel& model);
 
 /// How an arm motion is judged complete: by the measured joints, not the clock.
 struct ArmMotionConfig {
@@ -120,7 +121,7 @@ class MotionExecutor {
   std::optional<JointTrajectory> pending_arm_;
   std::optional<GripperCommand> pending_gripper_;
   Time arm_done_{};
-  ArmPose arm_target_{kTuckedArm};
+  ArmPose arm_target_{};  // the tucked arm, set from the model
   ArmMotionConfig arm_config_;
   std::optional<ArmPose> measured_arm_;
   std::string arm_failure_;

@@ -58,8 +58,8 @@ struct ButtonPlan {
   std::string actuator;  ///< Id of the button or plate in the mission map.
   planning::ButtonType type{planning::ButtonType::kPushButton};
   planning::ButtonTargets targets;
-  Pose2 X_MB_standoff;               ///< Where the base stands (from whole-body IK).
-  ArmPose approach_arm{kTuckedArm};  ///< The arm there (seed for the arm-only solves).
+  Pose2 X_MB_standoff;     ///< Where the base stands (from whole-body IK).
+  ArmPose approach_arm{};  ///< The arm there (seed for the arm-only solves; tucked if none).
 };
 
 struct TaskContext {

@@ -124,6 +124,19 @@ class RobotModel {
   WholeBodyVector ClampToLimits(const WholeBodyVector& q) const;
   bool IsWithinLimits(const WholeBodyVector& q) const;
 
+  /// A named configuration from the URDF: a root-level `<group_state name=".." group="..">`
+  /// element with `<joint name=".." value=".."/>` children (SRDF's vocabulary; urdfdom skips
+  /// the element). Base joints are zero; arm joints it does not name are zero clamped to their
+  /// limits. @throws InvalidArgument naming the configuration and the ones the URDF has.
+  WholeBodyVector NamedConfiguration(std::string_view name) const;
+  /// Names of the URDF's named configurations, sorted.
+  std::vector<std::string> named_configurations() const;
+  /// The arm folded over the base (nothing outside the footprint): the named configuration
+  /// "tucked" (kTuckedConfigurationName), or, for a URDF without one, every arm joint at zero
+  /// clamped to its limits.
+  WholeBodyVector tucked_configuration() const;
+  static constexpr std::string_view kTuckedConfigurationName = "tucked";
+
   /// Radius of the round base footprint [m].
   double footprint_radius() const;
 
