@@ -24,7 +24,8 @@ class IsPathClear final : public TaskNode<bt::ConditionNode> {
     // leave the robot in the doorway with the leaf about to close.
     if (ctx_.retreating) return last_ = NodeStatus::kFailure;
     if (IsDoorZoneOccupied(ctx_, door)) {
-      if (last_ != NodeStatus::kFailure) Note("a person is in or entering the door zone");
+      if (last_ != NodeStatus::kFailure)
+        Note("a person is in or entering the door zone", DecisionEvent::kPersonInDoorZone);
       ctx_.zone_occupied_at[door] = ctx_.now;
       return last_ = NodeStatus::kFailure;
     }
@@ -33,7 +34,7 @@ class IsPathClear final : public TaskNode<bt::ConditionNode> {
         ToSeconds(ctx_.now - it->second) < Input<double>("clear_for")) {
       return last_ = NodeStatus::kFailure;
     }
-    if (last_ == NodeStatus::kFailure) Note("door zone clear");
+    if (last_ == NodeStatus::kFailure) Note("door zone clear", DecisionEvent::kDoorZoneClear);
     return last_ = NodeStatus::kSuccess;
   }
 

@@ -422,12 +422,12 @@ bool Executive::Step(RobotPort& port) {
     m.next_tick = now + SecondsToDuration(1.0 / m.config.tick_rate_hz);
     const std::size_t notes_before = context_.notes.size();
     status_ = m.tree->TickOnce();
-    for (std::size_t i = notes_before; i < context_.notes.size(); ++i)
-      decisions_.push_back({ToSeconds(now), context_.notes[i]});
     bool preempted = false;
-    for (std::size_t i = notes_before; i < context_.notes.size(); ++i)
-      preempted =
-          preempted || context_.notes[i].find("entering the door zone") != std::string::npos;
+    for (std::size_t i = notes_before; i < context_.notes.size(); ++i) {
+      const NodeNote& note = context_.notes[i];
+      decisions_.push_back({ToSeconds(now), note.text, note.event});
+      preempted = preempted || note.event == DecisionEvent::kPersonInDoorZone;
+    }
     if (preempted && m.occupied_known_at) {
       // The halt (zero velocity) and the standby's first command go out in this same step.
       preemptions_.push_back({*m.occupied_known_at, ToSeconds(now)});
@@ -436,9 +436,10 @@ bool Executive::Step(RobotPort& port) {
     if (status_ == bt::NodeStatus::kSuccess || status_ == bt::NodeStatus::kFailure) {
       m.finished = true;
       m.motion.StopBase();
-      decisions_.push_back({ToSeconds(now), status_ == bt::NodeStatus::kSuccess
-                                                ? "mission succeeded"
-                                                : "mission failed"});
+      decisions_.push_back(
+          {ToSeconds(now),
+           status_ == bt::NodeStatus::kSuccess ? "mission succeeded" : "mission failed",
+           DecisionEvent::kNote});
     }
   }
 

@@ -67,22 +67,28 @@ planning::IkTarget PalmTarget(const Eigen::Vector3d& p_M, const Eigen::Vector3d&
 }
 
 // Where the base stands, and the arm there, for the hand to hold a grasp centre `p_M`
-// approached horizontally along `approach_M` (whole-body IK from 0.6 m short); nullopt if out
-// of reach.
+// approached along `approach_M` — horizontally, or straight down — by a robot coming from the
+// horizontal direction `toward_M` (whole-body IK from 0.6 m short); nullopt if out of reach.
 struct HandReach {
   Pose2 X_MB;
   ArmPose arm;
 };
 std::optional<HandReach> SolveHandReach(const TaskContext& ctx, const Eigen::Vector3d& p_M,
-                                        const Eigen::Vector3d& approach_M) {
+                                        const Eigen::Vector3d& approach_M,
+                                        const Eigen::Vector3d& toward_M) {
+  // Seeds: reaching forward (palm level), or from above (lift high, upper arm level, palm
+  // down), so the solve lands on the posture whose hand comes in from that side.
   static constexpr ArmPose kReachArm{0.2, -1.0, 0.0, -0.5, 0.0};
-  const Eigen::Vector2d a = approach_M.head<2>();
+  static constexpr ArmPose kReachFromAboveArm{0.5, -1.5707963267948966, 0.0, -1.5707963267948966,
+                                              0.0};
+  const bool from_above = approach_M.z() < -0.9;
+  const Eigen::Vector2d a = toward_M.head<2>().normalized();
   const Eigen::Vector2d base = p_M.head<2>() - a * 0.6;
   WholeBodyVector q0 = WholeBodyVector::Zero();
   q0[kBaseX] = base.x();
   q0[kBaseY] = base.y();
   q0[kBaseYaw] = std::atan2(a.y(), a.x());
-  q0 = WithArm(q0, kReachArm);
+  q0 = WithArm(q0, from_above ? kReachFromAboveArm : kReachArm);
   planning::IkConfig ik = ctx.config.ik;
   ik.fingertip = false;
   ik.use_base = true;
@@ -141,6 +147,37 @@ std::optional<double> ClutterTopBeforeGrasp(const TaskContext& ctx, const Eigen:
   return top;
 }
 
+// The centre of a low payload lying on a surface at `surface_z`, from the depth points that
+// stand out of the surface within `radius` of the estimate `p_M` (the centroid of what the
+// camera sees of it, horizontally): a grasp from above has no slack along the approach, where
+// the detection's single depth sample may be centimetres off. nullopt if too few points.
+std::optional<Eigen::Vector3d> LowPayloadCentre(const TaskContext& ctx, const Eigen::Vector3d& p_M,
+                                                double surface_z, double radius) {
+  if (!ctx.depth) return std::nullopt;
+  constexpr double kAboveSurface = 0.01;  // [m] points lower than this are the surface
+  constexpr int kMinPoints = 20;
+  const DepthImage& depth = *ctx.depth;
+  const CameraIntrinsics& K = ctx.depth_intrinsics;
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  int n = 0;
+  for (int v = 0; v < depth.height; ++v) {
+    for (int u = 0; u < depth.width; ++u) {
+      if (!depth.IsValidAt(u, v)) continue;
+      const double z = depth.At(u, v);
+      const Eigen::Vector3d p =
+          ctx.X_MC * Eigen::Vector3d((u + 0.5 - K.cx) / K.fx * z, (v + 0.5 - K.cy) / K.fy * z, z);
+      if (p.z() < surface_z + kAboveSurface || p.z() > p_M.z() + radius ||
+          (p.head<2>() - p_M.head<2>()).norm() > radius)
+        continue;
+      sum += p.head<2>();
+      ++n;
+    }
+  }
+  if (n < kMinPoints) return std::nullopt;
+  const Eigen::Vector2d c = sum / n;
+  return Eigen::Vector3d(c.x(), c.y(), p_M.z());
+}
+
 // Grasps a payload seen at `pose`: the base goes where whole-body IK puts it (palm level,
 // approaching horizontally from the robot's side), the arm reaches a pre-grasp 12 cm short, then
 // the grasp, the gripper closes, and the arm lifts 10 cm. Success when the gripper holds it.
@@ -159,6 +196,7 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
     centre_ = p_seen + approach_ * kPayloadRadius;
     // Something low in front of it (books, a box): grasp higher, so the hand passes above it.
     const double surface_z = centre_.z() - PayloadCentreHeight(Input<std::string>("kind"));
+    surface_z_ = surface_z;
     if (const auto top = ClutterTopBeforeGrasp(ctx_, centre_, approach_, kPayloadRadius, surface_z);
         top && *top + kHandBelowGrasp > centre_.z()) {
       const double raised = std::min(*top + kHandBelowGrasp, centre_.z() + kMaxGraspRaise);
@@ -166,7 +204,15 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
                   std::round((raised - centre_.z()) * 100), " cm higher"));
       centre_.z() = raised;
     }
-    const auto reach = SolveHandReach(ctx_, centre_, approach_);
+    // Too low to pass the hand in sideways without it brushing the surface (a lying
+    // flashlight): from above, the palm's axis straight down.
+    const Eigen::Vector3d toward = approach_;
+    if (centre_.z() - surface_z < kHandBelowGrasp) {
+      approach_ = -Eigen::Vector3d::UnitZ();
+      Note(StrCat("its centre is ", std::round((centre_.z() - surface_z) * 100),
+                  " cm above the surface: grasping from above"));
+    }
+    const auto reach = SolveHandReach(ctx_, centre_, approach_, toward);
     if (!reach) {
       Note("no whole-body reach for the grasp");
       return NodeStatus::kFailure;
@@ -188,6 +234,9 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
         if (gate_.Check(ctx_, "grasping", [this](const std::string& t) { Note(t); }) ==
             NodeStatus::kRunning)
           return NodeStatus::kRunning;
+        // From above there is no slack along the approach: look again from here, where the
+        // pose estimate is the one the arm will use (it drifts on the way, by centimetres).
+        if (approach_.z() < -0.9) RefreshLowPayloadCentre();
         // Arm-only from where the base stopped.
         const auto grasp = SolveArm(ctx_, ctx_.X_MB, PalmTarget(centre_, approach_), grasp_arm_,
                                     false, kHandError);
@@ -198,9 +247,26 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
           Note("the payload is out of the arm's reach from here");
           return NodeStatus::kFailure;
         }
-        ctx_.motion->MoveArm({{2.0, *pre}, {3.5, *grasp}}, ctx_.now);
+        // From above: raise the lift first when the pre-grasp stands higher. The lift is the
+        // arm's slowest joint, and swinging the arm out and down before it is up sweeps the
+        // hand and forearm through the table the payload lies on. (A level reach keeps the
+        // hand above the table top all the way.)
+        ArmPose raised = ctx_.motion->arm_target();
+        const double rise = (*pre)[0] - raised[0];
+        const double lift_speed = ctx_.model->limits(kArmLift).velocity;
+        double t = 0.0;
+        std::vector<std::pair<double, ArmPose>> knots;
+        if (approach_.z() < -0.9 && rise > kRaiseFirstAbove && lift_speed > 0.0) {
+          raised[0] = (*pre)[0];
+          t = rise / (kLiftSpeedShare * lift_speed);
+          knots.emplace_back(t, raised);
+        }
+        knots.emplace_back(t + 2.0, *pre);
+        knots.emplace_back(t + 3.5, *grasp);
+        ctx_.motion->MoveArm(knots, ctx_.now);
         lifted_ = *grasp;
-        lifted_[0] += 0.10;  // arm_lift
+        lifted_[0] = std::min(lifted_[0] + kLiftAfterGrasp,
+                              ctx_.model->limits(kArmLift).upper);  // arm_lift
         phase_ = Phase::kReach;
         Note("reaching for the payload");
         return NodeStatus::kRunning;
@@ -248,14 +314,44 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
   void OnHalted() override { ctx_.motion->StopBase(); }
 
  private:
+  // The tracked payload nearest the grasp centre (within kRefreshRadius), seen in the last
+  // second, then its centre from the depth points around it.
+  void RefreshLowPayloadCentre() {
+    const std::string kind = Input<std::string>("kind");
+    const perception::TrackedObject* best = nullptr;
+    for (const auto& object : ctx_.world.payloads) {
+      if ((!kind.empty() && object.label != kind) || ToSeconds(ctx_.now - object.last_seen) > 1.0)
+        continue;
+      const double d = (object.p_MO.head<2>() - centre_.head<2>()).norm();
+      if (d < kRefreshRadius &&
+          (best == nullptr || d < (best->p_MO.head<2>() - centre_.head<2>()).norm()))
+        best = &object;
+    }
+    Eigen::Vector3d centre = centre_;
+    if (best != nullptr) centre.head<2>() = best->p_MO.head<2>();
+    if (const auto refined = LowPayloadCentre(ctx_, centre, surface_z_, kLowPayloadSearch))
+      centre = *refined;
+    if ((centre - centre_).norm() > 0.005) {
+      Note(StrCat("looked again: the payload is ", std::round((centre - centre_).norm() * 100),
+                  " cm from where it was thought"));
+    }
+    centre_ = centre;
+  }
+
   RelocalizeGate gate_;
-  static constexpr double kPayloadRadius = 0.03;   // [m] a bottle's, about
-  static constexpr double kHandBelowGrasp = 0.06;  // [m] the hand's lowest point, with margin
-  static constexpr double kMaxGraspRaise = 0.06;   // [m] still on the payload's body
+  static constexpr double kRefreshRadius = 0.15;     // [m] the same payload, seen again
+  static constexpr double kPayloadRadius = 0.03;     // [m] a bottle's, about
+  static constexpr double kHandBelowGrasp = 0.06;    // [m] the hand's lowest point, with margin
+  static constexpr double kMaxGraspRaise = 0.06;     // [m] still on the payload's body
+  static constexpr double kLiftAfterGrasp = 0.10;    // [m] of arm lift, within its limit
+  static constexpr double kLowPayloadSearch = 0.08;  // [m] around the estimate, from above
+  static constexpr double kRaiseFirstAbove = 0.05;   // [m] a smaller rise goes with the reach
+  static constexpr double kLiftSpeedShare = 0.8;     // of the lift's speed limit, when raising
   enum class Phase { kToBase, kReach, kClose, kLift };
   Phase phase_{Phase::kToBase};
   Eigen::Vector3d approach_{Eigen::Vector3d::UnitX()};
   Eigen::Vector3d centre_{Eigen::Vector3d::Zero()};
+  double surface_z_{0.0};           // [m] what the payload rests on
   ArmPose grasp_arm_{}, lifted_{};  // set before use
   Pose2 X_MB_grasp_;
   Time closing_since_{};
@@ -355,7 +451,7 @@ class ReleaseAction : public TaskNode<bt::StatefulActionNode> {
 
   NodeStatus DriveToReach() {
     ++approaches_;
-    const auto reach = SolveHandReach(ctx_, centre_, approach_);
+    const auto reach = SolveHandReach(ctx_, centre_, approach_, approach_);
     if (!reach) {
       Note("no whole-body reach for the release point");
       return NodeStatus::kFailure;
@@ -433,7 +529,8 @@ class HandOver final : public ReleaseAction {
         (recipient->person.p_MP - p_M_payload.head<2>()).norm() < Input<double>("reach")) {
       Note(StrCat("the responder is within reach (at ",
                   PoseText({recipient->person.p_MP.x(), recipient->person.p_MP.y(), 0.0}),
-                  "): letting go"));
+                  "): letting go"),
+           DecisionEvent::kResponderInReach);
       return Release::kNow;
     }
     if (ToSeconds(ctx_.now - waiting_since()) > Input<double>("timeout")) {

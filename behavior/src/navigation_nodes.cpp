@@ -121,7 +121,8 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
       ctx_.motion->FollowPath(path, std::vector<bool>(path.size() - 1, false),
                               TuckedArm(*ctx_.model), ctx_.now);
       ctx_.retreating = true;
-      Note(StrCat("backing off to the last safe waypoint (", PoseText(*ctx_.last_safe), ")"));
+      Note(StrCat("backing off to the last safe waypoint (", PoseText(*ctx_.last_safe), ")"),
+           DecisionEvent::kRetreating);
     }
     return NodeStatus::kRunning;
   }

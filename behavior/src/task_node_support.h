@@ -54,8 +54,9 @@ class TaskNode : public Base {
     return *value;
   }
   std::string Door() const { return Input<std::string>("door"); }
-  void Note(const std::string& text) const {
-    ctx_.Note(StrCat(this->name().empty() ? this->registration_id() : this->name(), ": ", text));
+  void Note(const std::string& text, DecisionEvent event = DecisionEvent::kNote) const {
+    ctx_.Note(StrCat(this->name().empty() ? this->registration_id() : this->name(), ": ", text),
+              event);
   }
   TaskContext& ctx_;
 };

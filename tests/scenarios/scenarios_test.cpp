@@ -108,6 +108,10 @@ TEST(ScenarioTest, S4bFetchesTheFlashlightAndTakesItThroughTheDoor) {
   const BrainRun run = RunWithBrain(kScenarios / "s4b_fetch_flashlight.yaml", 1);
   EXPECT_TRUE(run.result.verdict.success) << twin::FormatVerdict(run.result.verdict);
   EXPECT_EQ(run.world->held_payload(), "flashlight");
+  // Lying 2 cm high, it is grasped from above: nothing of the robot touches its table (a
+  // sideways grasp brushed it in every trial).
+  EXPECT_EQ(run.result.verdict.metrics.contacts_with.count("side_table"), 0u)
+      << twin::FormatVerdict(run.result.verdict);
 }
 
 TEST(ScenarioTest, S5FetchesFromTheFarRoomThroughTwoDoorsAndPlacesOnTheStartTable) {
@@ -130,8 +134,7 @@ TEST(ScenarioTest, S6RetreatsFromAPersonCuttingThePathThenPasses) {
   EXPECT_TRUE(run.result.verdict.success) << twin::FormatVerdict(run.result.verdict);
   bool retreated = false;
   for (const auto& d : run.brain->decisions())
-    retreated =
-        retreated || d.text.find("backing off to the last safe waypoint") != std::string::npos;
+    retreated = retreated || d.event == behavior::DecisionEvent::kRetreating;
   EXPECT_TRUE(retreated);
 }
 
@@ -147,7 +150,7 @@ TEST(ScenarioTest, TheFetchedBottleIsHandedToTheResponder) {
   EXPECT_FALSE(run.world->held_payload().has_value());
   bool waited_for_reach = false;
   for (const auto& d : run.brain->decisions())
-    waited_for_reach = waited_for_reach || d.text.find("within reach") != std::string::npos;
+    waited_for_reach = waited_for_reach || d.event == behavior::DecisionEvent::kResponderInReach;
   EXPECT_TRUE(waited_for_reach);
 }
 

@@ -95,6 +95,7 @@ struct MissionTree {
 struct Decision {
   double time{0.0};  ///< [s] robot clock
   std::string text;
+  DecisionEvent event{DecisionEvent::kNote};  ///< What it records; read this, not the text.
 };
 
 class Executive {

@@ -62,6 +62,22 @@ struct ButtonPlan {
   ArmPose approach_arm{};  ///< The arm there (seed for the arm-only solves; tucked if none).
 };
 
+/// What a node's note records beyond its text. The executive and tests read the event, never
+/// the text (which is for people and may be reworded).
+enum class DecisionEvent {
+  kNote,              ///< A reason for the run log only.
+  kPersonInDoorZone,  ///< A person is in or entering a door zone: the robot yields.
+  kDoorZoneClear,     ///< The door zone is clear again (after the hysteresis).
+  kRetreating,        ///< A standby retreat to the last safe waypoint starts.
+  kResponderInReach,  ///< A hand-over's responder is within the arm's reach.
+};
+
+/// One note of a node: its event and its text.
+struct NodeNote {
+  DecisionEvent event{DecisionEvent::kNote};
+  std::string text;
+};
+
 struct TaskContext {
   const RobotModel* model{nullptr};
   const MissionMap* map{nullptr};
@@ -100,10 +116,12 @@ struct TaskContext {
   int relocalizations{0};
   /// A standby retreat is under way: it is finished before the robot resumes.
   bool retreating{false};
-  std::vector<std::string> notes;  ///< The nodes' reasons, for the run log.
+  std::vector<NodeNote> notes;  ///< The nodes' reasons and decision events, for the run log.
 
   double now_s() const { return ToSeconds(now); }
-  void Note(std::string text) { notes.push_back(std::move(text)); }
+  void Note(std::string text, DecisionEvent event = DecisionEvent::kNote) {
+    notes.push_back({event, std::move(text)});
+  }
 };
 
 }  // namespace egress::behavior
