@@ -1,0 +1,60 @@
+// The door nodes (behavior/src/door_nodes.cpp), ticked in one-node trees.
+
+#include "task_node_fixture.h"
+
+namespace egress::behavior {
+namespace {
+
+using bt::NodeStatus;
+using node_testing::At;
+using DoorNodesTest = node_testing::TaskNodeFixture;
+
+TEST_F(DoorNodesTest, ButtonTypeWritesTheActuatorKindOfThisSide) {
+  auto blackboard = bt::Blackboard::Create();
+  bt::Tree tree = Tree(R"(<ButtonType door="lab_door" type="{kind}"/>)", blackboard);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);
+  EXPECT_EQ(blackboard->Get<std::string>("kind"), "push_button");
+  // From the far side there is no actuator.
+  context_.X_MB = {0.0, 4.0, -M_PI / 2};
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
+}
+
+TEST_F(DoorNodesTest, ApproachButtonDrivesToAStandoffFacingTheButton) {
+  bt::Tree tree = Tree(R"(<ApproachButton door="lab_door"/>)");
+  context_.now = At(1.0);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  ASSERT_EQ(context_.button_plans.count("lab_door"), 1u);
+  const ButtonPlan& plan = context_.button_plans.at("lab_door");
+  EXPECT_EQ(plan.actuator, "lab_button");
+  // In front of the button (south of its wall), facing it (+y), within the arm's reach.
+  EXPECT_NEAR(plan.X_MB_standoff.yaw, M_PI / 2, 1e-6);
+  const double standoff = 2.93 - plan.X_MB_standoff.y;
+  EXPECT_GT(standoff, 0.3);
+  EXPECT_LT(standoff, 0.8);
+  EXPECT_NEAR(plan.X_MB_standoff.x, 1.075, 0.25);
+  ASSERT_GE(motion_.path().size(), 2u);
+  EXPECT_LT((motion_.path().back().translation() - plan.X_MB_standoff.translation()).norm(), 1e-6);
+  EXPECT_TRUE(motion_.base_moving());
+}
+
+TEST_F(DoorNodesTest, PressButtonNeedsTheApproachFirst) {
+  bt::Tree tree = Tree(R"(<PressButton door="lab_door"/>)");
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
+  EXPECT_NE(context_.notes.back().text.find("ApproachButton must run first"), std::string::npos);
+}
+
+TEST_F(DoorNodesTest, TraverseDoorLinesUpOnTheDoorsAxisBeforeGoing) {
+  bt::Tree tree = Tree(R"(<TraverseDoor door="lab_door"/>)");
+  context_.X_MB = {1.0, 2.2, M_PI / 2};  // beside the axis, before the door
+  context_.now = At(1.0);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  ASSERT_GE(motion_.path().size(), 2u);
+  // The line-up pose is on the door's axis (x = 0), before the door line, facing through it.
+  const Pose2& entry = motion_.path().back();
+  EXPECT_NEAR(entry.x, 0.0, 1e-6);
+  EXPECT_LT(entry.y, 3.0);
+  EXPECT_NEAR(entry.yaw, M_PI / 2, 1e-6);
+}
+
+}  // namespace
+}  // namespace egress::behavior

@@ -1,0 +1,83 @@
+// The navigation nodes (behavior/src/navigation_nodes.cpp), ticked in one-node trees.
+
+#include "task_node_fixture.h"
+
+namespace egress::behavior {
+namespace {
+
+using bt::NodeStatus;
+using node_testing::At;
+using node_testing::Person;
+using NavigationNodesTest = node_testing::TaskNodeFixture;
+
+TEST_F(NavigationNodesTest, NavigateToPlansAndFollowsAPathToTheGoal) {
+  bt::Tree tree = Tree(R"(<NavigateTo goal="1.5;1.0;0.0"/>)");
+  context_.now = At(1.0);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  ASSERT_GE(motion_.path().size(), 2u);
+  EXPECT_LT((motion_.path().back().translation() - Eigen::Vector2d(1.5, 1.0)).norm(), 1e-6);
+  EXPECT_TRUE(motion_.base_moving());
+  // Halted (a reactive condition failed): the base stops in the same tick.
+  tree.HaltTree();
+  EXPECT_FALSE(motion_.base_moving());
+}
+
+TEST_F(NavigationNodesTest, NavigateToAGoalWhereTheRobotStandsSucceedsAtOnce) {
+  bt::Tree tree = Tree(R"(<NavigateTo goal="0.0;2.0;1.5707963267948966"/>)");
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);
+}
+
+TEST_F(NavigationNodesTest, NavigateToAnUnreachableGoalWaitsItsPatienceThenFails) {
+  bt::Tree tree = Tree(R"(<NavigateTo goal="40.0;2.0;0.0" patience="1.0"/>)");  // off the map
+  context_.now = At(1.0);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_FALSE(motion_.base_moving());
+  context_.now = At(1.6);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  context_.now = At(2.2);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
+  EXPECT_NE(context_.notes.back().text.find("gave up"), std::string::npos);
+}
+
+TEST_F(NavigationNodesTest, RetractToSafeBacksOffToTheLastSafeWaypoint) {
+  bt::Tree tree = Tree(R"(<RetractToSafe/>)");
+  context_.X_MB = {0.0, 2.9, M_PI / 2};  // in the doorway
+  context_.last_safe = Pose2{0.0, 1.5, M_PI / 2};
+  context_.now = At(1.0);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(Noted(DecisionEvent::kRetreating));
+  EXPECT_TRUE(context_.retreating);
+  ASSERT_GE(motion_.path().size(), 2u);
+  EXPECT_LT((motion_.path().back().translation() - Eigen::Vector2d(0.0, 1.5)).norm(), 1e-6);
+  // Out of the doorway along its normal first: no waypoint beside the door line.
+  for (const Pose2& p : motion_.path())
+    EXPECT_LT(std::abs(p.x), 1e-6);
+}
+
+TEST_F(NavigationNodesTest, RetractToSafeWithNowhereToGoOnlyStops) {
+  bt::Tree tree = Tree(R"(<RetractToSafe/>)");
+  context_.now = At(1.0);
+  tree.TickOnce();
+  EXPECT_FALSE(Noted(DecisionEvent::kRetreating));
+  EXPECT_FALSE(motion_.base_moving());
+}
+
+TEST_F(NavigationNodesTest, WaitForClearWaitsForTheZoneAndGivesUpAfterItsTimeout) {
+  bt::Tree tree = Tree(R"(<WaitForClear door="lab_door" timeout="2.0"/>)");
+  context_.world.people = {Person({0.0, 3.3}, perception::PersonIntent::kStationary)};
+  context_.now = At(1.0);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  context_.now = At(2.0);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  context_.world.people.clear();
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);
+
+  context_.world.people = {Person({0.0, 3.3}, perception::PersonIntent::kStationary)};
+  context_.now = At(10.0);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  context_.now = At(12.5);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
+}
+
+}  // namespace
+}  // namespace egress::behavior

@@ -1,0 +1,103 @@
+#pragma once
+// A TaskContext for ticking task nodes one at a time in the family tests: the lab's door (the
+// wall y = 3, hinge at x = 0.475, latch at x = -0.475, opening north) with a push button south
+// of it at x = 1.075, a free floor around it, the real robot model, motion executor and planner,
+// and the factory with every task node registered.
+
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "egress/behavior/task_nodes.h"
+#include "egress/bt/factory.h"
+#include "egress/hsr_interface/error.h"
+
+namespace egress::behavior::node_testing {
+
+inline Time At(double t) {
+  return Time{} + SecondsToDuration(t);
+}
+
+inline MissionMap LabDoor() {
+  MissionMap map;
+  map.grid = perception::OccupancyGrid::FromBoxes({}, {-3.0, -1.0}, {3.0, 7.0}, 0.05);
+  perception::Doorway doorway;
+  doorway.id = "lab_door";
+  doorway.p_MHinge = {0.475, 3.0};
+  doorway.p_MLatch = {-0.475, 3.0};
+  map.doorways.push_back(doorway);
+  perception::DoorModel door;
+  door.id = "lab_door";
+  door.p_MHinge = doorway.p_MHinge;
+  door.p_MLatch = doorway.p_MLatch;
+  door.swing_sign = -1.0;
+  map.doors.push_back(door);
+  MapActuator button;
+  button.id = "lab_button";
+  button.door = "lab_door";
+  button.type = planning::ButtonType::kPushButton;
+  button.p_M = {1.075, 2.93, 1.0};
+  button.n_M = {0.0, -1.0, 0.0};
+  button.protrusion = 0.02;
+  map.actuators.push_back(button);
+  return map;
+}
+
+inline perception::TrackedPersonWithIntent Person(const Eigen::Vector2d& p_MP,
+                                                  perception::PersonIntent intent) {
+  perception::TrackedPersonWithIntent entry;
+  entry.person.p_MP = p_MP;
+  entry.intent = intent;
+  entry.door_id = "lab_door";
+  return entry;
+}
+
+class TaskNodeFixture : public ::testing::Test {
+ protected:
+  TaskNodeFixture()
+      : model_(RobotModel::LoadDefault()),
+        motion_(model_),
+        costmap_(map_.grid),
+        planner_(costmap_, nullptr) {
+    context_.map = &map_;
+    context_.model = &model_;
+    context_.motion = &motion_;
+    context_.planner = &planner_;
+    context_.X_MB = {0.0, 2.0, M_PI / 2};  // 1 m south of the door, facing it
+    RegisterTaskNodes(factory_, &context_);
+  }
+  // A tree of the one node `xml`, on `blackboard` if given.
+  bt::Tree Tree(const std::string& xml, bt::Blackboard::Ptr blackboard = nullptr) {
+    return factory_.CreateTreeFromText(
+        "<root BTCPP_format=\"4\"><BehaviorTree ID=\"t\">" + xml + "</BehaviorTree></root>", {},
+        blackboard);
+  }
+  // The door seen open at `angle_deg`, steady, `open_for` seconds at `now`.
+  void DoorSeenOpen(double angle_deg, double open_for) {
+    perception::TrackedDoor door;
+    door.model = map_.doors[0];
+    door.state.observed = true;
+    door.state.angle = angle_deg * M_PI / 180.0;
+    door.state.clearance_width = door.model.ClearanceWidth(door.state.angle);
+    door.state.motion = perception::DoorMotion::kHeldOpen;
+    door.state.stamp = context_.now;
+    context_.world.doors = {door};
+    context_.door_open_since["lab_door"] = context_.now - SecondsToDuration(open_for);
+  }
+  // Whether any note so far carries `event`.
+  bool Noted(DecisionEvent event) const {
+    for (const auto& note : context_.notes)
+      if (note.event == event) return true;
+    return false;
+  }
+
+  MissionMap map_ = LabDoor();
+  RobotModel model_;
+  MotionExecutor motion_;
+  perception::Costmap2D costmap_;
+  planning::BasePlanner planner_;
+  TaskContext context_;
+  bt::BehaviorTreeFactory factory_;
+};
+
+}  // namespace egress::behavior::node_testing
