@@ -61,7 +61,8 @@ TrialResult RunBrainTrial(const std::string& scenario_path, std::uint64_t seed) 
       const perception::DoorZone zone{door, brain.context().config.zone_depth,
                                       brain.context().config.person_radius};
       for (const auto& person : world.people()) {
-        if (person.started && person.phase != "holding" && zone.Contains(person.position))
+        if (person.started && person.phase != twin::PersonPhase::kHolding &&
+            zone.Contains(person.position))
           inside = true;
       }
     }

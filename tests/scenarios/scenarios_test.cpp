@@ -54,7 +54,7 @@ BrainRun RunWithBrain(const std::filesystem::path& file, std::uint64_t seed,
                 world.door_angle(0), brain.active_action().c_str());
     for (const auto& p : world.people()) {
       std::printf("         TRUE %s at %.2f %.2f phase %s\n", p.name.c_str(), p.position.x(),
-                  p.position.y(), p.phase.c_str());
+                  p.position.y(), std::string(twin::ToString(p.phase)).c_str());
     }
     for (const auto& p : brain.context().world.people) {
       std::printf("         person %d at %.2f %.2f v %.2f %.2f intent %d door %s\n", p.person.id,

@@ -171,7 +171,7 @@ people:
   EXPECT_GT(min_gap, 0.0);
   EXPECT_LT((world.people()[0].position - Eigen::Vector2d(7.5, 2.5)).norm(), 0.5);
   EXPECT_LT((world.people()[1].position - Eigen::Vector2d(3.0, 3.5)).norm(), 0.5);
-  EXPECT_EQ(world.people()[0].phase, "done");
+  EXPECT_EQ(world.people()[0].phase, PersonPhase::kDone);
 }
 
 TEST(TwinWorldTest, PeopleWaitAtAClosedDoor) {
@@ -184,7 +184,7 @@ people:
   auto loaded = LoadText(yaml, WorldsDir() / "office");
   TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
   world.StepFor(5.0);
-  EXPECT_EQ(world.people()[0].phase, "waiting_for_door");
+  EXPECT_EQ(world.people()[0].phase, PersonPhase::kWaitingForDoor);
   EXPECT_LT(world.people()[0].position.x(), 4.95 - 0.25);
   world.StepFor(10.0);
   EXPECT_GT(world.people()[0].position.x(), 7.0);

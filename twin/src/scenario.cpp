@@ -8,6 +8,10 @@
 #include <sstream>
 
 #include "egress/hsr_interface/error.h"
+#include "people/approach_and_wait.h"
+#include "people/evacuate.h"
+#include "people/hold_door.h"
+#include "people/walk_past.h"
 #include "yaml_field_reader.h"
 
 namespace egress::twin {
@@ -463,6 +467,26 @@ double Range::Sample(std::mt19937_64& rng) const {
   if (max <= min) return min;
   return std::uniform_real_distribution<double>(min, max)(rng);
 }
+
+namespace people {
+
+std::unique_ptr<PersonBehaviorModel> MakePersonBehavior(PersonBehavior kind) {
+  switch (kind) {
+    case PersonBehavior::kCrossDoorway:
+      return std::make_unique<CrossDoorway>();
+    case PersonBehavior::kHoldDoor:
+      return std::make_unique<HoldDoor>();
+    case PersonBehavior::kWalkPast:
+      return std::make_unique<WalkPast>();
+    case PersonBehavior::kApproachAndWait:
+      return std::make_unique<ApproachAndWait>();
+    case PersonBehavior::kEvacuate:
+      return std::make_unique<Evacuate>();
+  }
+  throw InvalidArgument(StrCat("unknown people behaviour ", int(kind)));
+}
+
+}  // namespace people
 
 std::string_view ToString(PersonBehavior behavior) {
   switch (behavior) {

@@ -152,7 +152,7 @@ void TraceRecorder::Observe(const TwinWorld& world, const TraceAnnotation* annot
     s += ',';
     s += Fixed(p.position.y());
     s += ',';
-    quoted(&s, p.phase);
+    quoted(&s, std::string(ToString(p.phase)));
     s += ']';
   }
   s += "],\"payloads\":[";

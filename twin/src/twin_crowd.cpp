@@ -1,6 +1,25 @@
+#include "people/person_behavior.h"
 #include "twin_world_impl.h"
 
 namespace egress::twin {
+
+std::string_view ToString(PersonPhase phase) {
+  switch (phase) {
+    case PersonPhase::kWaiting:
+      return "waiting";
+    case PersonPhase::kWalking:
+      return "walking";
+    case PersonPhase::kWaitingForDoor:
+      return "waiting_for_door";
+    case PersonPhase::kHolding:
+      return "holding";
+    case PersonPhase::kStanding:
+      return "standing";
+    case PersonPhase::kDone:
+      return "done";
+  }
+  return "unknown";
+}
 
 void TwinWorld::Impl::BuildPeople() {
   std::mt19937_64 rng(DeriveSeed(seed, 4));
@@ -8,14 +27,17 @@ void TwinWorld::Impl::BuildPeople() {
   std::mt19937_64 hold_rng(DeriveSeed(seed, 5));
   const auto& r = scenario.randomize;
   for (const auto& spec : scenario.people) {
-    const int count = spec.behavior == PersonBehavior::kEvacuate ? spec.count : 1;
+    auto& model = behavior_models[spec.behavior];
+    if (!model) model = people::MakePersonBehavior(spec.behavior);
+    const int count = model->GroupSize(spec);
     const int columns = int(std::ceil(std::sqrt(double(count))));
     for (int k = 0; k < count; ++k) {
       Person p;
       p.state.name = count == 1 ? spec.name : spec.name + "_" + std::to_string(k);
       p.state.behavior = spec.behavior;
       p.state.radius = spec.radius;
-      p.state.phase = "waiting";
+      p.state.phase = PersonPhase::kWaiting;
+      p.behavior = model.get();
       // A group stands in a grid around its start, 2.2 radii apart.
       Eigen::Vector2d offset = Eigen::Vector2d::Zero();
       if (count > 1) {
@@ -32,11 +54,11 @@ void TwinWorld::Impl::BuildPeople() {
       p.trigger_delay = r.person_delay_s.Sample(rng) + (count > 1 ? 0.3 * k : 0.0);
       p.door = spec.door.empty() ? -1 : FindDoor(spec.door);
       p.hold_angle = spec.hold_angle_deg * kDegToRad;
-      if (spec.behavior == PersonBehavior::kHoldDoor && r.hold_angle_deg.max > 0.0)
+      if (model->HoldsDoor() && r.hold_angle_deg.max > 0.0)
         p.hold_angle = r.hold_angle_deg.Sample(hold_rng) * kDegToRad;
       p.hold_duration = spec.hold_duration;
       p.state.position = p.walker.position;
-      BuildRoute(spec, &p);
+      model->PlanRoute(spec, p.door >= 0 ? &doors[std::size_t(p.door)] : nullptr, &p);
       const int e = AddEntity(EntityKind::kPerson, p.state.name, int(people.size()));
       const Pose3 X_W(
           Eigen::Vector3d(p.walker.position.x(), p.walker.position.y(), kPersonHeight / 2));
@@ -55,44 +77,6 @@ int TwinWorld::Impl::FindDoor(const std::string& name) const {
     if (world.doors[i].name == name) return int(i);
   }
   return -1;
-}
-
-void TwinWorld::Impl::BuildRoute(const PersonSpec& spec, Person* p) {
-  const Eigen::Vector2d start = p->walker.position;
-  auto through_door = [&](int door_index) {
-    const Door& d = doors[door_index];
-    const double side = (start - d.centre).dot(d.normal) >= 0 ? 1.0 : -1.0;
-    // People keep right: wait and leave kKeepRight to the right of the doorway's axis, so two
-    // walkers crossing in opposite directions do not meet head-on at its ends.
-    const Eigen::Vector2d heading = -d.normal * side;
-    const Eigen::Vector2d right(heading.y(), -heading.x());
-    p->route.push_back(d.centre - heading * 1.0 + right * kKeepRight);
-    p->wait_before_waypoint = int(p->route.size());
-    p->route.push_back(d.centre);
-    p->route.push_back(d.centre + heading * 1.0 + right * kKeepRight);
-  };
-  switch (spec.behavior) {
-    case PersonBehavior::kCrossDoorway:
-    case PersonBehavior::kEvacuate:
-      for (const auto& v : spec.via)
-        p->route.push_back(v);
-      through_door(p->door);
-      p->route.push_back(spec.goal);
-      break;
-    case PersonBehavior::kHoldDoor: {
-      const Door& d = doors[p->door];
-      const double side = (start - d.centre).dot(d.normal) >= 0 ? 1.0 : -1.0;
-      // Beside the hinge jamb on the person's side, out of the doorway.
-      p->route.push_back(d.desc->p_WH.head<2>() - d.along * 0.45 + d.normal * side * 0.45);
-      break;
-    }
-    case PersonBehavior::kWalkPast:
-    case PersonBehavior::kApproachAndWait:
-      for (const auto& v : spec.via)
-        p->route.push_back(v);
-      p->route.push_back(spec.goal);
-      break;
-  }
 }
 
 void TwinWorld::Impl::UpdatePeople() {
@@ -116,38 +100,23 @@ void TwinWorld::Impl::UpdatePeople() {
       }
       if (go) {
         p.state.started = true;
-        p.state.phase = "walking";
+        p.state.phase = PersonPhase::kWalking;
         AddEvent("person_started", p.state.name);
       }
       continue;
     }
-    if (p.state.phase == "holding") {
-      if (time - p.hold_started >= p.hold_duration) {
-        p.state.phase = "walking";
-        AddEvent("person_released_door", p.state.name, doors[p.door].desc->name);
-        const PersonSpec* spec = FindSpec(p.state.name);
-        if (spec != nullptr && (spec->goal - p.walker.position).norm() > 0.3)
-          p.route.push_back(spec->goal);
-      }
-      continue;
-    }
-    if (p.state.phase == "standing") {
-      if (p.state.behavior == PersonBehavior::kApproachAndWait && p.wait_started >= 0 &&
-          time - p.wait_started >= p.hold_duration && p.hold_duration > 0) {
-        p.state.phase = "done";
-      }
+    const Door* door = p.door >= 0 ? &doors[std::size_t(p.door)] : nullptr;
+    const people::EventSink add_event = [this](const std::string& kind, const std::string& subject,
+                                               const std::string& detail) {
+      AddEvent(kind, subject, detail);
+    };
+    if (p.state.phase == PersonPhase::kHolding || p.state.phase == PersonPhase::kStanding) {
+      p.behavior->WhileResting(time, FindSpec(p.state.name), door, &p, add_event);
       continue;
     }
     if (p.route.empty()) {
       p.walker.desired_speed = 0.0;
-      if (p.state.behavior == PersonBehavior::kHoldDoor && p.hold_started < 0) {
-        p.state.phase = "holding";
-        p.hold_started = time;
-        AddEvent("person_holding_door", p.state.name, doors[p.door].desc->name);
-      } else if (p.state.phase != "done") {
-        p.state.phase = p.state.behavior == PersonBehavior::kApproachAndWait ? "standing" : "done";
-        if (p.wait_started < 0) p.wait_started = time;
-      }
+      p.behavior->AtRouteEnd(time, door, &p, add_event);
       continue;
     }
     // Wait in front of a door that is not open enough.
@@ -156,15 +125,15 @@ void TwinWorld::Impl::UpdatePeople() {
     p.walker.desired_speed = p.speed;
     if (p.door >= 0 && p.wait_before_waypoint >= 0 && PendingDoorWaypoint(p) &&
         (doors[p.door].angle < config.door_crossed_open_angle_deg * kDegToRad || DoorwayTaken(p))) {
-      p.state.phase = "waiting_for_door";
+      p.state.phase = PersonPhase::kWaitingForDoor;
       p.walker.desired_speed = 0.0;
-    } else if (p.state.phase == "waiting_for_door") {
-      p.state.phase = "walking";
+    } else if (p.state.phase == PersonPhase::kWaitingForDoor) {
+      p.state.phase = PersonPhase::kWalking;
     }
     // Pushed against a jamb (a social-force local minimum, e.g. after making way for the
     // robot), a walker heading for the doorway steps back onto the door's axis and goes again.
-    const bool heading_for_doorway =
-        p.door >= 0 && p.reached == p.wait_before_waypoint && p.state.phase == "walking";
+    const bool heading_for_doorway = p.door >= 0 && p.reached == p.wait_before_waypoint &&
+                                     p.state.phase == PersonPhase::kWalking;
     p.stuck_for = heading_for_doorway && p.walker.velocity.norm() < 0.05 ? p.stuck_for + dt : 0.0;
     if (p.stuck_for > kStuckSec && !p.realigned) {
       const Door& d = doors[std::size_t(p.door)];
@@ -178,7 +147,7 @@ void TwinWorld::Impl::UpdatePeople() {
     }
     const double reached_radius = p.route.size() == 1 ? 0.25 : 0.4;
     if ((p.walker.position - p.route.front()).norm() < reached_radius &&
-        p.state.phase != "waiting_for_door") {
+        p.state.phase != PersonPhase::kWaitingForDoor) {
       p.route.erase(p.route.begin());
       ++p.reached;
     }

@@ -121,7 +121,7 @@ void TwinWorld::Impl::UpdateDoors() {
     btVector3 torque = -d.desc->damping * omega * axis;
     // People holding this door push it towards their hold angle.
     for (const auto& p : people) {
-      if (p.state.phase != "holding" || p.door != int(i)) continue;
+      if (p.state.phase != PersonPhase::kHolding || p.door != int(i)) continue;
       const double max_torque = config.person_hold_force * d.reach;
       const double tau =
           std::clamp(1000.0 * (p.hold_angle - d.angle) - 100.0 * omega, -max_torque, max_torque);

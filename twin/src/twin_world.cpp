@@ -1,3 +1,4 @@
+#include "people/person_behavior.h"
 #include "twin_world_impl.h"
 
 namespace egress::twin {

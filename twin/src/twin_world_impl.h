@@ -142,6 +142,56 @@ inline std::unique_ptr<btCollisionShape> MakeConvexShape(const ShapeDescription&
 }
 
 }  // namespace world_detail
+
+namespace people {
+class PersonBehaviorModel;  // people/person_behavior.h
+}  // namespace people
+
+namespace world_detail {
+// A door in the run: its description (fixed) and its state.
+struct Door {
+  const DoorDescription* desc{nullptr};
+  std::optional<DoorOperatorSpec> spec;
+  std::optional<AdaDoorOperator> op;
+  std::vector<PushButton> buttons;     // one per push-button actuator, in spec order
+  std::vector<ProximityPlate> plates;  // one per proximity-plate actuator, in spec order
+  std::size_t next_open_at{0};
+  btRigidBody* leaf{nullptr};
+  btHingeConstraint* hinge{nullptr};
+  double motor_sign{1.0};
+  double reach{0.0};
+  double angle{0.0};
+  int presses{0};
+  bool reported_open{false};
+  bool reported_closed{true};
+  DoorPhase last_phase{DoorPhase::kClosed};
+  Eigen::Vector2d centre{Eigen::Vector2d::Zero()};  // doorway centre in the plane
+  Eigen::Vector2d normal{Eigen::Vector2d::Zero()};  // doorway plane normal
+  Eigen::Vector2d along{Eigen::Vector2d::Zero()};   // hinge → latch direction (closed)
+};
+
+// A person in the run.
+struct Person {
+  PersonState state;
+  Walker walker;
+  TriggerSpec trigger;
+  double trigger_delay{0.0};
+  double speed{1.3};
+  std::vector<Eigen::Vector2d> route;  // waypoints still to go
+  int door{-1};
+  int wait_before_waypoint{-1};  // route index (counted from the start) of the doorway centre
+  int reached{0};                // waypoints reached so far
+  double stuck_for{0.0};         // [s] wanting to walk but not moving
+  bool realigned{false};         // stepped back onto the door's axis once
+  double hold_angle{0.0};
+  double hold_duration{0.0};
+  double hold_started{-1.0};
+  double wait_started{-1.0};
+  const people::PersonBehaviorModel* behavior{nullptr};  // owned by behavior_models
+  btRigidBody* body{nullptr};
+};
+
+}  // namespace world_detail
 using namespace world_detail;
 
 struct TwinWorld::Impl {
@@ -152,45 +202,8 @@ struct TwinWorld::Impl {
     bool glass{false};
   };
 
-  struct Door {
-    const DoorDescription* desc{nullptr};
-    std::optional<DoorOperatorSpec> spec;
-    std::optional<AdaDoorOperator> op;
-    std::vector<PushButton> buttons;     // one per push-button actuator, in spec order
-    std::vector<ProximityPlate> plates;  // one per proximity-plate actuator, in spec order
-    std::size_t next_open_at{0};
-    btRigidBody* leaf{nullptr};
-    btHingeConstraint* hinge{nullptr};
-    double motor_sign{1.0};
-    double reach{0.0};
-    double angle{0.0};
-    int presses{0};
-    bool reported_open{false};
-    bool reported_closed{true};
-    DoorPhase last_phase{DoorPhase::kClosed};
-    Eigen::Vector2d centre{Eigen::Vector2d::Zero()};  // doorway centre in the plane
-    Eigen::Vector2d normal{Eigen::Vector2d::Zero()};  // doorway plane normal
-    Eigen::Vector2d along{Eigen::Vector2d::Zero()};   // hinge → latch direction (closed)
-  };
-
-  struct Person {
-    PersonState state;
-    Walker walker;
-    TriggerSpec trigger;
-    double trigger_delay{0.0};
-    double speed{1.3};
-    std::vector<Eigen::Vector2d> route;  // waypoints still to go
-    int door{-1};
-    int wait_before_waypoint{-1};  // route index (counted from the start) of the doorway centre
-    int reached{0};                // waypoints reached so far
-    double stuck_for{0.0};         // [s] wanting to walk but not moving
-    bool realigned{false};         // stepped back onto the door's axis once
-    double hold_angle{0.0};
-    double hold_duration{0.0};
-    double hold_started{-1.0};
-    double wait_started{-1.0};
-    btRigidBody* body{nullptr};
-  };
+  using Door = world_detail::Door;
+  using Person = world_detail::Person;
 
   struct Payload {
     PayloadSpec spec;
@@ -249,8 +262,6 @@ struct TwinWorld::Impl {
   void BuildPeople();
 
   int FindDoor(const std::string& name) const;
-
-  void BuildRoute(const PersonSpec& spec, Person* p);
 
   // ----- per-step updates ------------------------------------------------------------
   bool HasEvent(const std::string& name) const { return fired_events.count(name) > 0; }
@@ -350,6 +361,8 @@ struct TwinWorld::Impl {
   std::vector<Entity> entities;
   std::vector<Door> doors;
   std::vector<Person> people;
+  // One model per people behaviour the scenario uses (the fixed model; Person is the run's state).
+  std::map<PersonBehavior, std::unique_ptr<people::PersonBehaviorModel>> behavior_models;
   std::vector<PersonState> states_cache;
   std::vector<Payload> payloads;
   std::vector<WallSegment> walls;

@@ -81,6 +81,18 @@ struct DetectableObject {
   int entity{-1};
 };
 
+/// What a person is doing.
+enum class PersonPhase {
+  kWaiting,         ///< Not started (waiting for the trigger).
+  kWalking,         ///< On the route.
+  kWaitingForDoor,  ///< Before a doorway whose leaf is not open enough, or that someone is in.
+  kHolding,         ///< Holding a door open.
+  kStanding,        ///< Standing at the route's end (approach_and_wait).
+  kDone,            ///< At the route's end for good.
+};
+/// waiting, walking, waiting_for_door, holding, standing, done (the trace's names).
+std::string_view ToString(PersonPhase phase);
+
 /// Ground truth of one person.
 struct PersonState {
   std::string name;
@@ -89,7 +101,7 @@ struct PersonState {
   Eigen::Vector2d velocity{Eigen::Vector2d::Zero()};
   double radius{0.25};
   bool started{false};
-  std::string phase;  ///< waiting, walking, waiting_for_door, holding, standing, done
+  PersonPhase phase{PersonPhase::kWaiting};
 };
 
 class TwinWorld {

@@ -1,0 +1,25 @@
+#include "person_behavior.h"
+
+namespace egress::twin::people {
+
+void PersonBehaviorModel::AtRouteEnd(double time, const Door* /*door*/, Person* p,
+                                     const EventSink& /*add_event*/) const {
+  if (p->state.phase != PersonPhase::kDone) {
+    p->state.phase = PersonPhase::kDone;
+    if (p->wait_started < 0) p->wait_started = time;
+  }
+}
+
+void PersonBehaviorModel::RouteThroughDoor(const Door& d, const Eigen::Vector2d& start, Person* p) {
+  const double side = (start - d.centre).dot(d.normal) >= 0 ? 1.0 : -1.0;
+  // People keep right: wait and leave kKeepRight to the right of the doorway's axis, so two
+  // walkers crossing in opposite directions do not meet head-on at its ends.
+  const Eigen::Vector2d heading = -d.normal * side;
+  const Eigen::Vector2d right(heading.y(), -heading.x());
+  p->route.push_back(d.centre - heading * 1.0 + right * kKeepRight);
+  p->wait_before_waypoint = int(p->route.size());
+  p->route.push_back(d.centre);
+  p->route.push_back(d.centre + heading * 1.0 + right * kKeepRight);
+}
+
+}  // namespace egress::twin::people
