@@ -114,6 +114,19 @@ double PayloadCentreHeight(std::string_view kind) {
   return 0.05;
 }
 
+// Calls fn(p_MQ) for every valid pixel of the latest depth image, unprojected into M.
+template <typename Fn>
+void ForEachDepthPointInMap(const TaskContext& ctx, Fn&& fn) {
+  const DepthImage& depth = *ctx.depth;
+  for (int v = 0; v < depth.height; ++v) {
+    for (int u = 0; u < depth.width; ++u) {
+      if (!depth.IsValidAt(u, v)) continue;
+      fn(Eigen::Vector3d(ctx.X_MC *
+                         ctx.depth_intrinsics.Unproject(u + 0.5, v + 0.5, depth.At(u, v))));
+    }
+  }
+}
+
 // The highest depth point standing out of the surface the payload rests on (`surface_z`) in the
 // corridor the hand sweeps horizontally towards a grasp centre `p_M` along `approach_M` (from
 // the pre-grasp to just before the payload, within a hand's width of the line), or nullopt if
@@ -124,26 +137,18 @@ std::optional<double> ClutterTopBeforeGrasp(const TaskContext& ctx, const Eigen:
   if (!ctx.depth) return std::nullopt;
   constexpr double kHandHalfWidth = 0.07;  // [m] fingers open, with a margin
   constexpr double kFlat = 0.02;           // [m] bumps lower than this are the surface
-  const DepthImage& depth = *ctx.depth;
-  const CameraIntrinsics& K = ctx.depth_intrinsics;
   const Eigen::Vector2d a = approach_M.head<2>().normalized();
   std::optional<double> top;
-  for (int v = 0; v < depth.height; ++v) {
-    for (int u = 0; u < depth.width; ++u) {
-      if (!depth.IsValidAt(u, v)) continue;
-      const double z = depth.At(u, v);
-      const Eigen::Vector3d p =
-          ctx.X_MC * Eigen::Vector3d((u + 0.5 - K.cx) / K.fx * z, (v + 0.5 - K.cy) / K.fy * z, z);
-      const Eigen::Vector2d d = p.head<2>() - p_M.head<2>();
-      const double along = d.dot(a);
-      const double lateral = (d - along * a).norm();
-      if (along > -(payload_radius + 0.01) || along < -(kPreGraspOffset + 0.1) ||
-          lateral > kHandHalfWidth || p.z() < surface_z + kFlat) {
-        continue;
-      }
-      top = top ? std::max(*top, p.z()) : p.z();
+  ForEachDepthPointInMap(ctx, [&](const Eigen::Vector3d& p) {
+    const Eigen::Vector2d d = p.head<2>() - p_M.head<2>();
+    const double along = d.dot(a);
+    const double lateral = (d - along * a).norm();
+    if (along > -(payload_radius + 0.01) || along < -(kPreGraspOffset + 0.1) ||
+        lateral > kHandHalfWidth || p.z() < surface_z + kFlat) {
+      return;
     }
-  }
+    top = top ? std::max(*top, p.z()) : p.z();
+  });
   return top;
 }
 
@@ -156,23 +161,15 @@ std::optional<Eigen::Vector3d> LowPayloadCentre(const TaskContext& ctx, const Ei
   if (!ctx.depth) return std::nullopt;
   constexpr double kAboveSurface = 0.01;  // [m] points lower than this are the surface
   constexpr int kMinPoints = 20;
-  const DepthImage& depth = *ctx.depth;
-  const CameraIntrinsics& K = ctx.depth_intrinsics;
   Eigen::Vector2d sum = Eigen::Vector2d::Zero();
   int n = 0;
-  for (int v = 0; v < depth.height; ++v) {
-    for (int u = 0; u < depth.width; ++u) {
-      if (!depth.IsValidAt(u, v)) continue;
-      const double z = depth.At(u, v);
-      const Eigen::Vector3d p =
-          ctx.X_MC * Eigen::Vector3d((u + 0.5 - K.cx) / K.fx * z, (v + 0.5 - K.cy) / K.fy * z, z);
-      if (p.z() < surface_z + kAboveSurface || p.z() > p_M.z() + radius ||
-          (p.head<2>() - p_M.head<2>()).norm() > radius)
-        continue;
-      sum += p.head<2>();
-      ++n;
-    }
-  }
+  ForEachDepthPointInMap(ctx, [&](const Eigen::Vector3d& p) {
+    if (p.z() < surface_z + kAboveSurface || p.z() > p_M.z() + radius ||
+        (p.head<2>() - p_M.head<2>()).norm() > radius)
+      return;
+    sum += p.head<2>();
+    ++n;
+  });
   if (n < kMinPoints) return std::nullopt;
   const Eigen::Vector2d c = sum / n;
   return Eigen::Vector3d(c.x(), c.y(), p_M.z());

@@ -5,27 +5,14 @@
 
 #include "egress/behavior/door_rules.h"
 #include "egress/hsr_interface/error.h"
+#include "task_node_fixture.h"
 
 namespace egress::behavior {
 namespace {
 
-// A door in the wall y = 3 (hinge at x = 0.475, latch at x = -0.475), as the lab's; the robot
-// waits south of it.
-MissionMap LabDoor() {
-  MissionMap map;
-  perception::Doorway doorway;
-  doorway.id = "lab_door";
-  doorway.p_MHinge = {0.475, 3.0};
-  doorway.p_MLatch = {-0.475, 3.0};
-  map.doorways.push_back(doorway);
-  perception::DoorModel door;
-  door.id = "lab_door";
-  door.p_MHinge = doorway.p_MHinge;
-  door.p_MLatch = doorway.p_MLatch;
-  door.swing_sign = -1.0;
-  map.doors.push_back(door);
-  return map;
-}
+// The lab's door in the wall y = 3 (hinge at x = 0.475, latch at x = -0.475); the robot waits
+// south of it.
+using node_testing::LabDoor;
 
 perception::TrackedPersonWithIntent StillPerson(const Eigen::Vector2d& p_MP,
                                                 perception::PersonIntent intent) {
