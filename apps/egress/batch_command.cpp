@@ -57,9 +57,9 @@ TrialResult RunBrainTrial(const std::string& scenario_path, std::uint64_t seed) 
   bool inside_before = false;
   options.after_step = [&](const twin::TwinWorld& world, const behavior::Executive& brain) {
     bool inside = false;
-    for (const auto& door : brain.context().map->doors) {
-      const perception::DoorZone zone{door, brain.context().config.zone_depth,
-                                      brain.context().config.person_radius};
+    for (const auto& door : brain.services().map->doors) {
+      const perception::DoorZone zone{door, brain.services().config.zone_depth,
+                                      brain.services().config.person_radius};
       for (const auto& person : world.people()) {
         if (person.started && person.phase != twin::PersonPhase::kHolding &&
             zone.Contains(person.position))

@@ -143,7 +143,7 @@ void RunSim(const SimOptions& o) {
                                                   const behavior::Executive& b) mutable {
       twin::TraceAnnotation note;
       note.label = b.active_action();
-      for (const Pose2& X : b.context().motion->path())
+      for (const Pose2& X : b.services().motion->path())
         note.path.push_back(X.translation());
       if (world.time() + 1e-9 >= next_costmap) {
         next_costmap = world.time() + kCostmapSnapshotPeriodSec;

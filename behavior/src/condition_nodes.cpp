@@ -9,6 +9,9 @@ namespace {
 
 // ---- conditions
 
+// No side effects: the zone's last occupied time is the belief's (kept by the executive every
+// control step), a retreat under way is RetractToSafe's `retreating` entry. The node remembers
+// only its own last answer, to note the transitions.
 class IsPathClear final : public TaskNode<bt::ConditionNode> {
  public:
   using TaskNode::TaskNode;
@@ -16,24 +19,21 @@ class IsPathClear final : public TaskNode<bt::ConditionNode> {
     return {InputPort<std::string>(
                 "door", "door whose zone must be free of people now and over the forecast"),
             InputPort<double>("clear_for", 1.0,
-                              "seconds the zone must have been clear (hysteresis) [s]")};
+                              "seconds the zone must have been clear (hysteresis) [s]"),
+            RetreatingPort(bt::PortDirection::kInput)};
   }
   NodeStatus Tick() override {
     const std::string door = Door();
     // A standby retreat runs to its end before the robot resumes: stopping it half-way can
     // leave the robot in the doorway with the leaf about to close.
-    if (ctx_.retreating) return last_ = NodeStatus::kFailure;
-    if (IsDoorZoneOccupied(ctx_, door)) {
+    if (Shared<bool>("retreating").value_or(false)) return last_ = NodeStatus::kFailure;
+    if (IsDoorZoneOccupied(task_, door)) {
       if (last_ != NodeStatus::kFailure)
         Note("a person is in or entering the door zone", DecisionEvent::kPersonInDoorZone);
-      ctx_.zone_occupied_at[door] = ctx_.now;
       return last_ = NodeStatus::kFailure;
     }
-    const auto it = ctx_.zone_occupied_at.find(door);
-    if (it != ctx_.zone_occupied_at.end() &&
-        ToSeconds(ctx_.now - it->second) < Input<double>("clear_for")) {
+    if (!IsDoorZoneClearFor(task_, door, Input<double>("clear_for")))
       return last_ = NodeStatus::kFailure;
-    }
     if (last_ == NodeStatus::kFailure) Note("door zone clear", DecisionEvent::kDoorZoneClear);
     return last_ = NodeStatus::kSuccess;
   }
@@ -48,11 +48,13 @@ class IsDoorOpen final : public TaskNode<bt::ConditionNode> {
   static PortsList ProvidedPorts() {
     return {InputPort<std::string>("door", "door id"),
             InputPort<double>("margin", 0.1,
-                              "clearance beyond the robot's footprint the opening must leave [m]")};
+                              "clearance beyond the robot's footprint the opening must leave [m]"),
+            VisitPort(bt::PortDirection::kInput)};
   }
   NodeStatus Tick() override {
-    return DoorPassable(ctx_, Door(), Input<double>("margin")) ? NodeStatus::kSuccess
-                                                               : NodeStatus::kFailure;
+    const DoorVisit visit = Visit();
+    return DoorPassable(task_, visit.door, Input<double>("margin"), &visit) ? NodeStatus::kSuccess
+                                                                            : NodeStatus::kFailure;
   }
 };
 
@@ -61,12 +63,14 @@ class IsPersonHoldingDoor final : public TaskNode<bt::ConditionNode> {
   using TaskNode::TaskNode;
   static PortsList ProvidedPorts() {
     return {InputPort<std::string>(
-        "door", "door id: a person stands still at the leaf and it is open enough")};
+                "door", "door id: a person stands still at the leaf and it is open enough"),
+            VisitPort(bt::PortDirection::kInput)};
   }
   NodeStatus Tick() override {
-    const std::string door = Door();
-    for (const auto& entry : ctx_.world.people) {
-      if (IsHoldingDoorAside(ctx_, entry, door) && DoorPassable(ctx_, door, 0.0)) {
+    const DoorVisit visit = Visit();
+    for (const auto& entry : belief_.world.people) {
+      if (IsHoldingDoorAside(task_, entry, visit.door) &&
+          DoorPassable(task_, visit.door, 0.0, &visit)) {
         return NodeStatus::kSuccess;
       }
     }
@@ -82,17 +86,17 @@ class IsHoldingPayload final : public TaskNode<bt::ConditionNode> {
         InputPort<std::string>("payload", "", "payload class (bottle, flashlight); empty: any")};
   }
   NodeStatus Tick() override {
-    return ctx_.holding_object ? NodeStatus::kSuccess : NodeStatus::kFailure;
+    return belief_.holding_object ? NodeStatus::kSuccess : NodeStatus::kFailure;
   }
 };
 
 }  // namespace
 
-void RegisterConditionNodes(bt::BehaviorTreeFactory& factory, TaskContext* context) {
-  Register<IsPathClear>(factory, "IsPathClear", context);
-  Register<IsDoorOpen>(factory, "IsDoorOpen", context);
-  Register<IsPersonHoldingDoor>(factory, "IsPersonHoldingDoor", context);
-  Register<IsHoldingPayload>(factory, "IsHoldingPayload", context);
+void RegisterConditionNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services) {
+  Register<IsPathClear>(factory, "IsPathClear", services);
+  Register<IsDoorOpen>(factory, "IsDoorOpen", services);
+  Register<IsPersonHoldingDoor>(factory, "IsPersonHoldingDoor", services);
+  Register<IsHoldingPayload>(factory, "IsHoldingPayload", services);
 }
 
 }  // namespace egress::behavior::detail

@@ -20,7 +20,7 @@ class ButtonType final : public TaskNode<bt::SyncActionNode> {
                 "type", "push_button or proximity_plate: sets the end-effector travel")};
   }
   NodeStatus Tick() override {
-    const MapActuator* actuator = ctx_.map->FindActuatorOf(Door(), ctx_.X_MB.translation());
+    const MapActuator* actuator = task_.map->FindActuatorOf(Door(), belief_.X_MB.translation());
     if (actuator == nullptr) {
       Note("door has no actuator on this side");
       return NodeStatus::kFailure;
@@ -36,60 +36,63 @@ class ApproachButton final : public TaskNode<bt::StatefulActionNode> {
  public:
   using TaskNode::TaskNode;
   static PortsList ProvidedPorts() {
-    return {InputPort<std::string>("door", "door whose actuator to stand off (base facing it)")};
+    return {InputPort<std::string>("door", "door whose actuator to stand off (base facing it)"),
+            VisitPort(bt::PortDirection::kInOut)};
   }
   NodeStatus OnStart() override {
-    const std::string door = Door();
-    const MapActuator* actuator = ctx_.map->FindActuatorOf(door, ctx_.X_MB.translation());
+    DoorVisit visit = Visit();
+    const std::string door = visit.door;
+    const MapActuator* actuator = task_.map->FindActuatorOf(door, belief_.X_MB.translation());
     if (actuator == nullptr) {
       Note("door has no actuator on this side");
       return NodeStatus::kFailure;
     }
-    CalcApproachPass(ctx_, door);  // remember which side is "before" the door
+    CalcApproachPass(task_, visit);  // remember which side is "before" the door
     ButtonPlan plan;
     plan.actuator = actuator->id;
     plan.type = actuator->type;
     plan.targets = planning::MakeButtonTargets(actuator->p_M, actuator->n_M, actuator->type,
-                                               ctx_.config.buttons);
+                                               task_.config.buttons);
     // Whole-body IK from the standoff with the arm tucked picks where the base stands.
-    planning::IkConfig ik = ctx_.config.ik;
+    planning::IkConfig ik = task_.config.ik;
     ik.fingertip = actuator->type == planning::ButtonType::kPushButton;
     ik.use_base = true;
     WholeBodyVector q0 = WholeBodyVector::Zero();
     q0[kBaseX] = plan.targets.X_MB_standoff.x;
     q0[kBaseY] = plan.targets.X_MB_standoff.y;
     q0[kBaseYaw] = plan.targets.X_MB_standoff.yaw;
-    q0 = WithArm(q0, TuckedArm(*ctx_.model));
+    q0 = WithArm(q0, TuckedArm(*task_.model));
     const planning::IkResult solution =
-        planning::DlsIkSolver(*ctx_.model, ik).Solve(plan.targets.approach, q0);
+        planning::DlsIkSolver(*task_.model, ik).Solve(plan.targets.approach, q0);
     plan.X_MB_standoff = solution.converged
                              ? Pose2{solution.q[kBaseX], solution.q[kBaseY], solution.q[kBaseYaw]}
                              : plan.targets.X_MB_standoff;
-    plan.approach_arm = solution.converged ? ArmOf(solution.q) : TuckedArm(*ctx_.model);
+    plan.approach_arm = solution.converged ? ArmOf(solution.q) : TuckedArm(*task_.model);
     if (!solution.converged) Note("whole-body IK did not converge; using the nominal standoff");
-    ctx_.button_plans[door] = plan;
-    return StartPath(ctx_, plan.X_MB_standoff, StrCat("the ", actuator->id, " standoff"),
+    visit.button_plan = plan;
+    Remember(visit);
+    return StartPath(task_, plan.X_MB_standoff, StrCat("the ", actuator->id, " standoff"),
                      [this](const std::string& s) { Note(s); });
   }
   NodeStatus OnRunning() override {
-    return DriveStatus(ctx_, [this](const std::string& s) { Note(s); });
+    return DriveStatus(task_, [this](const std::string& s) { Note(s); });
   }
-  void OnHalted() override { ctx_.motion->StopBase(); }
+  void OnHalted() override { task_.motion->StopBase(); }
 };
 
 // The base pose relative to the actuator's wall, corrected by the laser: the distance to the
 // wall straight ahead, measured, against the distance the believed pose predicts. Pressing a
 // 4 mm button stroke needs the wall's distance to a few millimetres; the localizer's estimate
 // is good to a few centimetres. Along the wall nothing changes (the button is 10 cm wide).
-Pose2 WallAlignedPose(const TaskContext& ctx, const MapActuator& actuator,
+Pose2 WallAlignedPose(const TaskServices& task, const MapActuator& actuator,
                       const std::function<void(const std::string&)>& note) {
-  if (!ctx.scan) return ctx.X_MB;
+  if (!task.belief->scan) return task.belief->X_MB;
   const Eigen::Vector2d n = actuator.n_M.head<2>().normalized();
   const Eigen::Vector2d t(-n.y(), n.x());
   const Eigen::Vector2d p_MWall = actuator.p_M.head<2>() - n * actuator.protrusion;
-  const Pose2 X_ML = ctx.X_MB * ctx.X_BL;
+  const Pose2 X_ML = task.belief->X_MB * task.belief->X_BL;
   std::vector<double> distances;
-  const LaserScan& scan = *ctx.scan;
+  const LaserScan& scan = *task.belief->scan;
   for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
     const double r = scan.ranges[i];
     if (!std::isfinite(r) || r < scan.range_min || r > 2.0) continue;
@@ -99,12 +102,12 @@ Pose2 WallAlignedPose(const TaskContext& ctx, const MapActuator& actuator,
     if (std::abs((p_M - p_MWall).dot(n)) > 0.15 || std::abs((p_M - p_MWall).dot(t)) > 0.4) continue;
     distances.push_back((X_ML.translation() - p_M).dot(n));
   }
-  if (distances.size() < 5) return ctx.X_MB;
+  if (distances.size() < 5) return task.belief->X_MB;
   auto middle = distances.begin() + std::ptrdiff_t(distances.size() / 2);
   std::nth_element(distances.begin(), middle, distances.end());
   const double expected = (X_ML.translation() - p_MWall).dot(n);
   const double error = *middle - expected;
-  Pose2 corrected = ctx.X_MB;
+  Pose2 corrected = task.belief->X_MB;
   corrected.x += n.x() * error;
   corrected.y += n.y() * error;
   note(StrCat("wall ", std::round(*middle * 1000) / 1000, " m ahead by laser, ",
@@ -115,16 +118,16 @@ Pose2 WallAlignedPose(const TaskContext& ctx, const MapActuator& actuator,
 // Presses (push button) or waves (proximity plate): one arm motion, RUNNING until it ends.
 class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
  public:
-  ActuatorAction(const std::string& name, NodeConfig config, TaskContext* context,
+  ActuatorAction(const std::string& name, NodeConfig config, const TaskServices* services,
                  planning::ButtonType type)
-      : TaskNode(name, std::move(config), context), type_(type) {}
+      : TaskNode(name, std::move(config), services), type_(type) {}
   NodeStatus OnStart() override {
-    door_ = Door();
-    const auto it = ctx_.button_plans.find(door_);
-    if (it == ctx_.button_plans.end() || it->second.type != type_) {
+    const DoorVisit visit = Visit();
+    if (!visit.button_plan || visit.button_plan->type != type_) {
       Note("no standoff for this actuator: ApproachButton must run first");
       return NodeStatus::kFailure;
     }
+    plan_ = *visit.button_plan;
     alignments_ = 0;
     arm_started_ = false;
     gate_.Reset();
@@ -132,22 +135,27 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
   }
   NodeStatus OnRunning() override {
     if (!arm_started_) {
-      if (ctx_.motion->base_failed()) {
-        Note("could not square up to the actuator: " + ctx_.motion->base_failure());
+      if (task_.motion->base_failed()) {
+        Note("could not square up to the actuator: " + task_.motion->base_failure());
         return NodeStatus::kFailure;
       }
-      if (ctx_.motion->base_moving()) return NodeStatus::kRunning;
+      if (task_.motion->base_moving()) return NodeStatus::kRunning;
       return AlignOrOperate();
     }
-    if (const NodeStatus arm = ArmMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+    if (const NodeStatus arm = ArmMotionStatus(task_, [this](const std::string& t) { Note(t); });
         arm != NodeStatus::kSuccess) {
       return arm;
     }
-    // A press (or wave) restarts the operator's hold window of an open door.
-    if (ctx_.door_open_since.count(door_) > 0) ctx_.door_open_since[door_] = ctx_.now;
+    // A press (or wave) restarts the operator's hold window of an open door — from the moment
+    // the hand reached the actuator, not from now: the stroke and the way back take another
+    // second or more, and a window timed from here would end that much before the robot thinks.
+    if (DoorVisit visit = Visit(); belief_.door_open_since.count(Door()) > 0 && visit.operated_at) {
+      visit.window_restarted_at = visit.operated_at;
+      Remember(visit);
+    }
     return NodeStatus::kSuccess;
   }
-  void OnHalted() override { ctx_.motion->StopBase(); }  // the arm is tucked by whoever runs next
+  void OnHalted() override { task_.motion->StopBase(); }  // the arm is tucked by whoever runs next
 
  private:
   RelocalizeGate gate_;
@@ -157,19 +165,19 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
   // The base squares up to the planned standoff (by the laser's wall distance) first, then the
   // arm presses or waves.
   NodeStatus AlignOrOperate() {
-    if (gate_.Check(ctx_, "operating the actuator", [this](const std::string& t) { Note(t); }) ==
-        NodeStatus::kRunning)
+    if (gate_.Check(task_, "operating the actuator", EventNoter()) == NodeStatus::kRunning)
       return NodeStatus::kRunning;
-    const ButtonPlan& plan = ctx_.button_plans.at(door_);
-    const MapActuator& actuator = *ctx_.map->FindActuator(plan.actuator);
-    const Pose2 X_MB = WallAlignedPose(ctx_, actuator, [this](const std::string& t) { Note(t); });
+    const ButtonPlan& plan = plan_;
+    const MapActuator& actuator = *task_.map->FindActuator(plan.actuator);
+    const Pose2 X_MB = WallAlignedPose(task_, actuator, [this](const std::string& t) { Note(t); });
     const Eigen::Vector2d n = actuator.n_M.head<2>().normalized();
     const double off = (X_MB.translation() - plan.X_MB_standoff.translation()).dot(n);
     if (std::abs(off) > kAlignTolerance && alignments_ < kMaxAlignments) {
       ++alignments_;
-      const Pose2 target{ctx_.X_MB.x - n.x() * off, ctx_.X_MB.y - n.y() * off,
+      const Pose2 target{belief_.X_MB.x - n.x() * off, belief_.X_MB.y - n.y() * off,
                          plan.X_MB_standoff.yaw};
-      ctx_.motion->FollowPath({ctx_.X_MB, target}, {false}, ctx_.motion->arm_target(), ctx_.now);
+      task_.motion->FollowPath({belief_.X_MB, target}, {false}, task_.motion->arm_target(),
+                               belief_.now);
       Note(StrCat("squaring up: ", std::round(off * 1000), " mm off the standoff"));
       return NodeStatus::kRunning;
     }
@@ -179,17 +187,19 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
   NodeStatus Operate(const ButtonPlan& plan, const Pose2& X_MB) {
     const bool push = type_ == planning::ButtonType::kPushButton;
     // The hand reaches the actuator's approach pose then; the press or wave follows.
-    ctx_.door_operated_at[door_] = ctx_.now + SecondsToDuration(ctx_.config.press_reach_time);
-    const auto approach = SolveArm(ctx_, X_MB, plan.targets.approach, plan.approach_arm, push);
+    DoorVisit visit = Visit();
+    visit.operated_at = belief_.now + SecondsToDuration(task_.config.press_reach_time);
+    Remember(visit);
+    const auto approach = SolveArm(task_, X_MB, plan.targets.approach, plan.approach_arm, push);
     if (!approach) {
       Note("the actuator is out of the arm's reach from here");
       return NodeStatus::kFailure;
     }
-    const TaskConfig& c = ctx_.config;
+    const TaskConfig& c = task_.config;
     if (push) {
       planning::IkTarget press = plan.targets.press;
       press.approach_M.reset();  // the arm alone cannot also hold the approach axis exactly
-      const auto stroke = SolveArmLine(ctx_, X_MB, plan.targets.approach, press, *approach, true,
+      const auto stroke = SolveArmLine(task_, X_MB, plan.targets.approach, press, *approach, true,
                                        kPressStrokeKnots);
       if (!stroke) {
         Note("the press point is out of the arm's reach from here");
@@ -202,12 +212,12 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
         knots.emplace_back(c.press_reach_time + (i + 1) * dt, (*stroke)[std::size_t(i)]);
       for (int i = kPressStrokeKnots - 2; i >= -1; --i)
         knots.emplace_back(knots.back().first + dt, i >= 0 ? (*stroke)[std::size_t(i)] : *approach);
-      ctx_.motion->MoveArm(knots, ctx_.now);
+      task_.motion->MoveArm(knots, belief_.now);
       Note("pressing the push button");
     } else {
-      ctx_.motion->MoveArm(
+      task_.motion->MoveArm(
           {{c.press_reach_time, *approach}, {c.press_reach_time + c.wave_hold_time, *approach}},
-          ctx_.now);
+          belief_.now);
       Note("waving at the proximity plate");
     }
     arm_started_ = true;
@@ -215,28 +225,31 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
   }
 
   planning::ButtonType type_;
-  std::string door_;
+  ButtonPlan plan_;  // from the visit, at the start
   int alignments_{0};
   bool arm_started_{false};
 };
 
 class PressButton final : public ActuatorAction {
  public:
-  PressButton(const std::string& name, NodeConfig config, TaskContext* context)
-      : ActuatorAction(name, std::move(config), context, planning::ButtonType::kPushButton) {}
+  PressButton(const std::string& name, NodeConfig config, const TaskServices* services)
+      : ActuatorAction(name, std::move(config), services, planning::ButtonType::kPushButton) {}
   static PortsList ProvidedPorts() {
     return {InputPort<std::string>(
-        "door", "door whose push button to press (fingertip past the face by the stroke)")};
+                "door", "door whose push button to press (fingertip past the face by the stroke)"),
+            VisitPort(bt::PortDirection::kInOut)};
   }
 };
 
 class WaveAtPlate final : public ActuatorAction {
  public:
-  WaveAtPlate(const std::string& name, NodeConfig config, TaskContext* context)
-      : ActuatorAction(name, std::move(config), context, planning::ButtonType::kProximityPlate) {}
+  WaveAtPlate(const std::string& name, NodeConfig config, const TaskServices* services)
+      : ActuatorAction(name, std::move(config), services, planning::ButtonType::kProximityPlate) {}
   static PortsList ProvidedPorts() {
-    return {InputPort<std::string>(
-        "door", "door whose proximity plate to wave at (palm within its range, no contact)")};
+    return {
+        InputPort<std::string>(
+            "door", "door whose proximity plate to wave at (palm within its range, no contact)"),
+        VisitPort(bt::PortDirection::kInOut)};
   }
 };
 
@@ -250,42 +263,45 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
   static PortsList ProvidedPorts() {
     return {InputPort<std::string>("door", "door to drive through"),
             InputPort<double>("wait_timeout", 8.0,
-                              "how long to wait for the leaf to open before failing [s]")};
+                              "how long to wait for the leaf to open before failing [s]"),
+            VisitPort(bt::PortDirection::kInOut)};
   }
   NodeStatus OnStart() override {
     gate_.Reset();
-    door_ = Door();
-    pass_ = CalcApproachPass(ctx_, door_);
-    if (!ArmAt(ctx_.motion->arm_target(), TuckedArm(*ctx_.model)) ||
-        ctx_.motion->arm_moving(ctx_.now)) {
-      ctx_.motion->MoveArm({{ctx_.config.arm_tuck_time, TuckedArm(*ctx_.model)}}, ctx_.now);
+    DoorVisit visit = Visit();
+    door_ = visit.door;
+    pass_ = CalcApproachPass(task_, visit);
+    Remember(visit);
+    if (!ArmAt(task_.motion->arm_target(), TuckedArm(*task_.model)) ||
+        task_.motion->arm_moving(belief_.now)) {
+      task_.motion->MoveArm({{task_.config.arm_tuck_time, TuckedArm(*task_.model)}}, belief_.now);
     }
     yaw_ = std::atan2(-pass_.n_M.y(), -pass_.n_M.x());  // facing through the door
-    entry_distance_ = EntryDistance(ctx_, door_, pass_);
+    entry_distance_ = EntryDistance(task_, door_, pass_);
     const Eigen::Vector2d entry = pass_.centre + pass_.n_M * entry_distance_;
-    const Eigen::Vector2d offset = ctx_.X_MB.translation() - pass_.centre;
+    const Eigen::Vector2d offset = belief_.X_MB.translation() - pass_.centre;
     const double lateral = std::abs(offset.dot(Eigen::Vector2d(-pass_.n_M.y(), pass_.n_M.x())));
     phase_ = Phase::kWaiting;
-    waiting_since_ = ctx_.now;
+    waiting_since_ = belief_.now;
     if (lateral > 0.05 || offset.dot(pass_.n_M) > entry_distance_ + 0.05) {
       // Straight when the costmap allows (the usual case), else round what is in the way.
       const Pose2 X_MB_entry{entry.x(), entry.y(), yaw_};
       // On the side the leaf opens into, out beyond its sweep first, then across to the axis: a
       // straight line from beside the hinge (a button's standoff) would cut the opening leaf.
-      std::vector<Pose2> line_up{ctx_.X_MB};
+      std::vector<Pose2> line_up{belief_.X_MB};
       const double out = offset.dot(pass_.n_M);
-      if (entry_distance_ > ctx_.config.door_entry_distance && out < entry_distance_ - 0.05) {
-        const Eigen::Vector2d p = ctx_.X_MB.translation() + pass_.n_M * (entry_distance_ - out);
+      if (entry_distance_ > task_.config.door_entry_distance && out < entry_distance_ - 0.05) {
+        const Eigen::Vector2d p = belief_.X_MB.translation() + pass_.n_M * (entry_distance_ - out);
         line_up.push_back({p.x(), p.y(), yaw_});
       }
       line_up.push_back(X_MB_entry);
-      if (ctx_.planner->IsPathValid(line_up)) {
-        ctx_.motion->FollowPath(line_up, std::vector<bool>(line_up.size() - 1, true),
-                                TuckedArm(*ctx_.model), ctx_.now);
+      if (task_.planner->IsPathValid(line_up)) {
+        task_.motion->FollowPath(line_up, std::vector<bool>(line_up.size() - 1, true),
+                                 TuckedArm(*task_.model), belief_.now);
         Note("lining up on the door's axis");
       } else {
         const NodeStatus s = StartPath(
-            ctx_, X_MB_entry, "the door's axis", [this](const std::string& t) { Note(t); }, true);
+            task_, X_MB_entry, "the door's axis", [this](const std::string& t) { Note(t); }, true);
         if (s != NodeStatus::kRunning) return s;
       }
       phase_ = Phase::kToEntry;
@@ -296,22 +312,22 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     const auto note = [this](const std::string& t) { Note(t); };
     switch (phase_) {
       case Phase::kToEntry: {
-        const NodeStatus s = DriveStatus(ctx_, note, true);
+        const NodeStatus s = DriveStatus(task_, note, true);
         if (s != NodeStatus::kSuccess) return s;
         phase_ = Phase::kWaiting;
-        waiting_since_ = ctx_.now;
+        waiting_since_ = belief_.now;
         [[fallthrough]];
       }
       case Phase::kWaiting: {
-        if (gate_.Check(ctx_, "driving through the door",
-                        [this](const std::string& t) { Note(t); }) == NodeStatus::kRunning)
+        if (gate_.Check(task_, "driving through the door", EventNoter()) == NodeStatus::kRunning)
           return NodeStatus::kRunning;
-        if (const NodeStatus arm = ArmMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+        if (const NodeStatus arm =
+                ArmMotionStatus(task_, [this](const std::string& t) { Note(t); });
             arm != NodeStatus::kSuccess) {
           return arm;
         }
-        if (!DoorPassable(ctx_, door_, 0.0)) {
-          if (ToSeconds(ctx_.now - waiting_since_) > Input<double>("wait_timeout")) {
+        if (const DoorVisit visit = Visit(); !DoorPassable(task_, door_, 0.0, &visit)) {
+          if (ToSeconds(belief_.now - waiting_since_) > Input<double>("wait_timeout")) {
             Note("the door did not open in time");
             return NodeStatus::kFailure;
           }
@@ -319,9 +335,9 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
         }
         // Through the middle of the clear opening, between the latch jamb and the leaf.
         const Eigen::Vector2d centre = ClearOpeningCentre();
-        const Eigen::Vector2d exit = centre - pass_.n_M * ExitDistance(ctx_, door_);
-        const Eigen::Vector2d offset = ctx_.X_MB.translation() - centre;
-        std::vector<Pose2> path{ctx_.X_MB};
+        const Eigen::Vector2d exit = centre - pass_.n_M * ExitDistance(task_, door_);
+        const Eigen::Vector2d offset = belief_.X_MB.translation() - centre;
+        std::vector<Pose2> path{belief_.X_MB};
         std::vector<bool> through;
         if (offset.dot(pass_.n_M) > 0.1) {  // square up on the opening's centre line first
           const Eigen::Vector2d in = centre + pass_.n_M * std::min(offset.dot(pass_.n_M), 0.4);
@@ -330,31 +346,33 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
         }
         path.push_back({exit.x(), exit.y(), yaw_});
         through.push_back(true);
-        ctx_.motion->FollowPath(path, through, TuckedArm(*ctx_.model), ctx_.now);
-        Note(StrCat("door open: driving through at ", ctx_.motion->trajectory_config().door_speed,
+        task_.motion->FollowPath(path, through, TuckedArm(*task_.model), belief_.now);
+        Note(StrCat("door open: driving through at ", task_.motion->trajectory_config().door_speed,
                     " m/s"));
         phase_ = Phase::kThrough;
         return NodeStatus::kRunning;
       }
       case Phase::kThrough: {
-        const NodeStatus s = BaseMotionStatus(ctx_, note);
+        const NodeStatus s = BaseMotionStatus(task_, note);
         if (s == NodeStatus::kSuccess) {
           Note("through the door");
-          ctx_.door_approach_side.erase(door_);  // a later traversal may come the other way
+          DoorVisit visit = Visit();
+          visit.approach_side.reset();  // a later traversal may come the other way
+          Remember(visit);
         }
         return s;
       }
     }
     return NodeStatus::kFailure;
   }
-  void OnHalted() override { ctx_.motion->StopBase(); }
+  void OnHalted() override { task_.motion->StopBase(); }
 
  private:
   RelocalizeGate gate_;
   Eigen::Vector2d ClearOpeningCentre() const {
-    const perception::DoorModel& door = *ctx_.map->FindDoor(door_);
+    const perception::DoorModel& door = *task_.map->FindDoor(door_);
     double angle = M_PI / 2;
-    for (const auto& d : ctx_.world.doors) {
+    for (const auto& d : belief_.world.doors) {
       if (d.model.id == door_ && d.state.observed) angle = std::min(d.state.angle, M_PI / 2);
     }
     constexpr double kLeafHalfThickness = 0.03;  // [m] with a margin
@@ -375,12 +393,12 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
 
 }  // namespace
 
-void RegisterDoorNodes(bt::BehaviorTreeFactory& factory, TaskContext* context) {
-  Register<ButtonType>(factory, "ButtonType", context);
-  Register<ApproachButton>(factory, "ApproachButton", context);
-  Register<PressButton>(factory, "PressButton", context);
-  Register<WaveAtPlate>(factory, "WaveAtPlate", context);
-  Register<TraverseDoor>(factory, "TraverseDoor", context);
+void RegisterDoorNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services) {
+  Register<ButtonType>(factory, "ButtonType", services);
+  Register<ApproachButton>(factory, "ApproachButton", services);
+  Register<PressButton>(factory, "PressButton", services);
+  Register<WaveAtPlate>(factory, "WaveAtPlate", services);
+  Register<TraverseDoor>(factory, "TraverseDoor", services);
 }
 
 }  // namespace egress::behavior::detail

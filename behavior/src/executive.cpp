@@ -149,15 +149,17 @@ Executive::Executive(std::shared_ptr<const RobotModel> model, MissionMap map, Mi
     const double sigma = m.config.initial_pose_sigma;
     m.localizer->Initialize(X_MB_initial, Eigen::Vector3d::Constant(sigma * sigma).asDiagonal());
   }
-  context_.model = m.model.get();
-  context_.X_BL = m.model->laser_pose().ToPose2();
-  context_.map = &m.map;
-  context_.config = m.config.tasks;
-  context_.motion = &m.motion;
-  context_.planner = m.planner.get();
-  context_.X_MB = X_MB_initial;
-  context_.last_safe = X_MB_initial;
-  RegisterTaskNodes(m.factory, &context_);
+  services_.model = m.model.get();
+  services_.map = &m.map;
+  services_.config = m.config.tasks;
+  services_.motion = &m.motion;
+  services_.planner = m.planner.get();
+  services_.log = &log_;
+  services_.belief = &belief_;
+  belief_.X_BL = m.model->laser_pose().ToPose2();
+  belief_.X_MB = X_MB_initial;
+  belief_.last_safe = X_MB_initial;
+  RegisterTaskNodes(m.factory, &services_);
   auto blackboard = bt::Blackboard::Create();
   for (const auto& [key, value] : tree.blackboard)
     blackboard->Set(key, bt::Any(value));
@@ -209,11 +211,11 @@ void Executive::UpdateBody(const SensorSnapshot& snapshot) {
     if (auto value = snapshot.joints.Position(joint)) q.emplace_back(joint, *value);
   }
   // Each control step, but the outline changes only when a joint or the grip does.
-  if (m.body_joints && *m.body_joints == q && m.body_holding == context_.holding_object) return;
+  if (m.body_joints && *m.body_joints == q && m.body_holding == belief_.holding_object) return;
   m.body_joints = q;
-  m.body_holding = context_.holding_object;
+  m.body_holding = belief_.holding_object;
   m.body = m.model->CalcCollisionShapesInBase(q);
-  if (context_.holding_object) {
+  if (belief_.holding_object) {
     // The payload hangs between the fingers, ahead of the palm along its approach axis.
     const Pose3 X_BG = m.model->CalcLinkPoseInBase("hand_palm_link", q);
     CollisionShape payload;
@@ -230,10 +232,10 @@ void Executive::UpdateBody(const SensorSnapshot& snapshot) {
 
 void Executive::InsertDepth(const DepthImage& depth, const Pose3& X_MC) {
   Impl& m = *impl_;
-  const Pose3 X_BM = Pose3::FromPose2(context_.X_MB).Inverse();
+  const Pose3 X_BM = Pose3::FromPose2(belief_.X_MB).Inverse();
   const auto& cfg = m.config;
   std::vector<Eigen::Vector2d> people;
-  for (const auto& p : context_.world.people)
+  for (const auto& p : belief_.world.people)
     people.push_back(p.person.p_MP);
   // The robot's shapes as seen from each (S from B), and a radius round the base beyond which
   // no point can be the robot.
@@ -277,13 +279,13 @@ void Executive::UpdateDoorLeaves() {
   // The leaf at its estimated angle, so paths keep out of it; re-marked when it moved by more
   // than a degree (each change recomputes the inflation round the door).
   constexpr double kLeafUpdateRad = 0.0175;
-  for (const auto& d : context_.world.doors) {
+  for (const auto& d : belief_.world.doors) {
     auto it = m.leaf_angles.find(d.model.id);
     // Only a leaf seen lately: an old estimate (the leaf out of the laser's view, e.g. from a
     // button's standoff beside the door) may have the leaf where it no longer is, across the
     // very pose the robot lines up at.
     const bool fresh =
-        d.state.observed && ToSeconds(context_.now - d.state.stamp) <= m.config.door_leaf_max_age;
+        d.state.observed && ToSeconds(belief_.now - d.state.stamp) <= m.config.door_leaf_max_age;
     if (!fresh) {
       if (it != m.leaf_angles.end()) {
         costmap_->SetDoorLeafAngle(d.model.id, std::nullopt);
@@ -308,7 +310,7 @@ bool Executive::Step(RobotPort& port) {
   Impl& m = *impl_;
   const SensorSnapshot snapshot = port.Sense();
   const Time now = port.clock().Now();
-  context_.now = now;
+  belief_.now = now;
   m.clock->Set(now);
 
   // Localize: odometry predicts, laser scans correct on the building map (or odometry alone
@@ -327,12 +329,12 @@ bool Executive::Step(RobotPort& port) {
       m.last_odometry = snapshot.odometry.X_OB;
       m.X_MB_at_scan = m.localizer->Estimate();
     }
-    context_.X_MB = m.X_MB_at_scan * (m.last_odometry->Inverse() * snapshot.odometry.X_OB);
+    belief_.X_MB = m.X_MB_at_scan * (m.last_odometry->Inverse() * snapshot.odometry.X_OB);
   } else {
     if (!m.X_MO) m.X_MO = m.X_MB_initial * snapshot.odometry.X_OB.Inverse();
-    context_.X_MB = *m.X_MO * snapshot.odometry.X_OB;
+    belief_.X_MB = *m.X_MO * snapshot.odometry.X_OB;
   }
-  const Pose3 X_MB3 = Pose3::FromPose2(context_.X_MB);
+  const Pose3 X_MB3 = Pose3::FromPose2(belief_.X_MB);
 
   // Proprioception: the arm's joints (arm motions end when they arrive) and the gripper's
   // angle and effort (whether it holds something).
@@ -345,7 +347,7 @@ bool Executive::Step(RobotPort& port) {
   }
   if (arm_measured) m.motion.SetMeasuredArm(arm);
   m.grasp.Update(snapshot.gripper);
-  context_.holding_object = m.grasp.holding();
+  belief_.holding_object = m.grasp.holding();
   // Perceive.
   UpdateBody(snapshot);
   if (snapshot.depth) {
@@ -353,10 +355,10 @@ bool Executive::Step(RobotPort& port) {
     m.X_BC = snapshot.X_BC;
     m.intrinsics = snapshot.depth_intrinsics;
     if (m.X_BC) {
-      context_.depth = snapshot.depth;
-      context_.X_MC = X_MB3 * *m.X_BC;
-      context_.depth_intrinsics = snapshot.depth_intrinsics;
-      if (m.octomap) InsertDepth(*snapshot.depth, context_.X_MC);
+      belief_.depth = snapshot.depth;
+      belief_.X_MC = X_MB3 * *m.X_BC;
+      belief_.depth_intrinsics = snapshot.depth_intrinsics;
+      if (m.octomap) InsertDepth(*snapshot.depth, belief_.X_MC);
     }
   }
   const Pose3& X_BL = m.model->laser_pose();
@@ -368,12 +370,12 @@ bool Executive::Step(RobotPort& port) {
       m.perception.ProcessScan(*snapshot.scan, X_ML, m.intrinsics, X_BL.Inverse() * *m.X_BC);
   }
   // Where the base was when the detections' image was taken (the detector runs behind).
-  pose_history_.emplace_back(now, context_.X_MB);
+  pose_history_.emplace_back(now, belief_.X_MB);
   while (!pose_history_.empty() && ToSeconds(now - pose_history_.front().first) > kPoseHistorySec)
     pose_history_.pop_front();
   const std::vector<Detection2D> detections = Detect(snapshot);
   if (!detections.empty() && m.depth && m.X_BC) {
-    Pose2 X_MB_capture = context_.X_MB;
+    Pose2 X_MB_capture = belief_.X_MB;
     for (const auto& [t, X] : pose_history_) {
       if (t <= detections.front().stamp) X_MB_capture = X;
     }
@@ -381,36 +383,37 @@ bool Executive::Step(RobotPort& port) {
                                     *m.depth, m.intrinsics, X_MB3 * *m.X_BC,
                                     Pose3::FromPose2(X_MB_capture) * *m.X_BC);
   }
-  context_.world = m.perception.Snapshot(
-      now, context_.X_MB, m.localizer ? m.localizer->Covariance() : Eigen::Matrix3d::Zero().eval(),
+  belief_.world = m.perception.Snapshot(
+      now, belief_.X_MB, m.localizer ? m.localizer->Covariance() : Eigen::Matrix3d::Zero().eval(),
       costmap_.get(), m.octomap ? m.octomap->tree() : nullptr);
   UpdateDoorLeaves();
   // Each door's current opening starts when it is first seen wide enough to pass, and ends
   // when it is seen closed or closing (a dip in the estimate, e.g. a person in front of the
   // leaf, does not end it).
-  for (const auto& d : context_.world.doors) {
+  for (const auto& d : belief_.world.doors) {
     if (!d.state.observed) continue;
     if (d.state.motion == perception::DoorMotion::kClosed ||
         d.state.motion == perception::DoorMotion::kClosing) {
-      context_.door_open_since.erase(d.model.id);
-    } else if (d.state.clearance_width >= 2 * context_.config.footprint_radius) {
-      context_.door_open_since.try_emplace(d.model.id, now);
+      belief_.door_open_since.erase(d.model.id);
+    } else if (d.state.clearance_width >= 2 * services_.config.footprint_radius) {
+      belief_.door_open_since.try_emplace(d.model.id, now);
     }
   }
-  if (snapshot.scan) context_.scan = snapshot.scan;
+  if (snapshot.scan) belief_.scan = snapshot.scan;
   bool in_any_zone = false;
   bool newly_occupied = false;
   for (const auto& door : m.map.doors) {
-    const DoorPass pass = CalcDoorPass(m.map, door.id, context_.X_MB);
-    const double along = (context_.X_MB.translation() - pass.centre).dot(pass.n_M);
-    const double lateral = std::abs((context_.X_MB.translation() - pass.centre)
+    const DoorPass pass = CalcDoorPass(m.map, door.id, belief_.X_MB);
+    const double along = (belief_.X_MB.translation() - pass.centre).dot(pass.n_M);
+    const double lateral = std::abs((belief_.X_MB.translation() - pass.centre)
                                         .dot(Eigen::Vector2d(-pass.n_M.y(), pass.n_M.x())));
-    if (along < context_.config.zone_depth && lateral < pass.width / 2 + 0.5) in_any_zone = true;
-    const bool occupied = IsDoorZoneOccupied(context_, door.id);
+    if (along < services_.config.zone_depth && lateral < pass.width / 2 + 0.5) in_any_zone = true;
+    const bool occupied = IsDoorZoneOccupied(services_, door.id);
+    if (occupied) belief_.zone_occupied_at[door.id] = now;
     if (occupied && !m.zone_occupied[door.id]) newly_occupied = true;
     m.zone_occupied[door.id] = occupied;
   }
-  if (!in_any_zone && !m.motion.base_failed()) context_.last_safe = context_.X_MB;
+  if (!in_any_zone && !m.motion.base_failed()) belief_.last_safe = belief_.X_MB;
   if (newly_occupied && !m.occupied_known_at) m.occupied_known_at = ToSeconds(now);
   bool any_occupied = false;
   for (const auto& entry : m.zone_occupied)
@@ -420,13 +423,12 @@ bool Executive::Step(RobotPort& port) {
   // Decide.
   if (!m.finished && (!m.next_tick || now >= *m.next_tick)) {
     m.next_tick = now + SecondsToDuration(1.0 / m.config.tick_rate_hz);
-    const std::size_t notes_before = context_.notes.size();
     status_ = m.tree->TickOnce();
     bool preempted = false;
-    for (std::size_t i = notes_before; i < context_.notes.size(); ++i) {
-      const NodeNote& note = context_.notes[i];
-      decisions_.push_back({ToSeconds(now), note.text, note.event});
+    for (NodeNote& note : log_.Take()) {
       preempted = preempted || note.event == DecisionEvent::kPersonInDoorZone;
+      if (note.event == DecisionEvent::kRelocalizing) ++relocalizations_;
+      decisions_.push_back({ToSeconds(now), std::move(note.text), note.event});
     }
     if (preempted && m.occupied_known_at) {
       // The halt (zero velocity) and the standby's first command go out in this same step.
@@ -446,13 +448,13 @@ bool Executive::Step(RobotPort& port) {
   // Act. A Bug2 detour steers by the latest scan and the tracked people.
   if (m.motion.bug_active() && snapshot.scan) {
     std::vector<Eigen::Vector2d> people;
-    for (const auto& p : context_.world.people)
+    for (const auto& p : belief_.world.people)
       people.push_back(p.person.p_MP);
     m.motion.SetSurroundings(
-        perception::ScanPoints(*snapshot.scan, (Pose3::FromPose2(context_.X_MB) * X_BL).ToPose2()),
+        perception::ScanPoints(*snapshot.scan, (Pose3::FromPose2(belief_.X_MB) * X_BL).ToPose2()),
         std::move(people));
   }
-  const Twist2 V_B = m.motion.Update(now, context_.X_MB, snapshot.odometry.V_B);
+  const Twist2 V_B = m.motion.Update(now, belief_.X_MB, snapshot.odometry.V_B);
   port.SendBaseVelocity(V_B);
   if (auto arm = m.motion.TakeArmCommand()) port.SendArmTrajectory(*arm);
   if (auto gripper = m.motion.TakeGripperCommand()) {

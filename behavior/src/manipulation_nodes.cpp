@@ -25,16 +25,16 @@ class DetectPayload final : public TaskNode<bt::StatefulActionNode> {
             OutputPort<std::string>("pose", "payload position x;y;z in the map")};
   }
   NodeStatus OnStart() override {
-    started_ = ctx_.now;
+    started_ = belief_.now;
     return OnRunning();
   }
   NodeStatus OnRunning() override {
     const std::string kind = Input<std::string>("kind");
     const perception::TrackedObject* best = nullptr;
-    for (const auto& object : ctx_.world.payloads) {
+    for (const auto& object : belief_.world.payloads) {
       if (object.label != kind) continue;
-      if (best == nullptr || (object.p_MO.head<2>() - ctx_.X_MB.translation()).norm() <
-                                 (best->p_MO.head<2>() - ctx_.X_MB.translation()).norm()) {
+      if (best == nullptr || (object.p_MO.head<2>() - belief_.X_MB.translation()).norm() <
+                                 (best->p_MO.head<2>() - belief_.X_MB.translation()).norm()) {
         best = &object;
       }
     }
@@ -45,7 +45,7 @@ class DetectPayload final : public TaskNode<bt::StatefulActionNode> {
                   std::round(best->p_MO.z() * 100) / 100, ")"));
       return NodeStatus::kSuccess;
     }
-    if (ToSeconds(ctx_.now - started_) > Input<double>("timeout")) {
+    if (ToSeconds(belief_.now - started_) > Input<double>("timeout")) {
       Note(StrCat("no ", kind, " in sight"));
       return NodeStatus::kFailure;
     }
@@ -73,7 +73,7 @@ struct HandReach {
   Pose2 X_MB;
   ArmPose arm;
 };
-std::optional<HandReach> SolveHandReach(const TaskContext& ctx, const Eigen::Vector3d& p_M,
+std::optional<HandReach> SolveHandReach(const TaskServices& task, const Eigen::Vector3d& p_M,
                                         const Eigen::Vector3d& approach_M,
                                         const Eigen::Vector3d& toward_M) {
   // Seeds: reaching forward (palm level), or from above (lift high, upper arm level, palm
@@ -89,11 +89,11 @@ std::optional<HandReach> SolveHandReach(const TaskContext& ctx, const Eigen::Vec
   q0[kBaseY] = base.y();
   q0[kBaseYaw] = std::atan2(a.y(), a.x());
   q0 = WithArm(q0, from_above ? kReachFromAboveArm : kReachArm);
-  planning::IkConfig ik = ctx.config.ik;
+  planning::IkConfig ik = task.config.ik;
   ik.fingertip = false;
   ik.use_base = true;
   const planning::IkResult r =
-      planning::DlsIkSolver(*ctx.model, ik).Solve(PalmTarget(p_M, approach_M), q0);
+      planning::DlsIkSolver(*task.model, ik).Solve(PalmTarget(p_M, approach_M), q0);
   if (!r.converged) return std::nullopt;
   return HandReach{{r.q[kBaseX], r.q[kBaseY], r.q[kBaseYaw]}, ArmOf(r.q)};
 }
@@ -116,13 +116,13 @@ double PayloadCentreHeight(std::string_view kind) {
 
 // Calls fn(p_MQ) for every valid pixel of the latest depth image, unprojected into M.
 template <typename Fn>
-void ForEachDepthPointInMap(const TaskContext& ctx, Fn&& fn) {
-  const DepthImage& depth = *ctx.depth;
+void ForEachDepthPointInMap(const TaskServices& task, Fn&& fn) {
+  const DepthImage& depth = *task.belief->depth;
   for (int v = 0; v < depth.height; ++v) {
     for (int u = 0; u < depth.width; ++u) {
       if (!depth.IsValidAt(u, v)) continue;
-      fn(Eigen::Vector3d(ctx.X_MC *
-                         ctx.depth_intrinsics.Unproject(u + 0.5, v + 0.5, depth.At(u, v))));
+      fn(Eigen::Vector3d(task.belief->X_MC * task.belief->depth_intrinsics.Unproject(
+                                                 u + 0.5, v + 0.5, depth.At(u, v))));
     }
   }
 }
@@ -131,15 +131,15 @@ void ForEachDepthPointInMap(const TaskContext& ctx, Fn&& fn) {
 // corridor the hand sweeps horizontally towards a grasp centre `p_M` along `approach_M` (from
 // the pre-grasp to just before the payload, within a hand's width of the line), or nullopt if
 // there is none.
-std::optional<double> ClutterTopBeforeGrasp(const TaskContext& ctx, const Eigen::Vector3d& p_M,
+std::optional<double> ClutterTopBeforeGrasp(const TaskServices& task, const Eigen::Vector3d& p_M,
                                             const Eigen::Vector3d& approach_M,
                                             double payload_radius, double surface_z) {
-  if (!ctx.depth) return std::nullopt;
+  if (!task.belief->depth) return std::nullopt;
   constexpr double kHandHalfWidth = 0.07;  // [m] fingers open, with a margin
   constexpr double kFlat = 0.02;           // [m] bumps lower than this are the surface
   const Eigen::Vector2d a = approach_M.head<2>().normalized();
   std::optional<double> top;
-  ForEachDepthPointInMap(ctx, [&](const Eigen::Vector3d& p) {
+  ForEachDepthPointInMap(task, [&](const Eigen::Vector3d& p) {
     const Eigen::Vector2d d = p.head<2>() - p_M.head<2>();
     const double along = d.dot(a);
     const double lateral = (d - along * a).norm();
@@ -156,14 +156,15 @@ std::optional<double> ClutterTopBeforeGrasp(const TaskContext& ctx, const Eigen:
 // stand out of the surface within `radius` of the estimate `p_M` (the centroid of what the
 // camera sees of it, horizontally): a grasp from above has no slack along the approach, where
 // the detection's single depth sample may be centimetres off. nullopt if too few points.
-std::optional<Eigen::Vector3d> LowPayloadCentre(const TaskContext& ctx, const Eigen::Vector3d& p_M,
-                                                double surface_z, double radius) {
-  if (!ctx.depth) return std::nullopt;
+std::optional<Eigen::Vector3d> LowPayloadCentre(const TaskServices& task,
+                                                const Eigen::Vector3d& p_M, double surface_z,
+                                                double radius) {
+  if (!task.belief->depth) return std::nullopt;
   constexpr double kAboveSurface = 0.01;  // [m] points lower than this are the surface
   constexpr int kMinPoints = 20;
   Eigen::Vector2d sum = Eigen::Vector2d::Zero();
   int n = 0;
-  ForEachDepthPointInMap(ctx, [&](const Eigen::Vector3d& p) {
+  ForEachDepthPointInMap(task, [&](const Eigen::Vector3d& p) {
     if (p.z() < surface_z + kAboveSurface || p.z() > p_M.z() + radius ||
         (p.head<2>() - p_M.head<2>()).norm() > radius)
       return;
@@ -188,13 +189,14 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
   NodeStatus OnStart() override {
     gate_.Reset();
     const Eigen::Vector3d p_seen = ParsePoint3(Input<std::string>("pose"));
-    approach_ = HorizontalApproach(ctx_.X_MB, p_seen);
+    approach_ = HorizontalApproach(belief_.X_MB, p_seen);
     // The camera sees the near surface; the centre is a radius further.
     centre_ = p_seen + approach_ * kPayloadRadius;
     // Something low in front of it (books, a box): grasp higher, so the hand passes above it.
     const double surface_z = centre_.z() - PayloadCentreHeight(Input<std::string>("kind"));
     surface_z_ = surface_z;
-    if (const auto top = ClutterTopBeforeGrasp(ctx_, centre_, approach_, kPayloadRadius, surface_z);
+    if (const auto top =
+            ClutterTopBeforeGrasp(task_, centre_, approach_, kPayloadRadius, surface_z);
         top && *top + kHandBelowGrasp > centre_.z()) {
       const double raised = std::min(*top + kHandBelowGrasp, centre_.z() + kMaxGraspRaise);
       Note(StrCat("something in front of it up to ", std::round(*top * 100) / 100, " m: grasping ",
@@ -209,7 +211,7 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
       Note(StrCat("its centre is ", std::round((centre_.z() - surface_z) * 100),
                   " cm above the surface: grasping from above"));
     }
-    const auto reach = SolveHandReach(ctx_, centre_, approach_, toward);
+    const auto reach = SolveHandReach(task_, centre_, approach_, toward);
     if (!reach) {
       Note("no whole-body reach for the grasp");
       return NodeStatus::kFailure;
@@ -218,28 +220,27 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
     X_MB_grasp_ = reach->X_MB;
     GripperCommand open;
     open.mode = GripperCommand::Mode::kOpen;
-    ctx_.motion->SetGripper(open);
+    task_.motion->SetGripper(open);
     phase_ = Phase::kToBase;
-    return StartPath(ctx_, X_MB_grasp_, "the grasp pose",
+    return StartPath(task_, X_MB_grasp_, "the grasp pose",
                      [this](const std::string& t) { Note(t); });
   }
   NodeStatus OnRunning() override {
     switch (phase_) {
       case Phase::kToBase: {
-        const NodeStatus s = BaseMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+        const NodeStatus s = BaseMotionStatus(task_, [this](const std::string& t) { Note(t); });
         if (s != NodeStatus::kSuccess) return s;
-        if (gate_.Check(ctx_, "grasping", [this](const std::string& t) { Note(t); }) ==
-            NodeStatus::kRunning)
+        if (gate_.Check(task_, "grasping", EventNoter()) == NodeStatus::kRunning)
           return NodeStatus::kRunning;
         // From above there is no slack along the approach: look again from here, where the
         // pose estimate is the one the arm will use (it drifts on the way, by centimetres).
         if (approach_.z() < -0.9) RefreshLowPayloadCentre();
         // Arm-only from where the base stopped.
-        const auto grasp = SolveArm(ctx_, ctx_.X_MB, PalmTarget(centre_, approach_), grasp_arm_,
+        const auto grasp = SolveArm(task_, belief_.X_MB, PalmTarget(centre_, approach_), grasp_arm_,
                                     false, kHandError);
-        const auto pre =
-            SolveArm(ctx_, ctx_.X_MB, PalmTarget(centre_ - approach_ * kPreGraspOffset, approach_),
-                     grasp ? *grasp : grasp_arm_, false, kHandError);
+        const auto pre = SolveArm(task_, belief_.X_MB,
+                                  PalmTarget(centre_ - approach_ * kPreGraspOffset, approach_),
+                                  grasp ? *grasp : grasp_arm_, false, kHandError);
         if (!grasp || !pre) {
           Note("the payload is out of the arm's reach from here");
           return NodeStatus::kFailure;
@@ -248,9 +249,9 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
         // arm's slowest joint, and swinging the arm out and down before it is up sweeps the
         // hand and forearm through the table the payload lies on. (A level reach keeps the
         // hand above the table top all the way.)
-        ArmPose raised = ctx_.motion->arm_target();
+        ArmPose raised = task_.motion->arm_target();
         const double rise = (*pre)[0] - raised[0];
-        const double lift_speed = ctx_.model->limits(kArmLift).velocity;
+        const double lift_speed = task_.model->limits(kArmLift).velocity;
         double t = 0.0;
         std::vector<std::pair<double, ArmPose>> knots;
         if (approach_.z() < -0.9 && rise > kRaiseFirstAbove && lift_speed > 0.0) {
@@ -260,45 +261,48 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
         }
         knots.emplace_back(t + 2.0, *pre);
         knots.emplace_back(t + 3.5, *grasp);
-        ctx_.motion->MoveArm(knots, ctx_.now);
+        task_.motion->MoveArm(knots, belief_.now);
         lifted_ = *grasp;
         lifted_[0] = std::min(lifted_[0] + kLiftAfterGrasp,
-                              ctx_.model->limits(kArmLift).upper);  // arm_lift
+                              task_.model->limits(kArmLift).upper);  // arm_lift
         phase_ = Phase::kReach;
         Note("reaching for the payload");
         return NodeStatus::kRunning;
       }
       case Phase::kReach: {
-        if (const NodeStatus arm = ArmMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+        if (const NodeStatus arm =
+                ArmMotionStatus(task_, [this](const std::string& t) { Note(t); });
             arm != NodeStatus::kSuccess) {
           return arm;
         }
         GripperCommand close;
         close.mode = GripperCommand::Mode::kGrasp;
         close.effort = 10.0;
-        ctx_.motion->SetGripper(close);
-        closing_since_ = ctx_.now;
+        task_.motion->SetGripper(close);
+        closing_since_ = belief_.now;
         phase_ = Phase::kClose;
         return NodeStatus::kRunning;
       }
       case Phase::kClose: {
-        if (ToSeconds(ctx_.now - closing_since_) < 1.5) return NodeStatus::kRunning;
+        if (ToSeconds(belief_.now - closing_since_) < 1.5) return NodeStatus::kRunning;
         // Lift, then fold the arm over the base at that height: the hand rises on its arc,
         // clear of what the payload stood among (a straight tuck in joint space would lower
         // the lift while folding and drag the payload through it). The tuck that follows only
         // lowers the lift.
-        ArmPose folded = TuckedArm(*ctx_.model);
+        ArmPose folded = TuckedArm(*task_.model);
         folded[0] = lifted_[0];
-        ctx_.motion->MoveArm({{1.0, lifted_}, {1.0 + ctx_.config.arm_tuck_time, folded}}, ctx_.now);
+        task_.motion->MoveArm({{1.0, lifted_}, {1.0 + task_.config.arm_tuck_time, folded}},
+                              belief_.now);
         phase_ = Phase::kLift;
         return NodeStatus::kRunning;
       }
       case Phase::kLift: {
-        if (const NodeStatus arm = ArmMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+        if (const NodeStatus arm =
+                ArmMotionStatus(task_, [this](const std::string& t) { Note(t); });
             arm != NodeStatus::kSuccess) {
           return arm;
         }
-        if (!ctx_.holding_object) {
+        if (!belief_.holding_object) {
           Note("the gripper closed on nothing");
           return NodeStatus::kFailure;
         }
@@ -308,7 +312,7 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
     }
     return NodeStatus::kFailure;
   }
-  void OnHalted() override { ctx_.motion->StopBase(); }
+  void OnHalted() override { task_.motion->StopBase(); }
 
  private:
   // The tracked payload nearest the grasp centre (within kRefreshRadius), seen in the last
@@ -316,8 +320,9 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
   void RefreshLowPayloadCentre() {
     const std::string kind = Input<std::string>("kind");
     const perception::TrackedObject* best = nullptr;
-    for (const auto& object : ctx_.world.payloads) {
-      if ((!kind.empty() && object.label != kind) || ToSeconds(ctx_.now - object.last_seen) > 1.0)
+    for (const auto& object : belief_.world.payloads) {
+      if ((!kind.empty() && object.label != kind) ||
+          ToSeconds(belief_.now - object.last_seen) > 1.0)
         continue;
       const double d = (object.p_MO.head<2>() - centre_.head<2>()).norm();
       if (d < kRefreshRadius &&
@@ -326,7 +331,7 @@ class GraspPayload final : public TaskNode<bt::StatefulActionNode> {
     }
     Eigen::Vector3d centre = centre_;
     if (best != nullptr) centre.head<2>() = best->p_MO.head<2>();
-    if (const auto refined = LowPayloadCentre(ctx_, centre, surface_z_, kLowPayloadSearch))
+    if (const auto refined = LowPayloadCentre(task_, centre, surface_z_, kLowPayloadSearch))
       centre = *refined;
     if ((centre - centre_).norm() > 0.005) {
       Note(StrCat("looked again: the payload is ", std::round((centre - centre_).norm() * 100),
@@ -361,27 +366,27 @@ class ReleaseAction : public TaskNode<bt::StatefulActionNode> {
  public:
   using TaskNode::TaskNode;
   NodeStatus OnStart() override {
-    if (!ctx_.holding_object) {
+    if (!belief_.holding_object) {
       Note("not holding a payload");
       return NodeStatus::kFailure;
     }
     const auto target = ReleaseTarget();
     if (!target) return NodeStatus::kFailure;
     centre_ = *target;
-    approach_ = HorizontalApproach(ctx_.X_MB, centre_);
+    approach_ = HorizontalApproach(belief_.X_MB, centre_);
     approaches_ = 0;
     return DriveToReach();
   }
   NodeStatus OnRunning() override {
     switch (phase_) {
       case Phase::kToBase: {
-        const NodeStatus s = BaseMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+        const NodeStatus s = BaseMotionStatus(task_, [this](const std::string& t) { Note(t); });
         if (s != NodeStatus::kSuccess) return s;
-        const auto at = SolveArm(ctx_, ctx_.X_MB, PalmTarget(centre_, approach_), release_arm_,
+        const auto at = SolveArm(task_, belief_.X_MB, PalmTarget(centre_, approach_), release_arm_,
                                  false, kHandError);
         const Eigen::Vector3d p_pre =
             centre_ - approach_ * kPreGraspOffset + Eigen::Vector3d(0, 0, kPreReleaseRise);
-        const auto pre = SolveArm(ctx_, ctx_.X_MB, PalmTarget(p_pre, approach_),
+        const auto pre = SolveArm(task_, belief_.X_MB, PalmTarget(p_pre, approach_),
                                   at ? *at : release_arm_, false, kHandError);
         if (!at || !pre) {
           // The base stopped a little off the planned pose: plan the reach again from here.
@@ -389,13 +394,14 @@ class ReleaseAction : public TaskNode<bt::StatefulActionNode> {
           return approaches_ < kMaxApproaches ? DriveToReach() : NodeStatus::kFailure;
         }
         pre_arm_ = *pre;
-        ctx_.motion->MoveArm({{2.0, *pre}, {3.5, *at}}, ctx_.now);
+        task_.motion->MoveArm({{2.0, *pre}, {3.5, *at}}, belief_.now);
         phase_ = Phase::kReach;
-        waiting_since_ = ctx_.now;
+        waiting_since_ = belief_.now;
         return NodeStatus::kRunning;
       }
       case Phase::kReach: {
-        if (const NodeStatus arm = ArmMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+        if (const NodeStatus arm =
+                ArmMotionStatus(task_, [this](const std::string& t) { Note(t); });
             arm != NodeStatus::kSuccess) {
           return arm;
         }
@@ -404,24 +410,26 @@ class ReleaseAction : public TaskNode<bt::StatefulActionNode> {
         if (release == Release::kWait) return NodeStatus::kRunning;
         GripperCommand open;
         open.mode = GripperCommand::Mode::kOpen;
-        ctx_.motion->SetGripper(open);
-        opened_at_ = ctx_.now;
+        task_.motion->SetGripper(open);
+        opened_at_ = belief_.now;
         phase_ = Phase::kOpen;
         return NodeStatus::kRunning;
       }
       case Phase::kOpen: {
-        if (ToSeconds(ctx_.now - opened_at_) < kOpenTime) return NodeStatus::kRunning;
-        ctx_.motion->MoveArm(
-            {{1.5, pre_arm_}, {1.5 + ctx_.config.arm_tuck_time, TuckedArm(*ctx_.model)}}, ctx_.now);
+        if (ToSeconds(belief_.now - opened_at_) < kOpenTime) return NodeStatus::kRunning;
+        task_.motion->MoveArm(
+            {{1.5, pre_arm_}, {1.5 + task_.config.arm_tuck_time, TuckedArm(*task_.model)}},
+            belief_.now);
         phase_ = Phase::kWithdraw;
         return NodeStatus::kRunning;
       }
       case Phase::kWithdraw: {
-        if (const NodeStatus arm = ArmMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+        if (const NodeStatus arm =
+                ArmMotionStatus(task_, [this](const std::string& t) { Note(t); });
             arm != NodeStatus::kSuccess) {
           return arm;
         }
-        if (ctx_.holding_object) {
+        if (belief_.holding_object) {
           Note("the payload is still in the gripper");
           return NodeStatus::kFailure;
         }
@@ -431,7 +439,7 @@ class ReleaseAction : public TaskNode<bt::StatefulActionNode> {
     }
     return NodeStatus::kFailure;
   }
-  void OnHalted() override { ctx_.motion->StopBase(); }
+  void OnHalted() override { task_.motion->StopBase(); }
 
  protected:
   // Where the payload's centre goes when released [m, M] (approached from where the robot is
@@ -448,15 +456,15 @@ class ReleaseAction : public TaskNode<bt::StatefulActionNode> {
 
   NodeStatus DriveToReach() {
     ++approaches_;
-    const auto reach = SolveHandReach(ctx_, centre_, approach_, approach_);
+    const auto reach = SolveHandReach(task_, centre_, approach_, approach_);
     if (!reach) {
       Note("no whole-body reach for the release point");
       return NodeStatus::kFailure;
     }
     release_arm_ = reach->arm;
     phase_ = Phase::kToBase;
-    const NodeStatus s =
-        StartPath(ctx_, reach->X_MB, "the release pose", [this](const std::string& t) { Note(t); });
+    const NodeStatus s = StartPath(task_, reach->X_MB, "the release pose",
+                                   [this](const std::string& t) { Note(t); });
     return s == NodeStatus::kSuccess ? OnRunning() : s;  // already there: reach now
   }
   int approaches_{0};
@@ -512,7 +520,7 @@ class HandOver final : public ReleaseAction {
     }
     // Held out half-way between a comfortable standoff and the person.
     const Eigen::Vector2d p_MP = recipient->person.p_MP;
-    Eigen::Vector2d to_robot = ctx_.X_MB.translation() - p_MP;
+    Eigen::Vector2d to_robot = belief_.X_MB.translation() - p_MP;
     if (to_robot.norm() < 1e-6) to_robot = Eigen::Vector2d::UnitX();
     const Eigen::Vector2d p = p_MP + to_robot.normalized() * kOfferDistance;
     const Eigen::Vector3d centre(p.x(), p.y(), Input<double>("hand_height"));
@@ -530,7 +538,7 @@ class HandOver final : public ReleaseAction {
            DecisionEvent::kResponderInReach);
       return Release::kNow;
     }
-    if (ToSeconds(ctx_.now - waiting_since()) > Input<double>("timeout")) {
+    if (ToSeconds(belief_.now - waiting_since()) > Input<double>("timeout")) {
       Note("nobody took the payload in time");
       return Release::kGiveUp;
     }
@@ -539,7 +547,7 @@ class HandOver final : public ReleaseAction {
   const perception::TrackedPersonWithIntent* Recipient(const Eigen::Vector2d& expected) const {
     const perception::TrackedPersonWithIntent* best = nullptr;
     double best_distance = Input<double>("search_radius");
-    for (const auto& entry : ctx_.world.people) {
+    for (const auto& entry : belief_.world.people) {
       const double d = (entry.person.p_MP - expected).norm();
       if (d <= best_distance) {
         best = &entry;
@@ -554,11 +562,11 @@ class HandOver final : public ReleaseAction {
 
 }  // namespace
 
-void RegisterManipulationNodes(bt::BehaviorTreeFactory& factory, TaskContext* context) {
-  Register<DetectPayload>(factory, "DetectPayload", context);
-  Register<GraspPayload>(factory, "GraspPayload", context);
-  Register<PlacePayload>(factory, "PlacePayload", context);
-  Register<HandOver>(factory, "HandOver", context);
+void RegisterManipulationNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services) {
+  Register<DetectPayload>(factory, "DetectPayload", services);
+  Register<GraspPayload>(factory, "GraspPayload", services);
+  Register<PlacePayload>(factory, "PlacePayload", services);
+  Register<HandOver>(factory, "HandOver", services);
 }
 
 }  // namespace egress::behavior::detail

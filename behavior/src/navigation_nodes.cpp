@@ -28,27 +28,27 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
   }
   NodeStatus OnRunning() override {
     if (blocked_since_) {
-      if (ToSeconds(ctx_.now - last_try_) < kReplanPeriod) return NodeStatus::kRunning;
+      if (ToSeconds(belief_.now - last_try_) < kReplanPeriod) return NodeStatus::kRunning;
       return Start();
     }
-    if (!ctx_.motion->bug_active() && IsPathAheadBlocked(ctx_)) {
-      ctx_.motion->StopBase();
+    if (!task_.motion->bug_active() && IsPathAheadBlocked(task_)) {
+      task_.motion->StopBase();
       Note("the path ahead is blocked: planning again");
       return Start();
     }
-    const NodeStatus s = BaseMotionStatus(ctx_, [this](const std::string& t) { Note(t); });
+    const NodeStatus s = BaseMotionStatus(task_, [this](const std::string& t) { Note(t); });
     return s == NodeStatus::kFailure ? Blocked() : s;
   }
-  void OnHalted() override { ctx_.motion->StopBase(); }
+  void OnHalted() override { task_.motion->StopBase(); }
 
  private:
   static constexpr double kReplanPeriod = 0.5;  // [s]
 
   NodeStatus Start() {
-    last_try_ = ctx_.now;
+    last_try_ = belief_.now;
     const Pose2 goal = ParsePose2(Input<std::string>("goal"));
     // Quiet while re-planning: the first failure is noted, not every retry.
-    const NodeStatus s = StartPath(ctx_, goal, "goal", [this](const std::string& t) {
+    const NodeStatus s = StartPath(task_, goal, "goal", [this](const std::string& t) {
       if (!blocked_since_) Note(t);
     });
     if (s != NodeStatus::kFailure) {
@@ -57,12 +57,12 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
       return s;
     }
     // No path on the costmap, though the goal itself is free: round the obstacle by the laser.
-    if (!detour_tried_ && ctx_.planner->IsValid(goal)) {
+    if (!detour_tried_ && task_.planner->IsValid(goal)) {
       detour_tried_ = true;
       planning::BugConfig bug;
       bug.speed = Input<double>("detour_speed");
-      bug.robot_radius = ctx_.config.footprint_radius;
-      ctx_.motion->FollowBug(ctx_.X_MB, goal.translation(), bug, ctx_.now);
+      bug.robot_radius = task_.config.footprint_radius;
+      task_.motion->FollowBug(belief_.X_MB, goal.translation(), bug, belief_.now);
       Note("no path on the costmap: detouring round the obstacle (Bug2)");
       return NodeStatus::kRunning;
     }
@@ -70,11 +70,11 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
   }
   NodeStatus Blocked() {
     if (!blocked_since_) {
-      blocked_since_ = ctx_.now;
-      last_try_ = ctx_.now;
+      blocked_since_ = belief_.now;
+      last_try_ = belief_.now;
       Note(StrCat("waiting up to ", Input<double>("patience"), " s for a way"));
     }
-    if (ToSeconds(ctx_.now - *blocked_since_) > Input<double>("patience")) {
+    if (ToSeconds(belief_.now - *blocked_since_) > Input<double>("patience")) {
       Note("gave up: the goal stayed blocked");
       return NodeStatus::kFailure;
     }
@@ -89,70 +89,76 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
  public:
   using TaskNode::TaskNode;
   static PortsList ProvidedPorts() {
-    return {InputPort<bool>("back_off", true, "also drive back to the last safe waypoint")};
+    return {InputPort<bool>("back_off", true, "also drive back to the last safe waypoint"),
+            VisitPort(bt::PortDirection::kInput), RetreatingPort(bt::PortDirection::kOutput)};
   }
   NodeStatus OnStart() override {
-    ctx_.motion->StopBase();
-    if (!ArmAt(ctx_.motion->arm_target(), TuckedArm(*ctx_.model)) ||
-        ctx_.motion->arm_moving(ctx_.now)) {
-      ctx_.motion->MoveArm({{ctx_.config.arm_tuck_time, TuckedArm(*ctx_.model)}}, ctx_.now);
+    task_.motion->StopBase();
+    if (!ArmAt(task_.motion->arm_target(), TuckedArm(*task_.model)) ||
+        task_.motion->arm_moving(belief_.now)) {
+      task_.motion->MoveArm({{task_.config.arm_tuck_time, TuckedArm(*task_.model)}}, belief_.now);
       Note("tucking the arm");
     }
-    if (Input<bool>("back_off") && ctx_.last_safe &&
-        (ctx_.last_safe->translation() - ctx_.X_MB.translation()).norm() > 0.05) {
+    if (Input<bool>("back_off") && belief_.last_safe &&
+        (belief_.last_safe->translation() - belief_.X_MB.translation()).norm() > 0.05) {
       // Out of a doorway straight back along the door's normal first (a diagonal line to the
       // safe waypoint would cut the jamb or the leaf), then to the waypoint.
-      std::vector<Pose2> path{ctx_.X_MB};
-      for (const auto& door : ctx_.map->doors) {
-        const DoorPass pass = CalcKnownPass(ctx_, door.id);
-        const Eigen::Vector2d offset = ctx_.X_MB.translation() - pass.centre;
+      std::vector<Pose2> path{belief_.X_MB};
+      const std::optional<DoorVisit> visit = Shared<DoorVisit>("visit");
+      for (const auto& door : task_.map->doors) {
+        const DoorPass pass = CalcKnownPass(task_, door.id, visit ? &*visit : nullptr);
+        const Eigen::Vector2d offset = belief_.X_MB.translation() - pass.centre;
         const double along = offset.dot(pass.n_M);
         const double lateral = std::abs(offset.dot(Eigen::Vector2d(-pass.n_M.y(), pass.n_M.x())));
-        const double entry = EntryDistance(ctx_, door.id, pass);
-        if (along < entry - 0.05 && along > -ExitDistance(ctx_, door.id) &&
+        const double entry = EntryDistance(task_, door.id, pass);
+        if (along < entry - 0.05 && along > -ExitDistance(task_, door.id) &&
             lateral < pass.width / 2 + 0.3) {
-          const Eigen::Vector2d out = ctx_.X_MB.translation() + pass.n_M * (entry - along);
-          path.push_back({out.x(), out.y(), ctx_.X_MB.yaw});
+          const Eigen::Vector2d out = belief_.X_MB.translation() + pass.n_M * (entry - along);
+          path.push_back({out.x(), out.y(), belief_.X_MB.yaw});
           break;
         }
       }
-      if ((path.back().translation() - ctx_.last_safe->translation()).norm() > 0.05)
-        path.push_back(*ctx_.last_safe);
-      ctx_.motion->FollowPath(path, std::vector<bool>(path.size() - 1, false),
-                              TuckedArm(*ctx_.model), ctx_.now);
-      ctx_.retreating = true;
-      Note(StrCat("backing off to the last safe waypoint (", PoseText(*ctx_.last_safe), ")"),
+      if ((path.back().translation() - belief_.last_safe->translation()).norm() > 0.05)
+        path.push_back(*belief_.last_safe);
+      task_.motion->FollowPath(path, std::vector<bool>(path.size() - 1, false),
+                               TuckedArm(*task_.model), belief_.now);
+      this->SetOutput("retreating", true);
+      Note(StrCat("backing off to the last safe waypoint (", PoseText(*belief_.last_safe), ")"),
            DecisionEvent::kRetreating);
     }
     return NodeStatus::kRunning;
   }
   NodeStatus OnRunning() override {
-    if (ctx_.motion->base_failed()) ctx_.motion->StopBase();  // blocked: stay, arm tucked
-    const bool busy = ctx_.motion->arm_moving(ctx_.now) || ctx_.motion->base_moving();
-    if (!busy) ctx_.retreating = false;
+    if (task_.motion->base_failed()) task_.motion->StopBase();  // blocked: stay, arm tucked
+    const bool busy = task_.motion->arm_moving(belief_.now) || task_.motion->base_moving();
+    if (!busy) this->SetOutput("retreating", false);
     return busy ? NodeStatus::kRunning : NodeStatus::kSuccess;
   }
   void OnHalted() override {
-    ctx_.motion->StopBase();
-    ctx_.retreating = false;
+    task_.motion->StopBase();
+    this->SetOutput("retreating", false);
   }
 };
 
+// Waits until the door zone has been clear as long as IsPathClear asks (the same hysteresis,
+// from the belief), so the retry after a standby finds the path clear.
 class WaitForClear final : public TaskNode<bt::StatefulActionNode> {
  public:
   using TaskNode::TaskNode;
   static PortsList ProvidedPorts() {
     return {InputPort<std::string>("door", "door whose zone to watch"),
+            InputPort<double>("clear_for", 1.0,
+                              "seconds the zone must have been clear (hysteresis) [s]"),
             InputPort<double>("timeout", 30.0, "give up after [s]")};
   }
   NodeStatus OnStart() override {
-    started_ = ctx_.now;
+    started_ = belief_.now;
     Note("waiting for the door zone to clear");
     return OnRunning();
   }
   NodeStatus OnRunning() override {
-    if (!IsDoorZoneOccupied(ctx_, Door())) return NodeStatus::kSuccess;
-    if (ToSeconds(ctx_.now - started_) > Input<double>("timeout")) {
+    if (IsDoorZoneClearFor(task_, Door(), Input<double>("clear_for"))) return NodeStatus::kSuccess;
+    if (ToSeconds(belief_.now - started_) > Input<double>("timeout")) {
       Note("gave up waiting");
       return NodeStatus::kFailure;
     }
@@ -166,10 +172,10 @@ class WaitForClear final : public TaskNode<bt::StatefulActionNode> {
 
 }  // namespace
 
-void RegisterNavigationNodes(bt::BehaviorTreeFactory& factory, TaskContext* context) {
-  Register<NavigateTo>(factory, "NavigateTo", context);
-  Register<RetractToSafe>(factory, "RetractToSafe", context);
-  Register<WaitForClear>(factory, "WaitForClear", context);
+void RegisterNavigationNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services) {
+  Register<NavigateTo>(factory, "NavigateTo", services);
+  Register<RetractToSafe>(factory, "RetractToSafe", services);
+  Register<WaitForClear>(factory, "WaitForClear", services);
 }
 
 }  // namespace egress::behavior::detail

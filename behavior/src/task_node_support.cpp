@@ -22,32 +22,34 @@ std::string PoseText(const Pose2& X) {
 // Starts a base motion along a planned path; RUNNING until it ends.
 // Plans from the robot to `goal` on the costmap and starts following the path; `door_speed`
 // runs every segment at the door speed (a door approach inside the hold window).
-NodeStatus StartPath(TaskContext& ctx, const Pose2& goal, const std::string& what,
+NodeStatus StartPath(const TaskServices& task, const Pose2& goal, const std::string& what,
                      const std::function<void(const std::string&)>& note, bool door_speed) {
-  planning::PlanResult plan = ctx.planner->Plan(ctx.X_MB, goal);
+  planning::PlanResult plan = task.planner->Plan(task.belief->X_MB, goal);
   if (plan.status == planning::PlanStatus::kStartInCollision) {
     // The robot stands where the costmap says it cannot (inflation around a leaf, a person seen
     // close by, an obstacle it brushed): step to the nearest free pose — never across an
     // obstacle cell — preferring the goal's direction, and plan from there.
-    const Eigen::Vector2d towards = (goal.translation() - ctx.X_MB.translation()).normalized();
+    const Eigen::Vector2d towards =
+        (goal.translation() - task.belief->X_MB.translation()).normalized();
     const double heading = std::atan2(towards.y(), towards.x());
-    const perception::Costmap2D& costmap = *ctx.world.costmap;
+    const perception::Costmap2D& costmap = *task.belief->world.costmap;
     bool escaped = false;
     for (double step = 0.05; step <= 0.6 && !escaped; step += 0.05) {
       for (int k = 0; k < 16 && !escaped; ++k) {
         // 0, +22.5°, -22.5°, +45°, ... around the goal's direction.
         const double a = heading + (k % 2 == 0 ? 1 : -1) * ((k + 1) / 2) * M_PI / 8;
         const Eigen::Vector2d d(std::cos(a), std::sin(a));
-        const Eigen::Vector2d p = ctx.X_MB.translation() + d * step;
-        const Pose2 escape{p.x(), p.y(), ctx.X_MB.yaw};
-        if (!ctx.planner->IsValid(escape)) continue;
+        const Eigen::Vector2d p = task.belief->X_MB.translation() + d * step;
+        const Pose2 escape{p.x(), p.y(), task.belief->X_MB.yaw};
+        if (!task.planner->IsValid(escape)) continue;
         bool crosses = false;
         for (double s = 0.02; s < step && !crosses; s += 0.02)
-          crosses = costmap.CostAt(ctx.X_MB.translation() + d * s) >= perception::kLethalCost;
+          crosses =
+              costmap.CostAt(task.belief->X_MB.translation() + d * s) >= perception::kLethalCost;
         if (crosses) continue;
-        planning::PlanResult rest = ctx.planner->Plan(escape, goal);
+        planning::PlanResult rest = task.planner->Plan(escape, goal);
         if (!rest.ok()) continue;
-        rest.path.insert(rest.path.begin(), ctx.X_MB);
+        rest.path.insert(rest.path.begin(), task.belief->X_MB);
         rest.length += step;
         plan = rest;
         escaped = true;
@@ -60,50 +62,50 @@ NodeStatus StartPath(TaskContext& ctx, const Pose2& goal, const std::string& wha
   }
   const std::vector<bool> through(plan.path.size() > 0 ? plan.path.size() - 1 : 0, door_speed);
   if (plan.path.size() < 2 ||
-      (plan.path.back().translation() - ctx.X_MB.translation()).norm() < 0.01) {
+      (plan.path.back().translation() - task.belief->X_MB.translation()).norm() < 0.01) {
     return NodeStatus::kSuccess;  // already there
   }
   // The base is holonomic: turn from the start yaw to the goal yaw evenly along the path
   // rather than through the planner's intermediate headings.
   std::vector<Pose2> path = plan.path;
-  path.front().yaw = ctx.X_MB.yaw;
-  const double turn = std::remainder(goal.yaw - ctx.X_MB.yaw, 2 * M_PI);
+  path.front().yaw = task.belief->X_MB.yaw;
+  const double turn = std::remainder(goal.yaw - task.belief->X_MB.yaw, 2 * M_PI);
   double travelled = 0.0;
   for (std::size_t i = 1; i < path.size(); ++i) {
     travelled += (path[i].translation() - path[i - 1].translation()).norm();
     const double fraction = plan.length > 0 ? std::min(1.0, travelled / plan.length) : 1.0;
-    path[i].yaw = ctx.X_MB.yaw + turn * fraction;
+    path[i].yaw = task.belief->X_MB.yaw + turn * fraction;
   }
-  ctx.motion->FollowPath(path, through, ctx.motion->arm_target(), ctx.now);
+  task.motion->FollowPath(path, through, task.motion->arm_target(), task.belief->now);
   note(StrCat("driving to ", what, " (", PoseText(goal), ", ", std::round(plan.length * 100) / 100,
               " m)"));
   return NodeStatus::kRunning;
 }
 
-NodeStatus BaseMotionStatus(const TaskContext& ctx,
+NodeStatus BaseMotionStatus(const TaskServices& task,
                             const std::function<void(const std::string&)>& note) {
-  if (ctx.motion->base_failed()) {
-    note("stopped: " + ctx.motion->base_failure());
+  if (task.motion->base_failed()) {
+    note("stopped: " + task.motion->base_failure());
     return NodeStatus::kFailure;
   }
-  return ctx.motion->base_moving() ? NodeStatus::kRunning : NodeStatus::kSuccess;
+  return task.motion->base_moving() ? NodeStatus::kRunning : NodeStatus::kSuccess;
 }
 
 // The arm motion under way: running while the joints travel, failure (with the joint that
 // stopped short) when they did not arrive in time, success once they are at the target.
-NodeStatus ArmMotionStatus(const TaskContext& ctx,
+NodeStatus ArmMotionStatus(const TaskServices& task,
                            const std::function<void(const std::string&)>& note) {
-  if (ctx.motion->arm_moving(ctx.now)) return NodeStatus::kRunning;
-  if (ctx.motion->arm_failed()) {
-    note(ctx.motion->arm_failure());
+  if (task.motion->arm_moving(task.belief->now)) return NodeStatus::kRunning;
+  if (task.motion->arm_failed()) {
+    note(task.motion->arm_failure());
     return NodeStatus::kFailure;
   }
   return NodeStatus::kSuccess;
 }
 
 // The next kPathLookahead metres of the path being followed cross lethal or inscribed cost.
-bool IsPathAheadBlocked(const TaskContext& ctx) {
-  const std::vector<Pose2>& path = ctx.motion->path();
+bool IsPathAheadBlocked(const TaskServices& task) {
+  const std::vector<Pose2>& path = task.motion->path();
   if (path.size() < 2) return false;
   // From the waypoint segment nearest the robot on.
   std::size_t next = 1;
@@ -113,15 +115,15 @@ bool IsPathAheadBlocked(const TaskContext& ctx) {
     const Eigen::Vector2d ab = b - a;
     const double t =
         ab.squaredNorm() > 0
-            ? std::clamp((ctx.X_MB.translation() - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0)
+            ? std::clamp((task.belief->X_MB.translation() - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0)
             : 0.0;
-    const double d = (a + t * ab - ctx.X_MB.translation()).norm();
+    const double d = (a + t * ab - task.belief->X_MB.translation()).norm();
     if (d < best) {
       best = d;
       next = i;
     }
   }
-  std::vector<Pose2> ahead{ctx.X_MB};
+  std::vector<Pose2> ahead{task.belief->X_MB};
   double length = 0.0;
   for (std::size_t i = next; i < path.size() && length < kPathLookahead; ++i) {
     const Eigen::Vector2d step = path[i].translation() - ahead.back().translation();
@@ -137,31 +139,31 @@ bool IsPathAheadBlocked(const TaskContext& ctx) {
   if (ahead.size() < 2) return false;
   // Starting inside inflation (e.g. beside a door) is not a new blockage: test from the
   // first free pose on.
-  return ctx.planner->IsValid(ctx.X_MB) && !ctx.planner->IsPathValid(ahead);
+  return task.planner->IsValid(task.belief->X_MB) && !task.planner->IsPathValid(ahead);
 }
 
 // BaseMotionStatus for a planned drive: when the path ahead becomes blocked on the costmap (an
 // obstacle the map does not show, seen only once the robot is on its way), plan again to the
 // same end pose instead of driving into it.
-NodeStatus DriveStatus(TaskContext& ctx, const std::function<void(const std::string&)>& note,
-                       bool door_speed) {
-  if (ctx.motion->base_moving() && !ctx.motion->bug_active() && IsPathAheadBlocked(ctx)) {
-    const Pose2 goal = ctx.motion->path().back();
-    ctx.motion->StopBase();
+NodeStatus DriveStatus(const TaskServices& task,
+                       const std::function<void(const std::string&)>& note, bool door_speed) {
+  if (task.motion->base_moving() && !task.motion->bug_active() && IsPathAheadBlocked(task)) {
+    const Pose2 goal = task.motion->path().back();
+    task.motion->StopBase();
     note("the path ahead is blocked: planning again");
-    const NodeStatus s = StartPath(ctx, goal, "the same pose", note, door_speed);
+    const NodeStatus s = StartPath(task, goal, "the same pose", note, door_speed);
     if (s != NodeStatus::kRunning) return s;
   }
-  return BaseMotionStatus(ctx, note);
+  return BaseMotionStatus(task, note);
 }
 
 // Arm-only IK at the current base pose (the base stays where it stopped). A solve that ends
 // within `accept_error` of the target counts (0: only a converged one; DLS with the paper's
 // damping creeps over the last millimetres, which a grasp does not need).
-std::optional<ArmPose> SolveArm(const TaskContext& ctx, const Pose2& X_MB,
+std::optional<ArmPose> SolveArm(const TaskServices& task, const Pose2& X_MB,
                                 const planning::IkTarget& target, const ArmPose& from,
                                 bool fingertip, double accept_error) {
-  planning::IkConfig ik = ctx.config.ik;
+  planning::IkConfig ik = task.config.ik;
   ik.fingertip = fingertip;
   ik.use_base = false;
   WholeBodyVector q = WholeBodyVector::Zero();
@@ -169,10 +171,10 @@ std::optional<ArmPose> SolveArm(const TaskContext& ctx, const Pose2& X_MB,
   q[kBaseY] = X_MB.y;
   q[kBaseYaw] = X_MB.yaw;
   q = WithArm(q, from);
-  const planning::DlsIkSolver solver(*ctx.model, ik);
+  const planning::DlsIkSolver solver(*task.model, ik);
   const auto good = [&](const planning::IkResult& r) {
     return r.converged || (r.position_error <= accept_error &&
-                           r.orientation_error <= ctx.config.ik.orientation_tolerance);
+                           r.orientation_error <= task.config.ik.orientation_tolerance);
   };
   planning::IkResult r = solver.Solve(target, q);
   if (!good(r) && target.approach_M) {
@@ -186,7 +188,7 @@ std::optional<ArmPose> SolveArm(const TaskContext& ctx, const Pose2& X_MB,
   return ArmOf(r.q);
 }
 
-std::optional<std::vector<ArmPose>> SolveArmLine(const TaskContext& ctx, const Pose2& X_MB,
+std::optional<std::vector<ArmPose>> SolveArmLine(const TaskServices& task, const Pose2& X_MB,
                                                  const planning::IkTarget& from_target,
                                                  const planning::IkTarget& to_target,
                                                  const ArmPose& from, bool fingertip, int steps) {
@@ -197,7 +199,7 @@ std::optional<std::vector<ArmPose>> SolveArmLine(const TaskContext& ctx, const P
     planning::IkTarget point = to_target;
     const double f = double(i) / steps;
     point.p_MT = (1.0 - f) * from_target.p_MT + f * to_target.p_MT;
-    const auto arm = SolveArm(ctx, X_MB, point, seed, fingertip);
+    const auto arm = SolveArm(task, X_MB, point, seed, fingertip);
     if (!arm) return std::nullopt;
     knots.push_back(*arm);
     seed = *arm;
@@ -205,32 +207,34 @@ std::optional<std::vector<ArmPose>> SolveArmLine(const TaskContext& ctx, const P
   return knots;
 }
 
-double PositionSigma(const TaskContext& ctx) {
-  const Eigen::Matrix2d C = ctx.world.X_MB_covariance.topLeftCorner<2, 2>();
+double PositionSigma(const TaskServices& task) {
+  const Eigen::Matrix2d C = task.belief->world.X_MB_covariance.topLeftCorner<2, 2>();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(C);
   return std::sqrt(std::max(0.0, eigen.eigenvalues().maxCoeff()));
 }
 
-NodeStatus RelocalizeGate::Check(TaskContext& ctx, const std::string& act, const NoteFn& note) {
-  const double sigma = PositionSigma(ctx);
-  const double limit = ctx.config.precise_pose_sigma;
+NodeStatus RelocalizeGate::Check(const TaskServices& task, const std::string& act,
+                                 const EventNoteFn& note) {
+  const double sigma = PositionSigma(task);
+  const double limit = task.config.precise_pose_sigma;
   if (!waiting_since_) {
     if (sigma <= limit) return NodeStatus::kSuccess;
-    waiting_since_ = ctx.now;
-    ++ctx.relocalizations;
-    ctx.motion->StopBase();
+    waiting_since_ = task.belief->now;
+    task.motion->StopBase();
     note(StrCat("the pose is uncertain (", std::round(sigma * 1000), " mm): re-localizing before ",
-                act));
+                act),
+         DecisionEvent::kRelocalizing);
     return NodeStatus::kRunning;
   }
   if (sigma <= limit) {
-    note(StrCat("re-localized (", std::round(sigma * 1000), " mm)"));
+    note(StrCat("re-localized (", std::round(sigma * 1000), " mm)"), DecisionEvent::kNote);
     waiting_since_.reset();
     return NodeStatus::kSuccess;
   }
-  if (ToSeconds(ctx.now - *waiting_since_) < ctx.config.relocalize_timeout)
+  if (ToSeconds(task.belief->now - *waiting_since_) < task.config.relocalize_timeout)
     return NodeStatus::kRunning;
-  note(StrCat("the pose stayed uncertain (", std::round(sigma * 1000), " mm): ", act, " anyway"));
+  note(StrCat("the pose stayed uncertain (", std::round(sigma * 1000), " mm): ", act, " anyway"),
+       DecisionEvent::kNote);
   waiting_since_.reset();
   return NodeStatus::kSuccess;
 }

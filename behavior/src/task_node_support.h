@@ -10,8 +10,8 @@
 #include <type_traits>
 
 #include "egress/behavior/door_rules.h"
-#include "egress/behavior/task_context.h"
 #include "egress/behavior/task_nodes.h"
+#include "egress/behavior/task_services.h"
 #include "egress/bt/factory.h"
 #include "egress/hsr_interface/error.h"
 
@@ -23,6 +23,7 @@ using bt::NodeStatus;
 using bt::OutputPort;
 using bt::PortsList;
 using NoteFn = std::function<void(const std::string&)>;
+using EventNoteFn = std::function<void(const std::string&, DecisionEvent)>;
 
 inline constexpr double kArmTolerance = 0.02;        ///< [rad or m] the arm counts as at a pose
 inline constexpr double kPathLookahead = 1.5;        ///< [m] of the path ahead checked for blockage
@@ -39,12 +40,13 @@ inline constexpr double kOperatorMaxClosingRate = (80.0 * M_PI / 180.0) / 3.0;
 bool ArmAt(const ArmPose& a, const ArmPose& b);
 std::string PoseText(const Pose2& X);
 
-// Base for the nodes: access to the context and typed inputs that fail the node loudly.
+// Base for the nodes: the read-only belief, the services, typed inputs that fail the node
+// loudly, and the door visit shared with the other door nodes on the `visit` port.
 template <typename Base>
 class TaskNode : public Base {
  public:
-  TaskNode(const std::string& name, NodeConfig config, TaskContext* context)
-      : Base(name, std::move(config)), ctx_(*context) {}
+  TaskNode(const std::string& name, NodeConfig config, const TaskServices* services)
+      : Base(name, std::move(config)), task_(*services), belief_(*services->belief) {}
 
  protected:
   template <typename T>
@@ -53,49 +55,99 @@ class TaskNode : public Base {
     if (!value) throw InvalidArgument(value.error());
     return *value;
   }
-  std::string Door() const { return Input<std::string>("door"); }
-  void Note(const std::string& text, DecisionEvent event = DecisionEvent::kNote) const {
-    ctx_.Note(StrCat(this->name().empty() ? this->registration_id() : this->name(), ": ", text),
-              event);
+  /// A port's value, or nullopt when it names a blackboard entry nobody has written yet (state
+  /// another node leaves, e.g. a visit or a retreat). Any other problem fails loudly.
+  template <typename T>
+  std::optional<T> Shared(std::string_view port) const {
+    const std::optional<std::string> text = this->PortText(port);
+    if (text) {
+      if (const auto key = bt::BlackboardKeyOf(*text, port);
+          key && !this->config().blackboard->Has(*key)) {
+        return std::nullopt;
+      }
+    }
+    return Input<T>(port);
   }
-  TaskContext& ctx_;
+  std::string Door() const { return Input<std::string>("door"); }
+  /// The visit to this node's door on the `visit` port; a new one if there is none yet or the
+  /// port holds a visit to another door.
+  DoorVisit Visit() const {
+    const std::string door = Door();
+    std::optional<DoorVisit> visit = Shared<DoorVisit>("visit");
+    if (visit && visit->door == door) return *visit;
+    DoorVisit fresh;
+    fresh.door = door;
+    return fresh;
+  }
+  void Remember(DoorVisit visit) { this->SetOutput("visit", std::move(visit)); }
+  void Note(const std::string& text, DecisionEvent event = DecisionEvent::kNote) const {
+    task_.log->Record(
+        event, StrCat(this->name().empty() ? this->registration_id() : this->name(), ": ", text));
+  }
+  /// A note function for helpers that record typed events too.
+  EventNoteFn EventNoter() const {
+    return [this](const std::string& t, DecisionEvent e) { Note(t, e); };
+  }
+  const TaskServices& task_;
+  const Belief& belief_;  ///< Refreshed by the executive before every tick.
 };
+
+/// The `visit` port of the door nodes (see DoorVisit): read by conditions, read and written by
+/// the actions.
+inline std::pair<std::string, bt::PortInfo> VisitPort(bt::PortDirection direction) {
+  auto port = bt::BidirectionalPort<DoorVisit>(
+      "visit",
+      "the robot's dealings with this door (approach side, button plan, when it operated it), "
+      "shared by the door nodes",
+      "{door_visit}");
+  port.second.direction = direction;
+  return port;
+}
+
+/// The `retreating` port: RetractToSafe writes whether its retreat is under way, IsPathClear
+/// reads it (a retreat is finished before the robot resumes).
+inline std::pair<std::string, bt::PortInfo> RetreatingPort(bt::PortDirection direction) {
+  auto port = bt::BidirectionalPort<bool>(
+      "retreating", "a standby retreat to the last safe waypoint is under way", "{retreating}");
+  port.second.direction = direction;
+  return port;
+}
 
 /// Plans from the robot to `goal` on the costmap and starts following the path; `door_speed`
 /// runs every segment at the door speed (a door approach inside the hold window). RUNNING while
 /// the base moves, SUCCESS if already there, FAILURE (noted) without a path.
-NodeStatus StartPath(TaskContext& ctx, const Pose2& goal, const std::string& what,
+NodeStatus StartPath(const TaskServices& task, const Pose2& goal, const std::string& what,
                      const NoteFn& note, bool door_speed = false);
 /// The base motion under way: RUNNING, SUCCESS when it ended, FAILURE (noted) when the
 /// watchdog stopped it.
-NodeStatus BaseMotionStatus(const TaskContext& ctx, const NoteFn& note);
+NodeStatus BaseMotionStatus(const TaskServices& task, const NoteFn& note);
 /// The arm motion under way: RUNNING while the joints travel, FAILURE (the joint that stopped
 /// short, noted) when they did not arrive in time, SUCCESS once they are at the target.
-NodeStatus ArmMotionStatus(const TaskContext& ctx, const NoteFn& note);
+NodeStatus ArmMotionStatus(const TaskServices& task, const NoteFn& note);
 /// The next kPathLookahead metres of the path being followed cross lethal or inscribed cost.
-bool IsPathAheadBlocked(const TaskContext& ctx);
+bool IsPathAheadBlocked(const TaskServices& task);
 /// BaseMotionStatus for a planned drive that plans again when the path ahead becomes blocked.
-NodeStatus DriveStatus(TaskContext& ctx, const NoteFn& note, bool door_speed = false);
+NodeStatus DriveStatus(const TaskServices& task, const NoteFn& note, bool door_speed = false);
 /// Arm-only IK at a fixed base pose; `accept_error` [m] accepts a solve that ends this close.
-std::optional<ArmPose> SolveArm(const TaskContext& ctx, const Pose2& X_MB,
+std::optional<ArmPose> SolveArm(const TaskServices& task, const Pose2& X_MB,
                                 const planning::IkTarget& target, const ArmPose& from,
                                 bool fingertip, double accept_error = 0.0);
 /// Arm-only IK for `steps` points evenly along the straight line from `from_target` (where the
 /// arm `from` already is) to `to_target`, each solved warm from the one before: knots that keep
 /// a press on the button's normal instead of the curve a joint-space move would draw. nullopt
 /// if a point is out of reach.
-std::optional<std::vector<ArmPose>> SolveArmLine(const TaskContext& ctx, const Pose2& X_MB,
+std::optional<std::vector<ArmPose>> SolveArmLine(const TaskServices& task, const Pose2& X_MB,
                                                  const planning::IkTarget& from_target,
                                                  const planning::IkTarget& to_target,
                                                  const ArmPose& from, bool fingertip, int steps);
 /// Far enough past the door line that the closing leaf cannot reach the footprint [m].
-double ExitDistance(const TaskContext& ctx, const std::string& door);
+double ExitDistance(const TaskServices& task, const std::string& door);
 /// How far before the door line the robot lines up and waits [m].
-double EntryDistance(const TaskContext& ctx, const std::string& door, const DoorPass& pass);
+double EntryDistance(const TaskServices& task, const std::string& door, const DoorPass& pass);
 
 /// The localizer's position standard deviation: the square root of the largest eigenvalue of
 /// the xy block of the belief's covariance [m].
-double PositionSigma(const TaskContext& ctx);
+double PositionSigma(const TaskServices& task);
 
 /// Holds a precise act until the pose is certain enough: when PositionSigma exceeds
 /// config.precise_pose_sigma, the base stands still while the localizer corrects on scans of
@@ -105,16 +157,17 @@ class RelocalizeGate {
   /// A new act: forget any earlier wait.
   void Reset() { waiting_since_.reset(); }
   /// RUNNING while re-localizing; SUCCESS when the pose is good enough (or the wait timed out,
-  /// noted). Counts each wait in ctx.relocalizations.
-  NodeStatus Check(TaskContext& ctx, const std::string& act, const NoteFn& note);
+  /// noted). Each wait is noted as a DecisionEvent::kRelocalizing (the executive counts them).
+  NodeStatus Check(const TaskServices& task, const std::string& act, const EventNoteFn& note);
 
  private:
   std::optional<Time> waiting_since_;
 };
 
-/// Registers node type T under `id` with its ports; its nodes share `context`.
+/// Registers node type T under `id` with its ports; its nodes act through `services`.
 template <typename T>
-void Register(bt::BehaviorTreeFactory& factory, const std::string& id, TaskContext* context) {
+void Register(bt::BehaviorTreeFactory& factory, const std::string& id,
+              const TaskServices* services) {
   bt::NodeManifest manifest;
   manifest.id = id;
   if constexpr (std::is_base_of_v<bt::ConditionNode, T>) {
@@ -123,16 +176,16 @@ void Register(bt::BehaviorTreeFactory& factory, const std::string& id, TaskConte
     manifest.kind = bt::NodeKind::kAction;
   }
   manifest.ports = T::ProvidedPorts();
-  factory.RegisterBuilder(std::move(manifest), [context](const std::string& name, NodeConfig c) {
-    return std::make_unique<T>(name, std::move(c), context);
+  factory.RegisterBuilder(std::move(manifest), [services](const std::string& name, NodeConfig c) {
+    return std::make_unique<T>(name, std::move(c), services);
   });
 }
 
 // Each family registers its own nodes (condition_nodes.cpp, navigation_nodes.cpp,
 // door_nodes.cpp, manipulation_nodes.cpp).
-void RegisterConditionNodes(bt::BehaviorTreeFactory& factory, TaskContext* context);
-void RegisterNavigationNodes(bt::BehaviorTreeFactory& factory, TaskContext* context);
-void RegisterDoorNodes(bt::BehaviorTreeFactory& factory, TaskContext* context);
-void RegisterManipulationNodes(bt::BehaviorTreeFactory& factory, TaskContext* context);
+void RegisterConditionNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
+void RegisterNavigationNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
+void RegisterDoorNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
+void RegisterManipulationNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 
 }  // namespace egress::behavior::detail

@@ -39,7 +39,7 @@ Pose2 ParsePose2(std::string_view text) {
 }
 
 std::string TaskNodesModelXml() {
-  // Registration needs only the node types' ports; no node is built, so no context.
+  // Registration needs only the node types' ports; no node is built, so no services.
   bt::BehaviorTreeFactory factory;
   detail::RegisterConditionNodes(factory, nullptr);
   detail::RegisterNavigationNodes(factory, nullptr);
@@ -48,15 +48,16 @@ std::string TaskNodesModelXml() {
   return factory.WriteTreeNodesModelXml(false);
 }
 
-void RegisterTaskNodes(bt::BehaviorTreeFactory& factory, TaskContext* context) {
-  ThrowUnless(context != nullptr && context->map != nullptr && context->model != nullptr &&
-                  context->motion != nullptr && context->planner != nullptr,
-              "RegisterTaskNodes: the context needs a map, a robot model, a motion executor and a "
-              "planner");
-  detail::RegisterConditionNodes(factory, context);
-  detail::RegisterNavigationNodes(factory, context);
-  detail::RegisterDoorNodes(factory, context);
-  detail::RegisterManipulationNodes(factory, context);
+void RegisterTaskNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services) {
+  ThrowUnless(services != nullptr && services->map != nullptr && services->model != nullptr &&
+                  services->motion != nullptr && services->planner != nullptr &&
+                  services->log != nullptr && services->belief != nullptr,
+              "RegisterTaskNodes: the services need a map, a robot model, a motion executor, a "
+              "planner, a decision log and a belief");
+  detail::RegisterConditionNodes(factory, services);
+  detail::RegisterNavigationNodes(factory, services);
+  detail::RegisterDoorNodes(factory, services);
+  detail::RegisterManipulationNodes(factory, services);
 }
 
 }  // namespace egress::behavior

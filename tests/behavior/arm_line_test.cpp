@@ -13,7 +13,7 @@ namespace {
 
 TEST(SolveArmLineTest, KnotsLieEvenlyOnTheLineFromTheStartToTheEnd) {
   const RobotModel model = RobotModel::LoadDefault();
-  TaskContext ctx;
+  TaskServices ctx;
   ctx.model = &model;
   const Pose2 X_MB{0.0, 0.0, 0.0};
   // A press 5.6 cm forward at button height, in front of the robot.
@@ -41,7 +41,7 @@ TEST(SolveArmLineTest, KnotsLieEvenlyOnTheLineFromTheStartToTheEnd) {
 
 TEST(SolveArmLineTest, APointOutOfReachFailsTheLineAndBadStepsAreAnError) {
   const RobotModel model = RobotModel::LoadDefault();
-  TaskContext ctx;
+  TaskServices ctx;
   ctx.model = &model;
   const Pose2 X_MB{0.0, 0.0, 0.0};
   const planning::IkTarget from{{0.55, 0.0, 1.0}, std::nullopt};

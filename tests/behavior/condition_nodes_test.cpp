@@ -1,5 +1,5 @@
 // The condition nodes (behavior/src/condition_nodes.cpp), ticked as a tree ticks them: one
-// node per tree, built by the factory from XML, on a TaskContext set up by hand.
+// node per tree, built by the factory from XML, on task services and a belief set up by hand.
 
 #include "task_node_fixture.h"
 
@@ -14,49 +14,71 @@ using ConditionNodesTest = node_testing::TaskNodeFixture;
 
 TEST_F(ConditionNodesTest, IsPathClearFailsWhileAPersonIsInTheZoneAndHoldsOffAfterward) {
   bt::Tree tree = Tree(R"(<IsPathClear door="lab_door" clear_for="1.0"/>)");
-  context_.now = At(10.0);
+  belief_.now = At(10.0);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);
-  EXPECT_TRUE(context_.notes.empty());
+  EXPECT_TRUE(log_.pending().empty());
 
   // Someone stands in the doorway: FAILURE, and the decision is a typed event.
-  context_.world.people = {Person({0.0, 3.3}, perception::PersonIntent::kStationary)};
-  context_.now = At(10.1);
+  belief_.now = At(10.1);
+  See({Person({0.0, 3.3}, perception::PersonIntent::kStationary)});
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
-  ASSERT_EQ(context_.notes.size(), 1u);
-  EXPECT_EQ(context_.notes.back().event, DecisionEvent::kPersonInDoorZone);
+  ASSERT_EQ(log_.pending().size(), 1u);
+  EXPECT_EQ(log_.pending().back().event, DecisionEvent::kPersonInDoorZone);
   // Still there: no second event for the same occupation.
-  context_.now = At(10.2);
+  belief_.now = At(10.2);
+  See(belief_.world.people);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
-  EXPECT_EQ(context_.notes.size(), 1u);
+  EXPECT_EQ(log_.pending().size(), 1u);
 
   // Gone: still FAILURE for the hysteresis (1 s since last seen), then SUCCESS and the event.
-  context_.world.people.clear();
-  context_.now = At(10.8);
+  belief_.now = At(10.3);
+  See({});
+  belief_.now = At(10.8);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
-  context_.now = At(11.3);
+  belief_.now = At(11.3);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);
-  ASSERT_EQ(context_.notes.size(), 2u);
-  EXPECT_EQ(context_.notes.back().event, DecisionEvent::kDoorZoneClear);
+  ASSERT_EQ(log_.pending().size(), 2u);
+  EXPECT_EQ(log_.pending().back().event, DecisionEvent::kDoorZoneClear);
+}
+
+TEST_F(ConditionNodesTest, IsPathClearTimesTheHysteresisFromTheBeliefNotFromItsOwnTicks) {
+  // The zone was last occupied while the condition was not being ticked (a retreat under way):
+  // the belief has it, and the hysteresis runs from then.
+  auto blackboard = bt::Blackboard::Create();
+  bt::Tree tree = Tree(R"(<IsPathClear door="lab_door" clear_for="1.0"/>)", blackboard);
+  belief_.now = At(5.0);
+  See({Person({0.0, 3.3}, perception::PersonIntent::kStationary)});
+  belief_.now = At(5.5);
+  See({});
+  belief_.now = At(5.8);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);  // 0.8 s since last seen occupied
+  belief_.now = At(6.1);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);  // 1.1 s
+  // A retreat under way (RetractToSafe's entry on the blackboard): FAILURE until it ends.
+  blackboard->Set("retreating", bt::Any(true));
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
+  blackboard->Set("retreating", bt::Any(false));
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);
 }
 
 TEST_F(ConditionNodesTest, IsPathClearSeesAPersonWalkingIntoTheZone) {
   bt::Tree tree = Tree(R"(<IsPathClear door="lab_door"/>)");
   auto walking_in = Person({0.0, 5.0}, perception::PersonIntent::kApproaching);
-  context_.world.people = {walking_in};
-  context_.now = At(1.0);
+  belief_.world.people = {walking_in};
+  belief_.now = At(1.0);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);  // far, and no forecast into the zone
   walking_in.person.forecast = {{0.0, 4.6}, {0.0, 4.2}};
-  context_.world.people = {walking_in};
+  belief_.world.people = {walking_in};
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
 }
 
 TEST_F(ConditionNodesTest, IsDoorOpenNeedsTheClearanceAndTimeLeftInTheWindow) {
   bt::Tree tree = Tree(R"(<IsDoorOpen door="lab_door" margin="0.1"/>)");
-  context_.now = At(50.0);
+  belief_.now = At(50.0);
   // Not seen: not open.
   perception::TrackedDoor unseen;
   unseen.model = map_.doors[0];
-  context_.world.doors = {unseen};
+  belief_.world.doors = {unseen};
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
   // Ajar at 20°: too narrow for the base.
   DoorSeenOpen(20.0, 1.0);
@@ -65,28 +87,28 @@ TEST_F(ConditionNodesTest, IsDoorOpenNeedsTheClearanceAndTimeLeftInTheWindow) {
   DoorSeenOpen(85.0, 1.0);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);
   // Closing: never.
-  context_.world.doors[0].state.motion = perception::DoorMotion::kClosing;
+  belief_.world.doors[0].state.motion = perception::DoorMotion::kClosing;
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
 }
 
 TEST_F(ConditionNodesTest, IsPersonHoldingDoorWantsAStillHolderBesideAnOpenLeaf) {
   bt::Tree tree = Tree(R"(<IsPersonHoldingDoor door="lab_door"/>)");
-  context_.now = At(50.0);
+  belief_.now = At(50.0);
   DoorSeenOpen(85.0, 1.0);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);  // nobody there
   // Standing still beside the hinge jamb on the far side, out of the lane: holding it.
-  context_.world.people = {Person({0.55, 3.45}, perception::PersonIntent::kHoldingDoor)};
+  belief_.world.people = {Person({0.55, 3.45}, perception::PersonIntent::kHoldingDoor)};
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);
   // The same person in the middle of the doorway holds nothing for the robot.
-  context_.world.people = {Person({0.0, 3.1}, perception::PersonIntent::kHoldingDoor)};
+  belief_.world.people = {Person({0.0, 3.1}, perception::PersonIntent::kHoldingDoor)};
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
 }
 
 TEST_F(ConditionNodesTest, IsHoldingPayloadReadsTheGripsBelief) {
   bt::Tree tree = Tree(R"(<IsHoldingPayload payload="bottle"/>)");
-  context_.holding_object = false;
+  belief_.holding_object = false;
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
-  context_.holding_object = true;
+  belief_.holding_object = true;
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);
 }
 

@@ -15,16 +15,24 @@ TEST_F(DoorNodesTest, ButtonTypeWritesTheActuatorKindOfThisSide) {
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);
   EXPECT_EQ(blackboard->Get<std::string>("kind"), "push_button");
   // From the far side there is no actuator.
-  context_.X_MB = {0.0, 4.0, -M_PI / 2};
+  belief_.X_MB = {0.0, 4.0, -M_PI / 2};
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
 }
 
 TEST_F(DoorNodesTest, ApproachButtonDrivesToAStandoffFacingTheButton) {
-  bt::Tree tree = Tree(R"(<ApproachButton door="lab_door"/>)");
-  context_.now = At(1.0);
+  auto blackboard = bt::Blackboard::Create();
+  bt::Tree tree = Tree(R"(<ApproachButton door="lab_door"/>)", blackboard);
+  belief_.now = At(1.0);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
-  ASSERT_EQ(context_.button_plans.count("lab_door"), 1u);
-  const ButtonPlan& plan = context_.button_plans.at("lab_door");
+  // The plan travels to PressButton on the blackboard, in the door's visit, with the side the
+  // robot came from (south: -y).
+  const auto visit = blackboard->Get<DoorVisit>("door_visit");
+  ASSERT_TRUE(visit.has_value());
+  EXPECT_EQ(visit->door, "lab_door");
+  ASSERT_TRUE(visit->approach_side.has_value());
+  EXPECT_NEAR(visit->approach_side->y(), -1.0, 1e-9);
+  ASSERT_TRUE(visit->button_plan.has_value());
+  const ButtonPlan& plan = *visit->button_plan;
   EXPECT_EQ(plan.actuator, "lab_button");
   // In front of the button (south of its wall), facing it (+y), within the arm's reach.
   EXPECT_NEAR(plan.X_MB_standoff.yaw, M_PI / 2, 1e-6);
@@ -40,13 +48,13 @@ TEST_F(DoorNodesTest, ApproachButtonDrivesToAStandoffFacingTheButton) {
 TEST_F(DoorNodesTest, PressButtonNeedsTheApproachFirst) {
   bt::Tree tree = Tree(R"(<PressButton door="lab_door"/>)");
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
-  EXPECT_NE(context_.notes.back().text.find("ApproachButton must run first"), std::string::npos);
+  EXPECT_NE(log_.pending().back().text.find("ApproachButton must run first"), std::string::npos);
 }
 
 TEST_F(DoorNodesTest, TraverseDoorLinesUpOnTheDoorsAxisBeforeGoing) {
   bt::Tree tree = Tree(R"(<TraverseDoor door="lab_door"/>)");
-  context_.X_MB = {1.0, 2.2, M_PI / 2};  // beside the axis, before the door
-  context_.now = At(1.0);
+  belief_.X_MB = {1.0, 2.2, M_PI / 2};  // beside the axis, before the door
+  belief_.now = At(1.0);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
   ASSERT_GE(motion_.path().size(), 2u);
   // The line-up pose is on the door's axis (x = 0), before the door line, facing through it.

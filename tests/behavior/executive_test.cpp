@@ -51,7 +51,7 @@ TEST(ExecutiveTest, TheFootprintComesFromTheRobotDescription) {
   config.tasks.footprint_radius = 0.1;
   const Executive wide(HsrWithBaseRadius("0.26"), EmptyRoom(), GoTo(), {2.0, 3.0, 0.0}, config);
   EXPECT_DOUBLE_EQ(wide.costmap().config().robot_radius, 0.26);
-  EXPECT_DOUBLE_EQ(wide.context().config.footprint_radius, 0.26);
+  EXPECT_DOUBLE_EQ(wide.services().config.footprint_radius, 0.26);
   const Executive hsr(std::make_shared<const RobotModel>(RobotModel::LoadDefault()), EmptyRoom(),
                       GoTo(), {2.0, 3.0, 0.0}, config);
   EXPECT_DOUBLE_EQ(hsr.costmap().config().robot_radius, 0.215);
@@ -136,8 +136,8 @@ TEST(ExecutiveTest, ColourImagesGoThroughTheDetectorStage) {
   }
   EXPECT_EQ(calls, 6);
   // The detector's bottle, placed with the depth image, is a confirmed payload in the belief.
-  ASSERT_EQ(brain.context().world.payloads.size(), 1u);
-  const Eigen::Vector3d p_MP = brain.context().world.payloads[0].p_MO;
+  ASSERT_EQ(brain.belief().world.payloads.size(), 1u);
+  const Eigen::Vector3d p_MP = brain.belief().world.payloads[0].p_MO;
   EXPECT_GT(p_MP.x(), 2.0 + 1.0);  // ahead of the robot, about 1.5 m from the camera
   EXPECT_NEAR(p_MP.y(), 3.0, 0.3);
 
@@ -148,7 +148,7 @@ TEST(ExecutiveTest, ColourImagesGoThroughTheDetectorStage) {
     blind.Step(other);
     other.Advance();
   }
-  EXPECT_TRUE(blind.context().world.payloads.empty());
+  EXPECT_TRUE(blind.belief().world.payloads.empty());
 }
 
 TEST(ExecutiveTest, BadConfigurationsAreRefusedNamingTheField) {

@@ -19,9 +19,9 @@ perception::TrackedObject Seen(const std::string& label, const Eigen::Vector3d& 
 TEST_F(ManipulationNodesTest, DetectPayloadWritesTheNearestOfItsKind) {
   auto blackboard = bt::Blackboard::Create();
   bt::Tree tree = Tree(R"(<DetectPayload kind="bottle" pose="{where}"/>)", blackboard);
-  context_.world.payloads = {Seen("flashlight", {0.5, 2.5, 0.75}), Seen("bottle", {2.0, 2.0, 0.8}),
-                             Seen("bottle", {0.6, 2.2, 0.8})};
-  context_.now = At(1.0);
+  belief_.world.payloads = {Seen("flashlight", {0.5, 2.5, 0.75}), Seen("bottle", {2.0, 2.0, 0.8}),
+                            Seen("bottle", {0.6, 2.2, 0.8})};
+  belief_.now = At(1.0);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);
   const auto where = blackboard->Get<std::string>("where");
   ASSERT_TRUE(where.has_value());
@@ -33,26 +33,26 @@ TEST_F(ManipulationNodesTest, DetectPayloadWritesTheNearestOfItsKind) {
 
 TEST_F(ManipulationNodesTest, DetectPayloadLooksUntilItsTimeout) {
   bt::Tree tree = Tree(R"(<DetectPayload kind="bottle" pose="{where}" timeout="2.0"/>)");
-  context_.world.payloads = {Seen("flashlight", {0.5, 2.5, 0.75})};
-  context_.now = At(1.0);
+  belief_.world.payloads = {Seen("flashlight", {0.5, 2.5, 0.75})};
+  belief_.now = At(1.0);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
-  context_.now = At(2.5);
+  belief_.now = At(2.5);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
-  context_.now = At(3.5);
+  belief_.now = At(3.5);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
 }
 
 TEST_F(ManipulationNodesTest, GraspPayloadRefusesWhatNoPostureReaches) {
   bt::Tree tree = Tree(R"(<GraspPayload kind="bottle" pose="0.5;2.5;2.6"/>)");  // 2.6 m up
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
-  EXPECT_NE(context_.notes.back().text.find("no whole-body reach"), std::string::npos);
+  EXPECT_NE(log_.pending().back().text.find("no whole-body reach"), std::string::npos);
   EXPECT_FALSE(motion_.base_moving());
 }
 
 TEST_F(ManipulationNodesTest, GraspPayloadDrivesToWhereTheHandReachesIt) {
   bt::Tree tree = Tree(R"(<GraspPayload kind="bottle" pose="0.0;3.8;0.8"/>)");
-  context_.X_MB = {0.0, 2.0, M_PI / 2};
-  context_.now = At(1.0);
+  belief_.X_MB = {0.0, 2.0, M_PI / 2};
+  belief_.now = At(1.0);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
   ASSERT_GE(motion_.path().size(), 2u);
   const Pose2& grasp = motion_.path().back();

@@ -12,7 +12,7 @@ using NavigationNodesTest = node_testing::TaskNodeFixture;
 
 TEST_F(NavigationNodesTest, NavigateToPlansAndFollowsAPathToTheGoal) {
   bt::Tree tree = Tree(R"(<NavigateTo goal="1.5;1.0;0.0"/>)");
-  context_.now = At(1.0);
+  belief_.now = At(1.0);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
   ASSERT_GE(motion_.path().size(), 2u);
   EXPECT_LT((motion_.path().back().translation() - Eigen::Vector2d(1.5, 1.0)).norm(), 1e-6);
@@ -29,24 +29,25 @@ TEST_F(NavigationNodesTest, NavigateToAGoalWhereTheRobotStandsSucceedsAtOnce) {
 
 TEST_F(NavigationNodesTest, NavigateToAnUnreachableGoalWaitsItsPatienceThenFails) {
   bt::Tree tree = Tree(R"(<NavigateTo goal="40.0;2.0;0.0" patience="1.0"/>)");  // off the map
-  context_.now = At(1.0);
+  belief_.now = At(1.0);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
   EXPECT_FALSE(motion_.base_moving());
-  context_.now = At(1.6);
+  belief_.now = At(1.6);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
-  context_.now = At(2.2);
+  belief_.now = At(2.2);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
-  EXPECT_NE(context_.notes.back().text.find("gave up"), std::string::npos);
+  EXPECT_NE(log_.pending().back().text.find("gave up"), std::string::npos);
 }
 
 TEST_F(NavigationNodesTest, RetractToSafeBacksOffToTheLastSafeWaypoint) {
-  bt::Tree tree = Tree(R"(<RetractToSafe/>)");
-  context_.X_MB = {0.0, 2.9, M_PI / 2};  // in the doorway
-  context_.last_safe = Pose2{0.0, 1.5, M_PI / 2};
-  context_.now = At(1.0);
+  auto blackboard = bt::Blackboard::Create();
+  bt::Tree tree = Tree(R"(<RetractToSafe/>)", blackboard);
+  belief_.X_MB = {0.0, 2.9, M_PI / 2};  // in the doorway
+  belief_.last_safe = Pose2{0.0, 1.5, M_PI / 2};
+  belief_.now = At(1.0);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
   EXPECT_TRUE(Noted(DecisionEvent::kRetreating));
-  EXPECT_TRUE(context_.retreating);
+  EXPECT_EQ(blackboard->Get<bool>("retreating"), true);
   ASSERT_GE(motion_.path().size(), 2u);
   EXPECT_LT((motion_.path().back().translation() - Eigen::Vector2d(0.0, 1.5)).norm(), 1e-6);
   // Out of the doorway along its normal first: no waypoint beside the door line.
@@ -56,26 +57,31 @@ TEST_F(NavigationNodesTest, RetractToSafeBacksOffToTheLastSafeWaypoint) {
 
 TEST_F(NavigationNodesTest, RetractToSafeWithNowhereToGoOnlyStops) {
   bt::Tree tree = Tree(R"(<RetractToSafe/>)");
-  context_.now = At(1.0);
+  belief_.now = At(1.0);
   tree.TickOnce();
   EXPECT_FALSE(Noted(DecisionEvent::kRetreating));
   EXPECT_FALSE(motion_.base_moving());
 }
 
 TEST_F(NavigationNodesTest, WaitForClearWaitsForTheZoneAndGivesUpAfterItsTimeout) {
-  bt::Tree tree = Tree(R"(<WaitForClear door="lab_door" timeout="2.0"/>)");
-  context_.world.people = {Person({0.0, 3.3}, perception::PersonIntent::kStationary)};
-  context_.now = At(1.0);
+  bt::Tree tree = Tree(R"(<WaitForClear door="lab_door" timeout="4.0" clear_for="1.0"/>)");
+  belief_.now = At(1.0);
+  See({Person({0.0, 3.3}, perception::PersonIntent::kStationary)});
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
-  context_.now = At(2.0);
+  belief_.now = At(2.0);
+  See(belief_.world.people);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
-  context_.world.people.clear();
+  // Gone, but the zone must stay clear for clear_for (as IsPathClear asks) before the retry.
+  belief_.now = At(2.1);
+  See({});
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  belief_.now = At(3.1);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);
 
-  context_.world.people = {Person({0.0, 3.3}, perception::PersonIntent::kStationary)};
-  context_.now = At(10.0);
+  belief_.now = At(10.0);
+  See({Person({0.0, 3.3}, perception::PersonIntent::kStationary)});
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
-  context_.now = At(12.5);
+  belief_.now = At(14.5);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
 }
 

@@ -18,43 +18,49 @@ Time At(double t) {
 TEST(RelocalizeGateTest, AnUncertainPoseIsSettledBeforeTheAct) {
   const RobotModel model = RobotModel::LoadDefault();
   MotionExecutor motion(model);
-  TaskContext ctx;
+  Belief belief;
+  TaskServices ctx;
   ctx.motion = &motion;
+  ctx.belief = &belief;
   std::vector<std::string> notes;
-  const NoteFn note = [&](const std::string& t) { notes.push_back(t); };
+  int relocalizations = 0;  // as the executive counts them: by event
+  const EventNoteFn note = [&](const std::string& t, DecisionEvent e) {
+    notes.push_back(t);
+    if (e == DecisionEvent::kRelocalizing) ++relocalizations;
+  };
   RelocalizeGate gate;
 
   // Certain enough (sigma 1 cm against the 2 cm default): act at once, nothing counted.
-  ctx.world.X_MB_covariance = Eigen::Vector3d(1e-4, 1e-4, 1e-4).asDiagonal();
+  belief.world.X_MB_covariance = Eigen::Vector3d(1e-4, 1e-4, 1e-4).asDiagonal();
   EXPECT_NEAR(PositionSigma(ctx), 0.01, 1e-12);
   EXPECT_EQ(gate.Check(ctx, "pressing", note), bt::NodeStatus::kSuccess);
-  EXPECT_EQ(ctx.relocalizations, 0);
+  EXPECT_EQ(relocalizations, 0);
 
   // 5 cm along y (the largest eigenvalue counts, whatever the axis): wait.
-  ctx.world.X_MB_covariance(1, 1) = 0.05 * 0.05;
-  ctx.now = At(1.0);
+  belief.world.X_MB_covariance(1, 1) = 0.05 * 0.05;
+  belief.now = At(1.0);
   EXPECT_EQ(gate.Check(ctx, "pressing", note), bt::NodeStatus::kRunning);
-  EXPECT_EQ(ctx.relocalizations, 1);
+  EXPECT_EQ(relocalizations, 1);
   ASSERT_FALSE(notes.empty());
   EXPECT_NE(notes.back().find("re-localizing before pressing"), std::string::npos) << notes.back();
-  ctx.now = At(2.0);
+  belief.now = At(2.0);
   EXPECT_EQ(gate.Check(ctx, "pressing", note), bt::NodeStatus::kRunning);
   // The scans pinned it: go on.
-  ctx.world.X_MB_covariance(1, 1) = 1e-4;
-  ctx.now = At(2.5);
+  belief.world.X_MB_covariance(1, 1) = 1e-4;
+  belief.now = At(2.5);
   EXPECT_EQ(gate.Check(ctx, "pressing", note), bt::NodeStatus::kSuccess);
-  EXPECT_EQ(ctx.relocalizations, 1);
+  EXPECT_EQ(relocalizations, 1);
 
   // It never settles: after relocalize_timeout (3 s) the act goes on, noted.
-  ctx.world.X_MB_covariance(0, 0) = 0.04 * 0.04;
-  ctx.now = At(10.0);
+  belief.world.X_MB_covariance(0, 0) = 0.04 * 0.04;
+  belief.now = At(10.0);
   EXPECT_EQ(gate.Check(ctx, "grasping", note), bt::NodeStatus::kRunning);
-  ctx.now = At(12.9);
+  belief.now = At(12.9);
   EXPECT_EQ(gate.Check(ctx, "grasping", note), bt::NodeStatus::kRunning);
-  ctx.now = At(13.1);
+  belief.now = At(13.1);
   EXPECT_EQ(gate.Check(ctx, "grasping", note), bt::NodeStatus::kSuccess);
   EXPECT_NE(notes.back().find("grasping anyway"), std::string::npos) << notes.back();
-  EXPECT_EQ(ctx.relocalizations, 2);
+  EXPECT_EQ(relocalizations, 2);
 }
 
 }  // namespace

@@ -1,13 +1,15 @@
 #pragma once
-// A TaskContext for ticking task nodes one at a time in the family tests: the lab's door (the
-// wall y = 3, hinge at x = 0.475, latch at x = -0.475, opening north) with a push button south
-// of it at x = 1.075, a free floor around it, the real robot model, motion executor and planner,
-// and the factory with every task node registered.
+// Task services and a belief for ticking task nodes one at a time in the family tests: the lab's
+// door (the wall y = 3, hinge at x = 0.475, latch at x = -0.475, opening north) with a push button
+// south of it at x = 1.075, a free floor around it, the real robot model, motion executor and
+// planner, and the factory with every task node registered.
 
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
+#include "egress/behavior/door_rules.h"
 #include "egress/behavior/task_nodes.h"
 #include "egress/bt/factory.h"
 #include "egress/hsr_interface/error.h"
@@ -59,12 +61,14 @@ class TaskNodeFixture : public ::testing::Test {
         motion_(model_),
         costmap_(map_.grid),
         planner_(costmap_, nullptr) {
-    context_.map = &map_;
-    context_.model = &model_;
-    context_.motion = &motion_;
-    context_.planner = &planner_;
-    context_.X_MB = {0.0, 2.0, M_PI / 2};  // 1 m south of the door, facing it
-    RegisterTaskNodes(factory_, &context_);
+    services_.map = &map_;
+    services_.model = &model_;
+    services_.motion = &motion_;
+    services_.planner = &planner_;
+    belief_.X_MB = {0.0, 2.0, M_PI / 2};  // 1 m south of the door, facing it
+    services_.log = &log_;
+    services_.belief = &belief_;
+    RegisterTaskNodes(factory_, &services_);
   }
   // A tree of the one node `xml`, on `blackboard` if given.
   bt::Tree Tree(const std::string& xml, bt::Blackboard::Ptr blackboard = nullptr) {
@@ -80,13 +84,21 @@ class TaskNodeFixture : public ::testing::Test {
     door.state.angle = angle_deg * M_PI / 180.0;
     door.state.clearance_width = door.model.ClearanceWidth(door.state.angle);
     door.state.motion = perception::DoorMotion::kHeldOpen;
-    door.state.stamp = context_.now;
-    context_.world.doors = {door};
-    context_.door_open_since["lab_door"] = context_.now - SecondsToDuration(open_for);
+    door.state.stamp = belief_.now;
+    belief_.world.doors = {door};
+    belief_.door_open_since["lab_door"] = belief_.now - SecondsToDuration(open_for);
+  }
+  // The people the robot sees now, and the door zones they occupy recorded in the belief as the
+  // executive records them every control step.
+  void See(std::vector<perception::TrackedPersonWithIntent> people) {
+    belief_.world.people = std::move(people);
+    for (const auto& door : map_.doors) {
+      if (IsDoorZoneOccupied(services_, door.id)) belief_.zone_occupied_at[door.id] = belief_.now;
+    }
   }
   // Whether any note so far carries `event`.
   bool Noted(DecisionEvent event) const {
-    for (const auto& note : context_.notes)
+    for (const auto& note : log_.pending())
       if (note.event == event) return true;
     return false;
   }
@@ -96,7 +108,9 @@ class TaskNodeFixture : public ::testing::Test {
   MotionExecutor motion_;
   perception::Costmap2D costmap_;
   planning::BasePlanner planner_;
-  TaskContext context_;
+  Belief belief_;
+  DecisionLog log_;
+  TaskServices services_;
   bt::BehaviorTreeFactory factory_;
 };
 

@@ -26,56 +26,59 @@ perception::TrackedPersonWithIntent StillPerson(const Eigen::Vector2d& p_MP,
 
 class DoorZoneRulesTest : public ::testing::Test {
  protected:
-  DoorZoneRulesTest() {
-    context_.map = &map_;
-    context_.X_MB = {0.0, 2.3, M_PI / 2};
-  }
+  DoorZoneRulesTest() { belief_.X_MB = {0.0, 2.3, M_PI / 2}; }
   MissionMap map_ = LabDoor();
-  TaskContext context_;
+  Belief belief_;
+  TaskServices services_ = [this] {
+    TaskServices s;
+    s.map = &map_;
+    s.belief = &belief_;
+    return s;
+  }();
 };
 
 TEST_F(DoorZoneRulesTest, AHolderBesideTheHingeJambIsNoReasonToWait) {
   // A person holding the door, standing by the hinge jamb, 0.4 m off the line: their disc
   // reaches into the zone, but not into the robot's lane through the opening.
   const auto holder = StillPerson({0.475 + 0.25, 3.4}, perception::PersonIntent::kHoldingDoor);
-  context_.world.people = {holder};
-  EXPECT_TRUE(IsHoldingDoorAside(context_, holder, "lab_door"));
-  EXPECT_FALSE(IsDoorZoneOccupied(context_, "lab_door"));
+  belief_.world.people = {holder};
+  EXPECT_TRUE(IsHoldingDoorAside(services_, holder, "lab_door"));
+  EXPECT_FALSE(IsDoorZoneOccupied(services_, "lab_door"));
   // Holding another door, the same person occupies this one's zone.
   auto elsewhere = holder;
   elsewhere.door_id = "door_b";
-  context_.world.people = {elsewhere};
-  EXPECT_FALSE(IsHoldingDoorAside(context_, elsewhere, "lab_door"));
-  EXPECT_TRUE(IsDoorZoneOccupied(context_, "lab_door"));
+  belief_.world.people = {elsewhere};
+  EXPECT_FALSE(IsHoldingDoorAside(services_, elsewhere, "lab_door"));
+  EXPECT_TRUE(IsDoorZoneOccupied(services_, "lab_door"));
 }
 
 TEST_F(DoorZoneRulesTest, APersonStoppedInTheDoorwayBlocksItWhateverTheirIntentReads) {
   // Stopped face to face with the robot, 0.2 m beyond the line in the opening's middle: still and
   // near the open leaf's hinge, so the tracker may read "holding" — but in the robot's lane.
   const auto in_lane = StillPerson({-0.2, 3.2}, perception::PersonIntent::kHoldingDoor);
-  context_.world.people = {in_lane};
-  EXPECT_FALSE(IsHoldingDoorAside(context_, in_lane, "lab_door"));
-  EXPECT_TRUE(IsDoorZoneOccupied(context_, "lab_door"));
+  belief_.world.people = {in_lane};
+  EXPECT_FALSE(IsHoldingDoorAside(services_, in_lane, "lab_door"));
+  EXPECT_TRUE(IsDoorZoneOccupied(services_, "lab_door"));
   // The lane is as wide as the footprint plus a person, either side of the opening's middle.
-  const double edge = context_.config.footprint_radius + context_.config.person_radius;
+  const double edge = services_.config.footprint_radius + services_.config.person_radius;
   EXPECT_FALSE(IsHoldingDoorAside(
-      context_, StillPerson({edge - 0.01, 3.4}, perception::PersonIntent::kHoldingDoor),
+      services_, StillPerson({edge - 0.01, 3.4}, perception::PersonIntent::kHoldingDoor),
       "lab_door"));
   EXPECT_TRUE(IsHoldingDoorAside(
-      context_, StillPerson({-edge - 0.01, 3.4}, perception::PersonIntent::kHoldingDoor),
+      services_, StillPerson({-edge - 0.01, 3.4}, perception::PersonIntent::kHoldingDoor),
       "lab_door"));
 }
 
 TEST_F(DoorZoneRulesTest, AStillPersonInTheZoneOccupiesItAndOneFarAwayDoesNot) {
-  context_.world.people = {StillPerson({0.0, 3.9}, perception::PersonIntent::kStationary)};
-  EXPECT_TRUE(IsDoorZoneOccupied(context_, "lab_door"));
-  context_.world.people = {StillPerson({0.0, 5.0}, perception::PersonIntent::kStationary)};
-  EXPECT_FALSE(IsDoorZoneOccupied(context_, "lab_door"));
+  belief_.world.people = {StillPerson({0.0, 3.9}, perception::PersonIntent::kStationary)};
+  EXPECT_TRUE(IsDoorZoneOccupied(services_, "lab_door"));
+  belief_.world.people = {StillPerson({0.0, 5.0}, perception::PersonIntent::kStationary)};
+  EXPECT_FALSE(IsDoorZoneOccupied(services_, "lab_door"));
   // Forecast into it: occupied now.
   auto walking_in = StillPerson({0.0, 5.0}, perception::PersonIntent::kApproaching);
   walking_in.person.forecast = {{0.0, 4.6}, {0.0, 4.2}};
-  context_.world.people = {walking_in};
-  EXPECT_TRUE(IsDoorZoneOccupied(context_, "lab_door"));
+  belief_.world.people = {walking_in};
+  EXPECT_TRUE(IsDoorZoneOccupied(services_, "lab_door"));
 }
 
 // A door held open out of the robot's sight (steady at 80°, no press of ours), seen open for
@@ -83,22 +86,21 @@ TEST_F(DoorZoneRulesTest, AStillPersonInTheZoneOccupiesItAndOneFarAwayDoesNot) {
 class DoorWindowTest : public DoorZoneRulesTest {
  protected:
   DoorWindowTest() : model_(RobotModel::LoadDefault()), motion_(model_) {
-    context_.motion = &motion_;
+    services_.motion = &motion_;
   }
   bool PassableAfter(double open_for, double side, double estimate_age = 0.0) {
-    context_.now = Time{} + SecondsToDuration(100.0);
-    context_.X_MB = {0.0, 3.0 + side * 1.0, side > 0 ? -M_PI / 2 : M_PI / 2};
-    context_.door_approach_side.clear();
-    context_.door_open_since["lab_door"] = context_.now - SecondsToDuration(open_for);
+    belief_.now = Time{} + SecondsToDuration(100.0);
+    belief_.X_MB = {0.0, 3.0 + side * 1.0, side > 0 ? -M_PI / 2 : M_PI / 2};
+    belief_.door_open_since["lab_door"] = belief_.now - SecondsToDuration(open_for);
     perception::TrackedDoor door;
     door.model = map_.doors[0];
     door.state.observed = true;
     door.state.angle = 80.0 * M_PI / 180.0;
     door.state.clearance_width = door.model.ClearanceWidth(door.state.angle);
     door.state.motion = perception::DoorMotion::kHeldOpen;
-    door.state.stamp = context_.now - SecondsToDuration(estimate_age);
-    context_.world.doors = {door};
-    return DoorPassable(context_, "lab_door", 0.0);
+    door.state.stamp = belief_.now - SecondsToDuration(estimate_age);
+    belief_.world.doors = {door};
+    return DoorPassable(services_, "lab_door", 0.0, nullptr);
   }
   RobotModel model_;
   MotionExecutor motion_;
@@ -125,7 +127,7 @@ TEST_F(DoorWindowTest, ADoorSeenOpenLongPastTheWindowIsHeldButOnlyIfSeenSoNow) {
 }
 
 TEST_F(DoorZoneRulesTest, AnUnknownDoorIsAClearError) {
-  EXPECT_THROW(IsDoorZoneOccupied(context_, "door_z"), InvalidArgument);
+  EXPECT_THROW(IsDoorZoneOccupied(services_, "door_z"), InvalidArgument);
 }
 
 }  // namespace

@@ -56,7 +56,7 @@ BrainRun RunWithBrain(const std::filesystem::path& file, std::uint64_t seed,
       std::printf("         TRUE %s at %.2f %.2f phase %s\n", p.name.c_str(), p.position.x(),
                   p.position.y(), std::string(twin::ToString(p.phase)).c_str());
     }
-    for (const auto& p : brain.context().world.people) {
+    for (const auto& p : brain.belief().world.people) {
       std::printf("         person %d at %.2f %.2f v %.2f %.2f intent %d door %s\n", p.person.id,
                   p.person.p_MP.x(), p.person.p_MP.y(), p.person.v_MP.x(), p.person.v_MP.y(),
                   int(p.intent), p.door_id.c_str());

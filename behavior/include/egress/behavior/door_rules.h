@@ -9,7 +9,7 @@
 
 #include <Eigen/Core>
 
-#include "egress/behavior/task_context.h"
+#include "egress/behavior/task_services.h"
 
 namespace egress::behavior {
 
@@ -21,28 +21,33 @@ struct DoorPass {
 };
 /// @throws InvalidArgument for an unknown door id.
 DoorPass CalcDoorPass(const MissionMap& map, const std::string& door, const Pose2& X_MB);
-/// The same, with the normal pointing to the side the robot approached the door from, if the
-/// context remembers one (else the side it is on now).
-DoorPass CalcKnownPass(const TaskContext& context, const std::string& door);
-/// CalcKnownPass, remembering the side the first time (the robot's side now).
-DoorPass CalcApproachPass(TaskContext& context, const std::string& door);
+/// The same, with the normal pointing to the side the robot approached the door from, if
+/// `visit` (a visit to this door) remembers one, else the side it is on now.
+DoorPass CalcKnownPass(const TaskServices& task, const std::string& door, const DoorVisit* visit);
+/// CalcKnownPass, remembering the side in `visit` the first time (the robot's side now).
+DoorPass CalcApproachPass(const TaskServices& task, DoorVisit& visit);
 
 /// True when `entry` holds `door` open standing out of the robot's lane through it: the strip
 /// through the opening's middle, as wide as the footprint plus the person. Someone standing in
 /// that lane blocks the way whatever the tracker reads as their intent (a person stopped in the
 /// doorway face to face with the robot is still, next to an open leaf, and not holding it).
-bool IsHoldingDoorAside(const TaskContext& context,
-                        const perception::TrackedPersonWithIntent& entry, const std::string& door);
+bool IsHoldingDoorAside(const TaskServices& task, const perception::TrackedPersonWithIntent& entry,
+                        const std::string& door);
 /// True when a person (not one holding this door aside) is in, or forecast into, the zone of
 /// `door`.
-bool IsDoorZoneOccupied(const TaskContext& context, const std::string& door);
+bool IsDoorZoneOccupied(const TaskServices& task, const std::string& door);
+/// The zone of `door` has been free of people (IsDoorZoneOccupied false) for at least
+/// `clear_for` [s], by the belief's zone_occupied_at.
+bool IsDoorZoneClearFor(const TaskServices& task, const std::string& door, double clear_for);
 /// The leaf leaves room for the footprint (plus `margin`) [m], is not closing, and — unless a
 /// person holds it aside — the operator's hold window (from the robot's own press, or from when
-/// it was first seen open) leaves time to drive clear of the leaf: past the line for a leaf that
-/// opens towards the robot (which then still has the time the closing leaf takes to reach its
-/// lane), beyond the sweep on the far side otherwise. Needs `context.motion` (door speed).
-bool DoorPassable(const TaskContext& context, const std::string& door, double margin);
+/// it was first seen open; `visit` holds the robot's own press) leaves time to drive clear of the
+/// leaf: past the line for a leaf that opens towards the robot (which then still has the time the
+/// closing leaf takes to reach its lane), beyond the sweep on the far side otherwise. Needs
+/// `task.motion` (door speed).
+bool DoorPassable(const TaskServices& task, const std::string& door, double margin,
+                  const DoorVisit* visit);
 /// Clearance of the door's opening from the latest estimate, or nullopt if never observed.
-std::optional<double> DoorClearance(const TaskContext& context, const std::string& door);
+std::optional<double> DoorClearance(const TaskServices& task, const std::string& door);
 
 }  // namespace egress::behavior

@@ -16,10 +16,11 @@
 #include <string>
 #include <vector>
 
+#include "egress/behavior/belief.h"
 #include "egress/behavior/grasp_monitor.h"
 #include "egress/behavior/mission_map.h"
 #include "egress/behavior/motion_executor.h"
-#include "egress/behavior/task_context.h"
+#include "egress/behavior/task_services.h"
 #include "egress/bt/status.h"
 #include "egress/hsr_interface/robot_port.h"
 #include "egress/perception/costmap.h"
@@ -121,15 +122,18 @@ class Executive {
   void SetDetector(std::unique_ptr<perception::Detector> detector);
   /// The running action's name (instance name, else its type), or empty.
   std::string active_action() const;
-  const Pose2& X_MB() const { return context_.X_MB; }
+  const Pose2& X_MB() const { return belief_.X_MB; }
   const perception::Costmap2D& costmap() const { return *costmap_; }
   /// The head camera's 3D obstacle map, or nullptr when config.use_octomap is false.
   const perception::OccupancyMap3D* octomap() const;
   /// The robot's 3D outline in B the planner checks (measured arm, held payload).
   const std::vector<PlacedShape>& body_shapes() const;
-  const TaskContext& context() const { return context_; }
+  /// What the task nodes believe at this step.
+  const Belief& belief() const { return belief_; }
+  /// What the task nodes act through (map, task config, motion executor, planner).
+  const TaskServices& services() const { return services_; }
   /// How often a precise act re-localized first (TaskConfig::precise_pose_sigma).
-  int relocalizations() const { return context_.relocalizations; }
+  int relocalizations() const { return relocalizations_; }
   /// Time of the first tick at which an IsPathClear check failed after having passed, and of
   /// the first zero-velocity / retract command after it, per event [s] (preemption latency).
   const std::vector<std::pair<double, double>>& preemptions() const { return preemptions_; }
@@ -147,7 +151,10 @@ class Executive {
 
   struct Impl;
   std::unique_ptr<Impl> impl_;
-  TaskContext context_;
+  Belief belief_;  // refreshed every step; the nodes read it
+  DecisionLog log_;
+  TaskServices services_;
+  int relocalizations_{0};
   std::unique_ptr<perception::Costmap2D> costmap_;
   bt::NodeStatus status_{bt::NodeStatus::kIdle};
   std::vector<Decision> decisions_;

@@ -1,14 +1,18 @@
 #pragma once
 /// @file
-/// TaskContext: what the task nodes share — the robot's latest belief (pose, world state), the
-/// building map, the planner and the motion executor — and TaskConfig, their parameters. The
-/// executive owns one and refreshes it every control step; the nodes read it when ticked.
+/// What a task node works with, handed to its constructor: TaskServices (the robot model, the
+/// building map, the planner, the motion executor, the decision log and the read-only Belief)
+/// and TaskConfig, the nodes' parameters. What nodes hand each other (a button plan, the side a
+/// door is approached from, when the robot operated it, a retreat under way) is not here: it
+/// travels on blackboard ports (DoorVisit, `retreating`), where the tree and Groot2 see it.
 
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "egress/behavior/belief.h"
 #include "egress/behavior/mission_map.h"
 #include "egress/behavior/motion_executor.h"
 #include "egress/hsr_interface/robot_model.h"
@@ -70,6 +74,7 @@ enum class DecisionEvent {
   kDoorZoneClear,     ///< The door zone is clear again (after the hysteresis).
   kRetreating,        ///< A standby retreat to the last safe waypoint starts.
   kResponderInReach,  ///< A hand-over's responder is within the arm's reach.
+  kRelocalizing,      ///< A precise act waits for the pose to settle (re-localizes) first.
 };
 
 /// One note of a node: its event and its text.
@@ -78,50 +83,48 @@ struct NodeNote {
   std::string text;
 };
 
-struct TaskContext {
+/// The decisions the nodes record, drained by the executive each tick into the run's log.
+class DecisionLog {
+ public:
+  void Record(DecisionEvent event, std::string text) { notes_.push_back({event, std::move(text)}); }
+  /// What was recorded since the last Take, oldest first; the log is empty afterwards.
+  std::vector<NodeNote> Take() { return std::exchange(notes_, {}); }
+  /// What was recorded since the last Take (tests read it).
+  const std::vector<NodeNote>& pending() const { return notes_; }
+
+ private:
+  std::vector<NodeNote> notes_;
+};
+
+/// The robot's dealings with one door, shared by the door nodes on a blackboard port (`visit`,
+/// default key `{door_visit}`): each DoorTraversal subtree instance has its own blackboard, so a
+/// traversal starts with a fresh visit and keeps it across its retries after a yield.
+struct DoorVisit {
+  std::string door;  ///< The door the visit is to; a node at another door starts a new visit.
+  /// The unit normal of the door line pointing to the side the robot came from: fixed when it
+  /// first works at the door, so a robot caught mid-doorway still knows which way is forward;
+  /// cleared once it is through, so it can come back the other way.
+  std::optional<Eigen::Vector2d> approach_side;
+  std::optional<ButtonPlan> button_plan;  ///< ApproachButton's, for PressButton / WaveAtPlate.
+  /// When the robot's hand reached the actuator to press or wave (the operator's hold window
+  /// starts soon after, whether or not the door is seen opening).
+  std::optional<Time> operated_at;
+  /// Set when a press or wave found the door already open: the operator restarted its hold
+  /// window when the hand reached the actuator (operated_at).
+  std::optional<Time> window_restarted_at;
+};
+
+/// What the task nodes act through, handed to each at construction. The executive owns every
+/// piece and keeps them alive as long as its trees.
+struct TaskServices {
   const RobotModel* model{nullptr};
   const MissionMap* map{nullptr};
   TaskConfig config;
   MotionExecutor* motion{nullptr};
   const planning::BasePlanner* planner{nullptr};
-
-  // Refreshed every control step by the executive.
-  Time now{};
-  Pose2 X_MB;  ///< Localized base pose.
-  perception::WorldState world;
-  bool holding_object{false};
-  std::optional<LaserScan> scan;  ///< The latest laser scan.
-  /// The latest head depth image, the camera in M when it was taken, and its intrinsics.
-  std::optional<DepthImage> depth;
-  Pose3 X_MC;
-  CameraIntrinsics depth_intrinsics;
-  Pose2 X_BL;  ///< The laser in the base frame.
-  /// The last pose at which the robot stood outside every door zone.
-  std::optional<Pose2> last_safe;
-
-  // Kept by the nodes.
-  std::map<std::string, ButtonPlan> button_plans;  ///< Per door.
-  std::map<std::string, Time> zone_occupied_at;    ///< Per door: when a person last was in it.
-  /// Per door: the unit normal of the door line pointing to the side the robot came from
-  /// (fixed when it first works at the door, so a robot caught mid-doorway still knows which
-  /// way is forward; forgotten once it is through, so it can come back the other way).
-  std::map<std::string, Eigen::Vector2d> door_approach_side;
-  /// Per door: since when it has been open enough to pass in its current opening (kept by the
-  /// executive from the angle estimate; a press restarts it).
-  std::map<std::string, Time> door_open_since;
-  /// Per door: when the robot's hand last reached its actuator to press or wave (the operator's
-  /// hold window starts soon after, whether or not the door is seen opening).
-  std::map<std::string, Time> door_operated_at;
-  /// How often a precise act waited for the pose to settle (re-localized) first.
-  int relocalizations{0};
-  /// A standby retreat is under way: it is finished before the robot resumes.
-  bool retreating{false};
-  std::vector<NodeNote> notes;  ///< The nodes' reasons and decision events, for the run log.
-
-  double now_s() const { return ToSeconds(now); }
-  void Note(std::string text, DecisionEvent event = DecisionEvent::kNote) {
-    notes.push_back({event, std::move(text)});
-  }
+  DecisionLog* log{nullptr};
+  /// The robot's belief, refreshed by the executive before every tick; read-only to the nodes.
+  const Belief* belief{nullptr};
 };
 
 }  // namespace egress::behavior

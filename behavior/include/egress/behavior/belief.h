@@ -1,0 +1,45 @@
+#pragma once
+/// @file
+/// Belief: what the robot believes at this control step — its localized pose, the world state
+/// (doors, people, payloads, costmap), its latest sensor data and what the executive derives from
+/// them over time (when each door's current opening began, when a person was last in each door
+/// zone, the last pose outside every door zone). The executive refreshes it every control step;
+/// task nodes only read it (they hold a const reference), so no node can leave state in it for
+/// another: state nodes share travels on blackboard ports.
+
+#include <map>
+#include <optional>
+#include <string>
+
+#include "egress/hsr_interface/geometry.h"
+#include "egress/hsr_interface/sensor_types.h"
+#include "egress/hsr_interface/time.h"
+#include "egress/perception/world_state.h"
+
+namespace egress::behavior {
+
+struct Belief {
+  Time now{};  ///< The robot clock at this step.
+  Pose2 X_MB;  ///< The localized base pose.
+  perception::WorldState world;
+  bool holding_object{false};     ///< From the gripper's own measurement (GraspMonitor).
+  std::optional<LaserScan> scan;  ///< The latest laser scan.
+  /// The latest head depth image, the camera in M when it was taken, and its intrinsics.
+  std::optional<DepthImage> depth;
+  Pose3 X_MC;
+  CameraIntrinsics depth_intrinsics;
+  Pose2 X_BL;  ///< The laser in the base frame.
+  /// The last pose at which the robot stood outside every door zone (where a standby retreats).
+  std::optional<Pose2> last_safe;
+  /// Per door: since when it has been open enough to pass in its current opening (from the
+  /// angle estimate: it starts when the leaf is first seen wide enough, ends when it is seen
+  /// closed or closing).
+  std::map<std::string, Time> door_open_since;
+  /// Per door: the last step at which a person (not one holding the door aside) was in, or
+  /// forecast into, its zone. Absent: never seen occupied.
+  std::map<std::string, Time> zone_occupied_at;
+
+  double now_s() const { return ToSeconds(now); }
+};
+
+}  // namespace egress::behavior
