@@ -190,6 +190,24 @@ people:
   EXPECT_GT(world.people()[0].position.x(), 7.0);
 }
 
+TEST(TwinWorldTest, AWalkerBlockedByAnOpenLeafStepsRoundItsFreeEdge) {
+  // S6's passer: along the far side of the lab door, across the sweep of its leaf held open at
+  // 80 deg (the leaf is a wall to the social forces). Without stepping round, the walker stood
+  // against the leaf in the doorway's zone for good.
+  const std::string yaml = R"(world: lab.sdf
+robot: {start: {x: 0.0, y: 1.0}}
+doors: [{door: lab_door, operator: push, actuator: lab_button, open_at: [0.0], hold_open_s: 60}]
+people:
+  - {name: passer, behavior: walk_past, start: [-2.6, 3.9], via: [[-1.0, 3.6]], goal: [2.6, 3.6], speed: 1.2, trigger: {event: "door_opened:lab_door"}}
+)";
+  auto loaded = LoadText(yaml, WorldsDir() / "lab");
+  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+  world.StepFor(25.0);
+  EXPECT_GT(world.door_angle(0), 70 * kDeg);  // still held open: the leaf was in the way
+  EXPECT_EQ(CountEvents(world, "person_steps_round_leaf", "passer"), 1);
+  EXPECT_LT((world.people()[0].position - Eigen::Vector2d(2.6, 3.6)).norm(), 0.5);
+}
+
 class GraspTest : public ::testing::Test {
  protected:
   // A bottle on the office table; the robot reaches it from the table's north side.

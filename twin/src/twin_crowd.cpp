@@ -2,6 +2,20 @@
 #include "twin_world_impl.h"
 
 namespace egress::twin {
+namespace {
+
+// Whether segments ab and cd cross (touching counts).
+bool SegmentsCross(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
+                   const Eigen::Vector2d& d) {
+  const auto cross = [](const Eigen::Vector2d& u, const Eigen::Vector2d& v) {
+    return u.x() * v.y() - u.y() * v.x();
+  };
+  const double d1 = cross(b - a, c - a), d2 = cross(b - a, d - a);
+  const double d3 = cross(d - c, a - c), d4 = cross(d - c, b - c);
+  return d1 * d2 <= 0.0 && d3 * d4 <= 0.0;
+}
+
+}  // namespace
 
 std::string_view ToString(PersonPhase phase) {
   switch (phase) {
@@ -144,6 +158,26 @@ void TwinWorld::Impl::UpdatePeople() {
       p.stuck_for = 0.0;
       p.walker.target = p.route.front();
       p.walker.final_target = false;
+    }
+    // Walking into an open leaf that stands across the way to the next waypoint (the leaf is a
+    // wall to the social forces, and a wall between walker and goal is a local minimum), a
+    // walker steps round the leaf's free edge, as people do.
+    p.blocked_for = p.state.phase == PersonPhase::kWalking && p.walker.velocity.norm() < 0.05
+                        ? p.blocked_for + dt
+                        : 0.0;
+    if (p.blocked_for > kStuckSec) {
+      for (const auto& d : doors) {
+        const Eigen::Vector2d hinge = d.desc->p_WH.head<2>();
+        const Eigen::Vector2d edge = d.desc->CalcFreeEdge(d.angle).head<2>();
+        if (!SegmentsCross(p.walker.position, p.route.front(), hinge, edge)) continue;
+        p.route.insert(p.route.begin(), edge + (edge - hinge).normalized() * kStepRoundLeaf);
+        --p.reached;  // a detour, not a waypoint of the route
+        p.walker.target = p.route.front();
+        p.walker.final_target = false;
+        AddEvent("person_steps_round_leaf", p.state.name, d.desc->name);
+        break;
+      }
+      p.blocked_for = 0.0;
     }
     const double reached_radius = p.route.size() == 1 ? 0.25 : 0.4;
     if ((p.walker.position - p.route.front()).norm() < reached_radius &&

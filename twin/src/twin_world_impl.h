@@ -43,6 +43,9 @@ constexpr int kMaskBase = kGStatic | kGDoor | kGPerson | kGPayload;
 constexpr int kMaskArm = kGStatic | kGDoor | kGPerson | kGPayload;
 constexpr double kStuckSec =
     2.0;  // [s] a walker that wants to move but has not, this long, is stuck
+// [m] beyond an open leaf's free edge a walker blocked by the leaf steps round it: a shoulder
+// (0.25 m) and a margin
+constexpr double kStepRoundLeaf = 0.45;
 constexpr double kKeepRight = 0.2;  // [m] off the doorway axis, clear of a 0.9 m door's jambs
 constexpr int kMaskPerson = kGStatic | kGDoor | kGBase | kGArm | kGPayload;
 constexpr int kMaskPayload = kGStatic | kGFloor | kGDoor | kGBase | kGArm | kGPerson | kGPayload;
@@ -183,6 +186,7 @@ struct Person {
   int reached{0};                // waypoints reached so far
   double stuck_for{0.0};         // [s] wanting to walk but not moving
   bool realigned{false};         // stepped back onto the door's axis once
+  double blocked_for{0.0};       // [s] walking but not moving (any leg of the route)
   double hold_angle{0.0};
   double hold_duration{0.0};
   double hold_started{-1.0};
