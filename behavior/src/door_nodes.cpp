@@ -189,6 +189,7 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
     // The hand reaches the actuator's approach pose then; the press or wave follows.
     DoorVisit visit = Visit();
     visit.operated_at = belief_.now + SecondsToDuration(task_.config.press_reach_time);
+    visit.window_restarted_at.reset();  // an earlier press's restart says nothing of this one
     Remember(visit);
     const auto approach = SolveArm(task_, X_MB, plan.targets.approach, plan.approach_arm, push);
     if (!approach) {

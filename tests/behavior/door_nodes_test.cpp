@@ -51,6 +51,31 @@ TEST_F(DoorNodesTest, PressButtonNeedsTheApproachFirst) {
   EXPECT_NE(log_.pending().back().text.find("ApproachButton must run first"), std::string::npos);
 }
 
+TEST_F(DoorNodesTest, APressRecordsWhenTheHandReachesTheButtonAndForgetsAnEarlierRestart) {
+  auto blackboard = bt::Blackboard::Create();
+  bt::Tree approach = Tree(R"(<ApproachButton door="lab_door"/>)", blackboard);
+  belief_.now = At(1.0);
+  ASSERT_EQ(approach.TickOnce(), NodeStatus::kRunning);
+  DoorVisit visit = *blackboard->Get<DoorVisit>("door_visit");
+  ASSERT_TRUE(visit.button_plan.has_value());
+  // An earlier press found the door open and restarted its window; this one starts afresh.
+  visit.window_restarted_at = At(0.5);
+  blackboard->Set("door_visit", bt::Any(visit));
+  belief_.X_MB = visit.button_plan->X_MB_standoff;  // standing at the standoff
+  belief_.now = At(20.0);
+  bt::Tree press = factory_.CreateTreeFromText(
+      R"(<root BTCPP_format="4"><BehaviorTree ID="press"><PressButton door="lab_door"/></BehaviorTree></root>)",
+      "press", blackboard);
+  EXPECT_EQ(press.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(motion_.arm_moving(belief_.now));
+  const DoorVisit after = *blackboard->Get<DoorVisit>("door_visit");
+  ASSERT_TRUE(after.operated_at.has_value());
+  // The hand reaches the button press_reach_time after the press starts.
+  EXPECT_NEAR(ToSeconds(*after.operated_at - At(20.0)), services_.config.press_reach_time, 1e-9);
+  EXPECT_FALSE(after.window_restarted_at.has_value());
+  EXPECT_TRUE(after.button_plan.has_value());  // the plan stays with the visit
+}
+
 TEST_F(DoorNodesTest, TraverseDoorLinesUpOnTheDoorsAxisBeforeGoing) {
   bt::Tree tree = Tree(R"(<TraverseDoor door="lab_door"/>)");
   belief_.X_MB = {1.0, 2.2, M_PI / 2};  // beside the axis, before the door
