@@ -116,6 +116,39 @@ TEST(TwinWorldTest, ABlockedLeafStopsAgainstTheRobot) {
   EXPECT_LT((world.robot_pose().translation() - Eigen::Vector2d(0.0, 3.55)).norm(), 0.1);
 }
 
+// The robot's body is its description's shapes: above the base it is a slim column (torso and
+// head behind the base's centre, the tucked arm ahead of it), not the base's circle extruded.
+// Each shelf reaches 0.12 m over the front of the footprint (edge 0.10 m ahead of B's origin).
+std::vector<std::string> ContactsUnderAShelfAt(double z_centre) {
+  const std::string shelf =
+      "obstacles: [{name: shelf, box: [0.6, 0.8, 0.05], x: -1.8, y: 0.8, z: " +
+      std::to_string(z_centre) + "}]\n";
+  auto loaded = LoadText(LabScenario({-2.2, 0.8, 0.0}, shelf), WorldsDir() / "lab");
+  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+  world.StepFor(0.5);
+  std::vector<std::string> parts;
+  for (const auto& e : world.events()) {
+    if (e.kind == "contact" && e.subject == "shelf") parts.push_back(e.detail);
+  }
+  return parts;
+}
+
+TEST(TwinWorldTest, AShelfOverTheBaseAboveTheArmTouchesNothing) {
+  // 0.90-0.95 m: above the tucked forearm (to 0.83 m), ahead of the head.
+  EXPECT_THAT(ContactsUnderAShelfAt(0.925), ::testing::IsEmpty());
+}
+
+TEST(TwinWorldTest, AShelfOverTheBaseAtTheArmsHeightTouchesTheArm) {
+  // 0.72-0.77 m: the tucked forearm stands there, ahead of B's origin.
+  EXPECT_THAT(ContactsUnderAShelfAt(0.745),
+              ::testing::Contains(::testing::HasSubstr("hsrb_forearm")));
+}
+
+TEST(TwinWorldTest, AShelfOverTheBaseAtBaseHeightTouchesTheBase) {
+  // 0.20-0.25 m: the base's own top (0.01-0.25 m) is the footprint's full circle.
+  EXPECT_THAT(ContactsUnderAShelfAt(0.225), ::testing::Contains(::testing::HasSubstr("by hsrb")));
+}
+
 TEST(TwinWorldTest, APersonHoldsTheDoorOpenThenItCloses) {
   const Scenario s = LoadScenario(WorldsDir() / "lab/lab_hold_door.yaml");
   TwinWorld world(s, LoadSdfWorld(s.world_file), 1, Hsr());

@@ -10,18 +10,6 @@ void TwinWorld::Impl::BuildRobot() {
   start.y += r.robot_dy.Sample(rng);
   start.yaw = WrapAngle(start.yaw + r.robot_dyaw.Sample(rng));
   robot_radius = model->footprint_radius();
-  const int e = AddEntity(EntityKind::kRobotBase, "hsrb", -1);
-  const Pose3 X_WB =
-      Pose3::FromPose2(start) * Pose3(Eigen::Vector3d(0, 0, 0.02 + kRobotBodyHeight / 2));
-  base = AddBody(std::make_unique<btCylinderShapeZ>(
-                     btVector3(robot_radius, robot_radius, kRobotBodyHeight / 2)),
-                 X_WB, config.robot_mass, kGBase, kMaskBase, e);
-  base->setFlags(base->getFlags() | BT_DISABLE_WORLD_GRAVITY);
-  base->setGravity(btVector3(0, 0, 0));
-  base->setLinearFactor(btVector3(1, 1, 0));
-  base->setAngularFactor(btVector3(0, 0, 1));
-  base->setActivationState(DISABLE_DEACTIVATION);
-  base->setFriction(0.0);
   // Arm at the robot description's tucked ("go") pose.
   const WholeBodyVector tucked = model->tucked_configuration();
   arm_q = {{"head_pan_joint", 0.0}, {"head_tilt_joint", 0.0}};
@@ -31,6 +19,38 @@ void TwinWorld::Impl::BuildRobot() {
     const JointLimits lim = model->GetJointLimits(name);
     q = std::clamp(q, lim.lower, lim.upper);
   }
+  // The trunk: the robot description's collision shapes of the links that move only with the
+  // lift and the head, one compound the wheels drive. Above its base the HSR is a slim column,
+  // so an overhang the base passes under meets the torso or the arm, as on the robot.
+  const std::vector<std::pair<std::string, double>> joints(arm_q.begin(), arm_q.end());
+  auto trunk_shape = std::make_unique<btCompoundShape>();
+  const std::vector<PlacedShape> placed = model->CalcCollisionShapesInBase(joints);
+  for (std::size_t i = 0; i < placed.size(); ++i) {
+    if (!IsTrunkLink(placed[i].shape.link)) continue;
+    auto child = MakeRobotShape(placed[i].shape);
+    trunk_shape->addChildShape(ToBt(placed[i].X_BS), child.get());
+    shapes.push_back(std::move(child));  // the compound does not own its children
+    trunk_shape_index.push_back(i);
+  }
+  ThrowUnless(trunk_shape->getNumChildShapes() > 0, "TwinWorld: the robot description '",
+              model->source(), "' has no collision shape on its base or torso links");
+  trunk = trunk_shape.get();
+  const int e = AddEntity(EntityKind::kRobotBase, "hsrb", -1);
+  base = AddBody(std::move(trunk_shape), Pose3::FromPose2(start), config.robot_mass, kGBase,
+                 kMaskBase, e);
+  // The planar dynamics of a solid round base of the footprint (the wheels' torque limit assumes
+  // it), whatever the compound's box-approximated inertia would be.
+  btVector3 inertia;
+  btCylinderShapeZ(btVector3(robot_radius, robot_radius, kRobotBodyHeight / 2))
+      .calculateLocalInertia(config.robot_mass, inertia);
+  base->setMassProps(config.robot_mass, inertia);
+  base->updateInertiaTensor();
+  base->setFlags(base->getFlags() | BT_DISABLE_WORLD_GRAVITY);
+  base->setGravity(btVector3(0, 0, 0));
+  base->setLinearFactor(btVector3(1, 1, 0));
+  base->setAngularFactor(btVector3(0, 0, 1));
+  base->setActivationState(DISABLE_DEACTIVATION);
+  base->setFriction(0.0);
   // The hand: palm block and two fingers (fingers do not collide: grasps are decided
   // analytically, see UpdateGripper).
   auto palm_block = std::make_unique<btBoxShape>(btVector3(0.04, 0.035, 0.02));
@@ -45,6 +65,19 @@ void TwinWorld::Impl::BuildRobot() {
   forearm_body =
       AddBody(std::make_unique<btCapsuleShapeZ>(0.045, 0.2), Pose3(), 0.0, kGArm, kMaskArm, fe);
   MakeKinematic(forearm_body);
+  // The upper arm: the arm flex link's own shapes, posed in W by its link frame.
+  auto upper_arm = std::make_unique<btCompoundShape>();
+  for (const CollisionShape& s : model->collision_shapes()) {
+    if (s.link != kUpperArmLink) continue;
+    auto child = MakeRobotShape(s);
+    upper_arm->addChildShape(ToBt(s.X_LS), child.get());
+    shapes.push_back(std::move(child));
+  }
+  if (upper_arm->getNumChildShapes() > 0) {
+    const int ue = AddEntity(EntityKind::kRobotArm, "hsrb_upper_arm", -1);
+    upper_arm_body = AddBody(std::move(upper_arm), Pose3(), 0.0, kGArm, kMaskArm, ue);
+    MakeKinematic(upper_arm_body);
+  }
   UpdateArmBodies();
 }
 
@@ -193,6 +226,11 @@ void TwinWorld::Impl::UpdateArmBodies() {
     const Pose3 X_BW = model->CalcLinkPoseInBase("wrist_flex_link", joints);
     X_BForearm_a = X_BR.translation();
     X_BForearm_b = X_BW.translation();
+    X_BUpperArm = model->CalcLinkPoseInBase(kUpperArmLink, joints);
+    const std::vector<PlacedShape> placed = model->CalcCollisionShapesInBase(joints);
+    for (int c = 0; c < trunk->getNumChildShapes(); ++c)
+      trunk->updateChildTransform(c, ToBt(placed[trunk_shape_index[std::size_t(c)]].X_BS),
+                                  c + 1 == trunk->getNumChildShapes());
     arm_pose_cache_q = joints;
     arm_pose_cache_valid = true;
   }
@@ -204,6 +242,11 @@ void TwinWorld::Impl::UpdateArmBodies() {
   const btTransform F = ToBt(Pose3(rot, mid));
   forearm_body->getMotionState()->setWorldTransform(F);
   forearm_body->setWorldTransform(F);
+  if (upper_arm_body != nullptr) {
+    const btTransform U = ToBt(X_WB * X_BUpperArm);
+    upper_arm_body->getMotionState()->setWorldTransform(U);
+    upper_arm_body->setWorldTransform(U);
+  }
 }
 
 void TwinWorld::Impl::UpdateGripper() {

@@ -128,6 +128,7 @@ void TwinWorld::Impl::RecordContacts() {
     };
     // What the hand holds is part of the robot's outline while carried.
     std::vector<btRigidBody*> parts{hand_body, forearm_body};
+    if (upper_arm_body != nullptr) parts.push_back(upper_arm_body);
     if (held >= 0) parts.push_back(payloads[held].body);
     for (btRigidBody* arm : parts) {
       Collector collector;

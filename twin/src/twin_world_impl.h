@@ -50,8 +50,10 @@ constexpr double kKeepRight = 0.2;  // [m] off the doorway axis, clear of a 0.9 
 constexpr int kMaskPerson = kGStatic | kGDoor | kGBase | kGArm | kGPayload;
 constexpr int kMaskPayload = kGStatic | kGFloor | kGDoor | kGBase | kGArm | kGPerson | kGPayload;
 
-constexpr double kPersonHeight = 1.7;       // [m]
-constexpr double kRobotBodyHeight = 1.0;    // base + torso cylinder [m]
+constexpr double kPersonHeight = 1.7;  // [m]
+// [m] height of the solid round base whose inertia the trunk is given (the wheels' torque
+// limit assumes it)
+constexpr double kRobotBodyHeight = 1.0;
 constexpr double kHandOpen = 1.24;          // hand_motor_joint fully open [rad]
 constexpr double kHandTouching = -0.3;      // fingertips meet [rad]
 constexpr double kHandMaxWidth = 0.135;     // finger gap when fully open [m]
@@ -81,6 +83,27 @@ inline Pose3 FromBt(const btTransform& T) {
 inline double HandWidth(double hand_q) {
   return kHandMaxWidth *
          std::clamp((hand_q - kHandTouching) / (kHandOpen - kHandTouching), 0.0, 1.0);
+}
+
+// The links whose shapes make the robot's trunk (the base body): they move only with the lift
+// and the head. The arm from its flex link on has its own kinematic bodies.
+inline bool IsTrunkLink(std::string_view link) {
+  return link == "base_link" || link == "torso_lift_link" || link == "head_pan_link" ||
+         link == "head_tilt_link" || link == "arm_lift_link";
+}
+inline constexpr const char* kUpperArmLink = "arm_flex_link";
+
+// A robot description's collision primitive as a Bullet shape (centred on its frame S).
+inline std::unique_ptr<btCollisionShape> MakeRobotShape(const CollisionShape& s) {
+  switch (s.kind) {
+    case CollisionShape::Kind::kBox:
+      return std::make_unique<btBoxShape>(ToBt(Eigen::Vector3d(s.size / 2)));
+    case CollisionShape::Kind::kCylinder:
+      return std::make_unique<btCylinderShapeZ>(btVector3(s.size.x(), s.size.x(), s.size.z() / 2));
+    case CollisionShape::Kind::kSphere:
+      break;
+  }
+  return std::make_unique<btSphereShape>(s.size.x());
 }
 
 // Outline segments of a static shape on the floor (for the people's wall forces).
@@ -373,6 +396,10 @@ struct TwinWorld::Impl {
   SocialForceModel sfm;
 
   btRigidBody* base{nullptr};
+  btCompoundShape* trunk{nullptr};             // the base body's shape
+  std::vector<std::size_t> trunk_shape_index;  // child -> CalcCollisionShapesInBase's index
+  btRigidBody* upper_arm_body{nullptr};        // null when the description has no upper arm shape
+  Pose3 X_BUpperArm;
   btRigidBody* hand_body{nullptr};
   btRigidBody* forearm_body{nullptr};
   double robot_radius{0.215};
