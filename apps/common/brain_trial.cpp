@@ -81,9 +81,17 @@ std::unique_ptr<behavior::Executive> MakeScenarioExecutive(
 BrainTrial RunBrainTrial(const twin::Scenario& scenario, const twin::WorldDescription& world,
                          std::uint64_t seed, std::shared_ptr<const RobotModel> model,
                          const BrainTrialOptions& options) {
+  return RunBrainTrial(std::make_shared<const twin::TwinModel>(scenario, world, std::move(model)),
+                       seed, options);
+}
+
+BrainTrial RunBrainTrial(std::shared_ptr<const twin::TwinModel> twin_model, std::uint64_t seed,
+                         const BrainTrialOptions& options) {
+  ThrowUnless(twin_model != nullptr, "RunBrainTrial: the twin model is null");
   BrainTrial trial;
-  trial.world = std::make_unique<twin::TwinWorld>(scenario, world, seed, model);
-  trial.brain = MakeScenarioExecutive(scenario, world, *trial.world, model, options.config);
+  trial.world = std::make_unique<twin::TwinWorld>(twin_model, seed);
+  trial.brain = MakeScenarioExecutive(twin_model->scenario(), twin_model->world(), *trial.world,
+                                      twin_model->robot_model(), options.config);
   twin::TwinRobot robot(trial.world.get());
   twin::RunOptions run = options.run;
   run.control_period = 1.0 / options.config.control_rate_hz;

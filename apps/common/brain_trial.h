@@ -58,7 +58,13 @@ struct BrainTrial {
   twin::RunResult result;
 };
 
-/// Runs `scenario` with `seed`, driven by the brain, to the end of its mission or time limit.
+/// Runs a compiled scenario with `seed`, driven by the brain (on the model's robot
+/// description), to the end of its mission or time limit. Trials of one scenario share its
+/// TwinModel: only the run's own state is built per seed.
+/// @throws what the tree or executive throw, naming the file or field.
+BrainTrial RunBrainTrial(std::shared_ptr<const twin::TwinModel> twin_model, std::uint64_t seed,
+                         const BrainTrialOptions& options = {});
+/// Compiles `scenario` and runs it once (as above).
 /// @throws what the scenario, world, tree or executive throw, naming the file or field.
 BrainTrial RunBrainTrial(const twin::Scenario& scenario, const twin::WorldDescription& world,
                          std::uint64_t seed, std::shared_ptr<const RobotModel> model,

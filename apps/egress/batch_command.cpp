@@ -44,11 +44,25 @@ WilsonInterval CalcWilsonInterval(int successes, int trials, double z) {
   return {std::max(0.0, centre - half), std::min(1.0, centre + half)};
 }
 
-TrialResult RunBrainTrial(const std::string& scenario_path, std::uint64_t seed) {
+// A worker's compiled scenario: its trials come scenario by scenario, so it keeps the last one.
+struct CompiledScenario {
+  std::string path;
+  std::shared_ptr<const twin::TwinModel> model;
+};
+
+TrialResult RunBrainTrial(const std::string& scenario_path, std::uint64_t seed,
+                          CompiledScenario* compiled) {
   const auto started = std::chrono::steady_clock::now();
-  const twin::Scenario scenario = twin::LoadScenario(scenario_path);
-  const twin::WorldDescription description = twin::LoadSdfWorld(scenario.world_file);
-  auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
+  if (compiled->model == nullptr || compiled->path != scenario_path) {
+    compiled->model.reset();  // a scenario that fails to load is not reused
+    twin::Scenario loaded = twin::LoadScenario(scenario_path);
+    twin::WorldDescription description = twin::LoadSdfWorld(loaded.world_file);
+    compiled->model = std::make_shared<const twin::TwinModel>(
+        std::move(loaded), std::move(description),
+        std::make_shared<const RobotModel>(RobotModel::LoadDefault()));
+    compiled->path = scenario_path;
+  }
+  const twin::Scenario& scenario = compiled->model->scenario();
   BrainTrialOptions options;
   options.run.record_trace = false;
   // Ground truth for the preemption latency: when a person (not one holding the door) really
@@ -69,7 +83,7 @@ TrialResult RunBrainTrial(const std::string& scenario_path, std::uint64_t seed) 
     if (inside && !inside_before) entered_at.push_back(world.time());
     inside_before = inside;
   };
-  const BrainTrial trial = RunBrainTrial(scenario, description, seed, model, options);
+  const BrainTrial trial = RunBrainTrial(compiled->model, seed, options);
   const twin::RunResult& run = trial.result;
   const behavior::Executive* brain = trial.brain.get();
   TrialResult r;
@@ -239,10 +253,11 @@ std::vector<TrialResult> RunTrialsInWorkers(
     if (pid < 0) throw CommandFailed("sim batch: cannot fork a worker");
     if (pid == 0) {
       ::close(fds[0]);
+      CompiledScenario compiled;
       for (std::size_t k = std::size_t(j); k < work.size(); k += std::size_t(jobs)) {
         TrialResult r;
         try {
-          r = RunBrainTrial(work[k].first, work[k].second);
+          r = RunBrainTrial(work[k].first, work[k].second, &compiled);
         } catch (const std::exception& e) {
           r.scenario = work[k].first;
           r.name = std::filesystem::path(work[k].first).stem().string();

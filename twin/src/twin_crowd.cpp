@@ -41,8 +41,7 @@ void TwinWorld::Impl::BuildPeople() {
   std::mt19937_64 hold_rng(DeriveSeed(seed, 5));
   const auto& r = scenario.randomize;
   for (const auto& spec : scenario.people) {
-    auto& model = behavior_models[spec.behavior];
-    if (!model) model = people::MakePersonBehavior(spec.behavior);
+    const auto& model = fixed.behavior_models.at(spec.behavior);
     const int count = model->GroupSize(spec);
     const int columns = int(std::ceil(std::sqrt(double(count))));
     for (int k = 0; k < count; ++k) {
@@ -151,8 +150,9 @@ void TwinWorld::Impl::UpdatePeople() {
     p.stuck_for = heading_for_doorway && p.walker.velocity.norm() < 0.05 ? p.stuck_for + dt : 0.0;
     if (p.stuck_for > kStuckSec && !p.realigned) {
       const Door& d = doors[std::size_t(p.door)];
-      const double side = (p.walker.position - d.centre).dot(d.normal) >= 0 ? 1.0 : -1.0;
-      p.route.insert(p.route.begin(), d.centre + d.normal * side * 0.8);
+      const double side =
+          (p.walker.position - d.fixed->centre).dot(d.fixed->normal) >= 0 ? 1.0 : -1.0;
+      p.route.insert(p.route.begin(), d.fixed->centre + d.fixed->normal * side * 0.8);
       --p.reached;  // the doorway centre stays the next waypoint after this one
       p.realigned = true;
       p.stuck_for = 0.0;
@@ -191,7 +191,7 @@ void TwinWorld::Impl::UpdatePeople() {
   walkers.reserve(people.size());
   for (const auto& p : people)
     walkers.push_back(p.walker);
-  std::vector<WallSegment> all_walls = walls;
+  std::vector<WallSegment> all_walls = fixed.walls;
   for (const auto& d : doors) {
     all_walls.push_back({d.desc->p_WH.head<2>(), d.desc->CalcFreeEdge(d.angle).head<2>()});
   }
@@ -217,7 +217,7 @@ bool TwinWorld::Impl::DoorwayTaken(const Person& me) const {
   const Door& d = doors[me.door];
   for (const auto& other : people) {
     if (&other == &me || !other.state.started) continue;
-    if ((other.walker.position - d.centre).norm() < 0.9) return true;
+    if ((other.walker.position - d.fixed->centre).norm() < 0.9) return true;
   }
   return false;
 }

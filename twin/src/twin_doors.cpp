@@ -8,10 +8,9 @@ void TwinWorld::Impl::BuildDoors() {
   for (std::size_t i = 0; i < world.doors.size(); ++i) {
     const DoorDescription& d = world.doors[i];
     Door door;
+    door.fixed = &fixed.doors[i];
     door.desc = &d;
-    for (const auto& spec : scenario.doors) {
-      if (spec.door == d.name) door.spec = spec;
-    }
+    door.spec = door.fixed->spec;
     if (door.spec && scenario.randomize.hold_open_s.max > 0.0) {
       door.spec->timing.hold_open_s = hold_override;
     }
@@ -40,11 +39,6 @@ void TwinWorld::Impl::BuildDoors() {
     door.hinge = hinge.get();
     dynamics->addConstraint(hinge.get(), true);
     constraints.push_back(std::move(hinge));
-    door.reach = d.LeafReach();
-    const Eigen::Vector3d edge = d.CalcFreeEdge(0.0);
-    door.along = (edge - d.p_WH).head<2>().normalized();
-    door.centre = d.p_WH.head<2>() + door.along * door.reach / 2;
-    door.normal = Eigen::Vector2d(-door.along.y(), door.along.x());
     if (door.spec) {
       door.op.emplace(door.spec->timing, d.max_open_angle);
       for (const auto& actuator : door.spec->actuators) {
@@ -103,7 +97,7 @@ void TwinWorld::Impl::UpdateDoors() {
   for (std::size_t i = 0; i < doors.size(); ++i) {
     Door& d = doors[i];
     d.angle = MeasureDoorAngle(d);
-    const double stall_impulse = (d.spec ? d.spec->timing.stall_force : 67.0) * d.reach * dt;
+    const double stall_impulse = (d.spec ? d.spec->timing.stall_force : 67.0) * d.fixed->reach * dt;
     if (d.op) {
       const double rate = d.op->Update(time, d.angle);
       d.hinge->enableAngularMotor(true, d.motor_sign * rate, stall_impulse);
@@ -114,7 +108,7 @@ void TwinWorld::Impl::UpdateDoors() {
     } else {
       // A manual door with a closer: gently back to closed (≥ 5 s from 90° to 12°).
       const double closer_rate = d.angle > AdaDoorOperator::kClosedAngle ? -0.25 : 0.0;
-      d.hinge->enableAngularMotor(true, d.motor_sign * closer_rate, 15.0 * d.reach * dt);
+      d.hinge->enableAngularMotor(true, d.motor_sign * closer_rate, 15.0 * d.fixed->reach * dt);
     }
     const btVector3 axis = ToBt(d.desc->axis_W * d.desc->open_sign);
     const double omega = d.leaf->getAngularVelocity().dot(axis);
@@ -122,7 +116,7 @@ void TwinWorld::Impl::UpdateDoors() {
     // People holding this door push it towards their hold angle.
     for (const auto& p : people) {
       if (p.state.phase != PersonPhase::kHolding || p.door != int(i)) continue;
-      const double max_torque = config.person_hold_force * d.reach;
+      const double max_torque = config.person_hold_force * d.fixed->reach;
       const double tau =
           std::clamp(1000.0 * (p.hold_angle - d.angle) - 100.0 * omega, -max_torque, max_torque);
       torque += tau * axis;

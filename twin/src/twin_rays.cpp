@@ -109,7 +109,7 @@ RayHit TwinWorld::Impl::CastSegment(const Eigen::Vector3d& from, const Eigen::Ve
   // Static boxes and planes: slab tests in each shape's frame, on the ray as a segment t in
   // [0, 1]. A ray starting inside a box hits its far side (as the triangles' did).
   const Eigen::Vector3d d = to - from;
-  for (const RayBox& box : ray_boxes) {
+  for (const RayBox& box : fixed.ray_boxes) {
     const Eigen::Vector3d o = box.R_SW * (from - box.p_WS);
     const Eigen::Vector3d v = box.R_SW * d;
     double t_in = -std::numeric_limits<double>::infinity();
@@ -146,12 +146,13 @@ RayHit TwinWorld::Impl::CastSegment(const Eigen::Vector3d& from, const Eigen::Ve
     cb.entity = box.entity;
     cb.glass = false;
   }
-  if (ray_mesh_shape != nullptr) {
+  if (fixed.ray_mesh_shape != nullptr) {
     // A hair past the closest hit, so that a mesh standing on the floor still wins the tie.
     const btScalar scale = std::min<btScalar>(1.0, cb.m_closestHitFraction * 1.001 + 1e-6);
     const btVector3 b_clipped = a + (b - a) * scale;
-    StaticMeshRayCallback mesh_cb(a, b_clipped, scale, static_mesh_body, &cb, ray_triangle_entity);
-    ray_mesh_shape->performRaycast(&mesh_cb, a, b_clipped);
+    StaticMeshRayCallback mesh_cb(a, b_clipped, scale, static_mesh_body, &cb,
+                                  fixed.ray_triangle_entity);
+    fixed.ray_mesh_shape->performRaycast(&mesh_cb, a, b_clipped);
   }
   RayHit hit;
   if (!cb.hasHit()) return hit;
@@ -198,6 +199,9 @@ const WorldDescription& TwinWorld::world() const {
 }
 const TwinConfig& TwinWorld::config() const {
   return impl_->config;
+}
+const std::shared_ptr<const TwinModel>& TwinWorld::model() const {
+  return impl_->twin_model;
 }
 std::uint64_t TwinWorld::seed() const {
   return impl_->seed;

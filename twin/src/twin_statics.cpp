@@ -3,57 +3,13 @@
 namespace egress::twin {
 
 void TwinWorld::Impl::BuildStatics() {
-  bool has_floor = false;
-  auto merged = std::make_unique<btTriangleMesh>(true, false);
-  auto ray_mesh = std::make_unique<btTriangleMesh>(true, false);
-  auto add = [&](const ShapeDescription& s) {
-    const bool floor = s.kind == ShapeKind::kPlane;
-    has_floor = has_floor || floor;
-    const int e = AddEntity(floor ? EntityKind::kFloor : EntityKind::kStatic, s.model, -1);
-    if (!floor) AppendFootprint(s, e, &walls);
-    if (AppendTriangles(s, merged.get())) {
-      static_triangle_entity.resize(std::size_t(merged->getNumTriangles()), e);
-      if (s.kind == ShapeKind::kBox || s.kind == ShapeKind::kPlane) {
-        RayBox box;
-        box.R_SW = s.X_WS.rotation().transpose();
-        box.p_WS = s.X_WS.translation();
-        box.half = s.kind == ShapeKind::kBox
-                       ? Eigen::Vector3d(s.box_size / 2)
-                       : Eigen::Vector3d(s.plane_size.x() > 0 ? s.plane_size.x() / 2 : 50.0,
-                                         s.plane_size.y() > 0 ? s.plane_size.y() / 2 : 50.0, 0.0);
-        box.entity = e;
-        ray_boxes.push_back(box);
-      } else {
-        AppendTriangles(s, ray_mesh.get());
-        ray_triangle_entity.resize(std::size_t(ray_mesh->getNumTriangles()), e);
-      }
-      return;
-    }
-    ray_targets.push_back(AddBody(MakeConvexShape(s), s.X_WS, 0.0, floor ? kGFloor : kGStatic,
-                                  floor ? kMaskFloor : kMaskStatic, e));
-  };
-  for (const auto& s : world.shapes)
-    add(s);
-  for (const auto& s : scenario.obstacles)
-    add(s);
-  if (!has_floor) {
-    ShapeDescription ground;
-    ground.model = "ground_plane";
-    ground.kind = ShapeKind::kPlane;
-    add(ground);
+  for (const StaticConvex& c : fixed.convex_statics) {
+    ray_targets.push_back(AddBodyWithShape(c.shape.get(), c.X_WS, 0.0, c.floor ? kGFloor : kGStatic,
+                                           c.floor ? kMaskFloor : kMaskStatic, c.entity));
   }
-  if (merged->getNumTriangles() > 0) {
-    auto shape = std::make_unique<btBvhTriangleMeshShape>(merged.get(), true);
-    static_mesh_shape = shape.get();
-    meshes.push_back(std::move(merged));
-    static_mesh_body =
-        AddBody(std::move(shape), Pose3(), 0.0, kGStatic, kMaskStatic, kMergedStatic);
-  }
-  if (ray_mesh->getNumTriangles() > 0) {
-    auto shape = std::make_unique<btBvhTriangleMeshShape>(ray_mesh.get(), true);
-    ray_mesh_shape = shape.get();
-    meshes.push_back(std::move(ray_mesh));
-    shapes.push_back(std::move(shape));
+  if (fixed.static_mesh_shape) {
+    static_mesh_body = AddBodyWithShape(fixed.static_mesh_shape.get(), Pose3(), 0.0, kGStatic,
+                                        kMaskStatic, kMergedStatic);
   }
 }
 

@@ -23,17 +23,16 @@ std::string_view ToString(EntityKind kind) {
   return "unknown";
 }
 
-TwinWorld::Impl::Impl(const Scenario& s, const WorldDescription& w, std::uint64_t seed_in,
-                      std::shared_ptr<const RobotModel> model_in, TwinConfig cfg)
-    : scenario(s),
-      world(w),
+TwinWorld::Impl::Impl(std::shared_ptr<const TwinModel> twin_model_in, std::uint64_t seed_in)
+    : twin_model(std::move(twin_model_in)),
+      fixed(twin_model->compiled()),
+      scenario(twin_model->scenario()),
+      world(twin_model->world()),
       seed(seed_in),
-      model(std::move(model_in)),
-      config(cfg),
-      dt(1.0 / cfg.physics_rate_hz) {
-  ThrowUnless(model != nullptr, "TwinWorld: robot model is null");
-  ThrowUnless(cfg.physics_rate_hz >= 60.0, "TwinWorld: physics_rate_hz must be at least 60");
-  scenario.ValidateAgainst(world);
+      model(twin_model->robot_model()),
+      config(twin_model->config()),
+      dt(twin_model->step_size()) {
+  entities = fixed.entities;
   collision_config = std::make_unique<btDefaultCollisionConfiguration>();
   dispatcher = std::make_unique<btCollisionDispatcher>(collision_config.get());
   broadphase = std::make_unique<btDbvtBroadphase>();
@@ -64,15 +63,21 @@ int TwinWorld::Impl::AddEntity(EntityKind kind, std::string name, int index, boo
 
 btRigidBody* TwinWorld::Impl::AddBody(std::unique_ptr<btCollisionShape> shape, const Pose3& X_W,
                                       double mass, int group, int mask, int entity) {
+  btRigidBody* body = AddBodyWithShape(shape.get(), X_W, mass, group, mask, entity);
+  shapes.push_back(std::move(shape));
+  return body;
+}
+
+btRigidBody* TwinWorld::Impl::AddBodyWithShape(btCollisionShape* shape, const Pose3& X_W,
+                                               double mass, int group, int mask, int entity) {
   btVector3 inertia(0, 0, 0);
   if (mass > 0) shape->calculateLocalInertia(mass, inertia);
   auto state = std::make_unique<btDefaultMotionState>(ToBt(X_W));
-  btRigidBody::btRigidBodyConstructionInfo info(mass, state.get(), shape.get(), inertia);
+  btRigidBody::btRigidBodyConstructionInfo info(mass, state.get(), shape, inertia);
   auto body = std::make_unique<btRigidBody>(info);
   body->setUserIndex(entity);
   dynamics->addRigidBody(body.get(), group, mask);
   btRigidBody* raw = body.get();
-  shapes.push_back(std::move(shape));
   states.push_back(std::move(state));
   bodies.push_back(std::move(body));
   return raw;
@@ -86,8 +91,8 @@ void TwinWorld::Impl::MakeKinematic(btRigidBody* body) {
 int TwinWorld::Impl::EntityOf(const btCollisionObject* object, int triangle) const {
   const int e = object->getUserIndex();
   if (e != kMergedStatic) return e;
-  return triangle >= 0 && std::size_t(triangle) < static_triangle_entity.size()
-             ? static_triangle_entity[std::size_t(triangle)]
+  return triangle >= 0 && std::size_t(triangle) < fixed.static_triangle_entity.size()
+             ? fixed.static_triangle_entity[std::size_t(triangle)]
              : -1;
 }
 
@@ -191,9 +196,15 @@ void TwinWorld::Impl::StepOnce() {
   ray_proxies_stale = true;  // re-posed before the next ray cast (sensors run at 5-40 Hz)
 }
 
+TwinWorld::TwinWorld(std::shared_ptr<const TwinModel> model, std::uint64_t seed) {
+  ThrowUnless(model != nullptr, "TwinWorld: the twin model is null");
+  impl_ = std::make_unique<Impl>(std::move(model), seed);
+}
+
 TwinWorld::TwinWorld(const Scenario& scenario, const WorldDescription& world, std::uint64_t seed,
                      std::shared_ptr<const RobotModel> robot_model, TwinConfig config)
-    : impl_(std::make_unique<Impl>(scenario, world, seed, std::move(robot_model), config)) {}
+    : TwinWorld(std::make_shared<const TwinModel>(scenario, world, std::move(robot_model), config),
+                seed) {}
 
 TwinWorld::~TwinWorld() = default;
 

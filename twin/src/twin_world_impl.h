@@ -5,179 +5,15 @@
 // ADA operators, actuators), twin_crowd.cpp (people), twin_robot_body.cpp (base, arm, gripper,
 // payloads), twin_rays.cpp (ray casting for the sensors).
 
-#include "egress/twin/twin_world.h"
-
-#include <BulletCollision/NarrowPhaseCollision/btRaycastCallback.h>
-#include <btBulletDynamicsCommon.h>
-
-#include <algorithm>
-#include <cmath>
-#include <functional>
-#include <limits>
-#include <map>
-#include <random>
-#include <set>
-
-#include "egress/hsr_interface/error.h"
-#include "egress/twin/actuators.h"
-#include "egress/twin/social_force.h"
-#include "seeds.h"
+#include "twin_model_compiled.h"
 
 namespace egress::twin {
 namespace world_detail {
-
-// Collision groups. Pairs collide when each one's group is in the other's mask.
-enum Group : int {
-  kGStatic = 1 << 0,
-  kGFloor = 1 << 1,
-  kGDoor = 1 << 2,
-  kGBase = 1 << 3,
-  kGArm = 1 << 4,
-  kGPerson = 1 << 5,
-  kGPayload = 1 << 6,
-};
-constexpr int kMaskStatic = kGBase | kGArm | kGPerson | kGPayload;
-constexpr int kMaskFloor = kGPayload;
-constexpr int kMaskDoor = kGBase | kGArm | kGPerson | kGPayload;
-constexpr int kMaskBase = kGStatic | kGDoor | kGPerson | kGPayload;
-constexpr int kMaskArm = kGStatic | kGDoor | kGPerson | kGPayload;
-constexpr double kStuckSec =
-    2.0;  // [s] a walker that wants to move but has not, this long, is stuck
-// [m] beyond an open leaf's free edge a walker blocked by the leaf steps round it: a shoulder
-// (0.25 m) and a margin
-constexpr double kStepRoundLeaf = 0.45;
-constexpr double kKeepRight = 0.2;  // [m] off the doorway axis, clear of a 0.9 m door's jambs
-constexpr int kMaskPerson = kGStatic | kGDoor | kGBase | kGArm | kGPayload;
-constexpr int kMaskPayload = kGStatic | kGFloor | kGDoor | kGBase | kGArm | kGPerson | kGPayload;
-
-constexpr double kPersonHeight = 1.7;  // [m]
-// [m] height of the solid round base whose inertia the trunk is given (the wheels' torque
-// limit assumes it)
-constexpr double kRobotBodyHeight = 1.0;
-constexpr double kHandOpen = 1.24;          // hand_motor_joint fully open [rad]
-constexpr double kHandTouching = -0.3;      // fingertips meet [rad]
-constexpr double kHandMaxWidth = 0.135;     // finger gap when fully open [m]
-constexpr double kHandSpeed = 1.0;          // [rad/s] (URDF limit)
-constexpr double kGraspDepthInPalm = 0.07;  // grasp centre along the palm's approach z [m]
-constexpr double kDegToRad = M_PI / 180.0;
-// A payload may start this deep in what it stands on (contact margins), no deeper [m].
-constexpr double kPayloadStartOverlapTolerance = 0.002;
-
-inline btVector3 ToBt(const Eigen::Vector3d& v) {
-  return {v.x(), v.y(), v.z()};
-}
-inline Eigen::Vector3d FromBt(const btVector3& v) {
-  return {v.x(), v.y(), v.z()};
-}
-
-inline btTransform ToBt(const Pose3& X) {
-  const Eigen::Quaterniond q = X.quaternion();
-  return btTransform(btQuaternion(q.x(), q.y(), q.z(), q.w()), ToBt(X.translation()));
-}
-
-inline Pose3 FromBt(const btTransform& T) {
-  const btQuaternion q = T.getRotation();
-  return Pose3(Eigen::Quaterniond(q.w(), q.x(), q.y(), q.z()).normalized(), FromBt(T.getOrigin()));
-}
-
-inline double HandWidth(double hand_q) {
-  return kHandMaxWidth *
-         std::clamp((hand_q - kHandTouching) / (kHandOpen - kHandTouching), 0.0, 1.0);
-}
-
-// The links whose shapes make the robot's trunk (the base body): they move only with the lift
-// and the head. The arm from its flex link on has its own kinematic bodies.
-inline bool IsTrunkLink(std::string_view link) {
-  return link == "base_link" || link == "torso_lift_link" || link == "head_pan_link" ||
-         link == "head_tilt_link" || link == "arm_lift_link";
-}
-inline constexpr const char* kUpperArmLink = "arm_flex_link";
-
-// A robot description's collision primitive as a Bullet shape (centred on its frame S).
-inline std::unique_ptr<btCollisionShape> MakeRobotShape(const CollisionShape& s) {
-  switch (s.kind) {
-    case CollisionShape::Kind::kBox:
-      return std::make_unique<btBoxShape>(ToBt(Eigen::Vector3d(s.size / 2)));
-    case CollisionShape::Kind::kCylinder:
-      return std::make_unique<btCylinderShapeZ>(btVector3(s.size.x(), s.size.x(), s.size.z() / 2));
-    case CollisionShape::Kind::kSphere:
-      break;
-  }
-  return std::make_unique<btSphereShape>(s.size.x());
-}
-
-// Outline segments of a static shape on the floor (for the people's wall forces).
-inline void AppendFootprint(const ShapeDescription& s, int obstacle,
-                            std::vector<WallSegment>* out) {
-  const auto f = CalcFloorFootprint(s, 0.1, 1.8);  // at body height
-  if (!f) return;
-  const Eigen::Vector2d h = f->size / 2;
-  const Eigen::Vector2d corners[4] = {
-      f->X_WF * Eigen::Vector2d(-h.x(), -h.y()), f->X_WF * Eigen::Vector2d(h.x(), -h.y()),
-      f->X_WF * Eigen::Vector2d(h.x(), h.y()), f->X_WF * Eigen::Vector2d(-h.x(), h.y())};
-  for (int i = 0; i < 4; ++i)
-    out->push_back({corners[i], corners[(i + 1) % 4], obstacle});
-}
-
-// Appends quad a-b-c-d (counter-clockwise seen from outside) as two triangles.
-inline void AppendQuad(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
-                       const Eigen::Vector3d& d, btTriangleMesh* mesh) {
-  mesh->addTriangle(ToBt(a), ToBt(b), ToBt(c));
-  mesh->addTriangle(ToBt(a), ToBt(c), ToBt(d));
-}
-
-// Appends a static box's, plane's or mesh's triangles, in W, to `mesh`; false for other kinds.
-inline bool AppendTriangles(const ShapeDescription& s, btTriangleMesh* mesh) {
-  if (s.kind == ShapeKind::kBox) {
-    const Eigen::Vector3d h = s.box_size / 2;
-    auto corner = [&](int i) {
-      return Eigen::Vector3d(s.X_WS * Eigen::Vector3d((i & 1) ? h.x() : -h.x(),
-                                                      (i & 2) ? h.y() : -h.y(),
-                                                      (i & 4) ? h.z() : -h.z()));
-    };
-    static constexpr int kFaces[6][4] = {{0, 2, 6, 4}, {1, 5, 7, 3}, {0, 4, 5, 1},
-                                         {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 6, 7, 5}};
-    for (const auto& f : kFaces)
-      AppendQuad(corner(f[0]), corner(f[1]), corner(f[2]), corner(f[3]), mesh);
-    return true;
-  }
-  if (s.kind == ShapeKind::kPlane) {
-    // A finite quad (100 m square when the file gives no size) in the plane's frame.
-    const double hx = s.plane_size.x() > 0 ? s.plane_size.x() / 2 : 50.0;
-    const double hy = s.plane_size.y() > 0 ? s.plane_size.y() / 2 : 50.0;
-    AppendQuad(s.X_WS * Eigen::Vector3d(-hx, -hy, 0), s.X_WS * Eigen::Vector3d(hx, -hy, 0),
-               s.X_WS * Eigen::Vector3d(hx, hy, 0), s.X_WS * Eigen::Vector3d(-hx, hy, 0), mesh);
-    return true;
-  }
-  if (s.kind == ShapeKind::kMesh) {
-    for (const auto& t : s.mesh->triangles) {
-      mesh->addTriangle(ToBt(s.X_WS * s.mesh->vertices[t[0]]),
-                        ToBt(s.X_WS * s.mesh->vertices[t[1]]),
-                        ToBt(s.X_WS * s.mesh->vertices[t[2]]));
-    }
-    return true;
-  }
-  return false;
-}
-
-// The convex static shapes; boxes, planes and meshes go into the merged triangle mesh
-// (AppendTriangles) instead.
-inline std::unique_ptr<btCollisionShape> MakeConvexShape(const ShapeDescription& s) {
-  if (s.kind == ShapeKind::kSphere) return std::make_unique<btSphereShape>(s.radius);
-  return std::make_unique<btCylinderShapeZ>(btVector3(s.radius, s.radius, s.length / 2));
-}
-
-}  // namespace world_detail
-
-namespace people {
-class PersonBehaviorModel;  // people/person_behavior.h
-}  // namespace people
-
-namespace world_detail {
-// A door in the run: its description (fixed) and its state.
+// A door in the run: its fixed model and its state.
 struct Door {
-  const DoorDescription* desc{nullptr};
-  std::optional<DoorOperatorSpec> spec;
+  const DoorModel* fixed{nullptr};
+  const DoorDescription* desc{nullptr};  // fixed->desc
+  std::optional<DoorOperatorSpec> spec;  // fixed->spec with the run's seeded hold time
   std::optional<AdaDoorOperator> op;
   std::vector<PushButton> buttons;     // one per push-button actuator, in spec order
   std::vector<ProximityPlate> plates;  // one per proximity-plate actuator, in spec order
@@ -185,15 +21,11 @@ struct Door {
   btRigidBody* leaf{nullptr};
   btHingeConstraint* hinge{nullptr};
   double motor_sign{1.0};
-  double reach{0.0};
   double angle{0.0};
   int presses{0};
   bool reported_open{false};
   bool reported_closed{true};
   DoorPhase last_phase{DoorPhase::kClosed};
-  Eigen::Vector2d centre{Eigen::Vector2d::Zero()};  // doorway centre in the plane
-  Eigen::Vector2d normal{Eigen::Vector2d::Zero()};  // doorway plane normal
-  Eigen::Vector2d along{Eigen::Vector2d::Zero()};   // hinge → latch direction (closed)
 };
 
 // A person in the run.
@@ -214,21 +46,18 @@ struct Person {
   double hold_duration{0.0};
   double hold_started{-1.0};
   double wait_started{-1.0};
-  const people::PersonBehaviorModel* behavior{nullptr};  // owned by behavior_models
+  const people::PersonBehaviorModel* behavior{nullptr};  // the model's behaviour
   btRigidBody* body{nullptr};
 };
 
 }  // namespace world_detail
 using namespace world_detail;
 
+// A run's state (MuJoCo's mjData to TwinModel's mjModel): the Bullet world with the run's
+// bodies (the statics' shapes are the model's), and the doors, people, robot and payloads as
+// this run's seed drew and moved them.
 struct TwinWorld::Impl {
-  struct Entity {
-    EntityKind kind;
-    std::string name;
-    int index;  // into doors_/people_/payloads_ where that applies
-    bool glass{false};
-  };
-
+  using Entity = world_detail::Entity;
   using Door = world_detail::Door;
   using Person = world_detail::Person;
 
@@ -240,8 +69,7 @@ struct TwinWorld::Impl {
     Pose3 X_GP;  // pose in the palm while held
   };
 
-  Impl(const Scenario& s, const WorldDescription& w, std::uint64_t seed_in,
-       std::shared_ptr<const RobotModel> model_in, TwinConfig cfg);
+  Impl(std::shared_ptr<const TwinModel> twin_model_in, std::uint64_t seed_in);
 
   ~Impl();
 
@@ -249,13 +77,13 @@ struct TwinWorld::Impl {
 
   btRigidBody* AddBody(std::unique_ptr<btCollisionShape> shape, const Pose3& X_W, double mass,
                        int group, int mask, int entity);
+  // A body whose shape someone else owns (the model's statics).
+  btRigidBody* AddBodyWithShape(btCollisionShape* shape, const Pose3& X_W, double mass, int group,
+                                int mask, int entity);
 
   void MakeKinematic(btRigidBody* body);
 
-  // Static boxes, planes and meshes become one triangle mesh (one BVH for contacts); the entity
-  // of each triangle is kept so rays and contacts still name the model they touch. Rays test
-  // boxes and planes analytically (a slab test is far cheaper than a BVH walk over their
-  // triangles) and only the meshes' triangles through their own BVH.
+  // The model's statics as bodies of this run's Bullet world (their shapes are the model's).
   void BuildStatics();
 
   // A collision object outside the dynamics world with a triangle version of `source`'s shape,
@@ -334,11 +162,13 @@ struct TwinWorld::Impl {
   // The base's actual velocity in B (what the wheels do, not what was commanded).
   Twist2 RobotVelocity() const;
 
-  Scenario scenario;
-  WorldDescription world;
+  std::shared_ptr<const TwinModel> twin_model;
+  const TwinModel::Compiled& fixed;
+  const Scenario& scenario;
+  const WorldDescription& world;
   std::uint64_t seed;
   std::shared_ptr<const RobotModel> model;
-  TwinConfig config;
+  const TwinConfig& config;
   double dt;
   std::uint64_t step{0};
   double time{0.0};
@@ -355,19 +185,7 @@ struct TwinWorld::Impl {
   std::vector<std::unique_ptr<btTypedConstraint>> constraints;
 
   static constexpr int kMergedStatic = -2;  // user index of the merged static mesh body
-  std::vector<int> static_triangle_entity;
-  btBvhTriangleMeshShape* static_mesh_shape{nullptr};
   btRigidBody* static_mesh_body{nullptr};
-  // Static boxes and planes (half extent 0 along the normal) for analytic ray tests.
-  struct RayBox {
-    Eigen::Matrix3d R_SW;  // world to shape
-    Eigen::Vector3d p_WS;
-    Eigen::Vector3d half;
-    int entity{-1};
-  };
-  std::vector<RayBox> ray_boxes;
-  btBvhTriangleMeshShape* ray_mesh_shape{nullptr};  // the static meshes only, for rays
-  std::vector<int> ray_triangle_entity;
   struct RayProxy {
     std::unique_ptr<btCollisionObject> proxy;
     const btCollisionObject* source;
@@ -388,11 +206,8 @@ struct TwinWorld::Impl {
   std::vector<Entity> entities;
   std::vector<Door> doors;
   std::vector<Person> people;
-  // One model per people behaviour the scenario uses (the fixed model; Person is the run's state).
-  std::map<PersonBehavior, std::unique_ptr<people::PersonBehaviorModel>> behavior_models;
   std::vector<PersonState> states_cache;
   std::vector<Payload> payloads;
-  std::vector<WallSegment> walls;
   SocialForceModel sfm;
 
   btRigidBody* base{nullptr};

@@ -9,7 +9,7 @@ class HoldDoor final : public PersonBehaviorModel {
  public:
   bool HoldsDoor() const override { return true; }
   void PlanRoute(const PersonSpec& /*spec*/, const Door* door, Person* p) const override {
-    const Door& d = *door;
+    const DoorModel& d = *door->fixed;
     const double side = (p->walker.position - d.centre).dot(d.normal) >= 0 ? 1.0 : -1.0;
     p->route.push_back(d.desc->p_WH.head<2>() - d.along * 0.45 + d.normal * side * 0.45);
   }

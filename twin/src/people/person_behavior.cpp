@@ -10,7 +10,9 @@ void PersonBehaviorModel::AtRouteEnd(double time, const Door* /*door*/, Person* 
   }
 }
 
-void PersonBehaviorModel::RouteThroughDoor(const Door& d, const Eigen::Vector2d& start, Person* p) {
+void PersonBehaviorModel::RouteThroughDoor(const Door& door, const Eigen::Vector2d& start,
+                                           Person* p) {
+  const DoorModel& d = *door.fixed;
   const double side = (start - d.centre).dot(d.normal) >= 0 ? 1.0 : -1.0;
   // People keep right: wait and leave kKeepRight to the right of the doorway's axis, so two
   // walkers crossing in opposite directions do not meet head-on at its ends.

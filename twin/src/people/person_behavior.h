@@ -15,6 +15,7 @@ namespace egress::twin::people {
 
 using Person = world_detail::Person;
 using Door = world_detail::Door;
+using DoorModel = world_detail::DoorModel;
 /// Raises a run event (kind, subject, detail).
 using EventSink = std::function<void(const std::string&, const std::string&, const std::string&)>;
 

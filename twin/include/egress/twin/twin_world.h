@@ -24,24 +24,10 @@
 #include "egress/hsr_interface/time.h"
 #include "egress/twin/door_operator.h"
 #include "egress/twin/scenario.h"
+#include "egress/twin/twin_model.h"
 #include "egress/twin/world_description.h"
 
 namespace egress::twin {
-
-/// Physics and robot-body settings.
-struct TwinConfig {
-  double physics_rate_hz{240.0};
-  double base_max_linear_acceleration{1.0};   ///< [m/s²]
-  double base_max_angular_acceleration{2.0};  ///< [rad/s²]
-  double base_max_linear_speed{0.8};          ///< [m/s] (HSR: ~3 km/h)
-  double base_max_angular_speed{1.5};         ///< [rad/s]
-  double base_command_timeout{0.5};           ///< Velocity command held this long [s]
-  double robot_mass{37.0};                    ///< [kg]
-  double base_max_force{100.0};               ///< Drive force limit of the wheels [N]
-  double grasp_tolerance{0.02};               ///< Lateral centring error a grasp accepts [m]
-  double person_hold_force{100.0};            ///< Force a person holds a door with [N]
-  double door_crossed_open_angle_deg{60.0};   ///< "Open when crossed" threshold [deg]
-};
 
 /// What a collision object is, for contacts, rays and the detector.
 enum class EntityKind { kStatic, kFloor, kDoor, kRobotBase, kRobotArm, kPerson, kPayload };
@@ -104,8 +90,15 @@ struct PersonState {
   PersonPhase phase{PersonPhase::kWaiting};
 };
 
+/// One run of a TwinModel (its state, as MuJoCo's mjData to mjModel): the seeded draws (robot
+/// start, payload jitter, people's speeds and delays, hold times) and everything that moves.
 class TwinWorld {
  public:
+  /// A run of `model` with `seed`; the model is shared, never copied.
+  /// @throws InvalidArgument for a null model; LoadError if a seeded draw makes the scenario
+  /// invalid (a payload jittered into furniture).
+  TwinWorld(std::shared_ptr<const TwinModel> model, std::uint64_t seed);
+  /// Compiles a model of its own and runs it (a single run; batches share one TwinModel).
   /// @throws LoadError if the scenario does not fit the world.
   TwinWorld(const Scenario& scenario, const WorldDescription& world, std::uint64_t seed,
             std::shared_ptr<const RobotModel> robot_model, TwinConfig config = {});
@@ -171,6 +164,7 @@ class TwinWorld {
   const Scenario& scenario() const;
   const WorldDescription& world() const;
   const TwinConfig& config() const;
+  const std::shared_ptr<const TwinModel>& model() const;  ///< The fixed part of this run.
   std::uint64_t seed() const;
 
  private:

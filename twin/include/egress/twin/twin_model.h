@@ -1,0 +1,70 @@
+#pragma once
+/// @file
+/// TwinModel: the fixed part of a twin run, as MuJoCo's mjModel is to mjData. A scenario
+/// compiled against its world and the robot description: the static collision geometry (one
+/// merged triangle BVH for contacts; analytic boxes and a mesh BVH for rays; the convex statics),
+/// the outline of walls and furniture the people steer round, each doorway's geometry, one model
+/// per people behaviour, and the physics settings. It does not depend on the seed and never
+/// changes once built: any number of runs (TwinWorld, one per seed) share one model, so a batch
+/// compiles a scenario once and each run builds only its own state (bodies, doors, people, robot,
+/// payloads, the seeded draws).
+///
+/// Thread safety: a model is immutable; runs on different threads may share it (Bullet only
+/// reads a shared static shape during collision queries).
+
+#include <memory>
+
+#include "egress/hsr_interface/robot_model.h"
+#include "egress/twin/scenario.h"
+#include "egress/twin/world_description.h"
+
+namespace egress::twin {
+
+/// Physics and robot-body settings.
+struct TwinConfig {
+  double physics_rate_hz{240.0};
+  double base_max_linear_acceleration{1.0};   ///< [m/s²]
+  double base_max_angular_acceleration{2.0};  ///< [rad/s²]
+  double base_max_linear_speed{0.8};          ///< [m/s] (HSR: ~3 km/h)
+  double base_max_angular_speed{1.5};         ///< [rad/s]
+  double base_command_timeout{0.5};           ///< Velocity command held this long [s]
+  double robot_mass{37.0};                    ///< [kg]
+  double base_max_force{100.0};               ///< Drive force limit of the wheels [N]
+  double grasp_tolerance{0.02};               ///< Lateral centring error a grasp accepts [m]
+  double person_hold_force{100.0};            ///< Force a person holds a door with [N]
+  double door_crossed_open_angle_deg{60.0};   ///< "Open when crossed" threshold [deg]
+  /// @throws InvalidArgument naming the field for a physics rate below 60 Hz or a non-positive
+  /// or non-finite limit.
+  void Validate() const;
+};
+
+class TwinModel {
+ public:
+  /// Compiles `scenario` against `world` for the robot `robot_model`.
+  /// @throws LoadError if the scenario does not fit the world; InvalidArgument for a null robot
+  /// model or a bad config.
+  TwinModel(Scenario scenario, WorldDescription world,
+            std::shared_ptr<const RobotModel> robot_model, TwinConfig config = {});
+  ~TwinModel();
+  TwinModel(const TwinModel&) = delete;
+  TwinModel& operator=(const TwinModel&) = delete;
+
+  const Scenario& scenario() const;
+  const WorldDescription& world() const;
+  const std::shared_ptr<const RobotModel>& robot_model() const;
+  const TwinConfig& config() const;
+  double step_size() const;  ///< [s] 1 / physics_rate_hz
+
+  /// The compiled geometry (defined in twin/src: only the twin's own code reads it).
+  struct Compiled;
+  const Compiled& compiled() const;
+
+ private:
+  Scenario scenario_;
+  WorldDescription world_;
+  std::shared_ptr<const RobotModel> robot_model_;
+  TwinConfig config_;
+  std::unique_ptr<Compiled> compiled_;
+};
+
+}  // namespace egress::twin
