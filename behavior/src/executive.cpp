@@ -348,6 +348,7 @@ bool Executive::Step(RobotPort& port) {
   if (arm_measured) m.motion.SetMeasuredArm(arm);
   m.grasp.Update(snapshot.gripper);
   belief_.holding_object = m.grasp.holding();
+  belief_.gripper_at_rest = m.grasp.at_rest();
   // Perceive.
   UpdateBody(snapshot);
   if (snapshot.depth) {

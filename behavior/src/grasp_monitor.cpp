@@ -22,6 +22,7 @@ GraspMonitor::GraspMonitor(GraspMonitorConfig config) : config_(config) {
 
 void GraspMonitor::OnCommand(const GripperCommand& command) {
   grasping_ = command.mode == GripperCommand::Mode::kGrasp;
+  moved_since_command_ = false;
   if (!grasping_) holding_ = false;
 }
 
@@ -33,12 +34,16 @@ void GraspMonitor::Update(const GripperState& state) {
                 " s)");
     const double dt = ToSeconds(state.stamp - last_->stamp);
     const double moved = std::abs(state.hand_motor_position - last_->hand_motor_position);
-    if (dt > 0 && moved > config_.settle_rate * dt) steady_since_ = state.stamp;
+    if (dt > 0 && moved > config_.settle_rate * dt) {
+      steady_since_ = state.stamp;
+      moved_since_command_ = true;
+    }
   } else {
     steady_since_ = state.stamp;
   }
   last_ = state;
   const bool settled = ToSeconds(state.stamp - steady_since_) >= config_.settle_time;
+  settled_ = settled;
   const bool short_of_closed =
       state.hand_motor_position >= config_.closed_position + config_.min_opening;
   if (!grasping_ || !short_of_closed || state.effort < config_.min_effort) {

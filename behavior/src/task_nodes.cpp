@@ -45,6 +45,8 @@ std::string TaskNodesModelXml() {
   detail::RegisterNavigationNodes(factory, nullptr);
   detail::RegisterDoorNodes(factory, nullptr);
   detail::RegisterManipulationNodes(factory, nullptr);
+  detail::RegisterGraspNodes(factory, nullptr);
+  detail::RegisterReleaseNodes(factory, nullptr);
   return factory.WriteTreeNodesModelXml(false);
 }
 
@@ -58,6 +60,8 @@ void RegisterTaskNodes(bt::BehaviorTreeFactory& factory, const TaskServices* ser
   detail::RegisterNavigationNodes(factory, services);
   detail::RegisterDoorNodes(factory, services);
   detail::RegisterManipulationNodes(factory, services);
+  detail::RegisterGraspNodes(factory, services);
+  detail::RegisterReleaseNodes(factory, services);
 }
 
 }  // namespace egress::behavior

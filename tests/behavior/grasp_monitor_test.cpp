@@ -43,6 +43,25 @@ TEST(GraspMonitorTest, FingersStoppedShortOfClosedAndSqueezingHoldSomething) {
   EXPECT_FALSE(m.holding());
 }
 
+TEST(GraspMonitorTest, TheFingersAreAtRestOnceTheyMovedAfterTheCommandAndStopped) {
+  GraspMonitor m;
+  Feed(&m, 0.0, 0.5, 1.24, 1.24, 0.0);  // open and still before any command: not "done"
+  m.OnCommand(Command(GripperCommand::Mode::kGrasp));
+  Feed(&m, 0.51, 0.6, 1.24, 1.24, 0.0);  // the command has not reached the fingers yet
+  EXPECT_FALSE(m.at_rest());
+  Feed(&m, 0.61, 1.4, 1.24, 0.45, 0.0);  // closing
+  EXPECT_FALSE(m.at_rest());
+  Feed(&m, 1.41, 1.5, 0.45, 0.45, 10.0);  // stopped, not settled yet
+  EXPECT_FALSE(m.at_rest());
+  Feed(&m, 1.51, 1.8, 0.45, 0.45, 10.0);
+  EXPECT_TRUE(m.at_rest());
+  EXPECT_TRUE(m.holding());
+  // A new command starts over, whatever it is.
+  m.OnCommand(Command(GripperCommand::Mode::kOpen));
+  m.Update(Reading(1.81, 0.45, 0.0));
+  EXPECT_FALSE(m.at_rest());
+}
+
 TEST(GraspMonitorTest, ClosingOnNothingOrASlipIsNotHolding) {
   GraspMonitor m;
   m.OnCommand(Command(GripperCommand::Mode::kGrasp));

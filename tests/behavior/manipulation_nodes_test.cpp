@@ -42,25 +42,5 @@ TEST_F(ManipulationNodesTest, DetectPayloadLooksUntilItsTimeout) {
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
 }
 
-TEST_F(ManipulationNodesTest, GraspPayloadRefusesWhatNoPostureReaches) {
-  bt::Tree tree = Tree(R"(<GraspPayload kind="bottle" pose="0.5;2.5;2.6"/>)");  // 2.6 m up
-  EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
-  EXPECT_NE(log_.pending().back().text.find("no whole-body reach"), std::string::npos);
-  EXPECT_FALSE(motion_.base_moving());
-}
-
-TEST_F(ManipulationNodesTest, GraspPayloadDrivesToWhereTheHandReachesIt) {
-  bt::Tree tree = Tree(R"(<GraspPayload kind="bottle" pose="0.0;3.8;0.8"/>)");
-  belief_.X_MB = {0.0, 2.0, M_PI / 2};
-  belief_.now = At(1.0);
-  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
-  ASSERT_GE(motion_.path().size(), 2u);
-  const Pose2& grasp = motion_.path().back();
-  // Closer, facing the bottle, but not on top of it.
-  const double d = (Eigen::Vector2d(0.0, 3.8) - grasp.translation()).norm();
-  EXPECT_GT(d, 0.3);
-  EXPECT_LT(d, 0.9);
-}
-
 }  // namespace
 }  // namespace egress::behavior

@@ -70,11 +70,17 @@ class TaskNodeFixture : public ::testing::Test {
     services_.belief = &belief_;
     RegisterTaskNodes(factory_, &services_);
   }
-  // A tree of the one node `xml`, on `blackboard` if given.
+  // A tree of the one node `xml`, on `blackboard` if given (each call registers a tree of its
+  // own, so a test may build several).
   bt::Tree Tree(const std::string& xml, bt::Blackboard::Ptr blackboard = nullptr) {
-    return factory_.CreateTreeFromText(
-        "<root BTCPP_format=\"4\"><BehaviorTree ID=\"t\">" + xml + "</BehaviorTree></root>", {},
-        blackboard);
+    std::string id = "t";
+    id += std::to_string(trees_made_++);
+    std::string text = R"(<root BTCPP_format="4"><BehaviorTree ID=")";
+    text += id;
+    text += R"(">)";
+    text += xml;
+    text += "</BehaviorTree></root>";
+    return factory_.CreateTreeFromText(text, id, blackboard);
   }
   // The door seen open at `angle_deg`, steady, `open_for` seconds at `now`.
   void DoorSeenOpen(double angle_deg, double open_for) {
@@ -112,6 +118,7 @@ class TaskNodeFixture : public ::testing::Test {
   DecisionLog log_;
   TaskServices services_;
   bt::BehaviorTreeFactory factory_;
+  int trees_made_{0};
 };
 
 }  // namespace egress::behavior::node_testing

@@ -18,7 +18,8 @@ TEST(TaskNodesModelTest, TheShippedModelMatchesTheRegistrations) {
   EXPECT_FALSE(ids.empty());
   EXPECT_EQ(shipped.WriteTreeNodesModelXml(false), generated)
       << "regenerate with: egress bt model --out behavior/trees/egress_nodes.xml --overwrite";
-  for (const char* id : {"NavigateTo", "TraverseDoor", "GraspPayload", "IsPathClear"})
+  for (const char* id :
+       {"NavigateTo", "TraverseDoor", "PlanGrasp", "CloseGripper", "WithdrawArm", "IsPathClear"})
     EXPECT_NE(generated.find(std::string("ID=\"") + id + "\""), std::string::npos) << id;
 }
 

@@ -192,9 +192,9 @@ TEST(FetchTreeTest, RetriesAGraspTheGripperDidNotHoldThenDelivers) {
   EXPECT_EQ(holding_checks, 2);
   int grasps = 0;
   for (const auto& name : run.Ticked(1))
-    grasps += name == "GraspPayload" ? 1 : 0;
+    grasps += name == "PlanGrasp" ? 1 : 0;
   EXPECT_EQ(grasps, 2);
-  EXPECT_EQ(run.Ticked(1).back(), "PlacePayload");
+  EXPECT_EQ(run.Ticked(1).back(), "WithdrawArm");  // the last of PlacePayload's phases
 }
 
 }  // namespace

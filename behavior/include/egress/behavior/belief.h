@@ -22,7 +22,9 @@ struct Belief {
   Time now{};  ///< The robot clock at this step.
   Pose2 X_MB;  ///< The localized base pose.
   perception::WorldState world;
-  bool holding_object{false};     ///< From the gripper's own measurement (GraspMonitor).
+  bool holding_object{false};  ///< From the gripper's own measurement (GraspMonitor).
+  /// The fingers moved after the last gripper command and have come to rest (GraspMonitor).
+  bool gripper_at_rest{false};
   std::optional<LaserScan> scan;  ///< The latest laser scan.
   /// The latest head depth image, the camera in M when it was taken, and its intrinsics.
   std::optional<DepthImage> depth;

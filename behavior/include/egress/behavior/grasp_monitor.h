@@ -39,11 +39,16 @@ class GraspMonitor {
   /// The hand holds an object: a grasp is in force and the fingers rest, squeezing, short of
   /// closed.
   bool holding() const { return holding_; }
+  /// The fingers moved after the last command and have come to rest since (on an object, or
+  /// closed or open on nothing): the command is done, as the gripper measures it.
+  bool at_rest() const { return moved_since_command_ && settled_; }
 
  private:
   GraspMonitorConfig config_;
   bool grasping_{false};
   bool holding_{false};
+  bool moved_since_command_{false};
+  bool settled_{false};
   std::optional<GripperState> last_;
   Time steady_since_{};
 };

@@ -114,6 +114,32 @@ struct DoorVisit {
   std::optional<Time> window_restarted_at;
 };
 
+/// A grasp, planned by PlanGrasp and carried out by the grasp leaves after it (DriveToGrasp,
+/// ReachForPayload, CloseGripper, LiftPayload; behavior/trees/grasp.xml) on a blackboard port
+/// (`grasp`, default `{grasp}`).
+struct GraspPlan {
+  Eigen::Vector3d p_MC{Eigen::Vector3d::Zero()};  ///< Grasp centre in M [m]; refined on the way.
+  /// Unit axis in M the palm comes in along: horizontal, or straight down for a low payload.
+  Eigen::Vector3d approach_M{Eigen::Vector3d::UnitX()};
+  double surface_z{0.0};  ///< Height of what the payload rests on [m].
+  std::string kind;       ///< bottle, flashlight, ... (how it stands)
+  Pose2 X_MB;             ///< Where the base stands for the grasp (whole-body IK).
+  /// The arm there (whole-body IK); once ReachForPayload has solved it from where the base
+  /// stopped, the arm at the grasp.
+  ArmPose arm{};
+};
+
+/// A release of the held payload (placing it, or handing it over), planned by PlanPlacement or
+/// PlanHandOver and carried out by the release leaves after it (DriveToRelease, ReachToRelease,
+/// WaitForRecipient, OpenGripper, WithdrawArm; behavior/trees/release.xml) on a blackboard port
+/// (`release`, default `{release}`).
+struct ReleasePlan {
+  Eigen::Vector3d p_MC{Eigen::Vector3d::Zero()};  ///< Where the payload's centre goes, in M [m].
+  Eigen::Vector3d approach_M{Eigen::Vector3d::UnitX()};  ///< Unit horizontal approach in M.
+  ArmPose arm{};      ///< The arm at the release (whole-body IK; DriveToRelease).
+  ArmPose pre_arm{};  ///< The arm short of it, which the hand withdraws through (ReachToRelease).
+};
+
 /// What the task nodes act through, handed to each at construction. The executive owns every
 /// piece and keeps them alive as long as its trees.
 struct TaskServices {
