@@ -21,10 +21,11 @@ class FieldReader {
 
   [[noreturn]] void Fail(const YAML::Node& node, const std::string& field,
                          const std::string& message) const {
-    std::string where = source_;
+    // StrCat, not "literal" + std::string: GCC 12 warns falsely (-Wrestrict) on that.
     if (node.IsDefined() && node.Mark().line >= 0)
-      where += ":" + std::to_string(node.Mark().line + 1);
-    throw LoadError(StrCat(where, ": field '", field, "': ", message));
+      throw LoadError(
+          StrCat(source_, ":", node.Mark().line + 1, ": field '", field, "': ", message));
+    throw LoadError(StrCat(source_, ": field '", field, "': ", message));
   }
 
   // Refuses keys outside `allowed`, so a typo never becomes a silent default.
