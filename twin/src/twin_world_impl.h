@@ -1,9 +1,10 @@
 #pragma once
-// Internal to twin/src: TwinWorld's implementation state (TwinWorld::Impl) and the helpers its
-// parts share. The Impl's methods live by concern: twin_world.cpp (building, stepping, contacts
-// and the public API), twin_statics.cpp (walls and furniture, ray proxies), twin_doors.cpp (leaves,
-// ADA operators, actuators), twin_crowd.cpp (people), twin_robot_body.cpp (base, arm, gripper,
-// payloads), twin_rays.cpp (ray casting for the sensors).
+// Internal to twin/src: the state of one run (TwinWorld::Impl) over its fixed model
+// (twin_model_compiled.h). The Impl's methods live by concern: twin_world.cpp (building,
+// stepping, contacts and the public API), twin_statics.cpp (the model's statics as bodies of the
+// run, ray proxies), twin_doors.cpp (leaves, ADA operators, actuators), twin_crowd.cpp (people),
+// twin_robot_body.cpp (base, arm, gripper, payloads), twin_rays.cpp (ray casting for the
+// sensors).
 
 #include "twin_model_compiled.h"
 
