@@ -21,20 +21,15 @@ void ForEachDepthPointInMap(const TaskServices& task, Fn&& fn) {
 
 }  // namespace
 
-// "x;y;z" → point. @throws InvalidArgument naming the text.
 Eigen::Vector3d ParsePoint3(std::string_view text) {
   const Pose2 xy = ParsePose2(text);  // x;y;z parses as x;y;yaw
   return {xy.x, xy.y, xy.yaw};
 }
 
-// The palm target that holds a grasp centre `p_M`, approached along the unit `approach_M`.
 planning::IkTarget PalmTarget(const Eigen::Vector3d& p_M, const Eigen::Vector3d& approach_M) {
   return {p_M - approach_M * kGraspDepthInPalm, approach_M};
 }
 
-// Where the base stands, and the arm there, for the hand to hold a grasp centre `p_M`
-// approached along `approach_M` — horizontally, or straight down — by a robot coming from the
-// horizontal direction `toward_M` (whole-body IK from 0.6 m short); nullopt if out of reach.
 std::optional<HandReach> SolveHandReach(const TaskServices& task, const Eigen::Vector3d& p_M,
                                         const Eigen::Vector3d& approach_M,
                                         const Eigen::Vector3d& toward_M) {
@@ -60,7 +55,6 @@ std::optional<HandReach> SolveHandReach(const TaskServices& task, const Eigen::V
   return HandReach{{r.q[kBaseX], r.q[kBaseY], r.q[kBaseYaw]}, ArmOf(r.q)};
 }
 
-// The unit horizontal direction from the robot to `p_M` (the robot's heading if it is there).
 Eigen::Vector3d HorizontalApproach(const Pose2& X_MB, const Eigen::Vector3d& p_M) {
   Eigen::Vector2d a = p_M.head<2>() - X_MB.translation();
   if (a.norm() < 1e-6) a = Eigen::Vector2d(std::cos(X_MB.yaw), std::sin(X_MB.yaw));
@@ -68,18 +62,12 @@ Eigen::Vector3d HorizontalApproach(const Pose2& X_MB, const Eigen::Vector3d& p_M
   return {a.x(), a.y(), 0.0};
 }
 
-// How far a payload's centre stands above the surface it rests on [m]: a bottle upright, a
-// flashlight lying; unknown kinds get a middle value.
 double PayloadCentreHeight(std::string_view kind) {
   if (kind == perception::labels::kBottle) return 0.105;
   if (kind == perception::labels::kFlashlight) return 0.021;
   return 0.05;
 }
 
-// The highest depth point standing out of the surface the payload rests on (`surface_z`) in the
-// corridor the hand sweeps horizontally towards a grasp centre `p_M` along `approach_M` (from
-// the pre-grasp to just before the payload, within a hand's width of the line), or nullopt if
-// there is none.
 std::optional<double> ClutterTopBeforeGrasp(const TaskServices& task, const Eigen::Vector3d& p_M,
                                             const Eigen::Vector3d& approach_M,
                                             double payload_radius, double surface_z) {
@@ -101,10 +89,6 @@ std::optional<double> ClutterTopBeforeGrasp(const TaskServices& task, const Eige
   return top;
 }
 
-// The centre of a low payload lying on a surface at `surface_z`, from the depth points that
-// stand out of the surface within `radius` of the estimate `p_M` (the centroid of what the
-// camera sees of it, horizontally): a grasp from above has no slack along the approach, where
-// the detection's single depth sample may be centimetres off. nullopt if too few points.
 std::optional<Eigen::Vector3d> LowPayloadCentre(const TaskServices& task,
                                                 const Eigen::Vector3d& p_M, double surface_z,
                                                 double radius) {

@@ -167,14 +167,14 @@ void TwinWorld::Impl::UpdatePeople() {
                         : 0.0;
     if (p.blocked_for > kStuckSec) {
       for (const auto& d : doors) {
-        const Eigen::Vector2d hinge = d.desc->p_WH.head<2>();
-        const Eigen::Vector2d edge = d.desc->CalcFreeEdge(d.angle).head<2>();
+        const Eigen::Vector2d hinge = d.fixed->desc->p_WH.head<2>();
+        const Eigen::Vector2d edge = d.fixed->desc->CalcFreeEdge(d.angle).head<2>();
         if (!SegmentsCross(p.walker.position, p.route.front(), hinge, edge)) continue;
         p.route.insert(p.route.begin(), edge + (edge - hinge).normalized() * kStepRoundLeaf);
         --p.reached;  // a detour, not a waypoint of the route
         p.walker.target = p.route.front();
         p.walker.final_target = false;
-        AddEvent("person_steps_round_leaf", p.state.name, d.desc->name);
+        AddEvent("person_steps_round_leaf", p.state.name, d.fixed->desc->name);
         break;
       }
       p.blocked_for = 0.0;
@@ -193,7 +193,8 @@ void TwinWorld::Impl::UpdatePeople() {
     walkers.push_back(p.walker);
   std::vector<WallSegment> all_walls = fixed.walls;
   for (const auto& d : doors) {
-    all_walls.push_back({d.desc->p_WH.head<2>(), d.desc->CalcFreeEdge(d.angle).head<2>()});
+    all_walls.push_back(
+        {d.fixed->desc->p_WH.head<2>(), d.fixed->desc->CalcFreeEdge(d.angle).head<2>()});
   }
   const Twist2 V_B = RobotVelocity();
   const Eigen::Vector2d v_W = X_WB.rotation() * Eigen::Vector2d(V_B.vx, V_B.vy);

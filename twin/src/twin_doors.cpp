@@ -9,7 +9,6 @@ void TwinWorld::Impl::BuildDoors() {
     const DoorDescription& d = world.doors[i];
     Door door;
     door.fixed = &fixed.doors[i];
-    door.desc = &d;
     door.spec = door.fixed->spec;
     if (door.spec && scenario.randomize.hold_open_s.max > 0.0) {
       door.spec->timing.hold_open_s = hold_override;
@@ -66,7 +65,7 @@ void TwinWorld::Impl::UpdateActuators() {
       if (result == PushButton::Result::kPressed) {
         triggered = &d.spec->actuators[k];
       } else if (result == PushButton::Result::kOverForce) {
-        AddEvent("button_overforce", d.desc->name, StrCat(d.buttons[k].force(), " N"));
+        AddEvent("button_overforce", d.fixed->desc->name, StrCat(d.buttons[k].force(), " N"));
       }
     }
     for (std::size_t k = 0; k < d.plates.size(); ++k) {
@@ -75,12 +74,12 @@ void TwinWorld::Impl::UpdateActuators() {
     if (d.spec && d.next_open_at < d.spec->open_at.size() &&
         time >= d.spec->open_at[d.next_open_at]) {
       ++d.next_open_at;
-      AddEvent("door_triggered", d.desc->name, "scheduled");
+      AddEvent("door_triggered", d.fixed->desc->name, "scheduled");
       d.op->Trigger(time);
     }
     if (triggered != nullptr) {
       ++d.presses;
-      AddEvent("button_pressed", d.desc->name, *triggered);
+      AddEvent("button_pressed", d.fixed->desc->name, *triggered);
       d.op->Trigger(time);
     }
   }
@@ -88,9 +87,10 @@ void TwinWorld::Impl::UpdateActuators() {
 
 double TwinWorld::Impl::MeasureDoorAngle(const Door& d) const {
   const Eigen::Matrix3d R =
-      FromBt(d.leaf->getWorldTransform()).rotation() * d.desc->X_WL.rotation().transpose();
-  const double about_axis = std::atan2(R(1, 0), R(0, 0)) * (d.desc->axis_W.z() > 0 ? 1.0 : -1.0);
-  return std::max(0.0, d.desc->open_sign * about_axis);
+      FromBt(d.leaf->getWorldTransform()).rotation() * d.fixed->desc->X_WL.rotation().transpose();
+  const double about_axis =
+      std::atan2(R(1, 0), R(0, 0)) * (d.fixed->desc->axis_W.z() > 0 ? 1.0 : -1.0);
+  return std::max(0.0, d.fixed->desc->open_sign * about_axis);
 }
 
 void TwinWorld::Impl::UpdateDoors() {
@@ -102,7 +102,7 @@ void TwinWorld::Impl::UpdateDoors() {
       const double rate = d.op->Update(time, d.angle);
       d.hinge->enableAngularMotor(true, d.motor_sign * rate, stall_impulse);
       if (d.op->phase() != d.last_phase) {
-        AddEvent(StrCat("door_", ToString(d.op->phase())), d.desc->name);
+        AddEvent(StrCat("door_", ToString(d.op->phase())), d.fixed->desc->name);
         d.last_phase = d.op->phase();
       }
     } else {
@@ -110,9 +110,9 @@ void TwinWorld::Impl::UpdateDoors() {
       const double closer_rate = d.angle > AdaDoorOperator::kClosedAngle ? -0.25 : 0.0;
       d.hinge->enableAngularMotor(true, d.motor_sign * closer_rate, 15.0 * d.fixed->reach * dt);
     }
-    const btVector3 axis = ToBt(d.desc->axis_W * d.desc->open_sign);
+    const btVector3 axis = ToBt(d.fixed->desc->axis_W * d.fixed->desc->open_sign);
     const double omega = d.leaf->getAngularVelocity().dot(axis);
-    btVector3 torque = -d.desc->damping * omega * axis;
+    btVector3 torque = -d.fixed->desc->damping * omega * axis;
     // People holding this door push it towards their hold angle.
     for (const auto& p : people) {
       if (p.state.phase != PersonPhase::kHolding || p.door != int(i)) continue;
@@ -126,11 +126,11 @@ void TwinWorld::Impl::UpdateDoors() {
     if (!d.reported_open && d.angle >= open_threshold) {
       d.reported_open = true;
       d.reported_closed = false;
-      AddEvent("door_opened", d.desc->name);
+      AddEvent("door_opened", d.fixed->desc->name);
     } else if (!d.reported_closed && d.angle <= AdaDoorOperator::kClosedAngle) {
       d.reported_closed = true;
       d.reported_open = false;
-      AddEvent("door_closed", d.desc->name);
+      AddEvent("door_closed", d.fixed->desc->name);
     }
   }
 }

@@ -66,7 +66,7 @@ std::vector<btVector3> TwinWorld::Impl::PrismTriangles(double radius, double hal
 
 void TwinWorld::Impl::BuildRayProxies() {
   for (const auto& d : doors)
-    AddRayProxy(d.leaf, BoxTriangles(ToBt(d.desc->leaf_size / 2)));
+    AddRayProxy(d.leaf, BoxTriangles(ToBt(d.fixed->desc->leaf_size / 2)));
   for (const auto& p : people)
     AddRayProxy(p.body, PrismTriangles(p.state.radius, kPersonHeight / 2, 2));
   for (const auto& p : payloads) {

@@ -321,7 +321,7 @@ std::size_t TwinWorld::door_count() const {
   return impl_->doors.size();
 }
 const DoorDescription& TwinWorld::door(std::size_t i) const {
-  return *impl_->doors.at(i).desc;
+  return *impl_->doors.at(i).fixed->desc;
 }
 double TwinWorld::door_angle(std::size_t i) const {
   return impl_->MeasureDoorAngle(impl_->doors.at(i));
@@ -368,8 +368,8 @@ std::vector<DetectableObject> TwinWorld::DetectableObjects() const {
   const auto& I = *impl_;
   for (std::size_t i = 0; i < I.doors.size(); ++i) {
     const auto& d = I.doors[i];
-    out.push_back({door_is_glass(i) ? "glass_door" : "door", d.desc->name,
-                   FromBt(d.leaf->getWorldTransform()), d.desc->leaf_size / 2,
+    out.push_back({door_is_glass(i) ? "glass_door" : "door", d.fixed->desc->name,
+                   FromBt(d.leaf->getWorldTransform()), d.fixed->desc->leaf_size / 2,
                    d.leaf->getUserIndex()});
     if (!d.spec) continue;
     for (const auto& actuator : d.spec->actuators) {

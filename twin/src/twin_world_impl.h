@@ -12,8 +12,7 @@ namespace egress::twin {
 namespace world_detail {
 // A door in the run: its fixed model and its state.
 struct Door {
-  const DoorModel* fixed{nullptr};
-  const DoorDescription* desc{nullptr};  // fixed->desc
+  const DoorModel* fixed{nullptr};       // its geometry and description (fixed->desc)
   std::optional<DoorOperatorSpec> spec;  // fixed->spec with the run's seeded hold time
   std::optional<AdaDoorOperator> op;
   std::vector<PushButton> buttons;     // one per push-button actuator, in spec order

@@ -18,7 +18,7 @@ class HoldDoor final : public PersonBehaviorModel {
     if (p->hold_started < 0) {
       p->state.phase = PersonPhase::kHolding;
       p->hold_started = time;
-      add_event("person_holding_door", p->state.name, door->desc->name);
+      add_event("person_holding_door", p->state.name, door->fixed->desc->name);
       return;
     }
     PersonBehaviorModel::AtRouteEnd(time, door, p, add_event);
@@ -28,7 +28,7 @@ class HoldDoor final : public PersonBehaviorModel {
     if (p->state.phase != PersonPhase::kHolding || time - p->hold_started < p->hold_duration)
       return;
     p->state.phase = PersonPhase::kWalking;
-    add_event("person_released_door", p->state.name, door->desc->name);
+    add_event("person_released_door", p->state.name, door->fixed->desc->name);
     if (spec != nullptr && (spec->goal - p->walker.position).norm() > 0.3)
       p->route.push_back(spec->goal);
   }
