@@ -7,8 +7,12 @@
 namespace egress::apps {
 
 behavior::MissionMap BuildMissionMap(const twin::WorldDescription& world,
-                                     const twin::Scenario& scenario, double resolution) {
-  SdfMap sdf = RasterizeSdfWorld(world, resolution, 20'000'000);
+                                     const twin::BuildingDescription& building,
+                                     const std::vector<Eigen::Vector2d>& cover, double resolution) {
+  std::vector<Eigen::Vector2d> points = cover;
+  for (const auto& p : building.places)
+    points.push_back(p.X_WP.translation());
+  SdfMap sdf = RasterizeSdfWorld(world, resolution, 20'000'000, points, kPlaceMapMarginM);
   behavior::MissionMap map;
   map.grid = std::move(sdf.grid);
   map.doorways = sdf.doors;
@@ -18,41 +22,24 @@ behavior::MissionMap BuildMissionMap(const twin::WorldDescription& world,
     door.p_MHinge = doorway.p_MHinge;
     door.p_MLatch = doorway.p_MLatch;
     door.swing_sign = doorway.swing_sign;
-    if (const twin::DoorDescription* d = world.FindDoor(doorway.id))
+    if (const twin::BuildingDoor* d = building.FindDoor(doorway.id))
       door.max_open_angle = d->max_open_angle;
     map.doors.push_back(door);
   }
-  for (const auto& spec : scenario.doors) {
-    if (spec.kind == twin::OperatorKind::kManual) continue;
-    for (const auto& id : spec.actuators) {
-      const auto shapes = world.ShapesOfModel(id);
-      ThrowUnless(!shapes.empty(), scenario.source.string(), ": actuator '", id,
-                  "' has no shape in ", world.source.string());
-      const twin::ShapeDescription& shape = *shapes.front();
-      const perception::DoorModel* door = map.FindDoor(spec.door);
-      ThrowUnless(door != nullptr, scenario.source.string(), ": door '", spec.door,
-                  "' is not a door of ", world.source.string());
-      behavior::MapActuator actuator;
-      actuator.id = id;
-      actuator.door = spec.door;
-      actuator.type = spec.kind == twin::OperatorKind::kPushButton
-                          ? planning::ButtonType::kPushButton
-                          : planning::ButtonType::kProximityPlate;
-      const Eigen::Vector3d centre = shape.X_WS.translation();
-      const Eigen::Vector2d along = (door->p_MLatch - door->p_MHinge).normalized();
-      Eigen::Vector2d n(-along.y(), along.x());
-      if (n.dot(centre.head<2>() - door->p_MHinge) < 0) n = -n;
-      actuator.n_M = Eigen::Vector3d(n.x(), n.y(), 0.0);
-      // The face: half the box's extent along the normal in front of its centre.
-      const Eigen::Matrix3d& R = shape.X_WS.rotation();
-      double half = 0.0;
-      for (int i = 0; i < 3; ++i)
-        half += std::abs(actuator.n_M.dot(R.col(i))) * shape.box_size[i] / 2;
-      actuator.p_M = centre + actuator.n_M * half;
-      actuator.protrusion = 2 * half;  // mounted on the wall's surface
-      map.actuators.push_back(actuator);
-    }
+  for (const auto& a : building.actuators) {
+    behavior::MapActuator actuator;
+    actuator.id = a.model;
+    actuator.door = a.door;
+    actuator.type = a.kind == twin::ActuatorKind::kPushButton
+                        ? planning::ButtonType::kPushButton
+                        : planning::ButtonType::kProximityPlate;
+    actuator.p_M = a.p_W;
+    actuator.n_M = a.n_W;
+    actuator.protrusion = a.protrusion;
+    map.actuators.push_back(actuator);
   }
+  for (const auto& p : building.places)
+    map.places.push_back({p.name, p.kind, p.X_WP, p.has_yaw});
   map.Validate();
   return map;
 }
@@ -69,9 +56,29 @@ std::unique_ptr<behavior::Executive> MakeScenarioExecutive(
   tree.file = scenario.mission->tree_file;
   tree.tree_id = scenario.mission->tree_id;
   tree.blackboard = scenario.mission->blackboard;
+  // A mission's {goal} defaults to the scenario's robot goal: the place, or the pose.
+  if (tree.blackboard.count("goal") == 0) {
+    if (!scenario.goal_place.empty()) {
+      tree.blackboard["goal"] = scenario.goal_place;
+    } else if (scenario.goal) {
+      tree.blackboard["goal"] =
+          StrCat(scenario.goal->x, ";", scenario.goal->y, ";", scenario.goal->yaw);
+    }
+  }
   try {
-    return std::make_unique<behavior::Executive>(std::move(model), BuildMissionMap(world, scenario),
-                                                 tree, twin_world.robot_pose(), config);
+    // A door the scenario says has no operator keeps no actuator on the map (as before the
+    // building description: the map says what works).
+    twin::BuildingDescription building = twin::DescribeScenarioBuilding(scenario, world);
+    for (const auto& spec : scenario.doors) {
+      if (spec.kind != twin::OperatorKind::kManual) continue;
+      std::erase_if(building.actuators,
+                    [&](const twin::BuildingActuator& a) { return a.door == spec.door; });
+    }
+    std::vector<Eigen::Vector2d> cover{scenario.robot_start.translation()};
+    if (scenario.goal) cover.push_back(scenario.goal->translation());
+    return std::make_unique<behavior::Executive>(std::move(model),
+                                                 BuildMissionMap(world, building, cover), tree,
+                                                 twin_world.robot_pose(), config);
   } catch (const std::exception& e) {
     throw InvalidArgument(StrCat(scenario.source.string(), ":", scenario.mission->tree_line,
                                  ": mission.tree '", tree.file.string(), "': ", e.what()));

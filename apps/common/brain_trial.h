@@ -18,19 +18,27 @@
 
 namespace egress::apps {
 
-/// The building map the robot brain gets for a twin scenario: the world's floor plan and doors
-/// (RasterizeSdfWorld) and the scenario's door actuators (their SDF boxes, face on the side of
-/// the door line they stand on). The scenario's extra obstacles, people and payloads are not in
-/// it: the robot perceives them. @throws InvalidArgument for an actuator without a shape.
+/// Free space the brain's map keeps round a place outside the building's walls [m] (beyond the
+/// exit): the robot must still be on its map, and localized, where the route leads out.
+inline constexpr double kPlaceMapMarginM = 2.0;
+
+/// The building map the robot brain gets: the world's floor plan (RasterizeSdfWorld, grown to
+/// cover every place and `cover` point by kPlaceMapMarginM), its doors, the building's actuators
+/// (each face and facing from its own box) and named places. The scenario's extra obstacles, people
+/// and payloads are not in it: the robot perceives them. @throws InvalidArgument for a map the grid
+/// cannot hold.
 behavior::MissionMap BuildMissionMap(const twin::WorldDescription& world,
-                                     const twin::Scenario& scenario, double resolution = 0.05);
+                                     const twin::BuildingDescription& building,
+                                     const std::vector<Eigen::Vector2d>& cover = {},
+                                     double resolution = 0.05);
 
 }  // namespace egress::apps
 
 namespace egress::apps {
 
-/// The robot brain for a twin run of `scenario`: its mission tree and blackboard, the building
-/// map, and as the initial pose the twin's start (what an operator's initial pose estimate
+/// The robot brain for a twin run of `scenario`: its mission tree and blackboard (whose {goal}
+/// defaults to the scenario's robot goal, a place or a pose), the building map, and as the
+/// initial pose the twin's start (what an operator's initial pose estimate
 /// gives a real robot; after that the brain localizes on odometry alone).
 /// @throws InvalidArgument / LogicError naming the file for a scenario without a mission, a bad
 /// tree or an unknown node.

@@ -3,13 +3,17 @@
 #include <cmath>
 
 #include "egress/hsr_interface/error.h"
+#include "egress/twin/building.h"
 
 namespace egress::apps {
 
 SdfMap RasterizeSdfWorld(const twin::WorldDescription& world, double resolution,
-                         std::int64_t max_cells) {
+                         std::int64_t max_cells, const std::vector<Eigen::Vector2d>& cover,
+                         double cover_margin) {
   ThrowUnless(resolution >= 0.01 && resolution <= 1.0, "resolution must be in [0.01, 1] m, got ",
               resolution);
+  ThrowUnless(cover_margin >= 0.0 && cover_margin <= 100.0,
+              "map cover margin must be in [0, 100] m, got ", cover_margin);
   std::vector<perception::Box2> boxes;
   Eigen::Vector2d lo = Eigen::Vector2d::Constant(1e18), hi = -lo;
   for (const auto& f : twin::CalcFloorFootprints(world)) {
@@ -20,6 +24,14 @@ SdfMap RasterizeSdfWorld(const twin::WorldDescription& world, double resolution,
   }
   ThrowUnless(!boxes.empty(), world.source.string(),
               ": the world has no walls or furniture to map");
+  // Points inside the walls' bounds are on the map already; one outside brings its margin.
+  const Eigen::Vector2d wall_lo = lo, wall_hi = hi;
+  for (const auto& p : cover) {
+    ThrowUnless(p.allFinite(), world.source.string(), ": a point to map is not finite");
+    if ((p.array() >= wall_lo.array()).all() && (p.array() <= wall_hi.array()).all()) continue;
+    lo = lo.cwiseMin(p - Eigen::Vector2d::Constant(cover_margin));
+    hi = hi.cwiseMax(p + Eigen::Vector2d::Constant(cover_margin));
+  }
   // Snap the bounds to the cell grid so walls on whole metres land on cell edges.
   lo = (lo / resolution).array().floor() * resolution;
   hi = (hi / resolution).array().ceil() * resolution;
@@ -28,8 +40,9 @@ SdfMap RasterizeSdfWorld(const twin::WorldDescription& world, double resolution,
               std::int64_t(cells), " cells at ", resolution, " m, more than the limit ", max_cells);
   SdfMap out{perception::OccupancyGrid::FromBoxes(boxes, lo, hi, resolution), {}};
   for (const auto& d : world.doors) {
-    perception::Doorway doorway{d.name, d.p_WH.head<2>(), d.CalcFreeEdge(0.0).head<2>()};
-    doorway.swing_sign = d.open_sign * (d.axis_W.z() > 0 ? 1.0 : -1.0);  // counter-clockwise = +1
+    const twin::BuildingDoor door = twin::DescribeDoor(d);
+    perception::Doorway doorway{door.model, door.p_WHinge, door.p_WLatch};
+    doorway.swing_sign = door.swing_sign;
     out.doors.push_back(doorway);
   }
   return out;

@@ -18,10 +18,13 @@ struct SdfMap {
   std::vector<perception::Doorway> doors;  ///< id = the SDF model name; hinge and latch jambs
 };
 
-/// Rasterizes `world` at `resolution` [m] over the bounds of its footprints (snapped to the
-/// grid). @throws InvalidArgument for a bad resolution, a world without walls, or more than
-/// `max_cells` cells.
+/// Rasterizes `world` at `resolution` [m] over the bounds of its footprints, grown to hold
+/// every point of `cover` outside them with `cover_margin` [m] of free space round it (places
+/// beyond the exit, where a route leads out of the building), snapped to the grid.
+/// @throws InvalidArgument for a bad resolution or margin, a non-finite point, a world without
+/// walls, or more than `max_cells` cells.
 SdfMap RasterizeSdfWorld(const twin::WorldDescription& world, double resolution,
-                         std::int64_t max_cells);
+                         std::int64_t max_cells, const std::vector<Eigen::Vector2d>& cover = {},
+                         double cover_margin = 0.0);
 
 }  // namespace egress::apps

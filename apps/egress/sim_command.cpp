@@ -7,11 +7,13 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -50,6 +52,10 @@ twin::TraceAnnotation::Grid CostmapLayer(const perception::Costmap2D& costmap) {
 
 struct SimOptions {
   std::string scenario;
+  std::string start;  // with a world file: a place or x;y;yaw
+  std::string goal;   // with a world file: a place or x;y;yaw
+  double time_limit{300.0};
+  std::string tree{std::string(EGRESS_TREES_DIR) + "/go_to.xml"};
   std::optional<std::uint64_t> seed;
   double duration{0.0};
   std::string driver{"auto"};
@@ -99,10 +105,67 @@ void ProgressBar(double fraction) {
   if (fraction >= 1.0) std::fprintf(stderr, "\n");
 }
 
+bool IsWorldFile(const std::string& path) {
+  const std::string ext = std::filesystem::path(path).extension().string();
+  return ext == ".sdf" || ext == ".world";
+}
+
+// "x;y;yaw" (or "x;y") as a YAML pose, or a place name as {place: ..}.
+std::string PoseOrPlaceYaml(const std::string& text, const char* option) {
+  if (text.find(';') == std::string::npos) {
+    if (text.empty() || text.find_first_of("{}[]:,#\"'") != std::string::npos)
+      throw CommandFailed(fmt::format("{} '{}': expected a place name or x;y;yaw", option, text));
+    return fmt::format("{{place: {}}}", text);
+  }
+  std::vector<double> v;
+  std::stringstream in(text);
+  std::string part;
+  while (std::getline(in, part, ';')) {
+    try {
+      std::size_t used = 0;
+      v.push_back(std::stod(part, &used));
+      if (used != part.size() || !std::isfinite(v.back())) throw std::invalid_argument(part);
+    } catch (const std::exception&) {
+      throw CommandFailed(fmt::format("{} '{}': '{}' is not a finite number", option, text, part));
+    }
+  }
+  if (v.size() != 2 && v.size() != 3)
+    throw CommandFailed(fmt::format("{} '{}': expected x;y;yaw or x;y", option, text));
+  return fmt::format("{{x: {}, y: {}, yaw: {}}}", v[0], v[1], v.size() == 3 ? v[2] : 0.0);
+}
+
+// A world and a goal as a scenario: the building's doors with their operators (from the world
+// and its building YAML), the robot at --start, the mission GoTo --goal.
+twin::Scenario GoalScenario(const SimOptions& o) {
+  if (o.goal.empty()) throw CommandFailed("a world file needs --goal (a place or x;y;yaw)");
+  const std::filesystem::path world = std::filesystem::absolute(o.scenario);
+  std::string start = o.start;
+  if (start.empty()) {
+    const twin::BuildingDescription building = twin::DescribeBuilding(
+        twin::LoadSdfWorld(world), twin::FindBuildingYamlBeside(world).value_or(""));
+    if (building.places.empty())
+      throw CommandFailed(
+          fmt::format("{}: the building has no places; pass --start x;y;yaw", o.scenario));
+    start = building.places.front().name;
+  }
+  const std::string goal = PoseOrPlaceYaml(o.goal, "--goal");
+  const std::string yaml = fmt::format(
+      "name: '{} to {}'\nworld: '{}'\ntime_limit: {}\nrobot:\n  start: {}\n  goal: {}\n"
+      "mission:\n  tree: '{}'\n  blackboard: {{max_yields: \"5\"}}\n"
+      "success: [reach_goal, no_person_contact, no_door_strike]\n",
+      world.stem().string(), o.goal, world.string(), o.time_limit,
+      PoseOrPlaceYaml(start, "--start"), goal.substr(0, goal.size() - 1) + ", tolerance: 0.3}",
+      o.tree);
+  return twin::LoadScenarioFromString(yaml, o.scenario + " --goal " + o.goal, world.parent_path());
+}
+
 void RunSim(const SimOptions& o) {
   for (const auto* path : {&o.trace, &o.json, &o.png, &o.mp4})
     RefuseOverwrite(*path, o.overwrite);
-  const twin::Scenario scenario = twin::LoadScenario(o.scenario);
+  if (!IsWorldFile(o.scenario) && (!o.goal.empty() || !o.start.empty()))
+    throw CommandFailed("--start and --goal go with a world file (.sdf/.world), not a scenario");
+  const twin::Scenario scenario =
+      IsWorldFile(o.scenario) ? GoalScenario(o) : twin::LoadScenario(o.scenario);
   const twin::WorldDescription world_description = twin::LoadSdfWorld(scenario.world_file);
   const std::uint64_t seed = o.seed.value_or(scenario.seed);
   auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
@@ -212,8 +275,20 @@ void AddSimCommand(CLI::App& app) {
       app.add_subcommand("sim", "Digital-twin runs: `sim run` (one scenario, judged), `sim batch`");
   sim_group->require_subcommand(1);
   auto* sim = sim_group->add_subcommand("run", "Run one twin scenario end to end and judge it");
-  sim->add_option("scenario", o->scenario, "scenario YAML (worlds/README.md)")
+  sim->add_option("scenario", o->scenario,
+                  "scenario YAML (worlds/README.md), or an SDF world with --goal")
       ->required()
+      ->check(CLI::ExistingFile);
+  sim->add_option("--goal", o->goal,
+                  "with a world file: where to go, a place of the building or x;y;yaw");
+  sim->add_option("--start", o->start,
+                  "with a world file: where the robot starts (default: the building's first "
+                  "place)");
+  sim->add_option("--time-limit", o->time_limit, "with a world file: time limit [s]")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  sim->add_option("--tree", o->tree, "with a world file: the mission tree (goal on {goal})")
+      ->capture_default_str()
       ->check(CLI::ExistingFile);
   sim->add_option("--seed", o->seed, "seed (default: the scenario's)");
   sim->add_option("--duration", o->duration,

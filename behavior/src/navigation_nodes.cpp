@@ -16,7 +16,7 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
  public:
   using TaskNode::TaskNode;
   static PortsList ProvidedPorts() {
-    return {InputPort<std::string>("goal", "goal pose x;y;yaw"),
+    return {InputPort<std::string>("goal", "goal: a place of the building, or a pose x;y;yaw"),
             InputPort<double>("detour_speed", 0.2,
                               "speed of the Bug2 detour when the costmap has no path [m/s]"),
             InputPort<double>("patience", 15.0, "how long to keep re-planning a blocked goal [s]")};
@@ -24,6 +24,7 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
   NodeStatus OnStart() override {
     blocked_since_.reset();
     detour_tried_ = false;
+    goal_.reset();  // a place without a heading is resolved once, from where the robot starts
     return Start();
   }
   NodeStatus OnRunning() override {
@@ -46,7 +47,15 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
 
   NodeStatus Start() {
     last_try_ = belief_.now;
-    const Pose2 goal = ParsePose2(Input<std::string>("goal"));
+    if (!goal_) {
+      try {
+        goal_ = ResolveGoal(*task_.map, Input<std::string>("goal"), belief_.X_MB);
+      } catch (const InvalidArgument& e) {
+        Note(e.what());
+        return NodeStatus::kFailure;
+      }
+    }
+    const Pose2 goal = *goal_;
     // Quiet while re-planning: the first failure is noted, not every retry.
     const NodeStatus s = StartPath(task_, goal, "goal", [this](const std::string& t) {
       if (!blocked_since_) Note(t);
@@ -81,6 +90,7 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
     return NodeStatus::kRunning;
   }
   std::optional<Time> blocked_since_;
+  std::optional<Pose2> goal_;
   Time last_try_{};
   bool detour_tried_{false};
 };

@@ -1,5 +1,7 @@
 #include "task_node_support.h"
 
+#include <cstdio>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -17,6 +19,12 @@ bool ArmAt(const ArmPose& a, const ArmPose& b) {
 
 std::string PoseText(const Pose2& X) {
   return StrCat(std::round(X.x * 100) / 100, ", ", std::round(X.y * 100) / 100);
+}
+
+std::string PosePortText(const Pose2& X) {
+  char buffer[96];  // %.17g: reads back to the same doubles
+  std::snprintf(buffer, sizeof(buffer), "%.17g;%.17g;%.17g", X.x, X.y, X.yaw);
+  return buffer;
 }
 
 // Starts a base motion along a planned path; RUNNING until it ends.

@@ -38,7 +38,10 @@ inline constexpr double kOperatorOpeningTime = 4.0;
 inline constexpr double kOperatorMaxClosingRate = (80.0 * M_PI / 180.0) / 3.0;
 
 bool ArmAt(const ArmPose& a, const ArmPose& b);
+/// "x, y" rounded to centimetres: for notes people read.
 std::string PoseText(const Pose2& X);
+/// "x;y;yaw" in full precision: for a pose port (ParsePose2 reads it back exactly).
+std::string PosePortText(const Pose2& X);
 
 // Base for the nodes: the read-only belief, the services, typed inputs that fail the node
 // loudly, and the door visit shared with the other door nodes on the `visit` port.
@@ -182,12 +185,13 @@ void Register(bt::BehaviorTreeFactory& factory, const std::string& id,
 }
 
 // Each family registers its own nodes (condition_nodes.cpp, navigation_nodes.cpp,
-// door_nodes.cpp, manipulation_nodes.cpp, grasp_nodes.cpp, release_nodes.cpp).
+// door_nodes.cpp, manipulation_nodes.cpp, grasp_nodes.cpp, release_nodes.cpp, route_nodes.cpp).
 void RegisterConditionNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 void RegisterNavigationNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 void RegisterDoorNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 void RegisterManipulationNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 void RegisterGraspNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 void RegisterReleaseNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
+void RegisterRouteNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 
 }  // namespace egress::behavior::detail

@@ -16,6 +16,7 @@ void TaskConfig::Validate() const {
   ThrowUnless(precise_pose_sigma > 0 && relocalize_timeout >= 0,
               "TaskConfig: precise_pose_sigma must be > 0 and relocalize_timeout >= 0");
   ik.Validate();
+  route.Validate();
 }
 
 Pose2 ParsePose2(std::string_view text) {
@@ -38,6 +39,23 @@ Pose2 ParsePose2(std::string_view text) {
   return X;
 }
 
+Pose2 ResolveGoal(const MissionMap& map, std::string_view text, const Pose2& X_MB) {
+  const std::string name(text);
+  if (const MapPlace* place = map.FindPlace(name)) {
+    if (place->has_yaw) return place->X_MP;
+    // Any heading will do: arrive facing the way from here.
+    const Eigen::Vector2d d = place->X_MP.translation() - X_MB.translation();
+    return {place->X_MP.x, place->X_MP.y, d.norm() > 0.05 ? std::atan2(d.y(), d.x()) : X_MB.yaw};
+  }
+  const bool looks_like_pose = name.find(';') != std::string::npos;
+  if (looks_like_pose) return ParsePose2(text);
+  std::string places;
+  for (const auto& p : map.places)
+    places += (places.empty() ? "" : ", ") + p.name;
+  throw InvalidArgument(StrCat("goal '", name, "' is neither a pose (x;y;yaw) nor a place of the ",
+                               "building (places: ", places.empty() ? "none" : places, ")"));
+}
+
 std::string TaskNodesModelXml() {
   // Registration needs only the node types' ports; no node is built, so no services.
   bt::BehaviorTreeFactory factory;
@@ -47,6 +65,7 @@ std::string TaskNodesModelXml() {
   detail::RegisterManipulationNodes(factory, nullptr);
   detail::RegisterGraspNodes(factory, nullptr);
   detail::RegisterReleaseNodes(factory, nullptr);
+  detail::RegisterRouteNodes(factory, nullptr);
   return factory.WriteTreeNodesModelXml(false);
 }
 
@@ -58,6 +77,7 @@ void RegisterTaskNodes(bt::BehaviorTreeFactory& factory, const TaskServices* ser
               "planner, a decision log and a belief");
   detail::RegisterConditionNodes(factory, services);
   detail::RegisterNavigationNodes(factory, services);
+  detail::RegisterRouteNodes(factory, services);
   detail::RegisterDoorNodes(factory, services);
   detail::RegisterManipulationNodes(factory, services);
   detail::RegisterGraspNodes(factory, services);

@@ -28,7 +28,7 @@ MissionMap EmptyRoom() {
 
 MissionTree GoTo() {
   MissionTree tree;
-  tree.file = std::filesystem::path(EGRESS_TREES_DIR) / "go_to_goal.xml";
+  tree.file = std::filesystem::path(EGRESS_TREES_DIR) / "go_to.xml";
   tree.blackboard["goal"] = "8.0;3.0;0.0";
   return tree;
 }

@@ -69,7 +69,7 @@ TEST(LaserSimulatorTest, GlassReturnsOnlyNearNormalIncidence) {
   const std::string doors_glass =
       "doors: [{door: door_b, operator: proximity, actuator: door_b_plate, glass: true}]\n";
   const std::string doors_solid =
-      "doors: [{door: door_b, operator: proximity, actuator: door_b_plate}]\n";
+      "doors: [{door: door_b, operator: proximity, actuator: door_b_plate, glass: false}]\n";
   auto glass = LoadText(At("office.sdf", 7.5, 1.3, 0.0, doors_glass), WorldsDir() / "office");
   auto solid = LoadText(At("office.sdf", 7.5, 1.3, 0.0, doors_solid), WorldsDir() / "office");
   TwinWorld glass_world(glass.scenario, glass.world, 1, Hsr());

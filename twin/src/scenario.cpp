@@ -163,8 +163,8 @@ PredicateSpec ParsePredicate(const FieldReader& r, const YAML::Node& node,
 Scenario Parse(const YAML::Node& root, const FieldReader& r,
                const std::filesystem::path& base_dir) {
   r.CheckKeys(root, "",
-              {"name", "world", "seed", "time_limit", "robot", "doors", "people", "payloads",
-               "obstacles", "randomize", "success", "sensors", "mission"});
+              {"name", "world", "building", "seed", "time_limit", "robot", "doors", "people",
+               "payloads", "obstacles", "randomize", "success", "sensors", "mission"});
   Scenario s;
   s.name = root["name"] ? r.String(root["name"], "name") : std::string();
   const std::string world = r.String(r.Required(root, "", "world"), "world");
@@ -172,6 +172,14 @@ Scenario Parse(const YAML::Node& root, const FieldReader& r,
       std::filesystem::path(world).is_absolute() ? std::filesystem::path(world) : base_dir / world;
   if (!std::filesystem::exists(s.world_file)) {
     r.Fail(root["world"], "world", "no such file: " + s.world_file.string());
+  }
+  if (root["building"]) {
+    const std::string building = r.String(root["building"], "building");
+    s.building_file = std::filesystem::path(building).is_absolute()
+                          ? std::filesystem::path(building)
+                          : base_dir / building;
+    if (!std::filesystem::exists(s.building_file))
+      r.Fail(root["building"], "building", "no such file: " + s.building_file.string());
   }
   if (root["seed"]) {
     const double seed = r.NonNegative(root["seed"], "seed");
@@ -182,8 +190,17 @@ Scenario Parse(const YAML::Node& root, const FieldReader& r,
 
   const YAML::Node robot = r.Required(root, "", "robot");
   r.CheckKeys(robot, "robot", {"start", "goal"});
-  s.robot_start = r.ReadPose2(r.Required(robot, "robot", "start"), "robot.start");
-  if (const YAML::Node goal = robot["goal"]) {
+  if (const YAML::Node start = r.Required(robot, "robot", "start"); start["place"]) {
+    r.CheckKeys(start, "robot.start", {"place"});
+    s.start_place = r.String(start["place"], "robot.start.place");
+  } else {
+    s.robot_start = r.ReadPose2(start, "robot.start");
+  }
+  if (const YAML::Node goal = robot["goal"]; goal && goal["place"]) {
+    r.CheckKeys(goal, "robot.goal", {"place", "tolerance"});
+    s.goal_place = r.String(goal["place"], "robot.goal.place");
+    if (goal["tolerance"]) s.goal_tolerance = r.Positive(goal["tolerance"], "robot.goal.tolerance");
+  } else if (goal) {
     r.CheckKeys(goal, "robot.goal", {"x", "y", "yaw", "yaw_deg", "tolerance"});
     Pose2 g;
     g.x = r.Number(r.Required(goal, "robot.goal", "x"), "robot.goal.x");
@@ -206,8 +223,9 @@ Scenario Parse(const YAML::Node& root, const FieldReader& r,
       DoorOperatorSpec op;
       op.door = r.String(r.Required(d, f, "door"), f + ".door");
       op.kind = ParseOperator(r, r.Required(d, f, "operator"), f + ".operator");
-      if (op.kind != OperatorKind::kManual) {
-        const YAML::Node a = r.Required(d, f, "actuator");
+      if (const YAML::Node a = d["actuator"]; a && op.kind == OperatorKind::kManual) {
+        r.Fail(a, f + ".actuator", "a manual door has no actuator");
+      } else if (a) {  // else the building's actuators of the door
         if (a.IsSequence()) {
           if (a.size() == 0) r.Fail(a, f + ".actuator", "expected at least one actuator");
           for (std::size_t k = 0; k < a.size(); ++k)
@@ -216,7 +234,10 @@ Scenario Parse(const YAML::Node& root, const FieldReader& r,
           op.actuators.push_back(r.String(a, f + ".actuator"));
         }
       }
-      if (d["glass"]) op.glass = r.Bool(d["glass"], f + ".glass");
+      if (d["glass"]) {
+        op.glass = r.Bool(d["glass"], f + ".glass");
+        op.glass_given = true;
+      }
       auto& t = op.timing;
       if (d["open_angle_deg"])
         t.open_angle_deg = r.Positive(d["open_angle_deg"], f + ".open_angle_deg");
@@ -368,7 +389,8 @@ Scenario Parse(const YAML::Node& root, const FieldReader& r,
     if (!success.IsSequence()) r.Fail(success, "success", "expected a list of predicates");
     for (std::size_t i = 0; i < success.size(); ++i) {
       s.success.push_back(ParsePredicate(r, success[i], "success[" + std::to_string(i) + "]"));
-      if (s.success.back().kind == PredicateSpec::Kind::kReachGoal && !s.goal) {
+      if (s.success.back().kind == PredicateSpec::Kind::kReachGoal && !s.goal &&
+          s.goal_place.empty()) {
         r.Fail(success[i], "success[" + std::to_string(i) + "]", "reach_goal needs robot.goal");
       }
     }
@@ -482,6 +504,11 @@ void Scenario::ValidateAgainst(const WorldDescription& world) const {
     if (world.FindDoor(op.door) == nullptr) {
       throw LoadError(
           StrCat(f, ".door': world ", world_file.string(), " has no hinged door '", op.door, "'"));
+    }
+    if (op.kind != OperatorKind::kManual && op.actuators.empty()) {
+      throw LoadError(StrCat(f, ".actuator': door '", op.door,
+                             "' has an operator but no actuator (name one, or give the building "
+                             "one the building description finds)"));
     }
     for (const auto& actuator : op.actuators) {
       const auto shapes = world.ShapesOfModel(actuator);

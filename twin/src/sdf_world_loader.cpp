@@ -15,6 +15,7 @@
 #include <sdf/Collision.hh>
 #include <sdf/Console.hh>
 #include <sdf/Cylinder.hh>
+#include <sdf/Frame.hh>
 #include <sdf/Geometry.hh>
 #include <sdf/Joint.hh>
 #include <sdf/JointAxis.hh>
@@ -79,6 +80,11 @@ class WorldReader {
     NoteUnknownChildren(world.Element(), "world '" + world.Name() + "'");
     for (uint64_t i = 0; i < world.ModelCount(); ++i) {
       ReadModel(*world.ModelByIndex(i), Pose3());
+    }
+    for (uint64_t i = 0; i < world.FrameCount(); ++i) {
+      const sdf::Frame& frame = *world.FrameByIndex(i);
+      out_.frames.emplace_back(frame.Name(),
+                               ResolvePose(frame, source_, StrCat("frame '", frame.Name(), "'")));
     }
     return std::move(out_);
   }

@@ -112,6 +112,8 @@ TwinModel::TwinModel(Scenario scenario, WorldDescription world,
       compiled_(std::make_unique<Compiled>()) {
   ThrowUnless(robot_model_ != nullptr, "TwinModel: robot model is null");
   config_.Validate();
+  building_ = DescribeScenarioBuilding(scenario_, world_);
+  ApplyBuildingDefaults(building_, &scenario_);
   scenario_.ValidateAgainst(world_);
   CompileStatics(scenario_, world_, compiled_.get());
   CompileDoors(scenario_, world_, compiled_.get());

@@ -1,5 +1,6 @@
 // Decorators: Inverter, ForceSuccess, ForceFailure, Repeat, RetryUntilSuccessful,
-// KeepRunningUntilFailure, Delay, Timeout, RunOnce, Precondition; and the SubTree node.
+// KeepRunningUntilFailure, Delay, Timeout, RunOnce, Precondition, LoopInt, LoopBool,
+// LoopDouble, LoopString; and the SubTree node.
 
 #include "builtin_nodes.h"
 #include "egress/bt/factory.h"
@@ -246,6 +247,54 @@ class PreconditionNode : public DecoratorNode {
   std::shared_ptr<const Script> script_;
 };
 
+/// LoopInt, LoopBool, LoopDouble, LoopString (BT.CPP 4's LoopNode<T>): pops the front of
+/// `queue` into `value` and ticks the child, once per element; RUNNING after each element (the
+/// next is popped on the next tick), FAILURE as soon as the child fails, `if_empty` once the
+/// queue is empty (or absent). A queue on the blackboard is popped in place; a literal
+/// ("a;b;c") is copied afresh at each start.
+template <typename T>
+class QueueLoopNode : public DecoratorNode {
+ public:
+  using DecoratorNode::DecoratorNode;
+  static PortsList ProvidedPorts() {
+    return {BidirectionalPort<SharedQueue<T>>("queue", "elements to loop over, popped in order"),
+            InputPort<NodeStatus>("if_empty", NodeStatus::kSuccess,
+                                  "status to return if the queue is empty: SUCCESS, FAILURE, "
+                                  "SKIPPED"),
+            OutputPort<T>("value", "the element the child runs with")};
+  }
+
+ protected:
+  NodeStatus Tick() override {
+    bool popped = false;
+    if (status() == NodeStatus::kIdle) {
+      child_running_ = false;
+      auto queue = GetInput<SharedQueue<T>>("queue");
+      queue_ = queue ? queue.value() : nullptr;
+    }
+    if (!child_running_ && queue_ && !queue_->empty()) {
+      T value = std::move(queue_->front());
+      queue_->pop_front();
+      popped = true;
+      SetOutput("value", value);
+    }
+    if (!popped && !child_running_) return GetInput<NodeStatus>("if_empty").value();
+    if (status() == NodeStatus::kIdle) SetStatus(NodeStatus::kRunning);
+    const NodeStatus child_status = child_->ExecuteTick();
+    child_running_ = child_status == NodeStatus::kRunning;
+    if (IsCompleted(child_status)) child_->ResetStatus();
+    return child_status == NodeStatus::kFailure ? NodeStatus::kFailure : NodeStatus::kRunning;
+  }
+  void Halt() override {
+    child_running_ = false;
+    HaltChild();
+  }
+
+ private:
+  bool child_running_{false};
+  SharedQueue<T> queue_;
+};
+
 }  // namespace
 
 NodeStatus SubTreeNode::Tick() {
@@ -296,6 +345,19 @@ void RegisterBuiltinDecorators(BehaviorTreeFactory& factory) {
   reg("Precondition", PreconditionNode::ProvidedPorts(), [](const std::string& n, NodeConfig c) {
     return std::make_unique<PreconditionNode>(n, std::move(c));
   });
+  reg("LoopInt", QueueLoopNode<int>::ProvidedPorts(), [](const std::string& n, NodeConfig c) {
+    return std::make_unique<QueueLoopNode<int>>(n, std::move(c));
+  });
+  reg("LoopBool", QueueLoopNode<bool>::ProvidedPorts(), [](const std::string& n, NodeConfig c) {
+    return std::make_unique<QueueLoopNode<bool>>(n, std::move(c));
+  });
+  reg("LoopDouble", QueueLoopNode<double>::ProvidedPorts(), [](const std::string& n, NodeConfig c) {
+    return std::make_unique<QueueLoopNode<double>>(n, std::move(c));
+  });
+  reg("LoopString", QueueLoopNode<std::string>::ProvidedPorts(),
+      [](const std::string& n, NodeConfig c) {
+        return std::make_unique<QueueLoopNode<std::string>>(n, std::move(c));
+      });
 }
 
 }  // namespace egress::bt::internal

@@ -1,5 +1,8 @@
 // Semantics of every built-in node, halting order and SKIPPED handling.
 
+#include <deque>
+#include <memory>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -262,6 +265,40 @@ TEST_F(NodesTest, RunOnceThenSkips) {
   Tree repeat_result = Load("<RunOnce then_skip='false'><AlwaysFailure/></RunOnce>");
   EXPECT_EQ(repeat_result.TickOnce(), F);
   EXPECT_EQ(repeat_result.TickOnce(), F);
+}
+
+TEST_F(NodesTest, LoopStringPopsTheBlackboardQueueOncePerElement) {
+  // BT.CPP 4's LoopNode: one element per child run, RUNNING after each, if_empty at the end.
+  auto queue = std::make_shared<std::deque<std::string>>(std::deque<std::string>{"a", "b"});
+  board->Set("doors", queue);
+  Tree tree = Load(
+      "<LoopString queue='{doors}' value='{door}'><Sequence><Counter key='{n}'/>"
+      "<Async name='A'/></Sequence></LoopString>");
+  board->Set("n", 0);
+  Queue("A", {R, S, S});
+  EXPECT_EQ(tree.TickOnce(), R);  // "a": A running
+  EXPECT_EQ(board->Get<std::string>("door"), "a");
+  EXPECT_EQ(queue->size(), 1u);   // popped in place
+  EXPECT_EQ(tree.TickOnce(), R);  // "a" done: RUNNING, not the next element in this tick
+  EXPECT_EQ(board->Get<int>("n"), 1);
+  EXPECT_EQ(tree.TickOnce(), R);  // "b"
+  EXPECT_EQ(board->Get<std::string>("door"), "b");
+  EXPECT_EQ(tree.TickOnce(), S);  // empty: if_empty
+  EXPECT_EQ(board->Get<int>("n"), 2);
+  EXPECT_TRUE(queue->empty());
+}
+
+TEST_F(NodesTest, LoopFailsWithItsChildAndLiteralQueuesRestart) {
+  board->Set("sum", 0.0);
+  Tree tree = Load(
+      "<LoopDouble queue='1.5;2.5' value='{x}'><ScriptCondition code='x &lt; 2'/></LoopDouble>");
+  EXPECT_EQ(tree.TickOnce(), R);  // 1.5 passes
+  EXPECT_EQ(tree.TickOnce(), F);  // 2.5 fails: the loop fails
+  EXPECT_EQ(tree.TickOnce(), R);  // a literal queue starts over
+  EXPECT_DOUBLE_EQ(*board->Get<double>("x"), 1.5);
+  factory.ClearRegisteredTrees();
+  Tree empty = Load("<LoopInt queue='{missing}' if_empty='SKIPPED'><AlwaysSuccess/></LoopInt>");
+  EXPECT_EQ(empty.TickOnce(), K);
 }
 
 TEST_F(NodesTest, PreconditionIsCheckedOnlyBeforeTheChildRuns) {

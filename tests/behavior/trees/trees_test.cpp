@@ -1,8 +1,11 @@
 // The executive's trees (behavior/trees/) load with the task-node model and decide as the paper
 // says, run with stand-in leaves whose outcomes each test scripts tick by tick.
 
+#include <algorithm>
+#include <deque>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -68,7 +71,10 @@ TEST(DoorTraversalTreeTest, EveryTreeLoadsWithTheTaskNodeModel) {
   for (const auto& [file, id] : std::vector<std::pair<std::string, std::string>>{
            {"door_traversal.xml", "DoorTraversal"},
            {"fetch_and_deliver.xml", "FetchAndDeliver"},
-           {"mission.xml", "OfficeFetchMission"}}) {
+           {"go_to.xml", "GoTo"},
+           {"fetch_through_door.xml", "FetchThroughDoor"},
+           {"fetch_for_responder.xml", "FetchForResponder"},
+           {"mission.xml", "FetchAndBringBack"}}) {
     BehaviorTreeFactory factory;
     factory.RegisterStandInsFromModelFile(kTrees / "egress_nodes.xml");
     factory.RegisterTreesFromFile(kTrees / file);
@@ -128,8 +134,9 @@ TEST(DoorTraversalTreeTest, AHeldDoorIsPassedWithoutPressing) {
 
 TEST(DoorTraversalTreeTest, APersonEnteringPreemptsThePressInTheSameTickThenItResumes) {
   // Tick 1: pressing (RUNNING). Tick 2: a person enters: the press is halted and the retract
-  // starts in that tick. Tick 3: retract done, waiting. Tick 4: clear again: the traversal is
-  // re-decided from the world (now the door is open) and passes.
+  // starts in that tick. Tick 3: retract done, waiting. Tick 4: clear again: the standby ends
+  // (one yield used). Tick 5: the traversal is re-decided from the world (now the door is
+  // open) and passes.
   ScriptedRun run(
       "door_traversal.xml", "DoorTraversal",
       [](int tick, const TreeNode& n) {
@@ -143,7 +150,7 @@ TEST(DoorTraversalTreeTest, APersonEnteringPreemptsThePressInTheSameTickThenItRe
         }
         if (Is(n, "PressButton")) return NodeStatus::kRunning;
         if (Is(n, "RetractToSafe")) return tick == 2 ? NodeStatus::kRunning : NodeStatus::kSuccess;
-        if (Is(n, "WaitForClear")) return NodeStatus::kRunning;
+        if (Is(n, "WaitForClear")) return tick == 3 ? NodeStatus::kRunning : NodeStatus::kSuccess;
         return NodeStatus::kSuccess;
       },
       kDoorA);
@@ -154,8 +161,44 @@ TEST(DoorTraversalTreeTest, APersonEnteringPreemptsThePressInTheSameTickThenItRe
   EXPECT_EQ(run.Ticked(2), (std::vector<std::string>{"reactive_check", "retract"}));
   EXPECT_EQ(run.Tick(), NodeStatus::kRunning);
   EXPECT_EQ(run.Ticked(3).back(), "WaitForClear");
+  EXPECT_EQ(run.Tick(), NodeStatus::kRunning);
+  EXPECT_EQ(run.Ticked(4).back(), "WaitForClear");  // the standby runs to its end
   EXPECT_EQ(run.Tick(), NodeStatus::kSuccess);
-  EXPECT_EQ(run.Ticked(4).back(), "traverse_open");
+  EXPECT_EQ(run.Ticked(5).back(), "traverse_open");
+}
+
+TEST(DoorTraversalTreeTest, AnApproachThatKeepsFailingUsesUpTheAttemptsInsteadOfLooping) {
+  // The path is clear but the actuator's standoff cannot be reached: each approach starts
+  // (RUNNING), then fails; the standby's retract takes a tick. Each failure costs one of the
+  // max_yields attempts and the traversal fails after the last. (With a reactive fallback over
+  // the standby, the approach re-started every tick and halted the standby, forever.)
+  int approaches = 0;
+  bool approach_running = false, retract_running = false;
+  ScriptedRun run("door_traversal.xml", "DoorTraversal",
+                  [&](int, const TreeNode& n) {
+                    if (Is(n, "IsDoorOpen") || Is(n, "IsPersonHoldingDoor"))
+                      return NodeStatus::kFailure;
+                    if (Is(n, "ApproachButton")) {
+                      if (!approach_running) ++approaches;
+                      approach_running = !approach_running;
+                      return approach_running ? NodeStatus::kRunning : NodeStatus::kFailure;
+                    }
+                    if (Is(n, "RetractToSafe")) {
+                      retract_running = !retract_running;
+                      return retract_running ? NodeStatus::kRunning : NodeStatus::kSuccess;
+                    }
+                    return NodeStatus::kSuccess;
+                  },
+                  {{"door", "door_a"}, {"max_yields", "3"}});
+  NodeStatus status = NodeStatus::kRunning;
+  int ticks = 0;
+  while (status == NodeStatus::kRunning && ticks < 100) {
+    status = run.Tick();
+    ++ticks;
+  }
+  EXPECT_EQ(status, NodeStatus::kFailure);
+  EXPECT_EQ(approaches, 3);
+  EXPECT_LE(ticks, 15);
 }
 
 TEST(DoorTraversalTreeTest, GivesUpAfterMaxYields) {
@@ -174,6 +217,77 @@ TEST(DoorTraversalTreeTest, GivesUpAfterMaxYields) {
   }
   EXPECT_EQ(status, NodeStatus::kFailure);
   EXPECT_LE(ticks, 4);
+}
+
+// GoTo with stand-ins: PlanRoute gives the first of `routes` (door lists) that avoids the
+// blocked door, or fails; `door_fails` (if any) cannot be passed.
+std::vector<std::string> RunGoTo(const std::vector<std::vector<std::string>>& routes,
+                                 const std::string& door_fails, NodeStatus* result, int* plans) {
+  std::vector<std::string> traversed;
+  ScriptedRun run("go_to.xml", "GoTo",
+                  [&](int, const TreeNode& n) {
+                    const auto& bb = n.config().blackboard;
+                    if (Is(n, "PlanRoute")) {
+                      ++*plans;
+                      const auto avoid = bb->Get<std::string>("blocked_doors");
+                      for (const auto& doors : routes) {
+                        if (avoid && std::find(doors.begin(), doors.end(), *avoid) != doors.end())
+                          continue;
+                        bb->Set("route_doors", Any(std::make_shared<std::deque<std::string>>(
+                                                   doors.begin(), doors.end())));
+                        return NodeStatus::kSuccess;
+                      }
+                      return NodeStatus::kFailure;
+                    }
+                    if (Is(n, "IsBeforeDoor") || Is(n, "IsDoorOpen")) return NodeStatus::kFailure;
+                    if (Is(n, "IsPersonHoldingDoor")) return NodeStatus::kFailure;
+                    if (Is(n, "ButtonType")) {
+                      bb->Set("button_type", Any(std::string("push_button")));
+                      return NodeStatus::kSuccess;
+                    }
+                    if (n.name() == "traverse_opened") {
+                      const std::string door = *bb->Get<std::string>("door");
+                      if (door == door_fails) return NodeStatus::kFailure;
+                      traversed.push_back(door);
+                    }
+                    if (n.name() == "to_goal") traversed.push_back("goal");
+                    if (Is(n, "MarkDoorBlocked"))  // what the real node does
+                      bb->Set("blocked_doors", Any(*bb->Get<std::string>("door")));
+                    return NodeStatus::kSuccess;
+                  },
+                  {{"goal", "far_room"}, {"max_yields", "2"}});
+  *result = NodeStatus::kRunning;
+  for (int tick = 0; tick < 50 && *result == NodeStatus::kRunning; ++tick)
+    *result = run.Tick();
+  return traversed;
+}
+
+TEST(GoToTreeTest, EveryDoorOnTheRouteIsTraversedInOrderThenTheGoal) {
+  NodeStatus result;
+  int plans = 0;
+  EXPECT_EQ(RunGoTo({{"door_a", "door_b"}}, "", &result, &plans),
+            (std::vector<std::string>{"door_a", "door_b", "goal"}));
+  EXPECT_EQ(result, NodeStatus::kSuccess);
+  EXPECT_EQ(plans, 1);
+  plans = 0;
+  EXPECT_EQ(RunGoTo({{}}, "", &result, &plans), (std::vector<std::string>{"goal"}));
+  EXPECT_EQ(result, NodeStatus::kSuccess);
+}
+
+TEST(GoToTreeTest, ADoorThatCannotBePassedIsRoutedRound) {
+  NodeStatus result;
+  int plans = 0;
+  // door_b fails: marked blocked, the route is planned again without it.
+  EXPECT_EQ(
+      RunGoTo({{"door_a", "door_b", "door_c"}, {"door_a", "door_c"}}, "door_b", &result, &plans),
+      (std::vector<std::string>{"door_a", "door_a", "door_c", "goal"}));
+  EXPECT_EQ(result, NodeStatus::kSuccess);
+  EXPECT_EQ(plans, 2);
+  // The only door fails every time: three routes, then the mission fails.
+  plans = 0;
+  RunGoTo({{"door_a"}}, "door_a", &result, &plans);
+  EXPECT_EQ(result, NodeStatus::kFailure);
+  EXPECT_EQ(plans, 3);
 }
 
 TEST(FetchTreeTest, RetriesAGraspTheGripperDidNotHoldThenDelivers) {

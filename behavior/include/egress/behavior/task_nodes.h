@@ -14,6 +14,7 @@
 /// GraspPayload, PlacePayload, HandOver). A tree naming any other node fails to load with an
 /// unknown-node error naming the file and line.
 
+#include "egress/behavior/mission_map.h"
 #include "egress/behavior/task_services.h"
 #include "egress/bt/factory.h"
 
@@ -29,5 +30,9 @@ std::string TaskNodesModelXml();
 
 /// "x;y;yaw" → pose. @throws InvalidArgument naming the text.
 Pose2 ParsePose2(std::string_view text);
+/// A goal as a mission gives it: a place of the building (its pose; a place without a heading
+/// is reached facing the way from X_MB) or a pose "x;y;yaw" / "x;y".
+/// @throws InvalidArgument naming the text and the building's places.
+Pose2 ResolveGoal(const MissionMap& map, std::string_view text, const Pose2& X_MB);
 
 }  // namespace egress::behavior

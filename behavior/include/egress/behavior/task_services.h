@@ -19,6 +19,7 @@
 #include "egress/perception/world_state.h"
 #include "egress/planning/base_planner.h"
 #include "egress/planning/ik_solver.h"
+#include "egress/planning/route_planner.h"
 
 namespace egress::behavior {
 
@@ -54,6 +55,8 @@ struct TaskConfig {
   double precise_pose_sigma{0.02};
   /// ... for at most this long, then acts anyway (noted) [s].
   double relocalize_timeout{3.0};
+  /// The building-scale route (PlanRoute): clearance, where to wait before doors.
+  planning::RoutePlannerConfig route;
   void Validate() const;
 };
 

@@ -17,6 +17,7 @@
 #include <Eigen/Core>
 
 #include "egress/hsr_interface/geometry.h"
+#include "egress/twin/building.h"
 #include "egress/twin/world_description.h"
 
 namespace egress::twin {
@@ -52,7 +53,8 @@ struct DoorOperatorSpec {
   /// the wall is usual for ADA doors (empty for kManual).
   std::vector<std::string> actuators;
   OperatorKind kind{OperatorKind::kPushButton};
-  bool glass{false};  ///< Glass leaf: the laser sees it only near normal incidence.
+  bool glass{false};        ///< Glass leaf: the laser sees it only near normal incidence.
+  bool glass_given{false};  ///< `glass` was in the file (else the building's word stands).
   DoorTiming timing;
   double button_stroke{0.004};      ///< Push-button travel that counts as a press [m].
   double button_max_force{22.0};    ///< Force above which a press is refused [N].
@@ -178,6 +180,13 @@ struct Scenario {
   std::string name;
   std::filesystem::path source;      ///< The YAML file.
   std::filesystem::path world_file;  ///< Resolved path of the SDF world.
+  /// Resolved path of the building YAML (`building:`); empty = `<world stem>.building.yaml`
+  /// beside the world if there is one.
+  std::filesystem::path building_file;
+  /// `robot.start: {place: ..}` / `robot.goal: {place: ..}`: named places of the building,
+  /// resolved into robot_start / goal by ApplyBuildingDefaults.
+  std::string start_place;
+  std::string goal_place;
   std::uint64_t seed{1};
   double time_limit{120.0};  ///< [s]
   Pose2 robot_start;
@@ -196,6 +205,20 @@ struct Scenario {
   /// walls. @throws LoadError naming the scenario file and field.
   void ValidateAgainst(const WorldDescription& world) const;
 };
+
+/// The building of `scenario`'s world: the world's doors, actuators and places
+/// (DescribeBuilding with the scenario's building YAML, or the one beside the world), and the
+/// actuators the scenario's `doors` list by name (of the door and kind it gives them).
+/// @throws LoadError naming the file and field or model.
+BuildingDescription DescribeScenarioBuilding(const Scenario& scenario,
+                                             const WorldDescription& world);
+/// Fills in what the scenario leaves to its building: start and goal places become poses; a
+/// listed door without `actuator` gets the building's actuators of its operator's kind; a door
+/// the scenario does not list but whose actuators the building found gets an operator of their
+/// kind (ADA defaults); a glass leaf in the building is glass in the twin.
+/// @throws LoadError naming the scenario file and field (an unknown place, a push door whose
+/// building has only plates, a door whose actuators are of both kinds).
+void ApplyBuildingDefaults(const BuildingDescription& building, Scenario* scenario);
 
 /// Reads a scenario YAML file. @throws LoadError naming file, line and field.
 Scenario LoadScenario(const std::filesystem::path& path);

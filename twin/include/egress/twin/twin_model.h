@@ -49,8 +49,11 @@ class TwinModel {
   TwinModel(const TwinModel&) = delete;
   TwinModel& operator=(const TwinModel&) = delete;
 
+  /// The scenario with its building's defaults applied (ApplyBuildingDefaults).
   const Scenario& scenario() const;
   const WorldDescription& world() const;
+  /// The scenario's building (DescribeScenarioBuilding).
+  const BuildingDescription& building() const { return building_; }
   const std::shared_ptr<const RobotModel>& robot_model() const;
   const TwinConfig& config() const;
   double step_size() const;  ///< [s] 1 / physics_rate_hz
@@ -62,6 +65,7 @@ class TwinModel {
  private:
   Scenario scenario_;
   WorldDescription world_;
+  BuildingDescription building_;
   std::shared_ptr<const RobotModel> robot_model_;
   TwinConfig config_;
   std::unique_ptr<Compiled> compiled_;

@@ -8,6 +8,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -91,6 +92,9 @@ struct WorldDescription {
   std::filesystem::path source;          ///< File it came from (or a label for strings).
   std::vector<ShapeDescription> shapes;  ///< Static collision shapes.
   std::vector<DoorDescription> doors;
+  /// The world's own `<frame name="...">` elements (SDF 1.7+), posed in W: named places (a
+  /// room, an exit, a responder's post) that Gazebo ignores and the building description reads.
+  std::vector<std::pair<std::string, Pose3>> frames;
   /// Informational lines: plugins and sensors the twin ignores, non-static models it fixes.
   std::vector<std::string> notes;
 

@@ -12,9 +12,11 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -99,6 +101,23 @@ struct StringConverter<std::vector<T>, std::enable_if_t<StringConverter<T>::kAva
     std::vector<T> out;
     for (std::string_view part : SplitSemicolons(text))
       out.push_back(StringConverter<T>::Convert(part));
+    return out;
+  }
+};
+
+/// A queue a Loop node pops from in place (BehaviorTree.CPP 4's SharedQueue): a node that
+/// writes one to the blackboard sees it shrink as the loop runs.
+template <typename T>
+using SharedQueue = std::shared_ptr<std::deque<T>>;
+
+template <typename T>
+struct StringConverter<SharedQueue<T>, std::enable_if_t<StringConverter<T>::kAvailable>> {
+  static constexpr bool kAvailable = true;
+  static SharedQueue<T> Convert(std::string_view text) {
+    auto out = std::make_shared<std::deque<T>>();
+    if (text.empty()) return out;
+    for (std::string_view part : SplitSemicolons(text))
+      out->push_back(StringConverter<T>::Convert(part));
     return out;
   }
 };
