@@ -7,6 +7,16 @@
 namespace egress::behavior::detail {
 namespace {
 
+// Other standoffs when the whole-body one is blocked: (shift along the wall [m], turn [rad]),
+// nearest first.
+constexpr std::pair<double, double> kStandoffSeeds[] = {
+    {-0.05, 0.0}, {0.05, 0.0}, {-0.1, 0.0},  {0.1, 0.0},  {0.0, 0.3},   {0.0, -0.3},
+    {-0.1, 0.3},  {0.1, -0.3}, {-0.1, -0.3}, {0.1, 0.3},  {-0.15, 0.6}, {0.15, -0.6},
+    {-0.2, 0.0},  {0.2, 0.0},  {-0.2, 0.6},  {0.2, -0.6}, {-0.25, 0.9}, {0.25, -0.9}};
+
+// An actuator the camera sees farther than this from where the map has it is another one [m].
+constexpr double kActuatorMatchDistance = 0.15;
+
 // Points along the press stroke the arm is solved for (pre-press to press): the fingertip
 // stays on the button's normal instead of a joint-space curve.
 constexpr int kPressStrokeKnots = 4;
@@ -57,6 +67,10 @@ class ApproachButton final : public TaskNode<bt::StatefulActionNode> {
     planning::IkConfig ik = task_.config.ik;
     ik.fingertip = actuator->type == planning::ButtonType::kPushButton;
     ik.use_base = true;
+    // Where the base stands: whole-body IK from the nominal standoff with the arm tucked. If
+    // that base pose is in collision (an actuator in a corner, beside a jamb or a side wall),
+    // the base stands shifted along the wall and turned, nearest first, the arm alone reaching
+    // (whole-body IK from a shifted seed slides the base back to the same spot).
     WholeBodyVector q0 = WholeBodyVector::Zero();
     q0[kBaseX] = plan.targets.X_MB_standoff.x;
     q0[kBaseY] = plan.targets.X_MB_standoff.y;
@@ -68,6 +82,29 @@ class ApproachButton final : public TaskNode<bt::StatefulActionNode> {
                              ? Pose2{solution.q[kBaseX], solution.q[kBaseY], solution.q[kBaseYaw]}
                              : plan.targets.X_MB_standoff;
     plan.approach_arm = solution.converged ? ArmOf(solution.q) : TuckedArm(*task_.model);
+    if (!task_.planner->IsValid(plan.X_MB_standoff)) {
+      const Eigen::Vector2d n = actuator->n_M.head<2>().normalized();
+      const Eigen::Vector2d t(-n.y(), n.x());
+      bool found = false;
+      for (const auto& [shift, turn] : kStandoffSeeds) {
+        const Pose2 base{plan.X_MB_standoff.x + t.x() * shift, plan.X_MB_standoff.y + t.y() * shift,
+                         plan.X_MB_standoff.yaw + turn};
+        if (!task_.planner->IsValid(base)) continue;
+        const auto arm =
+            SolveArm(task_, base, plan.targets.approach, plan.approach_arm, ik.fingertip);
+        if (!arm) continue;
+        Note(StrCat("the standoff is blocked: standing ", std::round(shift * 100),
+                    " cm along the wall, turned ", std::round(turn * 180 / M_PI), " deg"));
+        plan.X_MB_standoff = base;
+        plan.approach_arm = *arm;
+        found = true;
+        break;
+      }
+      if (!found) {
+        Note(StrCat("no free standoff from which the arm reaches ", actuator->id));
+        return NodeStatus::kFailure;
+      }
+    }
     if (!solution.converged) Note("whole-body IK did not converge; using the nominal standoff");
     visit.button_plan = plan;
     Remember(visit);
@@ -102,16 +139,36 @@ Pose2 WallAlignedPose(const TaskServices& task, const MapActuator& actuator,
     if (std::abs((p_M - p_MWall).dot(n)) > 0.15 || std::abs((p_M - p_MWall).dot(t)) > 0.4) continue;
     distances.push_back((X_ML.translation() - p_M).dot(n));
   }
-  if (distances.size() < 5) return task.belief->X_MB;
-  auto middle = distances.begin() + std::ptrdiff_t(distances.size() / 2);
-  std::nth_element(distances.begin(), middle, distances.end());
-  const double expected = (X_ML.translation() - p_MWall).dot(n);
-  const double error = *middle - expected;
   Pose2 corrected = task.belief->X_MB;
-  corrected.x += n.x() * error;
-  corrected.y += n.y() * error;
-  note(StrCat("wall ", std::round(*middle * 1000) / 1000, " m ahead by laser, ",
-              std::round(error * 1000), " mm off the estimate"));
+  if (distances.size() >= 5) {
+    auto middle = distances.begin() + std::ptrdiff_t(distances.size() / 2);
+    std::nth_element(distances.begin(), middle, distances.end());
+    const double expected = (X_ML.translation() - p_MWall).dot(n);
+    const double error = *middle - expected;
+    corrected.x += n.x() * error;
+    corrected.y += n.y() * error;
+    note(StrCat("wall ", std::round(*middle * 1000) / 1000, " m ahead by laser, ",
+                std::round(error * 1000), " mm off the estimate"));
+  }
+  // Along the wall the laser has nothing to measure (a long wall looks the same everywhere:
+  // after 15 m of corridor the estimate was 5 cm off there, half the button). The head camera's
+  // detection of the actuator itself has: placed in M from the believed pose, it is off its
+  // mapped position by that pose's own error.
+  const perception::TrackedObject* seen = nullptr;
+  double nearest = kActuatorMatchDistance;
+  for (const auto& object : task.belief->world.buttons) {
+    const double d = (object.p_MO.head<2>() - actuator.p_M.head<2>()).norm();
+    if (d < nearest) {
+      nearest = d;
+      seen = &object;
+    }
+  }
+  if (seen != nullptr) {
+    const double along = (seen->p_MO.head<2>() - actuator.p_M.head<2>()).dot(t);
+    corrected.x -= t.x() * along;
+    corrected.y -= t.y() * along;
+    note(StrCat("actuator seen ", std::round(along * 1000), " mm along the wall from the map"));
+  }
   return corrected;
 }
 
@@ -159,7 +216,7 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
 
  private:
   RelocalizeGate gate_;
-  static constexpr double kAlignTolerance = 0.01;  // [m] base off its standoff along the normal
+  static constexpr double kAlignTolerance = 0.01;  // [m] base off its standoff
   static constexpr int kMaxAlignments = 2;
 
   // The base squares up to the planned standoff (by the laser's wall distance) first, then the
@@ -170,15 +227,16 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
     const ButtonPlan& plan = plan_;
     const MapActuator& actuator = *task_.map->FindActuator(plan.actuator);
     const Pose2 X_MB = WallAlignedPose(task_, actuator, [this](const std::string& t) { Note(t); });
-    const Eigen::Vector2d n = actuator.n_M.head<2>().normalized();
-    const double off = (X_MB.translation() - plan.X_MB_standoff.translation()).dot(n);
-    if (std::abs(off) > kAlignTolerance && alignments_ < kMaxAlignments) {
+    // Off the standoff, in M, by the corrected pose: along the wall's normal (the laser) and
+    // along the wall (the camera's sighting of the actuator).
+    const Eigen::Vector2d off = X_MB.translation() - plan.X_MB_standoff.translation();
+    if (off.norm() > kAlignTolerance && alignments_ < kMaxAlignments) {
       ++alignments_;
-      const Pose2 target{belief_.X_MB.x - n.x() * off, belief_.X_MB.y - n.y() * off,
+      const Pose2 target{belief_.X_MB.x - off.x(), belief_.X_MB.y - off.y(),
                          plan.X_MB_standoff.yaw};
       task_.motion->FollowPath({belief_.X_MB, target}, {false}, task_.motion->arm_target(),
                                belief_.now);
-      Note(StrCat("squaring up: ", std::round(off * 1000), " mm off the standoff"));
+      Note(StrCat("squaring up: ", std::round(off.norm() * 1000), " mm off the standoff"));
       return NodeStatus::kRunning;
     }
     return Operate(plan, X_MB);

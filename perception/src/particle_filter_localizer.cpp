@@ -22,6 +22,8 @@ void LocalizerConfig::Validate() const {
   ThrowUnless(z_hit > 0.0 && z_hit <= 1.0, "Invalid LocalizerConfig: z_hit (", z_hit,
               ") must be in (0, 1].");
   ThrowUnless(max_beams >= 1, "Invalid LocalizerConfig: max_beams must be >= 1.");
+  ThrowUnless(min_beams >= 1 && min_beams <= max_beams, "Invalid LocalizerConfig: min_beams (",
+              min_beams, ") must be in [1, max_beams].");
   ThrowUnless(resample_threshold > 0.0 && resample_threshold <= 1.0,
               "Invalid LocalizerConfig: resample_threshold must be in (0, 1].");
 }
@@ -157,7 +159,7 @@ bool ParticleFilterLocalizer::Correct(const LaserScan& scan) {
     const double angle = scan.AngleAt(i), range = scan.ranges[i];
     beams.emplace_back(range * std::cos(angle), range * std::sin(angle));
   }
-  if (beams.empty()) return false;
+  if (beams.empty() || beams.size() < std::size_t(config_.min_beams)) return false;
   std::vector<double> log_weights(particles_.size());
   for (std::size_t k = 0; k < particles_.size(); ++k) {
     const Pose2 X_ML = particles_[k].X_MB * X_BL_;

@@ -81,6 +81,26 @@ TEST(ParticleFilterLocalizerTest, IsDeterministicForASeed) {
   EXPECT_EQ(a.yaw, b.yaw);
 }
 
+TEST(ParticleFilterLocalizerTest, AFewReturnsDoNotCorrectThePose) {
+  // Out in the open with a handful of returns (an unmapped leaf, a person), the correction is
+  // skipped: the same returns with enough beams do correct.
+  const OccupancyGrid map = testing::TwoRoomMap();
+  LaserScan scan = testing::MakeScan(121, 8.0);
+  testing::CastScan(map, {2.0, 2.0, 0.3}, &scan);
+  LocalizerConfig config;
+  config.max_beams = 121;
+  ParticleFilterLocalizer localizer(map, {}, config);
+  localizer.Initialize({2.05, 1.95, 0.32}, Eigen::Vector3d(0.02, 0.02, 0.01).asDiagonal());
+  LaserScan few = scan;
+  for (std::size_t i = 0; i < few.ranges.size(); ++i)
+    if (i % 12 != 0) few.ranges[i] = std::numeric_limits<float>::infinity();  // 11 beams left
+  localizer.Predict({0, 0, 0}, {0.1, 0.0, 0.0});
+  EXPECT_FALSE(localizer.Correct(few));
+  EXPECT_TRUE(localizer.Correct(scan));
+  config.min_beams = 0;
+  EXPECT_THROW(ParticleFilterLocalizer(map, {}, config), InvalidArgument);
+}
+
 TEST(ParticleFilterLocalizerTest, RejectsBadInput) {
   const OccupancyGrid map = testing::TwoRoomMap();
   ParticleFilterLocalizer localizer(map, {});

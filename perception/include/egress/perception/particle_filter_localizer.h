@@ -30,9 +30,13 @@ struct LocalizerConfig {
   double alpha_trans_trans{0.05};
   double alpha_trans_rot{0.02};
   double alpha_strafe_trans{0.02};
-  double sigma_hit{0.08};            ///< Std. dev. of the likelihood field [m].
-  double z_hit{0.9};                 ///< Weight of the hit term; the rest is uniform.
-  int max_beams{60};                 ///< Beams used per scan (evenly spread).
+  double sigma_hit{0.08};  ///< Std. dev. of the likelihood field [m].
+  double z_hit{0.9};       ///< Weight of the hit term; the rest is uniform.
+  int max_beams{60};       ///< Beams used per scan (evenly spread).
+  /// Fewer usable beams than this and the correction is skipped (odometry carries the pose):
+  /// a handful of returns (open ground beyond an exit, with an unmapped leaf or a person in
+  /// view) pulls the estimate onto whatever they hit.
+  int min_beams{12};
   double laser_max_range{20.0};      ///< Returns beyond this are ignored [m].
   double resample_threshold{0.5};    ///< Resample when N_eff < threshold * N.
   double update_min_distance{0.02};  ///< Skip a correction unless the base moved this far [m]…
