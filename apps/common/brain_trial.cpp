@@ -22,8 +22,10 @@ behavior::MissionMap BuildMissionMap(const twin::WorldDescription& world,
     door.p_MHinge = doorway.p_MHinge;
     door.p_MLatch = doorway.p_MLatch;
     door.swing_sign = doorway.swing_sign;
-    if (const twin::BuildingDoor* d = building.FindDoor(doorway.id))
+    if (const twin::BuildingDoor* d = building.FindDoor(doorway.id)) {
       door.max_open_angle = d->max_open_angle;
+      if (d->glass) map.glass_doors.insert(d->model);
+    }
     map.doors.push_back(door);
   }
   for (const auto& a : building.actuators) {
@@ -95,6 +97,12 @@ BrainTrial RunBrainTrial(const twin::Scenario& scenario, const twin::WorldDescri
 BrainTrial RunBrainTrial(std::shared_ptr<const twin::TwinModel> twin_model, std::uint64_t seed,
                          const BrainTrialOptions& options) {
   ThrowUnless(twin_model != nullptr, "RunBrainTrial: the twin model is null");
+  // A scenario family: this seed's variant is a scenario of its own.
+  if (twin_model->scenario().randomize.DrawsVariants()) {
+    twin_model = std::make_shared<const twin::TwinModel>(
+        twin::DrawScenarioVariant(twin_model->scenario(), twin_model->building(), seed),
+        twin_model->world(), twin_model->robot_model(), twin_model->config());
+  }
   BrainTrial trial;
   trial.world = std::make_unique<twin::TwinWorld>(twin_model, seed);
   trial.brain = MakeScenarioExecutive(twin_model->scenario(), twin_model->world(), *trial.world,

@@ -311,17 +311,22 @@ void Executive::UpdateDoorLeaves() {
     // very pose the robot lines up at.
     const bool fresh =
         d.state.observed && ToSeconds(belief_.now - d.state.stamp) <= m.config.door_leaf_max_age;
-    if (!fresh) {
+    std::optional<double> angle;
+    if (fresh) {
+      angle = d.state.angle;
+    } else if (m.map.glass_doors.count(d.model.id) > 0) {
+      angle = std::min(m.config.glass_leaf_assumed_angle, d.model.max_open_angle);
+    }
+    if (!angle) {
       if (it != m.leaf_angles.end()) {
         costmap_->SetDoorLeafAngle(d.model.id, std::nullopt);
         m.leaf_angles.erase(it);
       }
       continue;
     }
-    if (it != m.leaf_angles.end() && std::abs(it->second - d.state.angle) < kLeafUpdateRad)
-      continue;
-    costmap_->SetDoorLeafAngle(d.model.id, d.state.angle);
-    m.leaf_angles[d.model.id] = d.state.angle;
+    if (it != m.leaf_angles.end() && std::abs(it->second - *angle) < kLeafUpdateRad) continue;
+    costmap_->SetDoorLeafAngle(d.model.id, *angle);
+    m.leaf_angles[d.model.id] = *angle;
   }
 }
 

@@ -1,9 +1,13 @@
 #include "egress/twin/building.h"
 
+#include <set>
+
 #include <gtest/gtest.h>
 
 #include "egress/hsr_interface/error.h"
 #include "egress/twin/sdf_world_loader.h"
+#include "egress/twin/twin_model.h"
+#include "twin_test_util.h"
 
 namespace egress::twin {
 namespace {
@@ -157,6 +161,89 @@ TEST(BuildingTest, YamlErrorsNameTheFileLineAndField) {
   EXPECT_NE(message("actuators:\n  ghost: {door: fire_door}\n").find("no static model 'ghost'"),
             std::string::npos);
   EXPECT_THROW(DescribeBuilding(world, "/nonexistent/b.yaml"), LoadError);
+}
+
+}  // namespace
+}  // namespace egress::twin
+
+namespace egress::twin {
+namespace {
+
+// The office (worlds/office: door_a push buttons both sides, door_b glass with plates both
+// sides, its building YAML beside it), as a scenario that names no door and no coordinate.
+testing::Loaded GoalOnlyOffice(const std::string& extra = "") {
+  return testing::LoadText(
+      "world: office.sdf\nrobot:\n  start: {place: room_start}\n  goal: {place: room_far}\n" +
+          extra,
+      std::filesystem::path(EGRESS_WORLDS_DIR) / "office");
+}
+
+TEST(ScenarioBuildingTest, DoorsActuatorsAndPlacesComeFromTheBuilding) {
+  const auto loaded = GoalOnlyOffice("doors: [{door: door_a, operator: push}]\n");
+  const TwinModel model(loaded.scenario, loaded.world, testing::Hsr());
+  const Scenario& s = model.scenario();
+  EXPECT_DOUBLE_EQ(s.robot_start.x, 2.5);
+  ASSERT_TRUE(s.goal.has_value());
+  EXPECT_DOUBLE_EQ(s.goal->x, 11.0);
+  ASSERT_EQ(s.doors.size(), 2u);
+  EXPECT_EQ(s.doors[0].door, "door_a");  // listed, its buttons filled in
+  EXPECT_EQ(s.doors[0].actuators,
+            (std::vector<std::string>{"door_a_button", "door_a_button_east"}));
+  EXPECT_EQ(s.doors[1].door, "door_b");  // not listed: an operator of its plates' kind
+  EXPECT_EQ(s.doors[1].kind, OperatorKind::kProximityPlate);
+  EXPECT_TRUE(s.doors[1].glass);  // the building YAML says so
+}
+
+TEST(ScenarioBuildingTest, UnknownPlacesAndMismatchedOperatorsAreNamed) {
+  const auto message = [](const testing::Loaded& loaded) {
+    try {
+      const TwinModel model(loaded.scenario, loaded.world, testing::Hsr());
+    } catch (const LoadError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  auto loaded = GoalOnlyOffice();
+  loaded.scenario.goal_place = "kitchen";
+  const std::string unknown = message(loaded);
+  EXPECT_NE(unknown.find("field 'robot.goal.place': the building has no place 'kitchen'"),
+            std::string::npos)
+      << unknown;
+  EXPECT_NE(unknown.find("room_far"), std::string::npos);  // the places it has
+  const std::string plates = message(GoalOnlyOffice("doors: [{door: door_b, operator: push}]\n"));
+  EXPECT_NE(plates.find("door 'door_b' has no push button in the building"), std::string::npos)
+      << plates;
+}
+
+TEST(ScenarioFamilyTest, EachSeedDrawsAVariantAndTheSameSeedTheSameOne) {
+  const auto loaded = GoalOnlyOffice(
+      "obstacles: [{name: cart, box: [0.6, 0.4, 0.9], x: 7.0, y: 4.0}]\n"
+      "randomize:\n  start_places: [room_start, room_middle, room_far]\n"
+      "  goal_places: [room_start, room_middle, room_far, exit_east]\n"
+      "  open_doors: 1.0\n  obstacle_xy: 0.05\n");
+  const TwinModel model(loaded.scenario, loaded.world, testing::Hsr());
+  ASSERT_TRUE(model.scenario().randomize.DrawsVariants());
+  std::set<std::pair<std::string, std::string>> pairs;
+  for (std::uint64_t seed = 1; seed <= 30; ++seed) {
+    const Scenario v = DrawScenarioVariant(model.scenario(), model.building(), seed);
+    EXPECT_NE(v.start_place, v.goal_place);
+    EXPECT_FALSE(v.randomize.DrawsVariants());
+    EXPECT_DOUBLE_EQ(v.robot_start.x, model.building().FindPlace(v.start_place)->X_WP.x);
+    for (const auto& door : v.doors) {
+      ASSERT_FALSE(door.open_at.empty());
+      EXPECT_EQ(door.open_at.front(), 0.0);  // open_doors 1: every door opened at the start
+    }
+    const Eigen::Vector3d moved = v.obstacles[0].X_WS.translation() - Eigen::Vector3d(7, 4, 0.45);
+    EXPECT_LE(moved.head<2>().cwiseAbs().maxCoeff(), 0.05);
+    pairs.insert({v.start_place, v.goal_place});
+    const Scenario again = DrawScenarioVariant(model.scenario(), model.building(), seed);
+    EXPECT_EQ(again.goal_place, v.goal_place);
+    EXPECT_EQ(again.obstacles[0].X_WS.translation(), v.obstacles[0].X_WS.translation());
+  }
+  EXPECT_GE(pairs.size(), 5u);
+  auto bad = loaded.scenario;
+  bad.randomize.goal_places = {"attic"};
+  EXPECT_THROW(DrawScenarioVariant(bad, model.building(), 1), LoadError);
 }
 
 }  // namespace

@@ -360,12 +360,33 @@ Scenario Parse(const YAML::Node& root, const FieldReader& r,
     const std::string f = "randomize";
     r.CheckKeys(rnd, f,
                 {"robot_dx", "robot_dy", "robot_dyaw", "payload_xy", "hold_open_s",
-                 "hold_angle_deg", "person_delay_s", "person_speed_scale"});
+                 "hold_angle_deg", "person_delay_s", "person_speed_scale", "start_places",
+                 "goal_places", "person_places", "open_doors", "obstacle_xy"});
     auto& z = s.randomize;
     if (rnd["robot_dx"]) z.robot_dx = r.ReadRange(rnd["robot_dx"], f + ".robot_dx");
     if (rnd["robot_dy"]) z.robot_dy = r.ReadRange(rnd["robot_dy"], f + ".robot_dy");
     if (rnd["robot_dyaw"]) z.robot_dyaw = r.ReadRange(rnd["robot_dyaw"], f + ".robot_dyaw");
     if (rnd["payload_xy"]) z.payload_xy = r.NonNegative(rnd["payload_xy"], f + ".payload_xy");
+    const auto names = [&](const char* key, std::size_t at_least) {
+      std::vector<std::string> out;
+      const YAML::Node list = rnd[key];
+      if (!list) return out;
+      const std::string field = f + "." + key;
+      if (!list.IsSequence() || list.size() < at_least)
+        r.Fail(list, field, StrCat("expected a list of at least ", at_least, " place names"));
+      for (std::size_t k = 0; k < list.size(); ++k)
+        out.push_back(r.String(list[k], StrCat(field, "[", k, "]")));
+      return out;
+    };
+    z.start_places = names("start_places", 1);
+    z.goal_places = names("goal_places", 1);
+    z.person_places = names("person_places", 2);
+    if (z.start_places.size() == 1 && z.goal_places.size() == 1 &&
+        z.start_places[0] == z.goal_places[0]) {
+      r.Fail(rnd["goal_places"], f + ".goal_places", "the only goal is the only start");
+    }
+    if (rnd["open_doors"]) z.open_doors = r.Fraction(rnd["open_doors"], f + ".open_doors");
+    if (rnd["obstacle_xy"]) z.obstacle_xy = r.NonNegative(rnd["obstacle_xy"], f + ".obstacle_xy");
     if (rnd["hold_open_s"]) z.hold_open_s = r.ReadRange(rnd["hold_open_s"], f + ".hold_open_s");
     if (rnd["hold_angle_deg"]) {
       z.hold_angle_deg = r.ReadRange(rnd["hold_angle_deg"], f + ".hold_angle_deg");

@@ -1,8 +1,17 @@
 #include "people/person_behavior.h"
 #include "twin_world_impl.h"
 
+#include <algorithm>
+#include <optional>
+
 namespace egress::twin {
 namespace {
+
+// A walker at the end of its route steps to a wall within this reach [m], to this far from its
+// face [m], and at least this far from a doorway's centre [m].
+constexpr double kStepAsideReachM = 3.0;
+constexpr double kAsideFromWallM = 0.4;
+constexpr double kClearOfDoorwayM = 1.3;
 
 // Whether segments ab and cd cross (touching counts).
 bool SegmentsCross(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
@@ -128,6 +137,16 @@ void TwinWorld::Impl::UpdatePeople() {
       continue;
     }
     if (p.route.empty()) {
+      const PersonSpec* spec = FindSpec(p.state.name);
+      if (!p.stepped_aside && spec != nullptr && spec->behavior == PersonBehavior::kWalkPast) {
+        // Arrived: people do not stand in the middle of a corridor or on a door's axis; they
+        // step to the nearest wall, off any doorway, and wait there.
+        p.stepped_aside = true;
+        if (const auto aside = SpotBesideWall(p.walker.position)) {
+          p.route.push_back(*aside);
+          continue;
+        }
+      }
       p.walker.desired_speed = 0.0;
       p.behavior->AtRouteEnd(time, door, &p, add_event);
       continue;
@@ -221,6 +240,35 @@ bool TwinWorld::Impl::DoorwayTaken(const Person& me) const {
     if ((other.walker.position - d.fixed->centre).norm() < 0.9) return true;
   }
   return false;
+}
+
+std::optional<Eigen::Vector2d> TwinWorld::Impl::SpotBesideWall(const Eigen::Vector2d& p) const {
+  // The nearest wall within reach, the spot kAsideFromWallM off its face on this side, moved
+  // along the wall out of any doorway's way.
+  const WallSegment* nearest = nullptr;
+  Eigen::Vector2d foot = p;
+  double best = kStepAsideReachM;
+  for (const auto& w : fixed.walls) {
+    const Eigen::Vector2d ab = w.b - w.a;
+    const double t = std::clamp((p - w.a).dot(ab) / std::max(ab.squaredNorm(), 1e-12), 0.0, 1.0);
+    const Eigen::Vector2d q = w.a + t * ab;
+    if ((p - q).norm() < best) {
+      best = (p - q).norm();
+      nearest = &w;
+      foot = q;
+    }
+  }
+  if (nearest == nullptr || best < 1e-6) return std::nullopt;
+  Eigen::Vector2d spot = foot + (p - foot).normalized() * kAsideFromWallM;
+  const Eigen::Vector2d along = (nearest->b - nearest->a).normalized();
+  for (const auto& d : doors) {
+    const Eigen::Vector2d offset = spot - d.fixed->centre;
+    if (offset.norm() < kClearOfDoorwayM) {
+      const double s = offset.dot(along) >= 0 ? 1.0 : -1.0;
+      spot = d.fixed->centre + along * s * kClearOfDoorwayM + (spot - foot);
+    }
+  }
+  return spot;
 }
 
 const PersonSpec* TwinWorld::Impl::FindSpec(const std::string& person_name) const {

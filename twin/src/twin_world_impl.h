@@ -41,6 +41,7 @@ struct Person {
   int reached{0};                // waypoints reached so far
   double stuck_for{0.0};         // [s] wanting to walk but not moving
   bool realigned{false};         // stepped back onto the door's axis once
+  bool stepped_aside{false};     // walked to the side of the corridor at the end of its route
   double blocked_for{0.0};       // [s] walking but not moving (any leg of the route)
   double hold_angle{0.0};
   double hold_duration{0.0};
@@ -134,6 +135,9 @@ struct TwinWorld::Impl {
   static bool PendingDoorWaypoint(const Person& p) { return p.reached == p.wait_before_waypoint; }
 
   const PersonSpec* FindSpec(const std::string& person_name) const;
+  // Where a walker who has arrived at p stands out of the way: beside the nearest wall, off
+  // any doorway (nullopt: no wall near).
+  std::optional<Eigen::Vector2d> SpotBesideWall(const Eigen::Vector2d& p) const;
 
   void UpdateRobot();
 

@@ -176,6 +176,8 @@ def clinic():
     b.actuator("exit_door_button", (21.85, 9.0), "-y")
 
     b.frame("corridor_west", 1.2, 1.0)
+    b.frame("walk_west", 2.5, 0.6)
+    b.frame("walk_east", 13.5, 0.6)
     b.frame("corridor_middle", 12.0, 1.0)
     b.frame("corridor_east", 21.0, 1.0)
     b.frame("room_a", 4.0, 5.0)
@@ -230,6 +232,8 @@ def atrium():
     b.actuator("exit_button", (0.9, 8.0), "-y")
 
     b.frame("atrium", 0.0, 0.0)
+    b.frame("atrium_sw", -1.6, -1.6)
+    b.frame("atrium_ne", 1.6, 1.6)
     b.frame("room_west", -6.0, 1.0)
     b.frame("room_south", -1.0, -6.0)
     b.frame("room_east", 6.0, -1.0)

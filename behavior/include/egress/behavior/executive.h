@@ -74,6 +74,10 @@ struct ExecutiveConfig {
   double detection_merge_iou{0.5};
   /// A door's leaf is in the costmap while its angle estimate is at most this old [s].
   double door_leaf_max_age{0.5};
+  /// A glass leaf not seen lately is kept in the costmap at this angle [rad]: the laser sees
+  /// glass only near normal incidence, and an open glass door sticking into a corridor was
+  /// driven into (the ADA operators' open angle, 80 deg).
+  double glass_leaf_assumed_angle{80.0 * M_PI / 180.0};
   /// A held payload's outline for collision checks: a vertical cylinder at the palm [m].
   double held_payload_radius{0.05};
   double held_payload_length{0.26};

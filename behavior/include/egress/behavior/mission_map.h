@@ -6,6 +6,7 @@
 /// not ground truth: people, payloads, door angles and obstacles the map does not show are
 /// perceived at run time.
 
+#include <set>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,7 @@ struct MissionMap {
   std::vector<perception::DoorModel> doors;   ///< The same doors for door-angle estimation.
   std::vector<MapActuator> actuators;
   std::vector<MapPlace> places;
+  std::set<std::string> glass_doors;  ///< Doors with a glass leaf (the laser hardly sees it).
 
   const perception::DoorModel* FindDoor(const std::string& id) const;
   /// The actuator of `door` on the side of the door line where `p_M` is (the nearest if there

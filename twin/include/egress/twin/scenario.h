@@ -164,6 +164,14 @@ struct RandomizeSpec {
   Range hold_angle_deg;  ///< Overrides hold_door people's hold angle when non-zero [deg].
   Range person_delay_s;  ///< Added to each person's trigger.
   Range person_speed_scale{1.0, 1.0};  ///< Multiplies sampled speeds.
+  // A scenario family: each seed draws a variant (DrawScenarioVariant) before the run.
+  std::vector<std::string> start_places;   ///< The robot starts at one of these places.
+  std::vector<std::string> goal_places;    ///< It goes to one of these (not where it starts).
+  std::vector<std::string> person_places;  ///< Each person walks between two of these.
+  double open_doors{0.0};   ///< Chance that each operated door is opened at t = 0 by someone.
+  double obstacle_xy{0.0};  ///< Obstacle (furniture) xy jitter half-width [m].
+  /// True when seeds draw variants of the scenario (places, open doors, furniture).
+  bool DrawsVariants() const;
 };
 
 /// The robot brain's task in a scenario. The twin does not read it (it knows nothing of the
@@ -219,6 +227,13 @@ BuildingDescription DescribeScenarioBuilding(const Scenario& scenario,
 /// @throws LoadError naming the scenario file and field (an unknown place, a push door whose
 /// building has only plates, a door whose actuators are of both kinds).
 void ApplyBuildingDefaults(const BuildingDescription& building, Scenario* scenario);
+
+/// The variant of a scenario family `scenario` for `seed`: start and goal places, people's
+/// routes, doors already opened, furniture jitter drawn from `randomize` (a pure function of
+/// the scenario and the seed; a scenario that draws no variants is returned as it is). Places
+/// are the building's. @throws LoadError naming the field for a place the building lacks.
+Scenario DrawScenarioVariant(const Scenario& scenario, const BuildingDescription& building,
+                             std::uint64_t seed);
 
 /// Reads a scenario YAML file. @throws LoadError naming file, line and field.
 Scenario LoadScenario(const std::filesystem::path& path);
