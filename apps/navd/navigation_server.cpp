@@ -16,6 +16,7 @@
 #include "egress/nav/v1/navigation.grpc.pb.h"
 #include "egress/perception/costmap.h"
 #include "egress/planning/base_planner.h"
+#include "egress/planning/route_planner.h"
 #include "egress/twin/sdf_world_loader.h"
 #include "sdf_map.h"
 
@@ -43,7 +44,14 @@ struct World {
   std::unique_ptr<perception::Costmap2D> costmap;
   std::unique_ptr<planning::BasePlanner> planner;
   std::map<std::string, perception::Doorway> doors;
+  std::unique_ptr<planning::RoutePlanner> routes;  // over the static map, doors passable
 };
+
+void SetPose(const Pose2& X, v1::Pose2* out) {
+  out->set_x(X.x);
+  out->set_y(X.y);
+  out->set_yaw(X.yaw);
+}
 
 Status Invalid(const std::string& message) {
   return {StatusCode::INVALID_ARGUMENT, message};
@@ -229,6 +237,17 @@ class Service final : public v1::Navigation::Service {
       world->planner->AddDoor({door.id(), doorway.p_MHinge, doorway.p_MLatch});
       world->doors[door.id()] = doorway;
     }
+    {
+      std::vector<perception::Doorway> doorways;
+      for (const auto& [door_id, doorway] : world->doors) doorways.push_back(doorway);
+      planning::RoutePlannerConfig route_config;
+      route_config.clearance = costmap_config.robot_radius + 0.025;
+      try {
+        world->routes = std::make_unique<planning::RoutePlanner>(grid, doorways, route_config);
+      } catch (const std::exception& e) {
+        return Invalid(std::string("route planner: ") + e.what());
+      }
+    }
     std::string id;
     {
       std::lock_guard lock(worlds_mutex_);
@@ -363,6 +382,17 @@ class Service final : public v1::Navigation::Service {
     response->set_planning_time(result.planning_time);
     for (const auto& door : result.doors_crossed)
       response->add_doors_crossed(door);
+    const planning::RouteResult route =
+        world->routes->Plan({s.x(), s.y(), s.yaw()}, {g.x(), g.y(), g.yaw()});
+    if (route.ok()) {
+      for (const auto& leg : route.route->legs) {
+        auto* door = response->add_doors_on_route();
+        door->set_door(leg.door);
+        SetPose(leg.X_MB_approach, door->mutable_approach());
+        SetPose(leg.X_MB_exit, door->mutable_exit());
+        door->set_opens_towards_robot(leg.opens_towards_robot);
+      }
+    }
     return Status::OK;
   }
 

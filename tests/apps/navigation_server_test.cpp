@@ -293,6 +293,14 @@ TEST_F(NavigationServerTest, LoadsTheOfficeSdfWorldWithItsDoors) {
   EXPECT_THAT(
       std::vector<std::string>(response.doors_crossed().begin(), response.doors_crossed().end()),
       ::testing::ElementsAre("door_a", "door_b"));
+  // The building's route: both doors, each with where to wait before it, facing it.
+  ASSERT_EQ(response.doors_on_route_size(), 2);
+  EXPECT_EQ(response.doors_on_route(0).door(), "door_a");
+  EXPECT_EQ(response.doors_on_route(1).door(), "door_b");
+  EXPECT_NEAR(response.doors_on_route(0).approach().x(), 5.0 - 1.2, 1e-9);  // before x = 5
+  EXPECT_NEAR(response.doors_on_route(0).approach().yaw(), 0.0, 1e-9);      // facing east
+  EXPECT_FALSE(response.doors_on_route(0).opens_towards_robot());          // it opens east
+  EXPECT_GT(response.doors_on_route(1).exit().x(), 9.0);
   // The SDF's door ids work with SetDoorState.
   v1::SetDoorStateRequest close;
   close.set_world_id(loaded.world_id());
