@@ -27,16 +27,42 @@ std::optional<Eigen::Vector3d> PlaceDetection(const Detection2D& detection,
   const double hw = b.width() * sx * config.center_fraction / 2,
                hh = b.height() * sy * config.center_fraction / 2;
   std::vector<float> depths;
+  int pixels = 0;
   for (int v = int(std::floor(cv_ - hh)); v <= int(std::ceil(cv_ + hh)); ++v) {
     for (int u = int(std::floor(cu - hw)); u <= int(std::ceil(cu + hw)); ++u) {
+      ++pixels;
       if (depth.IsValidAt(u, v) && depth.At(u, v) <= config.max_depth)
         depths.push_back(depth.At(u, v));
     }
   }
-  if (int(depths.size()) < config.min_valid_pixels) return std::nullopt;
+  if (int(depths.size()) < config.min_valid_pixels ||
+      double(depths.size()) < config.min_valid_fraction * pixels) {
+    return std::nullopt;
+  }
   auto middle = depths.begin() + std::ptrdiff_t(depths.size() / 2);
   std::nth_element(depths.begin(), middle, depths.end());
   return X_MC * intrinsics.Unproject(cu, cv_, *middle);
+}
+
+std::optional<Eigen::Vector3d> PlacePersonBySize(const Detection2D& detection,
+                                                 cv::Size detection_image,
+                                                 const CameraIntrinsics& intrinsics,
+                                                 const Pose3& X_MC, double person_height) {
+  detection.Validate();
+  ThrowUnless(detection_image.width > 0 && detection_image.height > 0,
+              "Invalid detection image size.");
+  ThrowUnless(X_MC.IsFinite(), "Invalid camera pose X_MC: must be finite.");
+  ThrowUnless(person_height > 0.0, "Invalid person height: must be > 0.");
+  const PixelBox& b = detection.box;
+  if (b.v_min <= 1.0 || b.v_max >= detection_image.height - 1.0) return std::nullopt;
+  // In the camera's pixels (the intrinsics' image), as the depth placement does.
+  const double sx = double(intrinsics.width) / detection_image.width,
+               sy = double(intrinsics.height) / detection_image.height;
+  const double box_height = b.height() * sy;
+  if (!(box_height > 1.0)) return std::nullopt;
+  const double distance = intrinsics.fy * person_height / box_height;
+  const double cu = (b.u_min + b.u_max) / 2 * sx, cv_ = (b.v_min + b.v_max) / 2 * sy;
+  return X_MC * intrinsics.Unproject(cu, cv_, distance);
 }
 
 void ObjectTrackerConfig::Validate() const {

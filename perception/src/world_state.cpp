@@ -12,6 +12,9 @@ PerceptionPipeline::PerceptionPipeline(std::vector<DoorModel> doors, PerceptionC
     doors_.emplace_back(std::move(door), config_.door_state);
 }
 
+// A standing adult's height, for placing a person seen without depth [m].
+constexpr double kPersonHeightM = 1.7;
+
 void PerceptionPipeline::ProcessCameraFrame(const std::vector<Detection2D>& detections,
                                             cv::Size detection_image, const DepthImage& depth,
                                             const CameraIntrinsics& intrinsics, const Pose3& X_MC,
@@ -28,8 +31,11 @@ void PerceptionPipeline::ProcessCameraFrame(const std::vector<Detection2D>& dete
       glass_boxes_.push_back(detection);
       continue;
     }
-    const auto p_MO =
+    auto p_MO =
         PlaceDetection(detection, detection_image, depth, intrinsics, X_MC, config_.placement);
+    // No depth under a person (seen through glass): by the box's height instead.
+    if (!p_MO && detection.label == labels::kPerson)
+      p_MO = PlacePersonBySize(detection, detection_image, intrinsics, X_MC, kPersonHeightM);
     if (!p_MO) continue;
     if (detection.label == labels::kPerson) {
       people.push_back(p_MO->head<2>());

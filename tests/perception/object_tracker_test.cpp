@@ -77,5 +77,30 @@ TEST(PlaceDetectionTest, MedianDepthThroughTheIntrinsics) {
   EXPECT_THROW(PlaceDetection(detection, {640, 480}, depth, K, X_MC), InvalidArgument);
 }
 
+TEST(PlaceDetectionTest, APersonBehindGlassIsPlacedByTheSizeOfTheirBoxNotAtTheFrame) {
+  const CameraIntrinsics K = CameraIntrinsics::FromHorizontalFov(80, 60, 1.047);
+  const Pose3 X_MC =
+      Pose3::FromXyzRpy({1.0, 0.0, 1.0}, {-std::numbers::pi / 2, 0.0, -std::numbers::pi / 2});
+  // Glass over the whole box but for one column of the door's frame at 1.0 m.
+  DepthImage depth;
+  depth.width = 80;
+  depth.height = 60;
+  depth.depth.assign(80 * 60, std::nanf(""));
+  for (int v = 0; v < 60; ++v)
+    depth.depth[std::size_t(v * 80 + 40)] = 1.0f;
+  // A person 1.7 m tall whose box is 160 px high in the 640x480 image (20 px in the depth's).
+  const Detection2D person{"person", 0.9, {300, 160, 340, 320}, Time{0}};
+  EXPECT_FALSE(PlaceDetection(person, {640, 480}, depth, K, X_MC).has_value())
+      << "a few valid pixels (the frame) must not place the person at the frame's depth";
+  const auto p_MP = PlacePersonBySize(person, {640, 480}, K, X_MC, 1.7);
+  ASSERT_TRUE(p_MP.has_value());
+  const double expected = K.fy * 1.7 / 20.0;  // distance along the optical axis
+  EXPECT_NEAR(p_MP->x(), 1.0 + expected, 1e-6);
+  EXPECT_GT(p_MP->x(), 3.0);  // far behind the frame, not at 1 m
+  // Cut off by the image's edge: its height says nothing.
+  const Detection2D cut{"person", 0.9, {300, 0, 340, 320}, Time{0}};
+  EXPECT_FALSE(PlacePersonBySize(cut, {640, 480}, K, X_MC, 1.7).has_value());
+}
+
 }  // namespace
 }  // namespace egress::perception

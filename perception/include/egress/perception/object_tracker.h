@@ -20,8 +20,21 @@ namespace egress::perception {
 struct PlacementConfig {
   double center_fraction{0.5};  ///< Depths are taken from this central fraction of the box.
   int min_valid_pixels{3};      ///< Fewer valid depths: not placed (e.g. a glass door).
-  double max_depth{8.0};        ///< Farther depths are ignored [m].
+  /// Fewer valid depths than this share of the central region: not placed by depth. A person
+  /// seen through a glass leaf has no depth; the few valid pixels in the box are the door's
+  /// frame, metres nearer, and placed them in the doorway.
+  double min_valid_fraction{0.25};
+  double max_depth{8.0};  ///< Farther depths are ignored [m].
 };
+
+/// Places a person's detection in M without depth, by the box's height in the image and a
+/// person's height `person_height` [m] (pinhole: distance = fy * height / box height): for a
+/// person behind glass. nullopt when the box touches the image's top or bottom edge (cut off,
+/// its height says nothing) or is degenerate. @throws InvalidArgument as PlaceDetection.
+std::optional<Eigen::Vector3d> PlacePersonBySize(const Detection2D& detection,
+                                                 cv::Size detection_image,
+                                                 const CameraIntrinsics& intrinsics,
+                                                 const Pose3& X_MC, double person_height);
 
 /// Places a detection in M: the median of the valid depths in the box's central region,
 /// unprojected at the box centre, transformed by X_MC. `detection_image` is the size of the
