@@ -188,6 +188,22 @@ void RunSim(const SimOptions& o) {
       fmt::print("note      {}\n", note);
     fmt::print("seed      {}   driver {}   time limit {:.0f} s\n", seed, driver,
                scenario.time_limit);
+    if (scenario.randomize.DrawsVariants()) {
+      // Drawn as the run draws it: from the scenario with its building's defaults.
+      const twin::BuildingDescription building =
+          twin::DescribeScenarioBuilding(scenario, world_description);
+      twin::Scenario defaulted = scenario;
+      twin::ApplyBuildingDefaults(building, &defaulted);
+      const twin::Scenario variant = twin::DrawScenarioVariant(defaulted, building, seed);
+      std::string opened;
+      for (const auto& door : variant.doors)
+        if (!door.open_at.empty() && door.open_at.front() == 0.0)
+          opened += (opened.empty() ? "" : ", ") + door.door;
+      fmt::print("variant   start {}, goal {}, opened at the start: {}\n",
+                 variant.start_place.empty() ? "(pose)" : variant.start_place,
+                 variant.goal_place.empty() ? "(pose)" : variant.goal_place,
+                 opened.empty() ? "none" : opened);
+    }
   }
   twin::RunOptions options;
   options.duration = o.duration;
