@@ -162,6 +162,25 @@ TEST(TwinWorldTest, APersonHoldsTheDoorOpenThenItCloses) {
   EXPECT_LT(world.door_angle(0), 5 * kDeg);
 }
 
+TEST(TwinWorldTest, APersonReachesAHoldSpotInACornerAndAWalkerStepsAsideOnArrival) {
+  // The clinic's door_e: its hinge 0.5 m from the corridor's side wall, so the spot beside the
+  // hinge is against that wall; the holder comes from 3 m away and still holds it.
+  const auto loaded = LoadText(
+      "world: clinic.sdf\nrobot: {start: {x: 1.2, y: 1.0}}\npeople:\n"
+      "  - {name: holder, behavior: hold_door, door: door_e, start: [21.2, 6.0],"
+      " goal: [21.2, 6.0], hold_angle_deg: 75, hold_duration: 20}\n"
+      "  - {name: walker, behavior: walk_past, start: [3.0, 1.0], goal: [6.0, 1.0]}\n",
+      WorldsDir() / "clinic");
+  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+  world.StepFor(12.0);
+  EXPECT_EQ(CountEvents(world, "person_holding_door"), 1);
+  EXPECT_GT(world.door_angle(4), 60 * kDeg);
+  // The walker arrived in the corridor's middle (y = 1) and then stands by a wall (the social
+  // forces of the walls settle it 0.6 m from the nearer), leaving the middle to the robot.
+  const auto& walker = world.people()[1];
+  EXPECT_GT(std::abs(walker.position.y() - 1.0), 0.35) << walker.position.y();
+}
+
 TEST(TwinWorldTest, TheHoldAngleIsRandomizedBySeedWithinItsRange) {
   std::ifstream in(WorldsDir() / "lab/lab_hold_door.yaml");
   std::string yaml((std::istreambuf_iterator<char>(in)), {});

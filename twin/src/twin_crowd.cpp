@@ -12,6 +12,10 @@ namespace {
 constexpr double kStepAsideReachM = 3.0;
 constexpr double kAsideFromWallM = 0.4;
 constexpr double kClearOfDoorwayM = 1.3;
+// Stuck this near its final waypoint, a walker has arrived [m].
+constexpr double kNearEnoughM = 0.6;
+// A route's waypoint keeps at least the walker's radius plus this from any wall [m].
+constexpr double kWaypointWallMarginM = 0.05;
 
 // Whether segments ab and cd cross (touching counts).
 bool SegmentsCross(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
@@ -81,6 +85,10 @@ void TwinWorld::Impl::BuildPeople() {
       p.hold_duration = spec.hold_duration;
       p.state.position = p.walker.position;
       model->PlanRoute(spec, p.door >= 0 ? &doors[std::size_t(p.door)] : nullptr, &p);
+      // A waypoint a behaviour placed against a wall (a hold spot beside a hinge in a corner)
+      // cannot be reached: it moves out to where the walker fits.
+      for (auto& waypoint : p.route)
+        waypoint = ClearOfWalls(waypoint, spec.radius + kWaypointWallMarginM);
       const int e = AddEntity(EntityKind::kPerson, p.state.name, int(people.size()));
       const Pose3 X_W(
           Eigen::Vector3d(p.walker.position.x(), p.walker.position.y(), kPersonHeight / 2));
@@ -144,8 +152,18 @@ void TwinWorld::Impl::UpdatePeople() {
         p.stepped_aside = true;
         if (const auto aside = SpotBesideWall(p.walker.position)) {
           p.route.push_back(*aside);
+          p.aside_spot = aside;
           continue;
         }
+      }
+      // Standing aside: the walls' push would carry a standing walker back to the corridor's
+      // middle; they keep to their spot.
+      if (p.aside_spot) {
+        p.walker.target = *p.aside_spot;
+        p.walker.final_target = true;
+        p.walker.desired_speed = (p.walker.position - *p.aside_spot).norm() > 0.1 ? p.speed : 0.0;
+        p.behavior->AtRouteEnd(time, door, &p, add_event);
+        continue;
       }
       p.walker.desired_speed = 0.0;
       p.behavior->AtRouteEnd(time, door, &p, add_event);
@@ -184,6 +202,12 @@ void TwinWorld::Impl::UpdatePeople() {
     p.blocked_for = p.state.phase == PersonPhase::kWalking && p.walker.velocity.norm() < 0.05
                         ? p.blocked_for + dt
                         : 0.0;
+    // Held off its last waypoint by the walls round it (a hold spot in a corner: the social
+    // forces balance short of it), a walker who is near enough has arrived.
+    if (p.route.size() == 1 && p.blocked_for > kStuckSec &&
+        (p.walker.position - p.route.front()).norm() < kNearEnoughM) {
+      p.route.front() = p.walker.position;
+    }
     if (p.blocked_for > kStuckSec) {
       for (const auto& d : doors) {
         const Eigen::Vector2d hinge = d.fixed->desc->p_WH.head<2>();
@@ -240,6 +264,19 @@ bool TwinWorld::Impl::DoorwayTaken(const Person& me) const {
     if ((other.walker.position - d.fixed->centre).norm() < 0.9) return true;
   }
   return false;
+}
+
+Eigen::Vector2d TwinWorld::Impl::ClearOfWalls(Eigen::Vector2d p, double clearance) const {
+  for (int pass = 0; pass < 3; ++pass) {  // a corner needs two pushes
+    for (const auto& w : fixed.walls) {
+      const Eigen::Vector2d ab = w.b - w.a;
+      const double t = std::clamp((p - w.a).dot(ab) / std::max(ab.squaredNorm(), 1e-12), 0.0, 1.0);
+      const Eigen::Vector2d offset = p - (w.a + t * ab);
+      const double d = offset.norm();
+      if (d > 1e-6 && d < clearance) p += offset / d * (clearance - d);
+    }
+  }
+  return p;
 }
 
 std::optional<Eigen::Vector2d> TwinWorld::Impl::SpotBesideWall(const Eigen::Vector2d& p) const {

@@ -42,7 +42,8 @@ struct Person {
   double stuck_for{0.0};         // [s] wanting to walk but not moving
   bool realigned{false};         // stepped back onto the door's axis once
   bool stepped_aside{false};     // walked to the side of the corridor at the end of its route
-  double blocked_for{0.0};       // [s] walking but not moving (any leg of the route)
+  std::optional<Eigen::Vector2d> aside_spot;  // where it then stands (held against the walls' push)
+  double blocked_for{0.0};                    // [s] walking but not moving (any leg of the route)
   double hold_angle{0.0};
   double hold_duration{0.0};
   double hold_started{-1.0};
@@ -138,6 +139,8 @@ struct TwinWorld::Impl {
   // Where a walker who has arrived at p stands out of the way: beside the nearest wall, off
   // any doorway (nullopt: no wall near).
   std::optional<Eigen::Vector2d> SpotBesideWall(const Eigen::Vector2d& p) const;
+  // p moved out of every wall it is nearer than `clearance` to [m].
+  Eigen::Vector2d ClearOfWalls(Eigen::Vector2d p, double clearance) const;
 
   void UpdateRobot();
 
