@@ -239,7 +239,8 @@ class Service final : public v1::Navigation::Service {
     }
     {
       std::vector<perception::Doorway> doorways;
-      for (const auto& [door_id, doorway] : world->doors) doorways.push_back(doorway);
+      for (const auto& [door_id, doorway] : world->doors)
+        doorways.push_back(doorway);
       planning::RoutePlannerConfig route_config;
       route_config.clearance = costmap_config.robot_radius + 0.025;
       try {

@@ -299,7 +299,7 @@ TEST_F(NavigationServerTest, LoadsTheOfficeSdfWorldWithItsDoors) {
   EXPECT_EQ(response.doors_on_route(1).door(), "door_b");
   EXPECT_NEAR(response.doors_on_route(0).approach().x(), 5.0 - 1.2, 1e-9);  // before x = 5
   EXPECT_NEAR(response.doors_on_route(0).approach().yaw(), 0.0, 1e-9);      // facing east
-  EXPECT_FALSE(response.doors_on_route(0).opens_towards_robot());          // it opens east
+  EXPECT_FALSE(response.doors_on_route(0).opens_towards_robot());           // it opens east
   EXPECT_GT(response.doors_on_route(1).exit().x(), 9.0);
   // The SDF's door ids work with SetDoorState.
   v1::SetDoorStateRequest close;
