@@ -20,6 +20,7 @@
 #include "batch.h"
 #include "brain_trial.h"
 #include "commands.h"
+#include "egress/behavior/task_nodes.h"
 #include "egress/hsr_interface/error.h"
 #include "egress/twin/sdf_world_loader.h"
 #include "egress/twin/twin_run.h"
@@ -117,21 +118,13 @@ std::string PoseOrPlaceYaml(const std::string& text, const char* option) {
       throw CommandFailed(fmt::format("{} '{}': expected a place name or x;y;yaw", option, text));
     return fmt::format("{{place: {}}}", text);
   }
-  std::vector<double> v;
-  std::stringstream in(text);
-  std::string part;
-  while (std::getline(in, part, ';')) {
-    try {
-      std::size_t used = 0;
-      v.push_back(std::stod(part, &used));
-      if (used != part.size() || !std::isfinite(v.back())) throw std::invalid_argument(part);
-    } catch (const std::exception&) {
-      throw CommandFailed(fmt::format("{} '{}': '{}' is not a finite number", option, text, part));
-    }
+  Pose2 X;
+  try {
+    X = behavior::ParsePose2(text);
+  } catch (const std::exception& e) {
+    throw CommandFailed(fmt::format("{}: {}", option, e.what()));
   }
-  if (v.size() != 2 && v.size() != 3)
-    throw CommandFailed(fmt::format("{} '{}': expected x;y;yaw or x;y", option, text));
-  return fmt::format("{{x: {}, y: {}, yaw: {}}}", v[0], v[1], v.size() == 3 ? v[2] : 0.0);
+  return fmt::format("{{x: {}, y: {}, yaw: {}}}", X.x, X.y, X.yaw);
 }
 
 // A world and a goal as a scenario: the building's doors with their operators (from the world

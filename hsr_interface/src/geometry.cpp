@@ -8,6 +8,14 @@
 
 namespace egress {
 
+Eigen::Vector2d ClosestPointOnSegment(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                                      const Eigen::Vector2d& b) {
+  const Eigen::Vector2d ab = b - a;
+  const double length2 = ab.squaredNorm();
+  if (length2 <= 0.0) return a;
+  return a + std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) * ab;
+}
+
 double WrapAngle(double angle) {
   if (!std::isfinite(angle)) return angle;
   double wrapped = std::remainder(angle, 2.0 * std::numbers::pi);  // in [-pi, pi]

@@ -72,13 +72,6 @@ bool InsideAnyOther(const WorldDescription& world, const std::string& model,
   return false;
 }
 
-double DistanceToSegment(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
-                         const Eigen::Vector2d& b) {
-  const Eigen::Vector2d ab = b - a;
-  const double t = std::clamp((p - a).dot(ab) / std::max(ab.squaredNorm(), 1e-12), 0.0, 1.0);
-  return (p - (a + t * ab)).norm();
-}
-
 // What the building YAML says of one actuator.
 struct ActuatorOverride {
   std::optional<std::string> door;
@@ -269,7 +262,7 @@ BuildingDescription Describe(const WorldDescription& world, const BuildingYaml& 
     } else {
       double best = kMaxActuatorDistance;
       for (auto& d : b.doors) {
-        const double distance = DistanceToSegment(p, d.p_WHinge, d.p_WLatch);
+        const double distance = (p - ClosestPointOnSegment(p, d.p_WHinge, d.p_WLatch)).norm();
         if (distance <= best) {
           best = distance;
           door = &d;

@@ -1,16 +1,14 @@
 #include "egress/twin/social_force.h"
 
+#include "egress/hsr_interface/geometry.h"
+
 #include <algorithm>
 #include <cmath>
 
 namespace egress::twin {
 
 Eigen::Vector2d ClosestPointOnSegment(const Eigen::Vector2d& p, const WallSegment& s) {
-  const Eigen::Vector2d ab = s.b - s.a;
-  const double len2 = ab.squaredNorm();
-  if (len2 < 1e-12) return s.a;
-  const double t = std::clamp((p - s.a).dot(ab) / len2, 0.0, 1.0);
-  return s.a + t * ab;
+  return egress::ClosestPointOnSegment(p, s.a, s.b);
 }
 
 // HFV00 contact: compression along the normal and sliding friction along the tangent, only

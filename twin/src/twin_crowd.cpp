@@ -269,9 +269,7 @@ bool TwinWorld::Impl::DoorwayTaken(const Person& me) const {
 Eigen::Vector2d TwinWorld::Impl::ClearOfWalls(Eigen::Vector2d p, double clearance) const {
   for (int pass = 0; pass < 3; ++pass) {  // a corner needs two pushes
     for (const auto& w : fixed.walls) {
-      const Eigen::Vector2d ab = w.b - w.a;
-      const double t = std::clamp((p - w.a).dot(ab) / std::max(ab.squaredNorm(), 1e-12), 0.0, 1.0);
-      const Eigen::Vector2d offset = p - (w.a + t * ab);
+      const Eigen::Vector2d offset = p - ClosestPointOnSegment(p, w);
       const double d = offset.norm();
       if (d > 1e-6 && d < clearance) p += offset / d * (clearance - d);
     }
@@ -286,9 +284,7 @@ std::optional<Eigen::Vector2d> TwinWorld::Impl::SpotBesideWall(const Eigen::Vect
   Eigen::Vector2d foot = p;
   double best = kStepAsideReachM;
   for (const auto& w : fixed.walls) {
-    const Eigen::Vector2d ab = w.b - w.a;
-    const double t = std::clamp((p - w.a).dot(ab) / std::max(ab.squaredNorm(), 1e-12), 0.0, 1.0);
-    const Eigen::Vector2d q = w.a + t * ab;
+    const Eigen::Vector2d q = ClosestPointOnSegment(p, w);
     if ((p - q).norm() < best) {
       best = (p - q).norm();
       nearest = &w;

@@ -16,6 +16,10 @@ namespace egress {
 /// Wraps an angle to (-pi, pi]. Non-finite input is returned unchanged.
 double WrapAngle(double angle);
 
+/// The point of segment ab nearest to p (a for a degenerate segment).
+Eigen::Vector2d ClosestPointOnSegment(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                                      const Eigen::Vector2d& b);
+
 /// A pose in the plane: position (x, y) [m] and heading yaw [rad] about +z.
 struct Pose2 {
   double x{0.0};
