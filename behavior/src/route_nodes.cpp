@@ -6,7 +6,6 @@
 #include <deque>
 #include <memory>
 #include <set>
-#include <sstream>
 
 #include "task_node_support.h"
 
@@ -15,13 +14,11 @@ namespace {
 
 using RoutePtr = std::shared_ptr<const planning::Route>;
 
+// A door list "a;b" (BehaviorTree.CPP's vector convention, the engine's own splitter).
 std::set<std::string> SplitList(const std::string& text) {
   std::set<std::string> out;
-  std::stringstream in(text);
-  std::string part;
-  while (std::getline(in, part, ';')) {
-    if (!part.empty()) out.insert(part);
-  }
+  for (std::string_view part : bt::SplitSemicolons(text))
+    if (!part.empty()) out.emplace(part);
   return out;
 }
 
