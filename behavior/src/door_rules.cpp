@@ -120,7 +120,11 @@ bool DoorPassable(const TaskServices& task, const std::string& door, double marg
     const double since_press =
         pressed ? ToSeconds(task.belief->now - operated) : std::numeric_limits<double>::infinity();
     const bool ours = since_press < window + task.config.door_hold_margin + kOperatorOpeningTime;
-    if (!ours && d.state.motion != perception::DoorMotion::kHeldOpen) continue;
+    // An opening the robot did not see begin (first seen already open, e.g. a glass leaf out of
+    // the camera's view while it swung) may have begun a whole window ago: it is timed as one
+    // that may close now, whatever its motion reads.
+    const bool witnessed = task.belief->door_opening_witnessed.count(door) > 0;
+    if (!ours && witnessed && d.state.motion != perception::DoorMotion::kHeldOpen) continue;
     // How long it has been open in this opening (not the estimate's steady time, which a
     // person passing in front of the leaf resets); a press on the open door restarted it.
     std::optional<Time> since;
@@ -139,6 +143,7 @@ bool DoorPassable(const TaskServices& task, const std::string& door, double marg
     if (ours && (!since || ToSeconds(*since - operated) > kOperatorOpeningTime)) {
       open_for = std::max(open_for, since_press - kOperatorMinOpeningTime);
     }
+    if (!ours && !witnessed) open_for = std::max(open_for, window);
     const DoorPass pass = CalcKnownPass(task, door, visit);
     // From here to beyond the leaf's sweep on the far side (less if already past the line); a
     // leaf that opens towards the robot closes away from it: just past the line is clear.

@@ -12,6 +12,7 @@
 #include "egress/bt/tree.h"
 #include "egress/hsr_interface/error.h"
 #include "egress/perception/door_estimation.h"
+#include "task_node_support.h"
 
 namespace egress::behavior {
 
@@ -443,11 +444,25 @@ bool Executive::Step(RobotPort& port) {
   // leaf, does not end it).
   for (const auto& d : belief_.world.doors) {
     if (!d.state.observed) continue;
+    const std::string& id = d.model.id;
+    const bool wide = d.state.clearance_width >= 2 * services_.config.footprint_radius;
     if (d.state.motion == perception::DoorMotion::kClosed ||
         d.state.motion == perception::DoorMotion::kClosing) {
-      belief_.door_open_since.erase(d.model.id);
-    } else if (d.state.clearance_width >= 2 * services_.config.footprint_radius) {
-      belief_.door_open_since.try_emplace(d.model.id, now);
+      belief_.door_open_since.erase(id);
+      belief_.door_seen_shut[id] = d.state.stamp;
+    } else if (!wide) {
+      belief_.door_seen_shut[id] = d.state.stamp;
+    } else if (belief_.door_open_since.try_emplace(id, now).second) {
+      // A new opening: its age is known only if the robot saw the door shut just before (within
+      // the time an operator takes to open it) — never for a glass leaf, which the estimate may
+      // read shut while it stands open edge-on to the laser.
+      const auto shut = belief_.door_seen_shut.find(id);
+      if (m.map.glass_doors.count(id) == 0 && shut != belief_.door_seen_shut.end() &&
+          ToSeconds(now - shut->second) <= detail::kOperatorOpeningTime) {
+        belief_.door_opening_witnessed.insert(id);
+      } else {
+        belief_.door_opening_witnessed.erase(id);
+      }
     }
   }
   if (snapshot.scan) belief_.scan = snapshot.scan;
@@ -459,6 +474,10 @@ bool Executive::Step(RobotPort& port) {
     const double lateral = std::abs((belief_.X_MB.translation() - pass.centre)
                                         .dot(Eigen::Vector2d(-pass.n_M.y(), pass.n_M.x())));
     if (along < services_.config.zone_depth && lateral < pass.width / 2 + 0.5) in_any_zone = true;
+    // Nor where a closing leaf can reach: a retreat to it meets the leaf.
+    if (door.InSweep(belief_.X_MB.translation(),
+                     services_.config.footprint_radius + detail::kLeafClearance))
+      in_any_zone = true;
     const bool occupied = IsDoorZoneOccupied(services_, door.id);
     if (occupied) belief_.zone_occupied_at[door.id] = now;
     if (occupied && !m.zone_occupied[door.id]) newly_occupied = true;

@@ -21,6 +21,11 @@ Eigen::Vector2d DoorModel::LeafTip(double angle) const {
   return p_MHinge + width() * Eigen::Vector2d(std::cos(yaw), std::sin(yaw));
 }
 
+bool DoorModel::InSweep(const Eigen::Vector2d& p_MQ, double margin) const {
+  const Eigen::Vector2d offset = p_MQ - p_MHinge;
+  return offset.norm() <= width() + margin && offset.dot(SwingSide()) > -margin;
+}
+
 Eigen::Vector2d DoorModel::SwingSide() const {
   const Eigen::Vector2d along = (p_MLatch - p_MHinge).normalized();
   return swing_sign * Eigen::Vector2d(-along.y(), along.x());

@@ -45,6 +45,10 @@ void BasePlannerConfig::Validate() const {
   ThrowUnless(costmap_cost_weight >= 0.0 && door_standoff > 0.0,
               "Invalid BasePlannerConfig: costmap_cost_weight ",
               "must be >= 0 and door_standoff > 0.");
+  ThrowUnless(std::isfinite(clearance_weight) && clearance_weight >= 0.0 &&
+                  std::isfinite(clearance_margin) && clearance_margin >= 0.0,
+              "Invalid BasePlannerConfig: clearance_weight and clearance_margin must be finite ",
+              "and >= 0, got ", clearance_weight, " and ", clearance_margin, ".");
 }
 
 std::string_view ToString(PlanStatus status) {
@@ -291,22 +295,49 @@ struct BasePlanner::Impl {
   // Greedy line-of-sight shortcutting of a dense path (a grid seed): from each kept state, jump
   // to the farthest later state reachable by a valid straight motion (exponential then binary
   // search). OMPL's simplifier is far slower on thousands of states.
-  og::PathGeometric StringPull(const og::PathGeometric& dense) const {
+  // The cost of a cell clearance_margin beyond the footprint from an obstacle.
+  std::uint8_t CloseCost() const {
+    return std::max<std::uint8_t>(
+        1, costmap.InflatedCost(costmap.config().robot_radius + config.clearance_margin));
+  }
+
+  // With `keep_clearance`, a shortcut must also keep clearance_margin from obstacles unless the
+  // stretch of path it replaces came closer (its highest costmap cost bounds the shortcut's).
+  og::PathGeometric StringPull(const og::PathGeometric& dense, bool keep_clearance) const {
     og::PathGeometric pulled(si);
     const std::size_t n = dense.getStateCount();
+    const auto xy = [&](std::size_t i) {
+      const auto* st = dense.getState(i)->as<ob::SE2StateSpace::StateType>();
+      return Eigen::Vector2d(st->getX(), st->getY());
+    };
+    std::vector<std::uint8_t> cost(n);
+    for (std::size_t i = 0; i < n; ++i)
+      cost[i] = costmap.CostAt(xy(i));
+    const double step_length = 0.25 * costmap.geometry().resolution;
+    const auto shortcut_ok = [&](std::size_t from, std::size_t to) {
+      if (!si->checkMotion(dense.getState(from), dense.getState(to))) return false;
+      if (!keep_clearance) return true;
+      const std::uint8_t bound =
+          *std::max_element(cost.begin() + long(from), cost.begin() + long(to) + 1);
+      const Eigen::Vector2d a = xy(from), b = xy(to);
+      const int steps = int(std::ceil((b - a).norm() / step_length));
+      for (int k = 1; k < steps; ++k) {
+        if (costmap.CostAt(a + (b - a) * (double(k) / steps)) > bound) return false;
+      }
+      return true;
+    };
     std::size_t anchor = 0;
     pulled.append(dense.getState(0));
     while (anchor + 1 < n) {
       std::size_t good = anchor + 1, step = 2;
-      while (anchor + step < n &&
-             si->checkMotion(dense.getState(anchor), dense.getState(anchor + step))) {
+      while (anchor + step < n && shortcut_ok(anchor, anchor + step)) {
         good = anchor + step;
         step *= 2;
       }
       std::size_t lo = good, hi = std::min(anchor + step, n - 1);
       while (hi > lo + 1) {
         const std::size_t mid = (lo + hi) / 2;
-        if (si->checkMotion(dense.getState(anchor), dense.getState(mid))) {
+        if (shortcut_ok(anchor, mid)) {
           lo = mid;
         } else {
           hi = mid;
@@ -321,8 +352,8 @@ struct BasePlanner::Impl {
   // The grid's shortest path from start to goal, string-pulled; nullopt without one.
   std::optional<og::PathGeometric> GridSeed(const Pose2& start, const Pose2& goal,
                                             const ob::State* s, const ob::State* g) const {
-    const auto cells =
-        GridShortestPath(costmap, start.translation(), goal.translation(), config.allow_unknown);
+    const auto cells = GridCheapestPath(costmap, start.translation(), goal.translation(),
+                                        CloseCost(), config.clearance_weight, config.allow_unknown);
     if (!cells) return std::nullopt;
     og::PathGeometric dense(si);
     ob::ScopedState<ob::SE2StateSpace> state(space);
@@ -333,7 +364,7 @@ struct BasePlanner::Impl {
       dense.append(state.get());
     }
     dense.append(g);
-    return StringPull(dense);
+    return StringPull(dense, config.clearance_weight > 0.0);
   }
 
   // One OMPL query between two valid poses.
@@ -613,6 +644,15 @@ std::optional<std::vector<Eigen::Vector2d>> GridShortestPath(const perception::C
                                                              const Eigen::Vector2d& start,
                                                              const Eigen::Vector2d& goal,
                                                              bool allow_unknown) {
+  return GridCheapestPath(costmap, start, goal, kInscribedCost, 0.0, allow_unknown);
+}
+
+std::optional<std::vector<Eigen::Vector2d>> GridCheapestPath(
+    const perception::Costmap2D& costmap, const Eigen::Vector2d& start, const Eigen::Vector2d& goal,
+    std::uint8_t close_cost, double close_weight, bool allow_unknown) {
+  ThrowUnless(std::isfinite(close_weight) && close_weight >= 0.0,
+              "GridCheapestPath: close_weight must be finite and >= 0, got ", close_weight);
+  const float penalty = 1.0f + float(close_weight);
   const auto& g = costmap.geometry();
   const auto s = g.CellOf(start), t = g.CellOf(goal);
   if (!s || !t) return std::nullopt;
@@ -644,7 +684,9 @@ std::optional<std::vector<Eigen::Vector2d>> GridShortestPath(const perception::C
         if (dx != 0 && dy != 0 &&
             (!passable(g.Index(ix + dx, iy)) || !passable(g.Index(ix, iy + dy))))
           continue;
-        const float nd = d + ((dx != 0 && dy != 0) ? kDiagonal : 1.0f);
+        const std::uint8_t c = costmap.costs()[next];
+        const float factor = c != kUnknownCost && c >= close_cost ? penalty : 1.0f;
+        const float nd = d + ((dx != 0 && dy != 0) ? kDiagonal : 1.0f) * factor;
         if (nd < distance[next]) {
           distance[next] = nd;
           parent[next] = index;

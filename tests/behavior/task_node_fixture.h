@@ -82,8 +82,9 @@ class TaskNodeFixture : public ::testing::Test {
     text += "</BehaviorTree></root>";
     return factory_.CreateTreeFromText(text, id, blackboard);
   }
-  // The door seen open at `angle_deg`, steady, `open_for` seconds at `now`.
-  void DoorSeenOpen(double angle_deg, double open_for) {
+  // The door seen open at `angle_deg`, steady, `open_for` seconds at `now` (an opening the robot
+  // saw begin, unless `witnessed` is false).
+  void DoorSeenOpen(double angle_deg, double open_for, bool witnessed = true) {
     perception::TrackedDoor door;
     door.model = map_.doors[0];
     door.state.observed = true;
@@ -93,6 +94,11 @@ class TaskNodeFixture : public ::testing::Test {
     door.state.stamp = belief_.now;
     belief_.world.doors = {door};
     belief_.door_open_since["lab_door"] = belief_.now - SecondsToDuration(open_for);
+    if (witnessed) {
+      belief_.door_opening_witnessed.insert("lab_door");
+    } else {
+      belief_.door_opening_witnessed.erase("lab_door");
+    }
   }
   // The people the robot sees now, and the door zones they occupy recorded in the belief as the
   // executive records them every control step.

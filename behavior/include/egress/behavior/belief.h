@@ -9,6 +9,7 @@
 
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 
 #include "egress/hsr_interface/geometry.h"
@@ -37,6 +38,12 @@ struct Belief {
   /// angle estimate: it starts when the leaf is first seen wide enough, ends when it is seen
   /// closed or closing).
   std::map<std::string, Time> door_open_since;
+  /// Per door: when it was last seen shut (closed, closing, or opening but not yet wide enough).
+  std::map<std::string, Time> door_seen_shut;
+  /// Doors whose current opening the robot saw begin (seen shut shortly before it was first seen
+  /// wide enough): door_open_since is then the opening's age. For any other opening the age is
+  /// unknown — it may have begun a whole hold window ago.
+  std::set<std::string> door_opening_witnessed;
   /// Per door: the last step at which a person (not one holding the door aside) was in, or
   /// forecast into, its zone. Absent: never seen occupied.
   std::map<std::string, Time> zone_occupied_at;

@@ -82,13 +82,16 @@ class Costmap2D {
   const CostmapConfig& config() const { return config_; }
   /// The master grid, row-major (see GridGeometry).
   const std::vector<std::uint8_t>& costs() const { return master_; }
+  /// The inflation's cost at `distance` [m] from the nearest lethal cell (lethal at 0,
+  /// kInscribedCost within the robot radius, the exponential decay beyond, free past
+  /// inflation_radius): what a cell that far from an obstacle costs.
+  std::uint8_t InflatedCost(double distance) const;
   /// The master grid as an 8-bit image, row 0 = highest y (for PNG output).
   cv::Mat ToImage() const;
 
  private:
   void RecomputeWindow(int x0, int y0, int x1, int y1);
   void MarkLeaf(const Doorway& doorway, double angle, std::uint8_t value);
-  std::uint8_t InflatedCost(double distance) const;
 
   CostmapConfig config_;
   GridGeometry geometry_;

@@ -57,6 +57,16 @@ struct BasePlannerConfig {
   /// checker): a pure function of the costmap, for lock-step simulation where a run must be a
   /// pure function of its seed. Wall-clock budgets make sampling planners vary run to run.
   bool deterministic{false};
+  /// Clearance of the grid path (the deterministic answer and the narrow-passage seed): it keeps
+  /// clearance_margin beyond the footprint from obstacles where the free space allows — a grid
+  /// step into a cell closer than that costs (1 + clearance_weight) times its length, and
+  /// shortcutting never takes the path closer than the margin unless the grid path itself was.
+  /// Why: a path string-pulled on validity alone grazes every corner and open leaf at exactly
+  /// the footprint radius, with no room for localization error. Beyond the margin the path is
+  /// the shortest, so it still passes close enough to see round corners. clearance_weight 0:
+  /// the plain shortest path, shortcut on validity alone.
+  double clearance_margin{0.1};  ///< [m] beyond the footprint radius
+  double clearance_weight{4.0};
   void Validate() const;
 };
 
@@ -139,6 +149,12 @@ std::optional<std::vector<Eigen::Vector2d>> GridShortestPath(const perception::C
                                                              const Eigen::Vector2d& start,
                                                              const Eigen::Vector2d& goal,
                                                              bool allow_unknown = false);
+/// The cheapest 8-connected grid path (cell centres, no corner cutting) over cells below
+/// kInscribedCost, a step into a cell of cost >= `close_cost` costing (1 + close_weight) times
+/// its length (close_weight 0: the shortest path); nullopt if there is none.
+std::optional<std::vector<Eigen::Vector2d>> GridCheapestPath(
+    const perception::Costmap2D& costmap, const Eigen::Vector2d& start, const Eigen::Vector2d& goal,
+    std::uint8_t close_cost, double close_weight, bool allow_unknown = false);
 /// Length [m] of the shortest 8-connected grid path between two points over cells below
 /// kInscribedCost (the reference for path quality); nullopt if there is none.
 std::optional<double> GridShortestPathLength(const perception::Costmap2D& costmap,
