@@ -55,6 +55,16 @@ TEST(DoorEstimationTest, AngleOpenFractionAndClearanceAtKeyAngles) {
   EXPECT_GT(half.state().clearance_width, 0.25);
 }
 
+TEST(DoorEstimationTest, TheSweepIsTheQuarterDiscOnTheSwingSideGrownByTheMargin) {
+  const DoorModel door = LabDoor();
+  EXPECT_TRUE(door.InSweep({0.5, 0.5}, 0.0));    // under the opening leaf
+  EXPECT_FALSE(door.InSweep({0.5, -0.5}, 0.0));  // behind the door line
+  EXPECT_FALSE(door.InSweep({0.8, 0.8}, 0.0));   // 1.13 m from the hinge
+  EXPECT_TRUE(door.InSweep({0.8, 0.8}, 0.3));
+  EXPECT_TRUE(door.InSweep({0.5, -0.1}, 0.2));  // within the margin of the line
+  EXPECT_FALSE(door.InSweep({0.5, -0.3}, 0.2));
+}
+
 TEST(DoorEstimationTest, NoLeafSeenIsNoMeasurement) {
   EXPECT_FALSE(MeasureDoorAngle(LabDoor(), {{5.0, 5.0}, {-2.0, 0.0}}).has_value());
 }

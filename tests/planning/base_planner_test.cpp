@@ -1,5 +1,6 @@
 #include "egress/planning/base_planner.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <gmock/gmock.h>
@@ -193,6 +194,71 @@ TEST_F(BasePlannerTest, OptimizingPlannersByName) {
     ASSERT_TRUE(result.ok()) << name << ": " << result.message;
     EXPECT_LT(result.length, 4.0) << name;
   }
+}
+
+// A 6 m x 3 m room (walls 0.1 m thick) with a 1 m box standing out from the south wall in its
+// middle; `gap` [m] is left between the box and the north wall.
+Costmap2D RoomWithBox(double gap) {
+  std::vector<Box2> boxes = {{{3.0, -0.05, 0.0}, {6.2, 0.1}},
+                             {{3.0, 3.05, 0.0}, {6.2, 0.1}},
+                             {{-0.05, 1.5, 0.0}, {0.1, 3.2}},
+                             {{6.05, 1.5, 0.0}, {0.1, 3.2}}};
+  const double height = 3.0 - gap;
+  boxes.push_back({{3.0, height / 2, 0.0}, {1.0, height}});
+  return Costmap2D(OccupancyGrid::FromBoxes(boxes, {-0.5, -0.5}, {6.5, 3.5}, 0.05));
+}
+
+// Closest distance of the path (sampled at 1 cm) to the box's corner region: the box spans
+// x 2.5..3.5, y 0..top.
+double ClosestToBox(const std::vector<Pose2>& path, double top) {
+  double closest = 1e9;
+  for (std::size_t i = 1; i < path.size(); ++i) {
+    const Eigen::Vector2d a = path[i - 1].translation(), b = path[i].translation();
+    const int steps = std::max(1, int((b - a).norm() / 0.01));
+    for (int k = 0; k <= steps; ++k) {
+      const Eigen::Vector2d p = a + (b - a) * (double(k) / steps);
+      const Eigen::Vector2d q(std::clamp(p.x(), 2.5, 3.5), std::clamp(p.y(), 0.0, top));
+      closest = std::min(closest, (p - q).norm());
+    }
+  }
+  return closest;
+}
+
+TEST(BasePlannerClearanceTest, TheGridPathKeepsItsMarginRoundCornersWhereThereIsRoom) {
+  const Costmap2D costmap = RoomWithBox(1.5);
+  BasePlannerConfig config;
+  config.deterministic = true;
+  const Pose2 start{1.0, 0.5, 0.0}, goal{5.0, 0.5, 0.0};
+  const PlanResult kept = BasePlanner(costmap, nullptr, config).Plan(start, goal);
+  ASSERT_TRUE(kept.ok()) << kept.message;
+  // The margin beyond the footprint, less a cell of rasterization.
+  EXPECT_GE(ClosestToBox(kept.path, 1.5), config.footprint_radius + config.clearance_margin - 0.05);
+  // Without it the path is string-pulled on validity alone and grazes the corner.
+  config.clearance_weight = 0.0;
+  const PlanResult grazing = BasePlanner(costmap, nullptr, config).Plan(start, goal);
+  ASSERT_TRUE(grazing.ok()) << grazing.message;
+  EXPECT_LT(ClosestToBox(grazing.path, 1.5), config.footprint_radius + 0.05);
+  EXPECT_LT(grazing.length, kept.length);
+}
+
+TEST(BasePlannerClearanceTest, APassageNarrowerThanTheMarginIsStillPassed) {
+  // 0.55 m between the box and the wall: room for the 0.43 m footprint, not for the margin.
+  const Costmap2D costmap = RoomWithBox(0.55);
+  BasePlannerConfig config;
+  config.deterministic = true;
+  const PlanResult result =
+      BasePlanner(costmap, nullptr, config).Plan({1.0, 2.7, 0.0}, {5.0, 2.7, 0.0});
+  ASSERT_TRUE(result.ok()) << result.message;
+  EXPECT_GT(ClosestToBox(result.path, 2.45), config.footprint_radius - 0.05);
+}
+
+TEST(BasePlannerClearanceTest, ABadMarginIsRefused) {
+  BasePlannerConfig config;
+  config.clearance_margin = -0.1;
+  EXPECT_THROW(config.Validate(), InvalidArgument);
+  config.clearance_margin = 0.1;
+  config.clearance_weight = std::nan("");
+  EXPECT_THROW(config.Validate(), InvalidArgument);
 }
 
 }  // namespace
