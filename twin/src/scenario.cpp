@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "egress/hsr_interface/error.h"
+#include "egress/twin/mobility.h"
 #include "people/approach_and_wait.h"
 #include "people/evacuate.h"
 #include "people/hold_door.h"
@@ -273,9 +274,10 @@ Scenario Parse(const YAML::Node& root, const FieldReader& r,
     for (std::size_t i = 0; i < people.size(); ++i) {
       const std::string f = "people[" + std::to_string(i) + "]";
       const YAML::Node n = people[i];
-      r.CheckKeys(n, f,
-                  {"name", "behavior", "start", "goal", "via", "door", "speed", "trigger",
-                   "hold_angle_deg", "hold_duration", "wait_s", "count", "radius"});
+      r.CheckKeys(
+          n, f,
+          {"name", "behavior", "start", "goal", "via", "door", "speed", "trigger", "hold_angle_deg",
+           "hold_duration", "wait_s", "count", "radius", "mobility", "route"});
       PersonSpec p;
       p.name = n["name"] ? r.String(n["name"], f + ".name") : "person_" + std::to_string(i);
       p.behavior = ParseBehavior(r, r.Required(n, f, "behavior"), f + ".behavior");
@@ -288,6 +290,31 @@ Scenario Parse(const YAML::Node& root, const FieldReader& r,
         }
       }
       if (n["door"]) p.door = r.String(n["door"], f + ".door");
+      if (const YAML::Node route = n["route"]) {
+        if (!route.IsSequence() || route.size() == 0)
+          r.Fail(route, f + ".route", "expected a list of door names (the exit route, in order)");
+        for (std::size_t k = 0; k < route.size(); ++k)
+          p.route_doors.push_back(r.String(route[k], f + ".route[" + std::to_string(k) + "]"));
+        if (p.door.empty()) p.door = p.route_doors.front();
+      }
+      if (const YAML::Node mobility = n["mobility"]) {
+        if (!mobility.IsMap() || mobility.size() == 0)
+          r.Fail(mobility, f + ".mobility", "expected a map of mobility class -> share");
+        double total = 0.0;
+        for (const auto& entry : mobility) {
+          const std::string name = r.String(entry.first, f + ".mobility");
+          if (FindMobilityClass(name) == nullptr)
+            r.Fail(entry.first, f + ".mobility." + name,
+                   "is not a mobility class (" + MobilityClassNames() + ")");
+          const double share = r.NonNegative(entry.second, f + ".mobility." + name);
+          total += share;
+          p.mobility.emplace_back(name, share);
+        }
+        if (!(total > 0.0)) r.Fail(mobility, f + ".mobility", "the shares must not all be 0");
+      }
+      if ((!p.route_doors.empty() || !p.mobility.empty()) &&
+          p.behavior != PersonBehavior::kEvacuate)
+        r.Fail(n, f, "route and mobility are for behavior evacuate");
       const bool needs_door = p.behavior == PersonBehavior::kCrossDoorway ||
                               p.behavior == PersonBehavior::kHoldDoor ||
                               p.behavior == PersonBehavior::kEvacuate;
@@ -549,6 +576,11 @@ void Scenario::ValidateAgainst(const WorldDescription& world) const {
     if (!people[i].door.empty() && !known_door(people[i].door)) {
       throw LoadError(StrCat(where, ": field 'people[", i, "].door': world has no door '",
                              people[i].door, "'"));
+    }
+    for (std::size_t k = 0; k < people[i].route_doors.size(); ++k) {
+      if (!known_door(people[i].route_doors[k]))
+        throw LoadError(StrCat(where, ": field 'people[", i, "].route[", k,
+                               "]': world has no door '", people[i].route_doors[k], "'"));
     }
   }
   for (std::size_t i = 0; i < success.size(); ++i) {

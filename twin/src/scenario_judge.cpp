@@ -61,6 +61,7 @@ void ScenarioJudge::Observe(const TwinWorld& world) {
   }
   double nearest = std::numeric_limits<double>::infinity();
   for (const auto& p : world.people()) {
+    if (p.out) continue;  // left the scene
     nearest = std::min(nearest, (p.position - X_WB.translation()).norm() - robot_r - p.radius);
   }
   metrics_.min_person_distance = std::min(metrics_.min_person_distance, nearest);

@@ -39,7 +39,8 @@ Eigen::Vector2d SocialForceModel::CalcAcceleration(std::size_t i,
         w.final_target ? w.desired_speed * std::min(1.0, to_goal.norm() / 0.5) : w.desired_speed;
     desired = to_goal.normalized() * speed;
   }
-  Eigen::Vector2d a = P.drive_factor * (desired - w.velocity) / P.relaxation_time;
+  const double tau = w.relaxation_time > 0.0 ? w.relaxation_time : P.relaxation_time;
+  Eigen::Vector2d a = P.drive_factor * (desired - w.velocity) / tau;
   const Eigen::Vector2d heading =
       w.velocity.norm() > 0.05 ? Eigen::Vector2d(w.velocity.normalized())
                                : (to_goal.norm() > 1e-3 ? Eigen::Vector2d(to_goal.normalized())
@@ -97,7 +98,8 @@ Eigen::Vector2d SocialForceModel::CalcAcceleration(std::size_t i,
     if (dist < 1e-9 || dist > 3.0) continue;
     const Eigen::Vector2d n = r / dist;
     const double gap = dist - w.radius;
-    Eigen::Vector2d f = (P.wall_strength / P.wall_range) * std::exp(-gap / P.wall_range) * n;
+    Eigen::Vector2d f =
+        w.wall_scale * (P.wall_strength / P.wall_range) * std::exp(-gap / P.wall_range) * n;
     if (gap < 0.0) {
       const Eigen::Vector2d t(-n.y(), n.x());
       f += (P.body_compression * -gap * n - P.sliding_friction * -gap * w.velocity.dot(t) * t) /

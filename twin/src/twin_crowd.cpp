@@ -2,7 +2,11 @@
 #include "twin_world_impl.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <optional>
+
+#include "egress/twin/mobility.h"
 
 namespace egress::twin {
 namespace {
@@ -16,6 +20,24 @@ constexpr double kClearOfDoorwayM = 1.3;
 constexpr double kNearEnoughM = 0.6;
 // A route's waypoint keeps at least the walker's radius plus this from any wall [m].
 constexpr double kWaypointWallMarginM = 0.05;
+// Operating an actuator: where a person stands (this far in front of its face) [m], how near the
+// doorway they must be to go and operate it [m], near enough to the spot to operate [m], and
+// within arm's reach when the queue keeps them off the spot [m].
+constexpr double kActuatorStandOffM = 0.45;
+constexpr double kPersonAtActuatorRadiusM = 0.3;
+constexpr double kOperateReachM = 3.0;
+constexpr double kAtActuatorM = 0.25;
+constexpr double kArmReachM = 0.7;
+// Where an evacuee lines up before an open door, on its axis [m].
+constexpr double kLineUpBeforeDoorM = 0.6;
+// The pace whose drive every evacuee has (Boyce et al.'s mean without disability) [m/s].
+constexpr double kReferencePaceMps = 1.24;
+// The body whose room from walls the social force model keeps (a walker's, mobility.h) [m].
+constexpr double kReferenceBodyRadiusM = 0.23;
+// Within this of an open door's centre an evacuee skips the queueing spot before it [m].
+constexpr double kSkipQueueSpotM = 2.5;
+// Where the body of a person who has left the scene is put (below the floor: no ray, no contact).
+constexpr double kOutOfSceneZ = -50.0;
 
 // Whether segments ab and cd cross (touching counts).
 bool SegmentsCross(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
@@ -52,6 +74,7 @@ void TwinWorld::Impl::BuildPeople() {
   std::mt19937_64 rng(DeriveSeed(seed, 4));
   // Its own stream: a scenario without the range draws exactly what it drew before.
   std::mt19937_64 hold_rng(DeriveSeed(seed, 5));
+  std::mt19937_64 mobility_rng(DeriveSeed(seed, 6));
   const auto& r = scenario.randomize;
   for (const auto& spec : scenario.people) {
     const auto& model = fixed.behavior_models.at(spec.behavior);
@@ -83,8 +106,53 @@ void TwinWorld::Impl::BuildPeople() {
       if (model->HoldsDoor() && r.hold_angle_deg.max > 0.0)
         p.hold_angle = r.hold_angle_deg.Sample(hold_rng) * kDegToRad;
       p.hold_duration = spec.hold_duration;
+      // Evacuees operate a door they wait at; everyone else waits for it (the door scenarios'
+      // people wait for the robot).
+      p.can_operate = spec.behavior == PersonBehavior::kEvacuate;
+      if (!spec.mobility.empty()) {
+        // The member's class, drawn by the shares; it sets their size, pace and whether (and
+        // how fast) they operate an actuator.
+        double total = 0.0;
+        for (const auto& [name, share] : spec.mobility)
+          total += share;
+        double pick = std::uniform_real_distribution<double>(0.0, total)(mobility_rng);
+        const MobilityClass* cls = FindMobilityClass(spec.mobility.back().first);
+        for (const auto& [name, share] : spec.mobility) {
+          if (pick < share) {
+            cls = FindMobilityClass(name);
+            break;
+          }
+          pick -= share;
+        }
+        p.state.mobility = cls->name;
+        p.state.radius = p.walker.radius = cls->radius;
+        p.speed = cls->speed.Sample(mobility_rng) * r.person_speed_scale.Sample(mobility_rng);
+        p.can_operate =
+            std::uniform_real_distribution<double>(0.0, 1.0)(mobility_rng) < cls->operate_share;
+        p.operate_time = cls->operate_time.Sample(mobility_rng);
+        // The drive of a walker at the reference pace, whatever their own (social_force.h).
+        p.walker.relaxation_time =
+            sfm.params().relaxation_time * std::min(1.0, p.speed / kReferencePaceMps);
+        p.walker.wall_scale = std::min(1.0, std::pow(kReferenceBodyRadiusM / cls->radius, 4));
+        // A group of mixed sizes stands 2.2 of its largest radii apart.
+        if (count > 1) p.walker.position = spec.start + offset / spec.radius * 0.45;
+      }
       p.state.position = p.walker.position;
-      model->PlanRoute(spec, p.door >= 0 ? &doors[std::size_t(p.door)] : nullptr, &p);
+      p.state.can_operate = p.can_operate;
+      if (!spec.route_doors.empty()) {
+        // A multi-door route (an exit route): its via points, each door's doorway in order, the
+        // goal beyond the last.
+        for (const auto& v : spec.via)
+          p.route.push_back(v);
+        for (const auto& name : spec.route_doors) {
+          const int d = FindDoor(name);
+          people::PersonBehaviorModel::AppendDoorway(doors[std::size_t(d)], d, &p);
+        }
+        p.route.push_back(spec.goal);
+        p.door = -1;  // the route's doorways decide where to wait
+      } else {
+        model->PlanRoute(spec, p.door >= 0 ? &doors[std::size_t(p.door)] : nullptr, &p);
+      }
       // A waypoint a behaviour placed against a wall (a hold spot beside a hinge in a corner)
       // cannot be reached: it moves out to where the walker fits.
       for (auto& waypoint : p.route)
@@ -92,8 +160,9 @@ void TwinWorld::Impl::BuildPeople() {
       const int e = AddEntity(EntityKind::kPerson, p.state.name, int(people.size()));
       const Pose3 X_W(
           Eigen::Vector3d(p.walker.position.x(), p.walker.position.y(), kPersonHeight / 2));
+      const double body_radius = p.walker.radius;
       p.body =
-          AddBody(std::make_unique<btCapsuleShapeZ>(spec.radius, kPersonHeight - 2 * spec.radius),
+          AddBody(std::make_unique<btCapsuleShapeZ>(body_radius, kPersonHeight - 2 * body_radius),
                   X_W, 0.0, kGPerson, kMaskPerson, e);
       MakeKinematic(p.body);
       people.push_back(std::move(p));
@@ -145,6 +214,18 @@ void TwinWorld::Impl::UpdatePeople() {
       continue;
     }
     if (p.route.empty()) {
+      if (p.state.arrived_at < 0.0) {
+        p.state.arrived_at = time;
+        // An evacuee at the assembly point beyond the exit has left the building: out of the
+        // scene (the crowd behind would otherwise push them back towards the exit).
+        if (p.state.behavior == PersonBehavior::kEvacuate) {
+          p.state.out = true;
+          const btTransform T(btQuaternion::getIdentity(), btVector3(0, 0, kOutOfSceneZ));
+          p.body->getMotionState()->setWorldTransform(T);
+          p.body->setWorldTransform(T);
+        }
+      }
+      if (p.state.out) continue;
       const PersonSpec* spec = FindSpec(p.state.name);
       if (!p.stepped_aside && spec != nullptr && spec->behavior == PersonBehavior::kWalkPast) {
         // Arrived: people do not stand in the middle of a corridor or on a door's axis; they
@@ -169,24 +250,42 @@ void TwinWorld::Impl::UpdatePeople() {
       p.behavior->AtRouteEnd(time, door, &p, add_event);
       continue;
     }
-    // Wait in front of a door that is not open enough.
+    // An evacuee whose next door already stands open lines up on its axis, not at the spot to
+    // its right where they would queue (which may lie under the open leaf, or behind them after
+    // they operated the door from its actuator): square to the opening, a wide body (a
+    // wheelchair) clears both jambs.
+    if (p.state.behavior == PersonBehavior::kEvacuate && p.route.size() > 1) {
+      const auto next = p.doorway_waypoints.find(p.reached + 1);
+      if (next != p.doorway_waypoints.end()) {
+        const DoorModel& d = *doors[std::size_t(next->second)].fixed;
+        if (doors[std::size_t(next->second)].angle >=
+                config.door_crossed_open_angle_deg * kDegToRad &&
+            (p.walker.position - d.centre).norm() < kSkipQueueSpotM) {
+          const double side = (p.walker.position - d.centre).dot(d.normal) >= 0 ? 1.0 : -1.0;
+          p.route.front() = d.centre + d.normal * side * kLineUpBeforeDoorM;
+        }
+      }
+    }
+    // Wait in front of a door that is not open enough (operating its actuator if they can).
     p.walker.target = p.route.front();
     p.walker.final_target = p.route.size() == 1;
     p.walker.desired_speed = p.speed;
-    if (p.door >= 0 && p.wait_before_waypoint >= 0 && PendingDoorWaypoint(p) &&
-        (doors[p.door].angle < config.door_crossed_open_angle_deg * kDegToRad || DoorwayTaken(p))) {
+    const int gate = GateDoor(p);
+    if (gate >= 0 && (doors[gate].angle < config.door_crossed_open_angle_deg * kDegToRad ||
+                      DoorwayTaken(p, gate))) {
       p.state.phase = PersonPhase::kWaitingForDoor;
       p.walker.desired_speed = 0.0;
+      if (OperateDoor(p, gate)) continue;
     } else if (p.state.phase == PersonPhase::kWaitingForDoor) {
       p.state.phase = PersonPhase::kWalking;
+      p.operating = -1;
     }
     // Pushed against a jamb (a social-force local minimum, e.g. after making way for the
     // robot), a walker heading for the doorway steps back onto the door's axis and goes again.
-    const bool heading_for_doorway = p.door >= 0 && p.reached == p.wait_before_waypoint &&
-                                     p.state.phase == PersonPhase::kWalking;
+    const bool heading_for_doorway = gate >= 0 && p.state.phase == PersonPhase::kWalking;
     p.stuck_for = heading_for_doorway && p.walker.velocity.norm() < 0.05 ? p.stuck_for + dt : 0.0;
     if (p.stuck_for > kStuckSec && !p.realigned) {
-      const Door& d = doors[std::size_t(p.door)];
+      const Door& d = doors[std::size_t(gate)];
       const double side =
           (p.walker.position - d.fixed->centre).dot(d.fixed->normal) >= 0 ? 1.0 : -1.0;
       p.route.insert(p.route.begin(), d.fixed->centre + d.fixed->normal * side * 0.8);
@@ -231,9 +330,13 @@ void TwinWorld::Impl::UpdatePeople() {
   }
   // Social forces: the robot is a disc to avoid; door leaves are walls.
   std::vector<Walker> walkers;
+  std::vector<std::size_t> walker_of;  // people's index of each walker (those out are not)
   walkers.reserve(people.size());
-  for (const auto& p : people)
-    walkers.push_back(p.walker);
+  for (std::size_t i = 0; i < people.size(); ++i) {
+    if (people[i].state.out) continue;
+    walkers.push_back(people[i].walker);
+    walker_of.push_back(i);
+  }
   std::vector<WallSegment> all_walls = fixed.walls;
   for (const auto& d : doors) {
     all_walls.push_back(
@@ -244,10 +347,10 @@ void TwinWorld::Impl::UpdatePeople() {
   const std::vector<DiscObstacle> discs = {{X_WB.translation(), v_W, robot_radius}};
   // Standing people do not integrate (they would drift under wall forces).
   sfm.Step(&walkers, discs, all_walls, dt);
-  for (std::size_t i = 0; i < people.size(); ++i) {
-    Person& p = people[i];
+  for (std::size_t k = 0; k < walkers.size(); ++k) {
+    Person& p = people[walker_of[k]];
     if (!p.state.started) continue;
-    p.walker = walkers[i];
+    p.walker = walkers[k];
     p.state.position = p.walker.position;
     p.state.velocity = p.walker.velocity;
     const btTransform T(btQuaternion::getIdentity(),
@@ -257,11 +360,97 @@ void TwinWorld::Impl::UpdatePeople() {
   }
 }
 
-bool TwinWorld::Impl::DoorwayTaken(const Person& me) const {
-  const Door& d = doors[me.door];
+int TwinWorld::Impl::GateDoor(const Person& p) {
+  if (p.door >= 0 && p.wait_before_waypoint >= 0 && PendingDoorWaypoint(p)) return p.door;
+  const auto it = p.doorway_waypoints.find(p.reached);
+  return it == p.doorway_waypoints.end() ? -1 : it->second;
+}
+
+std::optional<Eigen::Vector2d> TwinWorld::Impl::ActuatorSpot(int door, double side,
+                                                             const Eigen::Vector2d& p_W) const {
+  const Door& d = doors[std::size_t(door)];
+  std::vector<const ActuatorBox*> boxes;
+  for (const auto& b : d.buttons)
+    boxes.push_back(&b.box());
+  for (const auto& plate : d.plates)
+    boxes.push_back(&plate.box());
+  const auto wall_distance = [&](const Eigen::Vector2d& q) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const auto& w : fixed.walls)
+      nearest = std::min(nearest, (q - ClosestPointOnSegment(q, w)).norm());
+    return nearest;
+  };
+  std::optional<Eigen::Vector2d> best;
+  for (const ActuatorBox* box : boxes) {
+    const Eigen::Vector2d c = box->X_WA.translation().head<2>();
+    Eigen::Vector2d n = box->NormalW().head<2>();
+    if (n.norm() < 1e-6) continue;
+    n.normalize();
+    // In front of the free face (the other is against its wall).
+    const Eigen::Vector2d a = c + n * kActuatorStandOffM, b = c - n * kActuatorStandOffM;
+    Eigen::Vector2d spot = wall_distance(a) >= wall_distance(b) ? a : b;
+    if ((spot - d.fixed->centre).dot(d.fixed->normal) * side <= 0.0) continue;
+    spot = ClearOfWalls(spot, kPersonAtActuatorRadiusM);
+    if (!best || (spot - p_W).norm() < (*best - p_W).norm()) best = spot;
+  }
+  return best;
+}
+
+bool TwinWorld::Impl::OperateDoor(Person& p, int gate) {
+  Door& d = doors[std::size_t(gate)];
+  if (!d.op) return false;
+  const bool shut = d.op->phase() == DoorPhase::kClosed || d.op->phase() == DoorPhase::kClosing;
+  if (p.operating >= 0 && (p.operating != gate || !shut)) {
+    p.operating = -1;  // someone else opened it meanwhile
+    return false;
+  }
+  if (p.operating < 0) {
+    if (!p.can_operate || !shut) return false;
+    // One operator per door: the first waiting person who can, within reach of the doorway.
+    if ((p.walker.position - d.fixed->centre).norm() > kOperateReachM) return false;
+    for (const auto& other : people) {
+      if (other.operating == gate) return false;
+    }
+    const double side = (p.walker.position - d.fixed->centre).dot(d.fixed->normal) >= 0 ? 1 : -1;
+    const auto spot = ActuatorSpot(gate, side, p.walker.position);
+    if (!spot) return false;
+    p.operating = gate;
+    p.operate_spot = *spot;
+    p.operate_elapsed = 0.0;
+  }
+  p.walker.target = p.operate_spot;
+  p.walker.final_target = true;
+  const double away = (p.walker.position - p.operate_spot).norm();
+  // At the actuator (or as near as the queue lets them: within reach and not getting closer).
+  const bool there = away < kAtActuatorM || (away < kArmReachM && p.walker.velocity.norm() < 0.05);
+  p.walker.desired_speed = there ? 0.0 : p.speed;
+  if (there) p.operate_elapsed += dt;
+  if (p.operate_elapsed >= p.operate_time) {
+    d.op->Trigger(time);
+    ++p.state.doors_operated;
+    AddEvent("door_operated", d.fixed->desc->name, p.state.name);
+    p.operating = -1;
+    p.operate_elapsed = 0.0;
+  }
+  return true;
+}
+
+bool TwinWorld::Impl::DoorwayTaken(const Person& me, int door) const {
+  const Door& d = doors[std::size_t(door)];
+  const double my_side = (me.walker.position - d.fixed->centre).dot(d.fixed->normal) >= 0 ? 1 : -1;
+  const Eigen::Vector2d my_heading = -d.fixed->normal * my_side;
+  const bool evacuee = me.state.behavior == PersonBehavior::kEvacuate;
   for (const auto& other : people) {
-    if (&other == &me || !other.state.started) continue;
-    if ((other.walker.position - d.fixed->centre).norm() < 0.9) return true;
+    if (&other == &me || !other.state.started || other.state.out) continue;
+    if ((other.walker.position - d.fixed->centre).norm() >= 0.9) continue;
+    // In an evacuation people go through one behind the other: only someone coming the other
+    // way (from the far side, or walking against them) keeps an evacuee waiting.
+    if (evacuee) {
+      const double side = (other.walker.position - d.fixed->centre).dot(d.fixed->normal);
+      const bool my_way = side * my_side > 0.0 || other.walker.velocity.dot(my_heading) > 0.2;
+      if (my_way) continue;
+    }
+    return true;
   }
   return false;
 }

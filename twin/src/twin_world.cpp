@@ -384,6 +384,7 @@ std::vector<DetectableObject> TwinWorld::DetectableObjects() const {
     }
   }
   for (const auto& p : I.people) {
+    if (p.state.out) continue;  // left the scene
     out.push_back(
         {"person", p.state.name,
          Pose3(Eigen::Vector3d(p.state.position.x(), p.state.position.y(), kPersonHeight / 2)),

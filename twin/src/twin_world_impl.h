@@ -48,6 +48,14 @@ struct Person {
   double hold_duration{0.0};
   double hold_started{-1.0};
   double wait_started{-1.0};
+  // Doorway centres of a multi-door route (evacuate's `route`): route index counted from the
+  // start -> door index. A single-door behaviour uses door and wait_before_waypoint instead.
+  std::map<int, int> doorway_waypoints;
+  bool can_operate{false};   // operates a waiting door's actuator (evacuees; their class decides)
+  double operate_time{1.5};  // [s] at the actuator until the door triggers
+  int operating{-1};         // the door whose actuator they are going to or operating
+  Eigen::Vector2d operate_spot{Eigen::Vector2d::Zero()};
+  double operate_elapsed{0.0};                           // [s] at the actuator so far
   const people::PersonBehaviorModel* behavior{nullptr};  // the model's behaviour
   btRigidBody* body{nullptr};
 };
@@ -129,11 +137,20 @@ struct TwinWorld::Impl {
   void UpdatePeople();
 
   // Someone else is in the doorway: wait for them to come through (one at a time).
-  bool DoorwayTaken(const Person& me) const;
+  bool DoorwayTaken(const Person& me, int door) const;
 
   // True while the next waypoint is the doorway centre (the person has reached the approach
   // point and must not step into a closed door).
   static bool PendingDoorWaypoint(const Person& p) { return p.reached == p.wait_before_waypoint; }
+  // The door whose doorway centre is the person's next waypoint, or -1.
+  static int GateDoor(const Person& p);
+  // Where a person on `side` (+1/-1 along the door's normal) stands to operate door `door`'s
+  // actuator: in front of its free face, on their side of the door; nullopt if none is there.
+  std::optional<Eigen::Vector2d> ActuatorSpot(int door, double side,
+                                              const Eigen::Vector2d& p_W) const;
+  // A waiting person who can goes to the actuator, operates it for their operate_time and
+  // triggers the door; true while they are busy with it (their walker is set).
+  bool OperateDoor(Person& p, int gate);
 
   const PersonSpec* FindSpec(const std::string& person_name) const;
   // Where a walker who has arrived at p stands out of the way: beside the nearest wall, off

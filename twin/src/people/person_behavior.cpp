@@ -10,6 +10,14 @@ void PersonBehaviorModel::AtRouteEnd(double time, const Door* /*door*/, Person* 
   }
 }
 
+void PersonBehaviorModel::AppendDoorway(const Door& door, int door_index, Person* p) {
+  const Eigen::Vector2d from = p->route.empty() ? p->walker.position : p->route.back();
+  const int saved = p->wait_before_waypoint;
+  RouteThroughDoor(door, from, p);
+  p->doorway_waypoints[p->wait_before_waypoint] = door_index;
+  p->wait_before_waypoint = saved;
+}
+
 void PersonBehaviorModel::RouteThroughDoor(const Door& door, const Eigen::Vector2d& start,
                                            Person* p) {
   const DoorModel& d = *door.fixed;

@@ -35,6 +35,9 @@ class PersonBehaviorModel {
   /// Each step while resting (holding a door, or standing): whether and where they move on.
   virtual void WhileResting(double /*time*/, const PersonSpec* /*spec*/, const Door* /*door*/,
                             Person* /*p*/, const EventSink& /*add_event*/) const {}
+  /// Appends the waypoints through `door` (index `door_index` in the run) from the route's end
+  /// (or where `p` stands), its centre recorded in p->doorway_waypoints: a multi-door route.
+  static void AppendDoorway(const Door& door, int door_index, Person* p);
 
  protected:
   /// Waypoints through `door`'s doorway from `start`: kKeepRight to the right of its axis 1 m

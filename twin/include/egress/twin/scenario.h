@@ -90,6 +90,12 @@ struct PersonSpec {
   double hold_duration{8.0};    ///< hold_door: time to hold it [s]; approach_and_wait: wait.
   int count{1};                 ///< evacuate: group size.
   double radius{0.25};          ///< Body radius [m].
+  /// evacuate: the group's mobility mix, class name (mobility.h) -> share (normalized); each
+  /// member's class is drawn by the run's seed and sets their speed, size and whether they can
+  /// operate a door's actuator. Empty: everyone walks at `speed` with `radius` and operates.
+  std::vector<std::pair<std::string, double>> mobility;
+  /// evacuate: the exit route's doors in order (`route:`); empty: `door` alone.
+  std::vector<std::string> route_doors;
 };
 
 enum class PayloadKind { kWaterBottle, kFlashlight };

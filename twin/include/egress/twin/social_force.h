@@ -44,6 +44,14 @@ struct Walker {
   double desired_speed{1.3};                        ///< v0 [m/s]; 0 = stand still
   Eigen::Vector2d target{Eigen::Vector2d::Zero()};  ///< Current waypoint
   bool final_target{true};  ///< Slow down to stop at the target (false: a via point)
+  /// τ of this walker [s]; 0: the model's. A slow walker (a wheelchair, a frame) pushes as hard
+  /// as anyone, only to a lower top speed: with the model's τ its drive, ∝ v0, would lose to the
+  /// walls' push short of a doorway.
+  double relaxation_time{0.0};
+  /// Scale of the walls' social push on this walker [-]: a wide body (a wheelchair) keeps less
+  /// room from walls than a walker does, or it would never pass a 1 m ADA doorway (both jambs
+  /// push it back). Body compression at contact is not scaled.
+  double wall_scale{1.0};
 };
 
 /// A disc that walkers avoid but the model does not move (the robot).

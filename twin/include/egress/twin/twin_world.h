@@ -88,6 +88,13 @@ struct PersonState {
   double radius{0.25};
   bool started{false};
   PersonPhase phase{PersonPhase::kWaiting};
+  std::string mobility;     ///< Mobility class (evacuees with a mobility mix), else empty.
+  double arrived_at{-1.0};  ///< When they reached the end of their route [s]; -1: not yet.
+  int doors_operated{0};    ///< How often they operated a door's actuator.
+  bool can_operate{false};  ///< Operates a door's actuator when they wait at it (evacuees).
+  /// An evacuee who reached the assembly point beyond the exit: left the scene (no body, no
+  /// forces); `position` stays where they arrived.
+  bool out{false};
 };
 
 /// One run of a TwinModel (its state, as MuJoCo's mjData to mjModel): the seeded draws (robot

@@ -1,0 +1,171 @@
+// Evacuees: mobility classes, multi-door exit routes, queueing and operating doors, and the
+// crowd model's flow through a fully open door against the hydraulic values.
+
+#include <algorithm>
+#include <map>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "egress/hsr_interface/error.h"
+#include "egress/twin/mobility.h"
+#include "twin_test_util.h"
+
+namespace egress::twin {
+namespace {
+
+using ::testing::HasSubstr;
+using testing::Hsr;
+using testing::LoadText;
+using testing::WorldsDir;
+
+// When each person first crossed the line y = y_line going north, stepping the world to `until`.
+std::vector<double> CrossingTimes(TwinWorld& world, double y_line, double until) {
+  std::map<std::string, double> crossed;
+  std::map<std::string, double> last_y;
+  while (world.time() < until) {
+    world.Step();
+    for (const auto& p : world.people()) {
+      const auto it = last_y.find(p.name);
+      if (it != last_y.end() && it->second < y_line && p.position.y() >= y_line &&
+          crossed.count(p.name) == 0)
+        crossed[p.name] = world.time();
+      last_y[p.name] = p.position.y();
+    }
+  }
+  std::vector<double> times;
+  for (const auto& [name, t] : crossed)
+    times.push_back(t);
+  std::sort(times.begin(), times.end());
+  return times;
+}
+
+// A dense group of `count` in the lab's south room going north through the lab door (1.0 m
+// between the jambs, a 0.95 m leaf), which stands open at 90 degrees from the start.
+std::string LabDoorFlow(int count, const std::string& mobility = "") {
+  return "world: lab.sdf\n"
+         "robot: {start: {x: 2.6, y: -0.6}}\n"
+         "doors: [{door: lab_door, operator: push, open_angle_deg: 90, hold_open_s: 1000, "
+         "open_at: [0.0]}]\n"
+         "people:\n"
+         "  - {name: e, behavior: evacuate, door: lab_door, start: [0.0, 1.0], goal: [0.0, 6.2], "
+         "speed: [1.1, 1.4], radius: 0.23, count: " +
+         std::to_string(count) + mobility + ", trigger: {at: 3.0}}\n";
+}
+
+TEST(EvacueesTest, DenseFlowThroughAFullyOpenDoorIsWithinTheHydraulicBand) {
+  auto loaded = LoadText(LabDoorFlow(30), WorldsDir() / "lab");
+  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+  const std::vector<double> t = CrossingTimes(world, 3.0, 90.0);
+  ASSERT_EQ(t.size(), 30u);
+  // Steady flow: from the 5th to the 25th crossing (the group's head and tail left out).
+  const double flow = 20.0 / (t[24] - t[4]);
+  // Clear width 0.95 m: SFPE 1.3 /(s m) x (0.95 - 0.3) = 0.85 /s; IMO 1.3 x 0.95 = 1.24 /s.
+  RecordProperty("flow_persons_per_s", std::to_string(flow));
+  EXPECT_GT(flow, 0.85 * 0.8);
+  EXPECT_LT(flow, 1.24 * 1.2);
+}
+
+int CountEvents(const TwinWorld& w, const std::string& kind, const std::string& subject = "") {
+  int n = 0;
+  for (const auto& e : w.events())
+    n += e.kind == kind && (subject.empty() || e.subject == subject) ? 1 : 0;
+  return n;
+}
+
+// The office: room 1 (x < 5), door_a (x = 5, push buttons), room 2, door_b (x = 9, glass,
+// proximity plates), room 3; both doors closed; the robot parked in room 1's corner.
+std::string OfficeExitRoute(int count, const std::string& mobility) {
+  return "world: office.sdf\n"
+         "robot: {start: {x: 0.6, y: 5.4}}\n"
+         "doors: [{door: door_a, operator: push}, {door: door_b, operator: proximity}]\n"
+         "people:\n"
+         "  - {name: e, behavior: evacuate, route: [door_a, door_b], start: [2.5, 3.0], "
+         "goal: [12.5, 1.5], count: " +
+         std::to_string(count) + mobility + "}\n";
+}
+
+TEST(EvacueesTest, AGroupFollowsItsExitRouteOperatingEachClosedDoor) {
+  auto loaded = LoadText(OfficeExitRoute(6, ""), WorldsDir() / "office");
+  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+  world.StepFor(120.0);
+  for (const auto& p : world.people()) {
+    EXPECT_TRUE(p.out) << p.name << " at " << p.position.transpose();
+    EXPECT_GT(p.arrived_at, 0.0);
+  }
+  // Each door opened by one of them, and only when it was shut.
+  EXPECT_GE(CountEvents(world, "door_operated", "door_a"), 1);
+  EXPECT_GE(CountEvents(world, "door_operated", "door_b"), 1);
+  EXPECT_EQ(CountEvents(world, "button_pressed"), 0);  // the robot pressed nothing
+}
+
+TEST(EvacueesTest, SomeoneWhoCannotOperateTheDoorWaitsAtItAndTheRestGoOn) {
+  // Wheelchair users alone: half of them cannot operate an actuator (mobility.h).
+  int stuck = 0, through = 0;
+  for (std::uint64_t seed = 1; seed <= 12; ++seed) {
+    auto loaded =
+        LoadText(OfficeExitRoute(1, ", mobility: {wheelchair: 1}"), WorldsDir() / "office");
+    TwinWorld world(loaded.scenario, loaded.world, seed, Hsr());
+    world.StepFor(90.0);
+    const PersonState& p = world.people().front();
+    EXPECT_EQ(p.mobility, "wheelchair");
+    EXPECT_DOUBLE_EQ(p.radius, FindMobilityClass("wheelchair")->radius);
+    if (p.can_operate) {
+      EXPECT_TRUE(p.out) << "seed " << seed << " at " << p.position.transpose() << " phase "
+                         << int(p.phase) << " operated " << p.doors_operated;
+      ++through;
+    } else {
+      EXPECT_EQ(p.phase, PersonPhase::kWaitingForDoor) << "seed " << seed;
+      EXPECT_LT(p.position.x(), 5.0);
+      EXPECT_EQ(CountEvents(world, "door_operated"), 0);
+      ++stuck;
+    }
+  }
+  EXPECT_GT(stuck, 0);
+  EXPECT_GT(through, 0);
+}
+
+TEST(EvacueesTest, TheMobilityMixIsDrawnBySeedFromTheShares) {
+  auto loaded =
+      LoadText(OfficeExitRoute(40, ", mobility: {walker: 3, frame: 1}"), WorldsDir() / "office");
+  TwinWorld a(loaded.scenario, loaded.world, 7, Hsr()), b(loaded.scenario, loaded.world, 7, Hsr());
+  int frames = 0;
+  for (std::size_t i = 0; i < a.people().size(); ++i) {
+    EXPECT_EQ(a.people()[i].mobility, b.people()[i].mobility);  // a function of the seed
+    EXPECT_THAT(a.people()[i].mobility, ::testing::AnyOf("walker", "frame"));
+    frames += a.people()[i].mobility == "frame" ? 1 : 0;
+  }
+  EXPECT_GT(frames, 3);  // about 10 of 40
+  EXPECT_LT(frames, 20);
+}
+
+TEST(EvacueesTest, BadMobilityOrRouteIsAClearError) {
+  const auto load = [](const std::string& person) {
+    auto loaded = LoadText(
+        "world: office.sdf\nrobot: {start: {x: 0.6, y: 5.4}}\npeople:\n  - " + person + "\n",
+        WorldsDir() / "office");
+    TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+  };
+  EXPECT_THAT(
+      [&] {
+        load(
+            "{behavior: evacuate, route: [door_a], start: [2, 3], goal: [12, 1.5], mobility: "
+            "{skater: 1}}");
+      },
+      ::testing::ThrowsMessage<LoadError>(HasSubstr("mobility.skater")));
+  EXPECT_THAT(
+      [&] {
+        load("{behavior: evacuate, route: [door_a, door_q], start: [2, 3], goal: [12, 1.5]}");
+      },
+      ::testing::ThrowsMessage<LoadError>(HasSubstr("route[1]")));
+  EXPECT_THAT(
+      [&] {
+        load(
+            "{behavior: cross_doorway, door: door_a, start: [2, 3], goal: [7, 3], mobility: "
+            "{walker: 1}}");
+      },
+      ::testing::ThrowsMessage<LoadError>(HasSubstr("evacuate")));
+}
+
+}  // namespace
+}  // namespace egress::twin
