@@ -7,8 +7,6 @@
 // scenario file and seed, so the results do not depend on --jobs, and a batch can be split into
 // shards (--first) whose merged files equal one machine's.
 
-#include <poll.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -29,6 +27,7 @@
 #include "egress/hsr_interface/error.h"
 #include "egress/twin/sdf_world_loader.h"
 #include "egress/twin/twin_run.h"
+#include "workers.h"
 
 namespace egress::apps {
 
@@ -233,28 +232,12 @@ struct BatchOptions {
   bool quiet{false};
 };
 
-// One worker process per job; worker j runs every J-th trial and writes one JSON line per trial
-// to its pipe. The parent reads all pipes and draws the progress bar.
+// The trials in worker processes (workers.h), in the order of the work list.
 std::vector<TrialResult> RunTrialsInWorkers(
     const std::vector<std::pair<std::string, std::uint64_t>>& work, int jobs, bool progress) {
-  jobs = std::max(1, std::min<int>(jobs, int(work.size())));
-  std::fflush(nullptr);
-  struct Worker {
-    pid_t pid;
-    int fd;
-    std::string buffer;
-    bool open{true};
-  };
-  std::vector<Worker> workers;
-  for (int j = 0; j < jobs; ++j) {
-    int fds[2];
-    if (::pipe(fds) != 0) throw CommandFailed("sim batch: cannot create a pipe");
-    const pid_t pid = ::fork();
-    if (pid < 0) throw CommandFailed("sim batch: cannot fork a worker");
-    if (pid == 0) {
-      ::close(fds[0]);
-      CompiledScenario compiled;
-      for (std::size_t k = std::size_t(j); k < work.size(); k += std::size_t(jobs)) {
+  CompiledScenario compiled;  // each worker's own copy after the fork
+  const std::vector<nlohmann::json> lines =
+      RunInWorkers(work.size(), jobs, progress, [&](std::size_t k) {
         TrialResult r;
         try {
           r = RunBrainTrial(work[k].first, work[k].second, &compiled);
@@ -264,79 +247,11 @@ std::vector<TrialResult> RunTrialsInWorkers(
           r.seed = work[k].second;
           r.error = e.what();
         }
-        const std::string line = ToJson(r).dump() + "\n";
-        std::size_t written = 0;
-        while (written < line.size()) {
-          const ssize_t n = ::write(fds[1], line.data() + written, line.size() - written);
-          if (n <= 0) ::_exit(3);
-          written += std::size_t(n);
-        }
-      }
-      ::close(fds[1]);
-      ::_exit(0);
-    }
-    ::close(fds[1]);
-    workers.push_back({pid, fds[0], {}});
-  }
+        return ToJson(r);
+      });
   std::vector<TrialResult> results;
-  const auto started = std::chrono::steady_clock::now();
-  const auto draw = [&] {
-    if (!progress) return;
-    const double fraction = double(results.size()) / double(work.size());
-    const int filled = int(fraction * 40);
-    const double elapsed =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-    std::fprintf(
-        stderr, "\r  [%s%s] %zu/%zu trials  %.0f s", std::string(std::size_t(filled), '#').c_str(),
-        std::string(std::size_t(40 - filled), ' ').c_str(), results.size(), work.size(), elapsed);
-    std::fflush(stderr);
-  };
-  draw();
-  std::size_t open = workers.size();
-  while (open > 0) {
-    std::vector<pollfd> fds;
-    for (const Worker& w : workers) {
-      if (w.open) fds.push_back({w.fd, POLLIN, 0});
-    }
-    if (::poll(fds.data(), fds.size(), -1) < 0) continue;
-    for (Worker& w : workers) {
-      if (!w.open) continue;
-      const auto it =
-          std::find_if(fds.begin(), fds.end(), [&](const pollfd& p) { return p.fd == w.fd; });
-      if (it == fds.end() || it->revents == 0) continue;
-      char chunk[4096];
-      const ssize_t n = ::read(w.fd, chunk, sizeof chunk);
-      if (n <= 0) {
-        ::close(w.fd);
-        w.open = false;
-        --open;
-        continue;
-      }
-      w.buffer.append(chunk, std::size_t(n));
-      std::size_t newline;
-      while ((newline = w.buffer.find('\n')) != std::string::npos) {
-        results.push_back(TrialFromJson(nlohmann::json::parse(w.buffer.substr(0, newline))));
-        w.buffer.erase(0, newline + 1);
-        draw();
-      }
-    }
-  }
-  for (const Worker& w : workers) {
-    int status = 0;
-    ::waitpid(w.pid, &status, 0);
-  }
-  if (progress) std::fprintf(stderr, "\n");
-  if (results.size() != work.size()) {
-    throw CommandFailed(fmt::format("sim batch: {} of {} trials reported (a worker died)",
-                                    results.size(), work.size()));
-  }
-  // The order of the work list, whatever order the workers finished in.
-  std::map<std::pair<std::string, std::uint64_t>, std::size_t> order;
-  for (std::size_t k = 0; k < work.size(); ++k)
-    order[work[k]] = k;
-  std::sort(results.begin(), results.end(), [&](const TrialResult& a, const TrialResult& b) {
-    return order[{a.scenario, a.seed}] < order[{b.scenario, b.seed}];
-  });
+  for (const auto& line : lines)
+    results.push_back(TrialFromJson(line));
   return results;
 }
 

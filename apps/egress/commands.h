@@ -38,6 +38,9 @@ void AddBenchCommand(CLI::App& app);
 /// `egress sim run SCENARIO` (one twin run, judged), `egress sim batch` (reserved) and
 /// `egress render TRACE` (PNG/MP4).
 void AddSimCommand(CLI::App& app);
+/// `egress evac study SCENARIO`: evacuation time with no robot, the robot escorting, and every
+/// door propped open, on the same seeds.
+void AddEvacCommand(CLI::App& app);
 /// A sub-command reserved for a capability that is not built yet: it is listed in --help with
 /// what it will do, and running it fails with a clear message.
 void AddPlannedCommand(CLI::App& app, const std::string& name, const std::string& description,

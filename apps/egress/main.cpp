@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   egress::apps::AddPlanCommand(app);
   egress::apps::AddBenchCommand(app);
   egress::apps::AddSimCommand(app);
+  egress::apps::AddEvacCommand(app);
 
   try {
     app.parse(argc, argv);

@@ -28,6 +28,8 @@ constexpr double kPersonAtActuatorRadiusM = 0.3;
 constexpr double kOperateReachM = 3.0;
 constexpr double kAtActuatorM = 0.25;
 constexpr double kArmReachM = 0.7;
+// An evacuee this near a doorway's centre, on its far side, is past it [m].
+constexpr double kPastDoorwayReachM = 2.5;
 // Where an evacuee lines up before an open door, on its axis [m].
 constexpr double kLineUpBeforeDoorM = 0.6;
 // The pace whose drive every evacuee has (Boyce et al.'s mean without disability) [m/s].
@@ -220,6 +222,7 @@ void TwinWorld::Impl::UpdatePeople() {
         // scene (the crowd behind would otherwise push them back towards the exit).
         if (p.state.behavior == PersonBehavior::kEvacuate) {
           p.state.out = true;
+          p.state.phase = PersonPhase::kDone;
           const btTransform T(btQuaternion::getIdentity(), btVector3(0, 0, kOutOfSceneZ));
           p.body->getMotionState()->setWorldTransform(T);
           p.body->setWorldTransform(T);
@@ -250,6 +253,9 @@ void TwinWorld::Impl::UpdatePeople() {
       p.behavior->AtRouteEnd(time, door, &p, add_event);
       continue;
     }
+    // Carried through a doorway by the crowd before reaching the waypoints before it, an evacuee
+    // goes on from beyond it: their route resumes after the doorway they are past.
+    if (p.state.behavior == PersonBehavior::kEvacuate) AdvancePastDoorways(p);
     // An evacuee whose next door already stands open lines up on its axis, not at the spot to
     // its right where they would queue (which may lie under the open leaf, or behind them after
     // they operated the door from its actuator): square to the opening, a wide body (a
@@ -321,7 +327,11 @@ void TwinWorld::Impl::UpdatePeople() {
       }
       p.blocked_for = 0.0;
     }
-    const double reached_radius = p.route.size() == 1 ? 0.25 : 0.4;
+    // An evacuee is at the assembly point anywhere near its goal (the others there would keep
+    // them off its exact spot).
+    const double reached_radius =
+        p.route.size() == 1 ? (p.state.behavior == PersonBehavior::kEvacuate ? kNearEnoughM : 0.25)
+                            : 0.4;
     if ((p.walker.position - p.route.front()).norm() < reached_radius &&
         p.state.phase != PersonPhase::kWaitingForDoor) {
       p.route.erase(p.route.begin());
@@ -357,6 +367,23 @@ void TwinWorld::Impl::UpdatePeople() {
                         btVector3(p.walker.position.x(), p.walker.position.y(), kPersonHeight / 2));
     p.body->getMotionState()->setWorldTransform(T);
     p.body->setWorldTransform(T);
+  }
+}
+
+void TwinWorld::Impl::AdvancePastDoorways(Person& p) const {
+  for (auto it = p.doorway_waypoints.rbegin(); it != p.doorway_waypoints.rend(); ++it) {
+    const int centre = it->first;
+    const std::size_t beyond = std::size_t(centre + 1 - p.reached);  // in the remaining route
+    if (centre < p.reached || beyond >= p.route.size()) continue;
+    const DoorModel& d = *doors[std::size_t(it->second)].fixed;
+    const Eigen::Vector2d rel = p.walker.position - d.centre;
+    const bool past = rel.dot(d.normal) * (p.route[beyond] - d.centre).dot(d.normal) > 0.0 &&
+                      std::abs(rel.dot(d.normal)) > p.walker.radius &&
+                      rel.norm() < kPastDoorwayReachM;
+    if (!past) continue;
+    p.route.erase(p.route.begin(), p.route.begin() + long(beyond));
+    p.reached = centre + 1;
+    return;
   }
 }
 

@@ -142,6 +142,9 @@ struct TwinWorld::Impl {
   // True while the next waypoint is the doorway centre (the person has reached the approach
   // point and must not step into a closed door).
   static bool PendingDoorWaypoint(const Person& p) { return p.reached == p.wait_before_waypoint; }
+  // An evacuee past a doorway of their route (pushed through by the crowd) resumes their route
+  // beyond it.
+  void AdvancePastDoorways(Person& p) const;
   // The door whose doorway centre is the person's next waypoint, or -1.
   static int GateDoor(const Person& p);
   // Where a person on `side` (+1/-1 along the door's normal) stands to operate door `door`'s

@@ -1,0 +1,417 @@
+// `egress evac study SCENARIO.yaml --trials N --out DIR`: what the robot buys an evacuation.
+// Each trial (seed) runs under three conditions on the same seed: no robot (it is parked off the
+// scene; residents open doors themselves where they can), the robot on the scenario's mission
+// (escorting), and every door propped open from the start (the upper bound). A trial ends when
+// every evacuee is out (at the assembly point beyond the exit) or at the time limit. Printed: a
+// table per condition (evacuation time median with its 95 % interval, people left behind,
+// robot-resident contacts and closest approach, time the robot stood in a doorway with a
+// resident within 2 m), per-door flow and queue time; written: DIR/study.json, DIR/trials.csv,
+// DIR/evacuated.png (people out vs time, median and 10-90 % band per condition).
+//
+// A trial is a pure function of the scenario file, the condition and the seed, whatever --jobs.
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "brain_trial.h"
+#include "commands.h"
+#include "egress/hsr_interface/error.h"
+#include "egress/twin/sdf_world_loader.h"
+#include "egress/twin/twin_robot.h"
+#include "egress/twin/twin_run.h"
+#include "workers.h"
+
+namespace egress::apps {
+namespace {
+
+constexpr const char* kConditions[] = {"no_robot", "robot", "propped_open"};
+// A resident this near the robot while it stands in a doorway counts as blocked by it [m].
+constexpr double kDoorwayBlockRadiusM = 2.0;
+// The robot is in a doorway within this of the door line (and within its jambs) [m].
+constexpr double kInDoorwayM = 0.5;
+// Where the robot is parked for the conditions without it: this far beyond the world [m].
+constexpr double kParkedOffSceneM = 50.0;
+
+struct StudyOptions {
+  std::string scenario;
+  int trials{20};
+  int jobs{2};
+  std::uint64_t seed_base{1};
+  std::string out{"study"};
+  bool overwrite{false};
+  bool quiet{false};
+};
+
+bool IsEvacuee(const twin::PersonState& p) {
+  return p.behavior == twin::PersonBehavior::kEvacuate;
+}
+
+// The scenario as `condition` runs it (defaults of the building already applied).
+twin::Scenario ConditionScenario(const twin::Scenario& base, const twin::WorldDescription& world,
+                                 const std::string& condition) {
+  twin::Scenario s = base;
+  if (condition == "robot") return s;
+  s.mission.reset();
+  s.start_place.clear();
+  double max_x = 0.0;
+  for (const auto& f : twin::CalcFloorFootprints(world))
+    max_x = std::max(max_x, f.X_WF.x + f.size.norm());
+  s.robot_start = {max_x + kParkedOffSceneM, 0.0, 0.0};
+  s.success.clear();
+  if (condition == "propped_open") {
+    for (auto& door : s.doors) {
+      door.open_at = {0.0};
+      door.timing.hold_open_s = 1e9;
+    }
+  }
+  return s;
+}
+
+struct DoorLine {
+  std::string name;
+  Eigen::Vector2d centre, normal, along;
+  double half_width{0.0};
+};
+
+std::vector<DoorLine> DoorLines(const twin::TwinWorld& world) {
+  std::vector<DoorLine> lines;
+  for (std::size_t i = 0; i < world.door_count(); ++i) {
+    const auto& d = world.door(i);
+    const Eigen::Vector2d hinge = d.p_WH.head<2>(), edge = d.CalcFreeEdge(0.0).head<2>();
+    DoorLine l;
+    l.name = d.name;
+    l.along = (edge - hinge).normalized();
+    l.normal = Eigen::Vector2d(-l.along.y(), l.along.x());
+    l.half_width = (edge - hinge).norm() / 2;
+    l.centre = hinge + l.along * l.half_width;
+    lines.push_back(l);
+  }
+  return lines;
+}
+
+// One trial of one condition.
+nlohmann::json RunStudyTrial(const twin::Scenario& scenario, const twin::WorldDescription& world,
+                             const std::shared_ptr<const RobotModel>& hsr,
+                             const std::string& condition, std::uint64_t seed) {
+  auto model = std::make_shared<const twin::TwinModel>(scenario, world, hsr);
+  twin::TwinWorld twin_world(model, seed);
+  twin::TwinRobot robot(&twin_world);
+  behavior::ExecutiveConfig config;
+  std::unique_ptr<behavior::Executive> brain;
+  if (condition == "robot")
+    brain = MakeScenarioExecutive(model->scenario(), model->world(), twin_world, hsr, config);
+  const std::vector<DoorLine> lines = DoorLines(twin_world);
+  std::map<std::string, std::vector<double>> crossings;  // per door
+  std::map<std::string, double> queue;                   // per door: person-seconds waiting
+  std::map<std::pair<std::string, std::string>, double> last_side;
+  double blocking = 0.0;
+  const double period = brain ? 1.0 / config.control_rate_hz : 0.1;
+  double last_t = 0.0;
+  const auto all_out = [&] {
+    bool any = false;
+    for (const auto& p : twin_world.people()) {
+      if (!IsEvacuee(p)) continue;
+      any = true;
+      if (!p.out) return false;
+    }
+    return any;
+  };
+  twin::RunOptions run;
+  run.record_trace = false;
+  run.control_period = period;
+  const twin::RunResult result = twin::RunScenario(
+      robot,
+      [&](RobotPort& port) {
+        if (brain) brain->Step(port);
+        const double t = twin_world.time(), dt = t - last_t;
+        last_t = t;
+        const Eigen::Vector2d p_WB = twin_world.robot_pose().translation();
+        bool robot_in_doorway = false;
+        for (const auto& l : lines) {
+          const Eigen::Vector2d rel = p_WB - l.centre;
+          if (std::abs(rel.dot(l.normal)) < kInDoorwayM &&
+              std::abs(rel.dot(l.along)) < l.half_width)
+            robot_in_doorway = true;
+        }
+        bool resident_near = false;
+        for (const auto& p : twin_world.people()) {
+          if (!IsEvacuee(p) || !p.started || p.out) continue;
+          resident_near = resident_near || (p.position - p_WB).norm() < kDoorwayBlockRadiusM;
+          const DoorLine* nearest = nullptr;
+          for (const auto& l : lines) {
+            const Eigen::Vector2d rel = p.position - l.centre;
+            const double side = rel.dot(l.normal);
+            auto& last = last_side[{p.name, l.name}];
+            if (last != 0.0 && (last < 0) != (side < 0) &&
+                std::abs(rel.dot(l.along)) <= l.half_width + 0.1)
+              crossings[l.name].push_back(t);
+            last = side;
+            if (!nearest || rel.norm() < (p.position - nearest->centre).norm()) nearest = &l;
+          }
+          if (p.phase == twin::PersonPhase::kWaitingForDoor && nearest) queue[nearest->name] += dt;
+        }
+        if (robot_in_doorway && resident_near) blocking += dt;
+        return !all_out();
+      },
+      run);
+  std::vector<double> arrivals;
+  int residents = 0, left = 0;
+  for (const auto& p : twin_world.people()) {
+    if (!IsEvacuee(p)) continue;
+    ++residents;
+    if (p.out) {
+      arrivals.push_back(p.arrived_at);
+    } else {
+      ++left;
+    }
+  }
+  std::sort(arrivals.begin(), arrivals.end());
+  nlohmann::json doors = nlohmann::json::object();
+  for (const auto& l : lines) {
+    const auto& c = crossings[l.name];
+    if (c.empty() && queue[l.name] == 0.0) continue;
+    doors[l.name] = {{"crossings", c.size()},
+                     {"flow", c.size() >= 2 && c.back() > c.front()
+                                  ? double(c.size() - 1) / (c.back() - c.front())
+                                  : 0.0},
+                     {"queue_s", c.empty() ? queue[l.name] : queue[l.name] / double(c.size())}};
+  }
+  const auto& m = result.verdict.metrics;
+  return {{"condition", condition},
+          {"seed", seed},
+          {"residents", residents},
+          {"out", arrivals.size()},
+          {"left_behind", left},
+          {"t_evac", left == 0 && !arrivals.empty() ? nlohmann::json(arrivals.back())
+                                                    : nlohmann::json(nullptr)},
+          {"arrivals", arrivals},
+          {"doors", doors},
+          {"contacts", m.contacts.count("person") ? m.contacts.at("person") : 0},
+          {"closest", std::isfinite(m.min_person_distance) ? nlohmann::json(m.min_person_distance)
+                                                           : nlohmann::json(nullptr)},
+          {"doorway_block_s", blocking},
+          {"time", result.simulated_time}};
+}
+
+// The median of sorted `v` and its 95 % interval from the order statistics (binomial).
+struct MedianCi {
+  double median{0.0}, low{0.0}, high{0.0};
+};
+MedianCi CalcMedianCi(std::vector<double> v) {
+  MedianCi out;
+  if (v.empty()) return out;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  out.median = n % 2 ? v[n / 2] : (v[n / 2 - 1] + v[n / 2]) / 2;
+  const double half = 1.96 * std::sqrt(double(n)) / 2;
+  const long lo = std::max(0L, long(std::floor(double(n) / 2 - half)) - 1);
+  const long hi = std::min(long(n) - 1, long(std::ceil(double(n) / 2 + half)));
+  out.low = v[std::size_t(lo)];
+  out.high = v[std::size_t(hi)];
+  return out;
+}
+
+// People out vs time, one curve (median) and band (10-90 %) per condition.
+void DrawEvacuated(const std::map<std::string, std::vector<nlohmann::json>>& by_condition,
+                   double time_limit, int residents, const std::filesystem::path& png) {
+  const int W = 900, H = 520, left = 70, right = 20, top = 30, bottom = 60;
+  cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
+  double t_max = 1.0;
+  for (const auto& [c, trials] : by_condition)
+    for (const auto& t : trials)
+      for (double a : t.at("arrivals").get<std::vector<double>>())
+        t_max = std::max(t_max, a);
+  t_max = std::min(time_limit, std::ceil(t_max / 10.0) * 10.0 + 10.0);
+  const auto X = [&](double t) { return left + int((W - left - right) * t / t_max); };
+  const auto Y = [&](double n) {
+    return H - bottom - int((H - top - bottom) * n / std::max(1, residents));
+  };
+  cv::line(img, {left, H - bottom}, {W - right, H - bottom}, {0, 0, 0});
+  cv::line(img, {left, top}, {left, H - bottom}, {0, 0, 0});
+  for (int k = 0; k <= 5; ++k) {
+    const double t = t_max * k / 5;
+    cv::putText(img, fmt::format("{:.0f}", t), {X(t) - 10, H - bottom + 20},
+                cv::FONT_HERSHEY_SIMPLEX, 0.45, {0, 0, 0});
+    const double n = double(residents) * k / 5;
+    cv::putText(img, fmt::format("{:.0f}", n), {left - 40, Y(n) + 5}, cv::FONT_HERSHEY_SIMPLEX,
+                0.45, {0, 0, 0});
+  }
+  cv::putText(img, "time [s]", {W / 2 - 30, H - 15}, cv::FONT_HERSHEY_SIMPLEX, 0.5, {0, 0, 0});
+  cv::putText(img, "people out", {5, top - 10}, cv::FONT_HERSHEY_SIMPLEX, 0.5, {0, 0, 0});
+  const std::map<std::string, cv::Scalar> colour = {
+      {"no_robot", {40, 40, 200}}, {"robot", {200, 120, 30}}, {"propped_open", {40, 160, 40}}};
+  int legend = 0;
+  for (const auto& [c, trials] : by_condition) {
+    std::vector<cv::Point> median, low, high;
+    for (double t = 0.0; t <= t_max; t += t_max / 200) {
+      std::vector<double> counts;
+      for (const auto& trial : trials) {
+        const auto a = trial.at("arrivals").get<std::vector<double>>();
+        counts.push_back(double(std::upper_bound(a.begin(), a.end(), t) - a.begin()));
+      }
+      std::sort(counts.begin(), counts.end());
+      const auto q = [&](double f) {
+        return counts[std::min(counts.size() - 1, std::size_t(f * double(counts.size())))];
+      };
+      median.push_back({X(t), Y(q(0.5))});
+      low.push_back({X(t), Y(q(0.1))});
+      high.push_back({X(t), Y(q(0.9))});
+    }
+    const cv::Scalar col = colour.count(c) ? colour.at(c) : cv::Scalar(0, 0, 0);
+    cv::polylines(img, std::vector<std::vector<cv::Point>>{low}, false,
+                  col * 0.5 + cv::Scalar::all(127), 1);
+    cv::polylines(img, std::vector<std::vector<cv::Point>>{high}, false,
+                  col * 0.5 + cv::Scalar::all(127), 1);
+    cv::polylines(img, std::vector<std::vector<cv::Point>>{median}, false, col, 2);
+    cv::putText(img, c, {W - 200, top + 20 + 20 * legend++}, cv::FONT_HERSHEY_SIMPLEX, 0.5, col, 2);
+  }
+  if (!cv::imwrite(png.string(), img))
+    throw CommandFailed(fmt::format("cannot write '{}'", png.string()));
+}
+
+void RunStudy(const StudyOptions& o) {
+  if (o.trials < 1 || o.trials > 100000) throw CommandFailed("--trials must be within 1..100000");
+  if (o.jobs < 1) throw CommandFailed("--jobs must be at least 1");
+  if (!std::filesystem::exists(o.scenario))
+    throw CommandFailed(fmt::format("'{}': no such scenario file", o.scenario));
+  const std::filesystem::path dir(o.out);
+  for (const char* f : {"study.json", "trials.csv", "evacuated.png"}) {
+    if (std::filesystem::exists(dir / f) && !o.overwrite)
+      throw CommandFailed(
+          fmt::format("'{}' exists; pass --overwrite to replace it", (dir / f).string()));
+  }
+  const twin::Scenario loaded = twin::LoadScenario(o.scenario);
+  if (!loaded.mission)
+    throw CommandFailed(fmt::format(
+        "{}: no 'mission' section: the study's robot condition runs the robot brain", o.scenario));
+  const twin::WorldDescription world = twin::LoadSdfWorld(loaded.world_file);
+  const auto hsr = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
+  // The building's defaults applied once (a model compiles them in), then the conditions.
+  const twin::Scenario base = twin::TwinModel(loaded, world, hsr).scenario();
+  bool evacuees = false;
+  for (const auto& p : base.people)
+    evacuees = evacuees || p.behavior == twin::PersonBehavior::kEvacuate;
+  if (!evacuees)
+    throw CommandFailed(fmt::format("{}: no people with behavior evacuate", o.scenario));
+  std::map<std::string, twin::Scenario> scenarios;
+  for (const char* c : kConditions)
+    scenarios[c] = ConditionScenario(base, world, c);
+  std::vector<std::pair<std::string, std::uint64_t>> work;
+  for (int i = 0; i < o.trials; ++i) {
+    for (const char* c : kConditions)
+      work.emplace_back(c, o.seed_base + std::uint64_t(i));
+  }
+  if (!o.quiet)
+    fmt::print("{}: {} trials x 3 conditions on {} worker process(es)\n", base.name, o.trials,
+               std::min(o.jobs, int(work.size())));
+  const std::vector<nlohmann::json> results =
+      RunInWorkers(work.size(), o.jobs, !o.quiet && ::isatty(::fileno(stderr)), [&](std::size_t k) {
+        return RunStudyTrial(scenarios.at(work[k].first), world, hsr, work[k].first,
+                             work[k].second);
+      });
+  std::map<std::string, std::vector<nlohmann::json>> by_condition;
+  for (std::size_t k = 0; k < results.size(); ++k) {
+    if (results[k].contains("error"))
+      throw CommandFailed(fmt::format("{} seed {}: {}", work[k].first, work[k].second,
+                                      results[k].at("error").get<std::string>()));
+    by_condition[work[k].first].push_back(results[k]);
+  }
+  nlohmann::json study = {{"scenario", o.scenario},
+                          {"trials", o.trials},
+                          {"seed_base", o.seed_base},
+                          {"conditions", nlohmann::json::array()}};
+  fmt::print("\n{:<14} {:>7} {:>24} {:>12} {:>9} {:>9} {:>12}\n", "condition", "trials",
+             "evacuation time [s]", "left behind", "contacts", "closest", "in doorway");
+  int residents = 0;
+  for (const char* c : kConditions) {
+    const auto& trials = by_condition[c];
+    std::vector<double> times;
+    int left = 0, contacts = 0;
+    double closest = std::numeric_limits<double>::infinity(), blocking = 0.0;
+    std::map<std::string, std::vector<double>> flow, queue;
+    for (const auto& t : trials) {
+      residents = t.at("residents").get<int>();
+      // A trial with people left behind counts at the time limit (censored, conservative).
+      times.push_back(t.at("t_evac").is_null() ? base.time_limit : t.at("t_evac").get<double>());
+      left += t.at("left_behind").get<int>();
+      contacts += t.at("contacts").get<int>();
+      if (!t.at("closest").is_null()) closest = std::min(closest, t.at("closest").get<double>());
+      blocking += t.at("doorway_block_s").get<double>();
+      for (const auto& [door, d] : t.at("doors").items()) {
+        if (d.at("flow").get<double>() > 0.0) flow[door].push_back(d.at("flow").get<double>());
+        queue[door].push_back(d.at("queue_s").get<double>());
+      }
+    }
+    const MedianCi ci = CalcMedianCi(times);
+    fmt::print("{:<14} {:>7} {:>9.1f} [{:6.1f}, {:6.1f}] {:>12} {:>9} {:>9} {:>10.1f} s\n", c,
+               trials.size(), ci.median, ci.low, ci.high, left,
+               c == std::string("robot") ? fmt::format("{}", contacts) : "-",
+               c == std::string("robot") && std::isfinite(closest)
+                   ? fmt::format("{:.2f} m", closest)
+                   : "-",
+               blocking);
+    nlohmann::json doors = nlohmann::json::object();
+    for (const auto& [door, q] : queue) {
+      const double f = flow[door].empty() ? 0.0 : CalcMedianCi(flow[door]).median;
+      doors[door] = {{"flow_median", f}, {"queue_s_median", CalcMedianCi(q).median}};
+      fmt::print("    {:<12} flow {:.2f} persons/s, queue {:.1f} s per person (medians)\n", door, f,
+                 CalcMedianCi(q).median);
+    }
+    study["conditions"].push_back(
+        {{"condition", c},
+         {"t_evac_median_s", ci.median},
+         {"t_evac_ci_s", {ci.low, ci.high}},
+         {"left_behind", left},
+         {"contacts", contacts},
+         {"closest_m", std::isfinite(closest) ? nlohmann::json(closest) : nlohmann::json(nullptr)},
+         {"doorway_block_s", blocking},
+         {"doors", doors}});
+  }
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "study.json") << study.dump(2) << "\n";
+  std::ofstream csv(dir / "trials.csv");
+  csv << "condition,seed,residents,out,left_behind,t_evac,contacts,closest,doorway_block_s\n";
+  for (const auto& r : results) {
+    csv << r.at("condition").get<std::string>() << "," << r.at("seed").get<std::uint64_t>() << ","
+        << r.at("residents").get<int>() << "," << r.at("out").get<int>() << ","
+        << r.at("left_behind").get<int>() << ","
+        << (r.at("t_evac").is_null() ? "" : fmt::format("{:.2f}", r.at("t_evac").get<double>()))
+        << "," << r.at("contacts").get<int>() << ","
+        << (r.at("closest").is_null() ? "" : fmt::format("{:.3f}", r.at("closest").get<double>()))
+        << "," << fmt::format("{:.1f}", r.at("doorway_block_s").get<double>()) << "\n";
+  }
+  DrawEvacuated(by_condition, base.time_limit, residents, dir / "evacuated.png");
+  fmt::print("wrote {}, {} and {}\n", (dir / "study.json").string(), (dir / "trials.csv").string(),
+             (dir / "evacuated.png").string());
+}
+
+}  // namespace
+
+void AddEvacCommand(CLI::App& app) {
+  auto* evac = app.add_subcommand("evac", "Evacuation assistance: `evac study`");
+  evac->require_subcommand(1);
+  auto* study = evac->add_subcommand(
+      "study", "Evacuation time with no robot, the robot escorting, and doors propped open");
+  auto o = std::make_shared<StudyOptions>();
+  study->add_option("scenario", o->scenario, "Scenario with evacuees and the robot's mission")
+      ->required();
+  study->add_option("--trials", o->trials, "Seeds per condition")->capture_default_str();
+  study->add_option("--jobs", o->jobs, "Worker processes")->capture_default_str();
+  study->add_option("--seed-base", o->seed_base, "Seed of the first trial")->capture_default_str();
+  study->add_option("--out", o->out, "Output folder")->capture_default_str();
+  study->add_flag("--overwrite", o->overwrite, "Replace existing output files");
+  study->add_flag("-q,--quiet", o->quiet, "No progress bar");
+  study->callback([o] { RunStudy(*o); });
+}
+
+}  // namespace egress::apps
