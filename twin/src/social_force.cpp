@@ -4,8 +4,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 
 namespace egress::twin {
+namespace {
+
+// Beyond this centre distance another walker (or a disc) exerts no social force [m]; it is also
+// the cell size of Step's neighbour grid, so that the 3 x 3 cells round a walker hold everyone
+// within it. (At 6 m HM95's term is below 1e-8 of its contact value.)
+constexpr double kSocialCutoffM = 6.0;
+
+}  // namespace
 
 Eigen::Vector2d ClosestPointOnSegment(const Eigen::Vector2d& p, const WallSegment& s) {
   return egress::ClosestPointOnSegment(p, s.a, s.b);
@@ -29,6 +38,12 @@ Eigen::Vector2d SocialForceModel::CalcAcceleration(std::size_t i,
                                                    const std::vector<Walker>& walkers,
                                                    const std::vector<DiscObstacle>& discs,
                                                    const std::vector<WallSegment>& walls) const {
+  return CalcAccelerationAmong(i, walkers, nullptr, discs, walls);
+}
+
+Eigen::Vector2d SocialForceModel::CalcAccelerationAmong(
+    std::size_t i, const std::vector<Walker>& walkers, const std::vector<std::size_t>* near,
+    const std::vector<DiscObstacle>& discs, const std::vector<WallSegment>& walls) const {
   const Walker& w = walkers[i];
   const auto& P = params_;
   Eigen::Vector2d desired = Eigen::Vector2d::Zero();
@@ -57,7 +72,7 @@ Eigen::Vector2d SocialForceModel::CalcAcceleration(std::size_t i,
     const Eigen::Vector2d r = w.position - other_p;
     const Eigen::Vector2d step = other_v * P.social_horizon;
     const double r_norm = r.norm();
-    if (r_norm < 1e-6 || r_norm > 6.0) return Eigen::Vector2d(Eigen::Vector2d::Zero());
+    if (r_norm < 1e-6 || r_norm > kSocialCutoffM) return Eigen::Vector2d(Eigen::Vector2d::Zero());
     const double s = r_norm + (r - step).norm();
     const double b = 0.5 * std::sqrt(std::max(s * s - step.squaredNorm(), 1e-12));
     const Eigen::Vector2d n = r / r_norm;
@@ -67,7 +82,9 @@ Eigen::Vector2d SocialForceModel::CalcAcceleration(std::size_t i,
       f += P.keep_right * f.norm() * Eigen::Vector2d(heading.y(), -heading.x());
     return Eigen::Vector2d(f * weight(f.normalized()));
   };
-  for (std::size_t j = 0; j < walkers.size(); ++j) {
+  const std::size_t others = near ? near->size() : walkers.size();
+  for (std::size_t k = 0; k < others; ++k) {
+    const std::size_t j = near ? (*near)[k] : k;
     if (j == i) continue;
     const Walker& o = walkers[j];
     // Social terms scale with the drive (their balance is what HM95 tuned); walls do not.
@@ -114,9 +131,30 @@ Eigen::Vector2d SocialForceModel::CalcAcceleration(std::size_t i,
 
 void SocialForceModel::Step(std::vector<Walker>* walkers, const std::vector<DiscObstacle>& discs,
                             const std::vector<WallSegment>& walls, double dt) const {
-  std::vector<Eigen::Vector2d> accelerations(walkers->size());
-  for (std::size_t i = 0; i < walkers->size(); ++i) {
-    accelerations[i] = CalcAcceleration(i, *walkers, discs, walls);
+  // A uniform grid of kSocialCutoffM cells (a cell list): each walker meets only the walkers
+  // of the 3 x 3 cells round it, in ascending index as over the whole crowd, so the sums (and
+  // the run) are the same as without the grid, in O(n) instead of O(n^2).
+  const std::vector<Walker>& all = *walkers;
+  std::vector<Eigen::Vector2d> accelerations(all.size());
+  std::map<std::pair<long, long>, std::vector<std::size_t>> cells;
+  const auto cell_of = [](const Eigen::Vector2d& p) {
+    return std::pair<long, long>(long(std::floor(p.x() / kSocialCutoffM)),
+                                 long(std::floor(p.y() / kSocialCutoffM)));
+  };
+  for (std::size_t i = 0; i < all.size(); ++i)
+    cells[cell_of(all[i].position)].push_back(i);
+  std::vector<std::size_t> near;
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const auto [cx, cy] = cell_of(all[i].position);
+    near.clear();
+    for (long dx = -1; dx <= 1; ++dx) {
+      for (long dy = -1; dy <= 1; ++dy) {
+        const auto it = cells.find({cx + dx, cy + dy});
+        if (it != cells.end()) near.insert(near.end(), it->second.begin(), it->second.end());
+      }
+    }
+    std::sort(near.begin(), near.end());
+    accelerations[i] = CalcAccelerationAmong(i, all, &near, discs, walls);
   }
   for (std::size_t i = 0; i < walkers->size(); ++i) {
     Walker& w = (*walkers)[i];

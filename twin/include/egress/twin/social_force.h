@@ -87,6 +87,11 @@ class SocialForceModel {
   const SocialForceParams& params() const { return params_; }
 
  private:
+  // CalcAcceleration among the walkers `near` (indices, ascending; nullptr: all of them).
+  Eigen::Vector2d CalcAccelerationAmong(std::size_t i, const std::vector<Walker>& walkers,
+                                        const std::vector<std::size_t>* near,
+                                        const std::vector<DiscObstacle>& discs,
+                                        const std::vector<WallSegment>& walls) const;
   Eigen::Vector2d BodyForce(const Walker& w, const Eigen::Vector2d& other_p,
                             const Eigen::Vector2d& other_v, double other_r) const;
   SocialForceParams params_;
