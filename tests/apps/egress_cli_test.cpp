@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 
 #include <gmock/gmock.h>
@@ -346,6 +347,49 @@ TEST(EgressCliTest, SimRunWithTheBrainPrintsDecisionsAndTracesTheRunningAction) 
   const std::string trace((std::istreambuf_iterator<char>(in)), {});
   EXPECT_THAT(trace, HasSubstr("\"label\":\"traverse_open\""));
   EXPECT_THAT(trace, HasSubstr("\"path\":[["));
+  std::filesystem::remove_all(dir);
+}
+
+TEST(EgressCliTest, EvacStudyComparesTheThreeConditionsOnTheSameSeeds) {
+  const auto dir = egress::testing::TestTempPath("study");
+  const std::string scenario = kWorldsDir + "/scenarios/evacuation/lab_escort.yaml";
+  Result two = RunEgress("evac study " + scenario + " --trials 1 --jobs 2 -q --out " +
+                         (dir / "two").string());
+  ASSERT_EQ(two.exit_code, 0) << two.output;
+  for (const char* c : {"no_robot", "robot", "propped_open"})
+    EXPECT_THAT(two.output, HasSubstr(c));
+  EXPECT_THAT(two.output, HasSubstr("lab_door"));
+  const auto study = nlohmann::json::parse(std::ifstream(dir / "two" / "study.json"));
+  ASSERT_EQ(study.at("conditions").size(), 3u);
+  std::map<std::string, nlohmann::json> by;
+  for (const auto& c : study.at("conditions"))
+    by[c.at("condition").get<std::string>()] = c;
+  // Everyone out in every condition; doors propped open are the fastest (the upper bound), and
+  // nobody is out faster than with them.
+  for (const auto& [name, c] : by)
+    EXPECT_EQ(c.at("left_behind").get<int>(), 0) << name;
+  EXPECT_LE(by["propped_open"].at("t_evac_median_s").get<double>(),
+            by["no_robot"].at("t_evac_median_s").get<double>());
+  EXPECT_EQ(by["robot"].at("contacts").get<int>(), 0);
+  EXPECT_TRUE(std::filesystem::exists(dir / "two" / "evacuated.png"));
+  // The same with one worker: the results do not depend on the number of jobs.
+  Result one = RunEgress("evac study " + scenario + " --trials 1 --jobs 1 -q --out " +
+                         (dir / "one").string());
+  ASSERT_EQ(one.exit_code, 0) << one.output;
+  const auto read = [&](const std::string& run) {
+    std::ifstream in(dir / run / "trials.csv");
+    return std::string((std::istreambuf_iterator<char>(in)), {});
+  };
+  EXPECT_EQ(read("one"), read("two"));
+  // Never overwrites; refuses a scenario without evacuees, naming it.
+  Result again =
+      RunEgress("evac study " + scenario + " --trials 1 -q --out " + (dir / "one").string());
+  EXPECT_EQ(again.exit_code, 1);
+  EXPECT_THAT(again.output, HasSubstr("--overwrite"));
+  Result none = RunEgress("evac study " + kWorldsDir + "/scenarios/s3_held_door.yaml -q --out " +
+                          (dir / "x").string());
+  EXPECT_EQ(none.exit_code, 1);
+  EXPECT_THAT(none.output, HasSubstr("no people with behavior evacuate"));
   std::filesystem::remove_all(dir);
 }
 

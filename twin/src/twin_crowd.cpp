@@ -395,28 +395,16 @@ int TwinWorld::Impl::GateDoor(const Person& p) {
 
 std::optional<Eigen::Vector2d> TwinWorld::Impl::ActuatorSpot(int door, double side,
                                                              const Eigen::Vector2d& p_W) const {
-  const Door& d = doors[std::size_t(door)];
-  std::vector<const ActuatorBox*> boxes;
-  for (const auto& b : d.buttons)
-    boxes.push_back(&b.box());
-  for (const auto& plate : d.plates)
-    boxes.push_back(&plate.box());
-  const auto wall_distance = [&](const Eigen::Vector2d& q) {
-    double nearest = std::numeric_limits<double>::infinity();
-    for (const auto& w : fixed.walls)
-      nearest = std::min(nearest, (q - ClosestPointOnSegment(q, w)).norm());
-    return nearest;
-  };
+  // The building's actuators of this door, each faced from its own box (building.h): the
+  // person stands in front of the face, on their side of the door.
+  const DoorModel& d = *doors[std::size_t(door)].fixed;
   std::optional<Eigen::Vector2d> best;
-  for (const ActuatorBox* box : boxes) {
-    const Eigen::Vector2d c = box->X_WA.translation().head<2>();
-    Eigen::Vector2d n = box->NormalW().head<2>();
+  for (const BuildingActuator& a : twin_model->building().actuators) {
+    if (a.door != d.desc->name) continue;
+    const Eigen::Vector2d n = a.n_W.head<2>();
     if (n.norm() < 1e-6) continue;
-    n.normalize();
-    // In front of the free face (the other is against its wall).
-    const Eigen::Vector2d a = c + n * kActuatorStandOffM, b = c - n * kActuatorStandOffM;
-    Eigen::Vector2d spot = wall_distance(a) >= wall_distance(b) ? a : b;
-    if ((spot - d.fixed->centre).dot(d.fixed->normal) * side <= 0.0) continue;
+    Eigen::Vector2d spot = a.p_W.head<2>() + n.normalized() * kActuatorStandOffM;
+    if ((spot - d.centre).dot(d.normal) * side <= 0.0) continue;
     spot = ClearOfWalls(spot, kPersonAtActuatorRadiusM);
     if (!best || (spot - p_W).norm() < (*best - p_W).norm()) best = spot;
   }
