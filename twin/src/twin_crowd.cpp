@@ -28,6 +28,8 @@ constexpr double kPersonAtActuatorRadiusM = 0.3;
 constexpr double kOperateReachM = 3.0;
 constexpr double kAtActuatorM = 0.25;
 constexpr double kArmReachM = 0.7;
+// Kept from the actuator this long, a person gives up operating it (and for as long again) [s].
+constexpr double kOperateGiveUpSec = 12.0;
 // An evacuee this near a doorway's centre, on its far side, is past it [m].
 constexpr double kPastDoorwayReachM = 2.5;
 // Where an evacuee lines up before an open door, on its axis [m].
@@ -420,18 +422,32 @@ bool TwinWorld::Impl::OperateDoor(Person& p, int gate) {
     return false;
   }
   if (p.operating < 0) {
-    if (!p.can_operate || !shut) return false;
-    // One operator per door: the first waiting person who can, within reach of the doorway.
+    if (!p.can_operate || !shut || time < p.operate_retry_at) return false;
+    // One operator per door: of the waiting people who can, within reach of the doorway, the
+    // one nearest the actuator.
     if ((p.walker.position - d.fixed->centre).norm() > kOperateReachM) return false;
-    for (const auto& other : people) {
-      if (other.operating == gate) return false;
-    }
     const double side = (p.walker.position - d.fixed->centre).dot(d.fixed->normal) >= 0 ? 1 : -1;
     const auto spot = ActuatorSpot(gate, side, p.walker.position);
     if (!spot) return false;
+    const double mine = (p.walker.position - *spot).norm();
+    for (const auto& other : people) {
+      if (other.operating == gate) return false;
+      if (&other != &p && other.can_operate && !other.state.out && GateDoor(other) == gate &&
+          other.state.phase == PersonPhase::kWaitingForDoor && time >= other.operate_retry_at &&
+          (other.walker.position - *spot).norm() < mine)
+        return false;
+    }
     p.operating = gate;
     p.operate_spot = *spot;
     p.operate_elapsed = 0.0;
+    p.operate_started = time;
+  }
+  // Kept off the actuator by the queue for too long: they give up for a while, someone else
+  // (nearer now) may get there.
+  if (time - p.operate_started > kOperateGiveUpSec && p.operate_elapsed == 0.0) {
+    p.operating = -1;
+    p.operate_retry_at = time + kOperateGiveUpSec;
+    return false;
   }
   p.walker.target = p.operate_spot;
   p.walker.final_target = true;

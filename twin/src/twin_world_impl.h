@@ -56,6 +56,8 @@ struct Person {
   int operating{-1};         // the door whose actuator they are going to or operating
   Eigen::Vector2d operate_spot{Eigen::Vector2d::Zero()};
   double operate_elapsed{0.0};                           // [s] at the actuator so far
+  double operate_started{0.0};                           // [s] when they set off for the actuator
+  double operate_retry_at{0.0};                          // [s] not before this (after giving up)
   const people::PersonBehaviorModel* behavior{nullptr};  // the model's behaviour
   btRigidBody* body{nullptr};
 };
