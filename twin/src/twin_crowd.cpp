@@ -258,11 +258,13 @@ void TwinWorld::Impl::UpdatePeople() {
     // Carried through a doorway by the crowd before reaching the waypoints before it, an evacuee
     // goes on from beyond it: their route resumes after the doorway they are past.
     if (p.state.behavior == PersonBehavior::kEvacuate) AdvancePastDoorways(p);
-    // An evacuee whose next door already stands open lines up on its axis, not at the spot to
-    // its right where they would queue (which may lie under the open leaf, or behind them after
-    // they operated the door from its actuator): square to the opening, a wide body (a
-    // wheelchair) clears both jambs.
-    if (p.state.behavior == PersonBehavior::kEvacuate && p.route.size() > 1) {
+    // A wide evacuee (a wheelchair, a frame) whose next door already stands open lines up on
+    // its axis, not at the spot to its right where they would queue (which may lie under the
+    // open leaf, or behind them after they operated the door from its actuator): square to the
+    // opening, a wide body clears both jambs. Walkers keep to the queue (their flow through a
+    // door is the hydraulic one, evacuees_test).
+    if (p.state.behavior == PersonBehavior::kEvacuate && p.route.size() > 1 &&
+        p.walker.radius > kReferenceBodyRadiusM + 0.01) {
       const auto next = p.doorway_waypoints.find(p.reached + 1);
       if (next != p.doorway_waypoints.end()) {
         const DoorModel& d = *doors[std::size_t(next->second)].fixed;
