@@ -445,20 +445,16 @@ bool Executive::Step(RobotPort& port) {
   for (const auto& d : belief_.world.doors) {
     if (!d.state.observed) continue;
     const std::string& id = d.model.id;
-    const bool wide = d.state.clearance_width >= 2 * services_.config.footprint_radius;
     if (d.state.motion == perception::DoorMotion::kClosed ||
         d.state.motion == perception::DoorMotion::kClosing) {
       belief_.door_open_since.erase(id);
-      belief_.door_seen_shut[id] = d.state.stamp;
-    } else if (!wide) {
-      belief_.door_seen_shut[id] = d.state.stamp;
-    } else if (belief_.door_open_since.try_emplace(id, now).second) {
-      // A new opening: its age is known only if the robot saw the door shut just before (within
-      // the time an operator takes to open it) — never for a glass leaf, which the estimate may
-      // read shut while it stands open edge-on to the laser.
-      const auto shut = belief_.door_seen_shut.find(id);
-      if (m.map.glass_doors.count(id) == 0 && shut != belief_.door_seen_shut.end() &&
-          ToSeconds(now - shut->second) <= detail::kOperatorOpeningTime) {
+    } else if (d.state.clearance_width >= 2 * services_.config.footprint_radius &&
+               belief_.door_open_since.try_emplace(id, now).second) {
+      // A new opening. Its age is taken as known from when the laser first sees the leaf wide
+      // enough — except a glass leaf's: the laser sees it only near normal incidence and the
+      // estimate may read it shut while it stands open edge-on, so it may have opened a whole
+      // window before it was first seen open.
+      if (m.map.glass_doors.count(id) == 0) {
         belief_.door_opening_witnessed.insert(id);
       } else {
         belief_.door_opening_witnessed.erase(id);

@@ -228,6 +228,7 @@ TEST(BasePlannerClearanceTest, TheGridPathKeepsItsMarginRoundCornersWhereThereIs
   const Costmap2D costmap = RoomWithBox(1.5);
   BasePlannerConfig config;
   config.deterministic = true;
+  config.clearance_weight = 4.0;
   const Pose2 start{1.0, 0.5, 0.0}, goal{5.0, 0.5, 0.0};
   const PlanResult kept = BasePlanner(costmap, nullptr, config).Plan(start, goal);
   ASSERT_TRUE(kept.ok()) << kept.message;
@@ -246,6 +247,7 @@ TEST(BasePlannerClearanceTest, APassageNarrowerThanTheMarginIsStillPassed) {
   const Costmap2D costmap = RoomWithBox(0.55);
   BasePlannerConfig config;
   config.deterministic = true;
+  config.clearance_weight = 4.0;
   const PlanResult result =
       BasePlanner(costmap, nullptr, config).Plan({1.0, 2.7, 0.0}, {5.0, 2.7, 0.0});
   ASSERT_TRUE(result.ok()) << result.message;

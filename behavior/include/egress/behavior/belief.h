@@ -38,11 +38,9 @@ struct Belief {
   /// angle estimate: it starts when the leaf is first seen wide enough, ends when it is seen
   /// closed or closing).
   std::map<std::string, Time> door_open_since;
-  /// Per door: when it was last seen shut (closed, closing, or opening but not yet wide enough).
-  std::map<std::string, Time> door_seen_shut;
-  /// Doors whose current opening the robot saw begin (seen shut shortly before it was first seen
-  /// wide enough): door_open_since is then the opening's age. For any other opening the age is
-  /// unknown — it may have begun a whole hold window ago.
+  /// Doors whose current opening's age door_open_since gives (from when the leaf was first
+  /// seen wide enough; never a glass leaf's, which may stand open long before it is seen so).
+  /// For any other opening the age is unknown — it may have begun a whole hold window ago.
   std::set<std::string> door_opening_witnessed;
   /// Per door: the last step at which a person (not one holding the door aside) was in, or
   /// forecast into, its zone. Absent: never seen occupied.

@@ -63,10 +63,13 @@ struct BasePlannerConfig {
   /// shortcutting never takes the path closer than the margin unless the grid path itself was.
   /// Why: a path string-pulled on validity alone grazes every corner and open leaf at exactly
   /// the footprint radius, with no room for localization error. Beyond the margin the path is
-  /// the shortest, so it still passes close enough to see round corners. clearance_weight 0:
-  /// the plain shortest path, shortcut on validity alone.
+  /// the shortest, so it still passes close enough to see round corners. clearance_weight 0
+  /// (the default): the plain shortest path, shortcut on validity alone. Off by default because
+  /// the brain's judgement of a door someone holds depends on what it sees on the way: with the
+  /// clearance on (weight 4), S7's robot, passing the cabinet wider, saw the held lab door late
+  /// and pressed its button in 51 of 100 trials (issue 16's note).
   double clearance_margin{0.1};  ///< [m] beyond the footprint radius
-  double clearance_weight{4.0};
+  double clearance_weight{0.0};
   void Validate() const;
 };
 
