@@ -14,6 +14,7 @@
 namespace egress::twin {
 namespace {
 
+using testing::CountEvents;
 using ::testing::HasSubstr;
 using testing::Hsr;
 using testing::LoadText;
@@ -64,13 +65,6 @@ TEST(EvacueesTest, DenseFlowThroughAFullyOpenDoorIsWithinTheHydraulicBand) {
   RecordProperty("flow_persons_per_s", std::to_string(flow));
   EXPECT_GT(flow, 0.85 * 0.8);
   EXPECT_LT(flow, 1.24 * 1.2);
-}
-
-int CountEvents(const TwinWorld& w, const std::string& kind, const std::string& subject = "") {
-  int n = 0;
-  for (const auto& e : w.events())
-    n += e.kind == kind && (subject.empty() || e.subject == subject) ? 1 : 0;
-  return n;
 }
 
 // The office: room 1 (x < 5), door_a (x = 5, push buttons), room 2, door_b (x = 9, glass,

@@ -44,4 +44,13 @@ inline Loaded LoadText(const std::string& yaml, const std::filesystem::path& dir
   return out;
 }
 
+/// How many events of `kind` (about `subject`, if given) the world has raised.
+inline int CountEvents(const TwinWorld& w, const std::string& kind,
+                       const std::string& subject = "") {
+  int n = 0;
+  for (const auto& e : w.events())
+    n += e.kind == kind && (subject.empty() || e.subject == subject) ? 1 : 0;
+  return n;
+}
+
 }  // namespace egress::twin::testing

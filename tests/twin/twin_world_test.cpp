@@ -14,18 +14,12 @@
 namespace egress::twin {
 namespace {
 
+using testing::CountEvents;
 using testing::Hsr;
 using testing::LoadText;
 using testing::WorldsDir;
 
 constexpr double kDeg = M_PI / 180.0;
-
-int CountEvents(const TwinWorld& w, const std::string& kind, const std::string& subject = "") {
-  int n = 0;
-  for (const auto& e : w.events())
-    n += e.kind == kind && (subject.empty() || e.subject == subject) ? 1 : 0;
-  return n;
-}
 
 std::optional<double> FirstEvent(const TwinWorld& w, const std::string& kind) {
   for (const auto& e : w.events()) {

@@ -1,0 +1,93 @@
+// The grid searches of base_planner.h: the shortest and the cheapest 8-connected path over the
+// costmap's free cells (reachability, the doors on the way, the narrow-passage seed).
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <queue>
+
+#include "egress/hsr_interface/error.h"
+#include "egress/planning/base_planner.h"
+
+namespace egress::planning {
+
+using perception::kInscribedCost;
+using perception::kUnknownCost;
+
+std::optional<double> GridShortestPathLength(const perception::Costmap2D& costmap,
+                                             const Eigen::Vector2d& start,
+                                             const Eigen::Vector2d& goal, bool allow_unknown) {
+  const auto path = GridShortestPath(costmap, start, goal, allow_unknown);
+  if (!path) return std::nullopt;
+  double length = 0.0;
+  for (std::size_t i = 1; i < path->size(); ++i)
+    length += ((*path)[i] - (*path)[i - 1]).norm();
+  return length;
+}
+
+std::optional<std::vector<Eigen::Vector2d>> GridShortestPath(const perception::Costmap2D& costmap,
+                                                             const Eigen::Vector2d& start,
+                                                             const Eigen::Vector2d& goal,
+                                                             bool allow_unknown) {
+  return GridCheapestPath(costmap, start, goal, kInscribedCost, 0.0, allow_unknown);
+}
+
+std::optional<std::vector<Eigen::Vector2d>> GridCheapestPath(
+    const perception::Costmap2D& costmap, const Eigen::Vector2d& start, const Eigen::Vector2d& goal,
+    std::uint8_t close_cost, double close_weight, bool allow_unknown) {
+  ThrowUnless(std::isfinite(close_weight) && close_weight >= 0.0,
+              "GridCheapestPath: close_weight must be finite and >= 0, got ", close_weight);
+  const float penalty = 1.0f + float(close_weight);
+  const auto& g = costmap.geometry();
+  const auto s = g.CellOf(start), t = g.CellOf(goal);
+  if (!s || !t) return std::nullopt;
+  const auto passable = [&](std::size_t i) {
+    const std::uint8_t c = costmap.costs()[i];
+    return c == kUnknownCost ? allow_unknown : c < kInscribedCost;
+  };
+  const std::size_t source = g.Index(s->x(), s->y()), target = g.Index(t->x(), t->y());
+  if (!passable(source) || !passable(target)) return std::nullopt;
+  std::vector<float> distance(g.size(), std::numeric_limits<float>::infinity());
+  std::vector<std::uint32_t> parent(g.size(), std::numeric_limits<std::uint32_t>::max());
+  using Item = std::pair<float, std::uint32_t>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> open;
+  distance[source] = 0.0f;
+  open.push({0.0f, std::uint32_t(source)});
+  constexpr float kDiagonal = 1.41421356f;
+  while (!open.empty()) {
+    const auto [d, index] = open.top();
+    open.pop();
+    if (d > distance[index]) continue;
+    if (index == target) break;
+    const int ix = int(index % std::uint32_t(g.width)), iy = int(index / std::uint32_t(g.width));
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        if ((dx == 0 && dy == 0) || !g.Contains(ix + dx, iy + dy)) continue;
+        const std::size_t next = g.Index(ix + dx, iy + dy);
+        if (!passable(next)) continue;
+        // No corner cutting: a diagonal step needs both cells beside it free.
+        if (dx != 0 && dy != 0 &&
+            (!passable(g.Index(ix + dx, iy)) || !passable(g.Index(ix, iy + dy))))
+          continue;
+        const std::uint8_t c = costmap.costs()[next];
+        const float factor = c != kUnknownCost && c >= close_cost ? penalty : 1.0f;
+        const float nd = d + ((dx != 0 && dy != 0) ? kDiagonal : 1.0f) * factor;
+        if (nd < distance[next]) {
+          distance[next] = nd;
+          parent[next] = index;
+          open.push({nd, std::uint32_t(next)});
+        }
+      }
+    }
+  }
+  if (!std::isfinite(distance[target])) return std::nullopt;
+  std::vector<Eigen::Vector2d> path;
+  for (std::size_t i = target;; i = parent[i]) {
+    path.push_back(g.CellCenter(int(i % std::size_t(g.width)), int(i / std::size_t(g.width))));
+    if (i == source) break;
+  }
+  std::reverse(path.begin(), path.end());
+  return path;
+}
+
+}  // namespace egress::planning
