@@ -77,25 +77,15 @@ twin::Scenario ConditionScenario(const twin::Scenario& base, const twin::WorldDe
   return s;
 }
 
-struct DoorLine {
+// Each door's frame with its name.
+struct DoorLine : twin::DoorwayFrame {
   std::string name;
-  Eigen::Vector2d centre, normal, along;
-  double half_width{0.0};
 };
 
 std::vector<DoorLine> DoorLines(const twin::TwinWorld& world) {
   std::vector<DoorLine> lines;
-  for (std::size_t i = 0; i < world.door_count(); ++i) {
-    const auto& d = world.door(i);
-    const Eigen::Vector2d hinge = d.p_WH.head<2>(), edge = d.CalcFreeEdge(0.0).head<2>();
-    DoorLine l;
-    l.name = d.name;
-    l.along = (edge - hinge).normalized();
-    l.normal = Eigen::Vector2d(-l.along.y(), l.along.x());
-    l.half_width = (edge - hinge).norm() / 2;
-    l.centre = hinge + l.along * l.half_width;
-    lines.push_back(l);
-  }
+  for (std::size_t i = 0; i < world.door_count(); ++i)
+    lines.push_back({twin::CalcDoorwayFrame(world.door(i)), world.door(i).name});
   return lines;
 }
 

@@ -7,26 +7,21 @@
 #include "egress/twin/trace.h"
 
 namespace egress::twin {
-namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
-
-// Doorway frame: centre, unit normal and unit along-axis (hinge → latch) in the plane.
-struct Doorway {
-  Eigen::Vector2d centre, normal, along;
-  double half_width;
-};
-
-Doorway MakeDoorway(const DoorDescription& d) {
+DoorwayFrame CalcDoorwayFrame(const DoorDescription& d) {
   const Eigen::Vector2d hinge = d.p_WH.head<2>();
   const Eigen::Vector2d edge = d.CalcFreeEdge(0.0).head<2>();
-  Doorway w;
+  DoorwayFrame w;
   w.along = (edge - hinge).normalized();
   w.normal = Eigen::Vector2d(-w.along.y(), w.along.x());
   w.half_width = (edge - hinge).norm() / 2;
   w.centre = hinge + w.along * w.half_width;
   return w;
 }
+
+namespace {
+
+constexpr double kRadToDeg = 180.0 / M_PI;
 
 std::string Fmt(double v, int digits = 2) {
   char buf[64];
@@ -44,7 +39,7 @@ void ScenarioJudge::Observe(const TwinWorld& world) {
     last_pose_ = X_WB;
     last_time_ = t;
     for (std::size_t i = 0; i < world.door_count(); ++i) {
-      const Doorway w = MakeDoorway(world.door(i));
+      const DoorwayFrame w = CalcDoorwayFrame(world.door(i));
       last_side_.push_back((X_WB.translation() - w.centre).dot(w.normal));
     }
     return;
@@ -68,7 +63,7 @@ void ScenarioJudge::Observe(const TwinWorld& world) {
   if (nearest < kPersonalSpace) metrics_.time_in_personal_space += dt;
   for (std::size_t i = 0; i < world.door_count(); ++i) {
     const DoorDescription& d = world.door(i);
-    const Doorway w = MakeDoorway(d);
+    const DoorwayFrame w = CalcDoorwayFrame(d);
     const Eigen::Vector2d rel = X_WB.translation() - w.centre;
     const double side = rel.dot(w.normal);
     const bool within_jambs = std::abs(rel.dot(w.along)) <= w.half_width + 0.1;

@@ -26,6 +26,16 @@ struct DoorCrossing {
   int direction{0};   ///< +1 along the doorway normal, −1 against
 };
 
+/// A doorway's frame in the plane: centre, unit normal and unit along-axis (hinge -> latch) of
+/// the closed leaf's line, and half its width [m] (the judge's crossings, the evac study's flows).
+struct DoorwayFrame {
+  Eigen::Vector2d centre{Eigen::Vector2d::Zero()};
+  Eigen::Vector2d normal{Eigen::Vector2d::UnitY()};
+  Eigen::Vector2d along{Eigen::Vector2d::UnitX()};
+  double half_width{0.0};
+};
+DoorwayFrame CalcDoorwayFrame(const DoorDescription& door);
+
 struct RunMetrics {
   double end_time{0.0};                                                 ///< [s]
   std::optional<double> time_to_goal;                                   ///< [s]
