@@ -1,5 +1,7 @@
 #include "egress/twin/social_force.h"
 
+#include <random>
+
 #include <gtest/gtest.h>
 
 namespace egress::twin {
@@ -81,6 +83,52 @@ TEST(SocialForceModelTest, ARobotDiscIsAvoided) {
   }
   EXPECT_GT(min_gap, 0.05);
   EXPECT_GT(w[0].position.x(), 3.0);
+}
+
+// Step's cell lists (walkers within the social cutoff, walls within reach) give bit for bit
+// the accelerations of summing over every walker and every wall, so runs do not change with
+// the crowd's size or the building's.
+TEST(SocialForceModelTest, StepsCellListsMatchTheSumOverEverything) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> pos(0.0, 40.0), unit(-1.0, 1.0), len(0.2, 8.0);
+  std::vector<Walker> walkers(80);
+  for (auto& w : walkers) {
+    w.position = {pos(rng), pos(rng) / 4.0};  // a dense band: many within the cutoff
+    w.velocity = {unit(rng) * 0.3, unit(rng) * 0.3};
+    w.target = {pos(rng), pos(rng) / 4.0};
+    w.desired_speed = 1.2;
+  }
+  std::vector<WallSegment> walls;
+  for (int k = 0; k < 60; ++k) {
+    const Eigen::Vector2d a(pos(rng), pos(rng) / 4.0);
+    const Eigen::Vector2d b = a + len(rng) * Eigen::Vector2d(unit(rng), unit(rng)).normalized();
+    // Loose segments and obstacles of 1-4 segments, interleaved so that an obstacle's first
+    // segment may be far from a walker its later ones reach.
+    walls.push_back({a, b, k % 3 == 0 ? -1 : k % 7});
+  }
+  const std::vector<DiscObstacle> discs = {{{20.0, 5.0}, {0.2, 0.0}, 0.3}};
+  SocialForceModel sfm;
+  std::vector<Eigen::Vector2d> expected;
+  for (std::size_t i = 0; i < walkers.size(); ++i)
+    expected.push_back(sfm.CalcAcceleration(i, walkers, discs, walls));
+  const double dt = 1e-4;  // small enough that no speed is clipped
+  std::vector<Walker> stepped = walkers;
+  sfm.Step(&stepped, discs, walls, dt);
+  int pushed_by_walls = 0;
+  for (std::size_t i = 0; i < walkers.size(); ++i) {
+    const Eigen::Vector2d v = walkers[i].velocity + expected[i] * dt;
+    EXPECT_EQ(stepped[i].velocity.x(), v.x()) << "walker " << i;
+    EXPECT_EQ(stepped[i].velocity.y(), v.y()) << "walker " << i;
+    const double gap = [&] {
+      double g = 1e9;
+      for (const auto& s : walls)
+        g = std::min(g,
+                     (walkers[i].position - ClosestPointOnSegment(walkers[i].position, s)).norm());
+      return g;
+    }();
+    pushed_by_walls += gap < 3.0;
+  }
+  EXPECT_GT(pushed_by_walls, 20);  // walls did act
 }
 
 }  // namespace

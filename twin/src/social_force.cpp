@@ -13,6 +13,9 @@ namespace {
 // the cell size of Step's neighbour grid, so that the 3 x 3 cells round a walker hold everyone
 // within it. (At 6 m HM95's term is below 1e-8 of its contact value.)
 constexpr double kSocialCutoffM = 6.0;
+// Beyond this distance from its nearest point an obstacle exerts no force [m]; the cell size
+// of Step's wall lists.
+constexpr double kWallCutoffM = 3.0;
 
 }  // namespace
 
@@ -38,11 +41,11 @@ Eigen::Vector2d SocialForceModel::CalcAcceleration(std::size_t i,
                                                    const std::vector<Walker>& walkers,
                                                    const std::vector<DiscObstacle>& discs,
                                                    const std::vector<WallSegment>& walls) const {
-  return CalcAccelerationAmong(i, walkers, nullptr, discs, walls);
+  return CalcAccelerationAmong(i, walkers, Neighbours{}, discs, walls);
 }
 
 Eigen::Vector2d SocialForceModel::CalcAccelerationAmong(
-    std::size_t i, const std::vector<Walker>& walkers, const std::vector<std::size_t>* near,
+    std::size_t i, const std::vector<Walker>& walkers, const Neighbours& near,
     const std::vector<DiscObstacle>& discs, const std::vector<WallSegment>& walls) const {
   const Walker& w = walkers[i];
   const auto& P = params_;
@@ -82,9 +85,9 @@ Eigen::Vector2d SocialForceModel::CalcAccelerationAmong(
       f += P.keep_right * f.norm() * Eigen::Vector2d(heading.y(), -heading.x());
     return Eigen::Vector2d(f * weight(f.normalized()));
   };
-  const std::size_t others = near ? near->size() : walkers.size();
+  const std::size_t others = near.walkers ? near.walkers->size() : walkers.size();
   for (std::size_t k = 0; k < others; ++k) {
-    const std::size_t j = near ? (*near)[k] : k;
+    const std::size_t j = near.walkers ? (*near.walkers)[k] : k;
     if (j == i) continue;
     const Walker& o = walkers[j];
     // Social terms scale with the drive (their balance is what HM95 tuned); walls do not.
@@ -95,24 +98,37 @@ Eigen::Vector2d SocialForceModel::CalcAccelerationAmong(
     a += social(d.position, d.velocity, P.drive_factor * P.robot_strength, P.robot_range);
     a += BodyForce(w, d.position, d.velocity, d.radius) / P.mass;
   }
-  // The nearest point of each obstacle (or of each loose segment) repels.
-  std::vector<std::pair<int, Eigen::Vector2d>> nearest;  // obstacle id, nearest point
-  for (const auto& wall : walls) {
+  // The nearest point of each obstacle (or of each loose segment) repels. Obstacles are summed
+  // in the order of their first segment in `walls`, whichever segments are near.
+  struct Nearest {
+    std::size_t rank;
+    int id;
+    Eigen::Vector2d q;
+  };
+  thread_local std::vector<Nearest> nearest;
+  nearest.clear();
+  const std::size_t candidates = near.walls ? near.walls->size() : walls.size();
+  for (std::size_t k = 0; k < candidates; ++k) {
+    const std::size_t s = near.walls ? (*near.walls)[k] : k;
+    const WallSegment& wall = walls[s];
     const Eigen::Vector2d q = ClosestPointOnSegment(w.position, wall);
     auto it = wall.obstacle < 0 ? nearest.end()
                                 : std::find_if(nearest.begin(), nearest.end(), [&](const auto& e) {
-                                    return e.first == wall.obstacle;
+                                    return e.id == wall.obstacle;
                                   });
     if (it == nearest.end()) {
-      nearest.emplace_back(wall.obstacle, q);
-    } else if ((w.position - q).squaredNorm() < (w.position - it->second).squaredNorm()) {
-      it->second = q;
+      nearest.push_back({near.wall_rank ? (*near.wall_rank)[s] : s, wall.obstacle, q});
+    } else if ((w.position - q).squaredNorm() < (w.position - it->q).squaredNorm()) {
+      it->q = q;
     }
   }
-  for (const auto& [id, q] : nearest) {
-    const Eigen::Vector2d r = w.position - q;
+  if (near.wall_rank)
+    std::sort(nearest.begin(), nearest.end(),
+              [](const Nearest& a, const Nearest& b) { return a.rank < b.rank; });
+  for (const Nearest& e : nearest) {
+    const Eigen::Vector2d r = w.position - e.q;
     const double dist = r.norm();
-    if (dist < 1e-9 || dist > 3.0) continue;
+    if (dist < 1e-9 || dist > kWallCutoffM) continue;
     const Eigen::Vector2d n = r / dist;
     const double gap = dist - w.radius;
     Eigen::Vector2d f =
@@ -143,6 +159,29 @@ void SocialForceModel::Step(std::vector<Walker>* walkers, const std::vector<Disc
   };
   for (std::size_t i = 0; i < all.size(); ++i)
     cells[cell_of(all[i].position)].push_back(i);
+  // Walls in cells of kWallCutoffM: each segment is listed in every cell its bounding box,
+  // grown by the cutoff, overlaps, so a walker's own cell lists every segment within reach.
+  const auto wall_cell_of = [](double x, double y) {
+    return std::pair<long, long>(long(std::floor(x / kWallCutoffM)),
+                                 long(std::floor(y / kWallCutoffM)));
+  };
+  std::map<std::pair<long, long>, std::vector<std::size_t>> wall_cells;
+  std::vector<std::size_t> wall_rank(walls.size());
+  std::map<int, std::size_t> first_of_obstacle;
+  for (std::size_t s = 0; s < walls.size(); ++s) {
+    const WallSegment& wall = walls[s];
+    wall_rank[s] =
+        wall.obstacle < 0 ? s : first_of_obstacle.emplace(wall.obstacle, s).first->second;
+    const Eigen::Vector2d lo = wall.a.cwiseMin(wall.b).array() - kWallCutoffM;
+    const Eigen::Vector2d hi = wall.a.cwiseMax(wall.b).array() + kWallCutoffM;
+    if (!lo.allFinite() || !hi.allFinite()) continue;
+    const auto [x0, y0] = wall_cell_of(lo.x(), lo.y());
+    const auto [x1, y1] = wall_cell_of(hi.x(), hi.y());
+    for (long cx = x0; cx <= x1; ++cx)
+      for (long cy = y0; cy <= y1; ++cy)
+        wall_cells[{cx, cy}].push_back(s);
+  }
+  const std::vector<std::size_t> no_walls;
   std::vector<std::size_t> near;
   for (std::size_t i = 0; i < all.size(); ++i) {
     const auto [cx, cy] = cell_of(all[i].position);
@@ -154,7 +193,10 @@ void SocialForceModel::Step(std::vector<Walker>* walkers, const std::vector<Disc
       }
     }
     std::sort(near.begin(), near.end());
-    accelerations[i] = CalcAccelerationAmong(i, all, &near, discs, walls);
+    const auto walls_here = wall_cells.find(wall_cell_of(all[i].position.x(), all[i].position.y()));
+    const Neighbours neighbours{
+        &near, walls_here != wall_cells.end() ? &walls_here->second : &no_walls, &wall_rank};
+    accelerations[i] = CalcAccelerationAmong(i, all, neighbours, discs, walls);
   }
   for (std::size_t i = 0; i < walkers->size(); ++i) {
     Walker& w = (*walkers)[i];

@@ -34,7 +34,9 @@ enum Group : int {
   kGPerson = 1 << 5,
   kGPayload = 1 << 6,
 };
-constexpr int kMaskStatic = kGBase | kGArm | kGPerson | kGPayload;
+// People are kinematic: against the (static) walls Bullet's contacts would do nothing (the
+// social force model keeps them off walls), yet cost a convex-mesh test per person per step.
+constexpr int kMaskStatic = kGBase | kGArm | kGPayload;
 constexpr int kMaskFloor = kGPayload;
 constexpr int kMaskDoor = kGBase | kGArm | kGPerson | kGPayload;
 constexpr int kMaskBase = kGStatic | kGDoor | kGPerson | kGPayload;
@@ -45,7 +47,7 @@ constexpr double kStuckSec =
 // (0.25 m) and a margin
 constexpr double kStepRoundLeaf = 0.45;
 constexpr double kKeepRight = 0.2;  // [m] off the doorway axis, clear of a 0.9 m door's jambs
-constexpr int kMaskPerson = kGStatic | kGDoor | kGBase | kGArm | kGPayload;
+constexpr int kMaskPerson = kGDoor | kGBase | kGArm | kGPayload;
 constexpr int kMaskPayload = kGStatic | kGFloor | kGDoor | kGBase | kGArm | kGPerson | kGPayload;
 
 constexpr double kPersonHeight = 1.7;  // [m]

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "ray_bins.h"
 #include "twin_detail.h"
 
 namespace egress::twin {
@@ -64,6 +65,7 @@ struct TwinModel::Compiled {
   // Rays test boxes and planes analytically (a slab test is far cheaper than a BVH walk over
   // their triangles) and only the meshes' triangles through their own BVH.
   std::vector<world_detail::RayBox> ray_boxes;
+  world_detail::RayBins ray_box_bins;  // which ray_boxes a ray may cross
   std::unique_ptr<btTriangleMesh> ray_mesh;
   std::unique_ptr<btBvhTriangleMeshShape> ray_mesh_shape;  // null without static meshes
   std::vector<int> ray_triangle_entity;

@@ -94,8 +94,12 @@ RayHit TwinWorld::Impl::CastSegment(const Eigen::Vector3d& from, const Eigen::Ve
   // that hit: the mesh's BVH walk costs in proportion to the ray's length. Dynamic bodies are
   // cast as triangle proxies of their shapes (see BuildRayProxies): Bullet's triangle ray test
   // is exact and much cheaper than its iterative convex cast.
+  // Only the targets and boxes the ray's ground track may cross, in index order as over all.
+  thread_local std::vector<int> near;
   const btTransform from_T(btMatrix3x3::getIdentity(), a), to_T(btMatrix3x3::getIdentity(), b);
-  for (std::size_t i = 0; i < ray_targets.size(); ++i) {
+  ray_target_bins.Query(from.head<2>(), to.head<2>(), &near);
+  for (const int k : near) {
+    const std::size_t i = std::size_t(k);
     const btCollisionObject* target = ray_targets[i];
     btVector3 normal;
     btScalar param = cb.m_closestHitFraction;
@@ -109,7 +113,9 @@ RayHit TwinWorld::Impl::CastSegment(const Eigen::Vector3d& from, const Eigen::Ve
   // Static boxes and planes: slab tests in each shape's frame, on the ray as a segment t in
   // [0, 1]. A ray starting inside a box hits its far side (as the triangles' did).
   const Eigen::Vector3d d = to - from;
-  for (const RayBox& box : fixed.ray_boxes) {
+  fixed.ray_box_bins.Query(from.head<2>(), to.head<2>(), &near);
+  for (const int k : near) {
+    const RayBox& box = fixed.ray_boxes[std::size_t(k)];
     const Eigen::Vector3d o = box.R_SW * (from - box.p_WS);
     const Eigen::Vector3d v = box.R_SW * d;
     double t_in = -std::numeric_limits<double>::infinity();

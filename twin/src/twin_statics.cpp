@@ -84,6 +84,18 @@ void TwinWorld::Impl::SyncRayProxies() const {
     ray_targets[i]->getCollisionShape()->getAabb(
         ray_targets[i]->getWorldTransform(), ray_target_aabbs[i].first, ray_target_aabbs[i].second);
   }
+  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> extents;
+  extents.reserve(ray_target_aabbs.size());
+  for (std::size_t i = 0; i < ray_targets.size(); ++i) {
+    const bool plane =
+        ray_targets[i]->getCollisionShape()->getShapeType() == STATIC_PLANE_PROXYTYPE;
+    const auto& [lo, hi] = ray_target_aabbs[i];
+    // A plane is tested by every ray (its bounds are not its extent).
+    extents.emplace_back(
+        plane ? Eigen::Vector2d::Constant(-INFINITY) : Eigen::Vector2d(lo.x(), lo.y()),
+        plane ? Eigen::Vector2d::Constant(INFINITY) : Eigen::Vector2d(hi.x(), hi.y()));
+  }
+  ray_target_bins.Build(extents, kRayBinCellM);
 }
 
 }  // namespace egress::twin

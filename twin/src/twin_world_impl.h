@@ -222,7 +222,8 @@ struct TwinWorld::Impl {
   std::vector<RayProxy> ray_proxies;
   std::vector<const btCollisionObject*> ray_targets;  // cast one by one in CastRay
   mutable std::vector<std::pair<btVector3, btVector3>> ray_target_aabbs;  // their world bounds
-  mutable bool ray_proxies_stale{true};  // bodies moved since the proxies were posed
+  mutable world_detail::RayBins ray_target_bins;  // which ray_targets a ray may cross
+  mutable bool ray_proxies_stale{true};           // bodies moved since the proxies were posed
 
   RayHit CastSegment(const Eigen::Vector3d& from, const Eigen::Vector3d& to, GlassMode mode,
                      double glass_max_incidence) const;

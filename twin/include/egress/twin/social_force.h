@@ -87,9 +87,15 @@ class SocialForceModel {
   const SocialForceParams& params() const { return params_; }
 
  private:
-  // CalcAcceleration among the walkers `near` (indices, ascending; nullptr: all of them).
+  // Who can reach walker i, from Step's cell lists (nullptr: everyone, everything).
+  struct Neighbours {
+    const std::vector<std::size_t>* walkers{nullptr};  // indices, ascending
+    const std::vector<std::size_t>* walls{nullptr};    // indices, ascending
+    // Per wall: the index of the first wall of its obstacle (the order obstacles are summed).
+    const std::vector<std::size_t>* wall_rank{nullptr};
+  };
   Eigen::Vector2d CalcAccelerationAmong(std::size_t i, const std::vector<Walker>& walkers,
-                                        const std::vector<std::size_t>* near,
+                                        const Neighbours& near,
                                         const std::vector<DiscObstacle>& discs,
                                         const std::vector<WallSegment>& walls) const;
   Eigen::Vector2d BodyForce(const Walker& w, const Eigen::Vector2d& other_p,

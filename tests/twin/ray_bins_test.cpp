@@ -1,0 +1,93 @@
+// RayBins (twin/src/ray_bins.h): which boxes a ray's ground track may cross.
+#include "ray_bins.h"
+
+#include <algorithm>
+#include <random>
+
+#include <gtest/gtest.h>
+
+namespace egress::twin::world_detail {
+namespace {
+
+using Box = std::pair<Eigen::Vector2d, Eigen::Vector2d>;
+
+// Whether the segment a-b touches the box (slab test, closed intervals).
+bool SegmentTouchesBox(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Box& box) {
+  double t0 = 0.0, t1 = 1.0;
+  const Eigen::Vector2d d = b - a;
+  for (int i = 0; i < 2; ++i) {
+    if (std::abs(d[i]) < 1e-15) {
+      if (a[i] < box.first[i] || a[i] > box.second[i]) return false;
+      continue;
+    }
+    double ta = (box.first[i] - a[i]) / d[i], tb = (box.second[i] - a[i]) / d[i];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return false;
+  }
+  return true;
+}
+
+TEST(RayBinsTest, ReturnsEveryBoxTheSegmentTouchesAscendingAndOnce) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> pos(-5.0, 25.0), size(0.05, 3.0);
+  std::vector<Box> boxes;
+  for (int i = 0; i < 300; ++i) {
+    const Eigen::Vector2d lo(pos(rng), pos(rng));
+    boxes.emplace_back(lo, lo + Eigen::Vector2d(size(rng), size(rng)));
+  }
+  RayBins bins;
+  bins.Build(boxes, 1.0);
+  std::vector<int> got;
+  int touched_total = 0;
+  for (int k = 0; k < 2000; ++k) {
+    const Eigen::Vector2d a(pos(rng), pos(rng));
+    // Short rays (a few metres, the sensors' near piece) and long ones (across the grid).
+    const double reach = k % 2 ? 3.0 : 40.0;
+    std::uniform_real_distribution<double> step(-reach, reach);
+    const Eigen::Vector2d b = a + Eigen::Vector2d(step(rng), step(rng));
+    bins.Query(a, b, &got);
+    ASSERT_TRUE(std::is_sorted(got.begin(), got.end()));
+    ASSERT_EQ(std::adjacent_find(got.begin(), got.end()), got.end());
+    for (std::size_t i = 0; i < boxes.size(); ++i) {
+      if (!SegmentTouchesBox(a, b, boxes[i])) continue;
+      ++touched_total;
+      ASSERT_TRUE(std::binary_search(got.begin(), got.end(), int(i)))
+          << "box " << i << " missed by the segment (" << a.transpose() << ") - (" << b.transpose()
+          << ")";
+    }
+  }
+  EXPECT_GT(touched_total, 1000);  // the check above was exercised
+}
+
+TEST(RayBinsTest, CullsBoxesFarFromTheSegment) {
+  std::vector<Box> boxes;
+  for (int i = 0; i < 100; ++i)
+    boxes.emplace_back(Eigen::Vector2d(i, 0.0), Eigen::Vector2d(i + 0.5, 0.5));
+  RayBins bins;
+  bins.Build(boxes, 1.0);
+  std::vector<int> got;
+  bins.Query({10.2, -1.0}, {10.2, 2.0}, &got);
+  EXPECT_TRUE(std::binary_search(got.begin(), got.end(), 10));
+  EXPECT_LE(got.size(), 4u);
+  bins.Query({-10.0, 50.0}, {-20.0, 60.0}, &got);  // off the grid entirely
+  EXPECT_TRUE(got.empty());
+}
+
+TEST(RayBinsTest, UnboundedBoxesAreReturnedByEveryQuery) {
+  std::vector<Box> boxes = {
+      {Eigen::Vector2d(0, 0), Eigen::Vector2d(1, 1)},
+      {Eigen::Vector2d::Constant(-INFINITY), Eigen::Vector2d::Constant(INFINITY)},  // a plane
+      {Eigen::Vector2d(-1e4, -1e4), Eigen::Vector2d(1e4, 1e4)}};  // too many cells to bin
+  RayBins bins;
+  bins.Build(boxes, 1.0);
+  std::vector<int> got;
+  bins.Query({50.0, 50.0}, {51.0, 50.0}, &got);
+  EXPECT_EQ(got, (std::vector<int>{1, 2}));
+  bins.Query({0.5, -1.0}, {0.5, 2.0}, &got);
+  EXPECT_EQ(got, (std::vector<int>{0, 1, 2}));
+}
+
+}  // namespace
+}  // namespace egress::twin::world_detail
