@@ -48,6 +48,7 @@ struct StudyOptions {
   int jobs{2};
   std::uint64_t seed_base{1};
   std::string out{"study"};
+  std::vector<std::string> conditions{std::begin(kConditions), std::end(kConditions)};
   bool overwrite{false};
   bool quiet{false};
 };
@@ -293,17 +294,22 @@ void RunStudy(const StudyOptions& o) {
     evacuees = evacuees || p.behavior == twin::PersonBehavior::kEvacuate;
   if (!evacuees)
     throw CommandFailed(fmt::format("{}: no people with behavior evacuate", o.scenario));
-  std::map<std::string, twin::Scenario> scenarios;
+  // The conditions asked for, in the study's order.
+  std::vector<std::string> conditions;
   for (const char* c : kConditions)
+    if (std::find(o.conditions.begin(), o.conditions.end(), c) != o.conditions.end())
+      conditions.emplace_back(c);
+  std::map<std::string, twin::Scenario> scenarios;
+  for (const std::string& c : conditions)
     scenarios[c] = ConditionScenario(base, world, c);
   std::vector<std::pair<std::string, std::uint64_t>> work;
   for (int i = 0; i < o.trials; ++i) {
-    for (const char* c : kConditions)
+    for (const std::string& c : conditions)
       work.emplace_back(c, o.seed_base + std::uint64_t(i));
   }
   if (!o.quiet)
-    fmt::print("{}: {} trials x 3 conditions on {} worker process(es)\n", base.name, o.trials,
-               std::min(o.jobs, int(work.size())));
+    fmt::print("{}: {} trials x {} condition(s) on {} worker process(es)\n", base.name, o.trials,
+               conditions.size(), std::min(o.jobs, int(work.size())));
   const std::vector<nlohmann::json> results =
       RunInWorkers(work.size(), o.jobs, !o.quiet && ::isatty(::fileno(stderr)), [&](std::size_t k) {
         return RunStudyTrial(scenarios.at(work[k].first), world, hsr, work[k].first,
@@ -323,7 +329,7 @@ void RunStudy(const StudyOptions& o) {
   fmt::print("\n{:<14} {:>7} {:>24} {:>12} {:>9} {:>9} {:>12}\n", "condition", "trials",
              "evacuation time [s]", "left behind", "contacts", "closest", "in doorway");
   int residents = 0;
-  for (const char* c : kConditions) {
+  for (const std::string& c : conditions) {
     const auto& trials = by_condition[c];
     std::vector<double> times;
     int left = 0, contacts = 0;
@@ -345,10 +351,8 @@ void RunStudy(const StudyOptions& o) {
     const MedianCi ci = CalcMedianCi(times);
     fmt::print("{:<14} {:>7} {:>9.1f} [{:6.1f}, {:6.1f}] {:>12} {:>9} {:>9} {:>10.1f} s\n", c,
                trials.size(), ci.median, ci.low, ci.high, left,
-               c == std::string("robot") ? fmt::format("{}", contacts) : "-",
-               c == std::string("robot") && std::isfinite(closest)
-                   ? fmt::format("{:.2f} m", closest)
-                   : "-",
+               c == "robot" ? fmt::format("{}", contacts) : "-",
+               c == "robot" && std::isfinite(closest) ? fmt::format("{:.2f} m", closest) : "-",
                blocking);
     nlohmann::json doors = nlohmann::json::object();
     for (const auto& [door, q] : queue) {
@@ -399,6 +403,11 @@ void AddEvacCommand(CLI::App& app) {
   study->add_option("--jobs", o->jobs, "Worker processes")->capture_default_str();
   study->add_option("--seed-base", o->seed_base, "Seed of the first trial")->capture_default_str();
   study->add_option("--out", o->out, "Output folder")->capture_default_str();
+  study
+      ->add_option("--conditions", o->conditions,
+                   "Conditions to run (no_robot, robot, propped_open; default: all three)")
+      ->check(CLI::IsMember({"no_robot", "robot", "propped_open"}))
+      ->capture_default_str();
   study->add_flag("--overwrite", o->overwrite, "Replace existing output files");
   study->add_flag("-q,--quiet", o->quiet, "No progress bar");
   study->callback([o] { RunStudy(*o); });

@@ -461,7 +461,14 @@ bool Executive::Step(RobotPort& port) {
       }
     }
   }
-  if (snapshot.scan) belief_.scan = snapshot.scan;
+  if (snapshot.scan) {
+    belief_.scan = snapshot.scan;
+    belief_.off_map_returns.clear();
+    const Pose2 X_ML = (X_MB3 * X_BL).ToPose2();
+    for (const Eigen::Vector2d& p : perception::ScanPoints(*snapshot.scan, X_ML))
+      if (!costmap_->IsNearMappedObstacle(p, kOffMapM)) belief_.off_map_returns.push_back(p);
+    belief_.moving_returns = scan_motion_.Update(now, X_ML, belief_.off_map_returns);
+  }
   bool in_any_zone = false;
   bool newly_occupied = false;
   for (const auto& door : m.map.doors) {

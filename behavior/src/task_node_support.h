@@ -185,7 +185,8 @@ void Register(bt::BehaviorTreeFactory& factory, const std::string& id,
 }
 
 // Each family registers its own nodes (condition_nodes.cpp, navigation_nodes.cpp,
-// door_nodes.cpp, manipulation_nodes.cpp, grasp_nodes.cpp, release_nodes.cpp, route_nodes.cpp).
+// door_nodes.cpp, manipulation_nodes.cpp, grasp_nodes.cpp, release_nodes.cpp, route_nodes.cpp,
+// escort_nodes.cpp).
 void RegisterConditionNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 void RegisterNavigationNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 void RegisterDoorNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
@@ -193,5 +194,6 @@ void RegisterManipulationNodes(bt::BehaviorTreeFactory& factory, const TaskServi
 void RegisterGraspNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 void RegisterReleaseNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 void RegisterRouteNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
+void RegisterEscortNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 
 }  // namespace egress::behavior::detail

@@ -66,6 +66,7 @@ std::string TaskNodesModelXml() {
   detail::RegisterGraspNodes(factory, nullptr);
   detail::RegisterReleaseNodes(factory, nullptr);
   detail::RegisterRouteNodes(factory, nullptr);
+  detail::RegisterEscortNodes(factory, nullptr);
   return factory.WriteTreeNodesModelXml(false);
 }
 
@@ -82,6 +83,7 @@ void RegisterTaskNodes(bt::BehaviorTreeFactory& factory, const TaskServices* ser
   detail::RegisterManipulationNodes(factory, services);
   detail::RegisterGraspNodes(factory, services);
   detail::RegisterReleaseNodes(factory, services);
+  detail::RegisterEscortNodes(factory, services);
 }
 
 }  // namespace egress::behavior

@@ -140,6 +140,15 @@ void Costmap2D::SetProjectedObstacles(const std::vector<Eigen::Vector2d>& p_MObs
 }
 
 bool Costmap2D::IsNearSensedObstacle(const Eigen::Vector2d& p_MQ, double radius) const {
+  return IsNearLethal(p_MQ, radius, {&static_, &obstacle_, &leaves_});
+}
+
+bool Costmap2D::IsNearMappedObstacle(const Eigen::Vector2d& p_MQ, double radius) const {
+  return IsNearLethal(p_MQ, radius, {&static_, &leaves_});
+}
+
+bool Costmap2D::IsNearLethal(const Eigen::Vector2d& p_MQ, double radius,
+                             std::initializer_list<const std::vector<std::uint8_t>*> layers) const {
   const auto c = geometry_.CellOf(p_MQ);
   if (!c) return false;
   const int n = int(std::ceil(radius / geometry_.resolution));
@@ -152,8 +161,8 @@ bool Costmap2D::IsNearSensedObstacle(const Eigen::Vector2d& p_MQ, double radius)
         continue;
       }
       const std::size_t i = geometry_.Index(x, y);
-      if (static_[i] == kLethalCost || obstacle_[i] == kLethalCost || leaves_[i] == kLethalCost)
-        return true;
+      for (const auto* layer : layers)
+        if ((*layer)[i] == kLethalCost) return true;
     }
   }
   return false;

@@ -138,6 +138,20 @@ TEST(CostmapTest, SensedObstaclesAreTheMapTheLaserAndLeavesNotTheProjection) {
   EXPECT_FALSE(costmap.IsNearSensedObstacle({-1.0, -1.0}, 0.1));  // outside the map
 }
 
+TEST(CostmapTest, MappedObstaclesAreTheMapAndLeavesNotWhatTheLaserSaw) {
+  const OccupancyGrid walls =
+      OccupancyGrid::FromBoxes({{{5.0, 2.25, 0.0}, {0.1, 4.5}}}, {0, 0}, {10, 10}, 0.05);
+  Costmap2D costmap(walls);
+  costmap.AddDoorway({"office", {5.0, 4.5}, {5.0, 5.5}, -1.0, 0.3});
+  EXPECT_TRUE(costmap.IsNearMappedObstacle({5.1, 2.0}, 0.1));        // the map's wall
+  costmap.UpdateWithScan(SingleReturn(0.0, 1.0f), {1.0, 8.0, 0.0});  // a return at (2, 8)
+  EXPECT_TRUE(costmap.IsNearSensedObstacle({2.0, 8.0}, 0.1));
+  EXPECT_FALSE(costmap.IsNearMappedObstacle({2.0, 8.0}, 0.1));   // someone off the map
+  EXPECT_FALSE(costmap.IsNearMappedObstacle({5.05, 5.0}, 0.1));  // no leaf marked yet
+  costmap.SetDoorLeafAngle("office", 0.0);
+  EXPECT_TRUE(costmap.IsNearMappedObstacle({5.05, 5.0}, 0.1));
+}
+
 TEST(CostmapTest, MalformedInputIsRejectedWithoutCrashing) {
   Costmap2D costmap(EmptyMap());
   LaserScan empty = testing::MakeScan(2);

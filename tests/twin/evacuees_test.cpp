@@ -93,6 +93,51 @@ TEST(EvacueesTest, AGroupFollowsItsExitRouteOperatingEachClosedDoor) {
   EXPECT_EQ(CountEvents(world, "button_pressed"), 0);  // the robot pressed nothing
 }
 
+// door_a opens into room 1, towards the group: they wait clear of its sweep and step out of
+// it when it opens, so the leaf swings wide open (a group standing in the sweep held it shut
+// below the angle they wait for, and waited for ever).
+TEST(EvacueesTest, PeopleKeepOutOfTheSweepOfALeafOpeningTowardsThem) {
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    auto loaded = LoadText(OfficeExitRoute(10, ""), WorldsDir() / "office");
+    TwinWorld world(loaded.scenario, loaded.world, seed, Hsr());
+    double widest = 0.0;
+    while (world.time() < 40.0) {
+      world.Step();
+      widest = std::max(widest, world.door_angle(0));
+    }
+    EXPECT_GT(widest, 75.0 * M_PI / 180.0) << "seed " << seed;
+    world.StepFor(150.0);
+    for (const auto& p : world.people())
+      EXPECT_TRUE(p.out) << "seed " << seed << ": " << p.name << " at " << p.position.transpose();
+  }
+}
+
+// The clinic's south ward out through door_d (into the corridor), door_e and the exit, all
+// propped open: 20 residents of mixed mobility all reach the assembly point (the leaf of door_d
+// pushed shut by the crowd, people waiting in its sweep, used to strand most of them).
+TEST(EvacueesTest, AMixedGroupLeavesTheClinicThroughProppedDoors) {
+  const std::string text =
+      "world: clinic.sdf\n"
+      "robot: {start: {x: 9.0, y: -1.6}}\n"
+      "doors:\n"
+      "  - {door: door_d, operator: push, open_at: [0.0], hold_open_s: 1000000}\n"
+      "  - {door: door_e, operator: push, open_at: [0.0], hold_open_s: 1000000}\n"
+      "  - {door: exit_door, operator: push, open_at: [0.0], hold_open_s: 1000000}\n"
+      "people:\n"
+      "  - {name: r, behavior: evacuate, route: [door_d, door_e, exit_door], start: [2.8, -3.0],"
+      " goal: [21.0, 11.5], count: 20, trigger: {at: 5.0},"
+      " mobility: {walker: 10, cane: 3, frame: 3, wheelchair: 2, wheelchair_pushed: 2}}\n";
+  for (std::uint64_t seed = 1; seed <= 2; ++seed) {
+    auto loaded = LoadText(text, WorldsDir() / "clinic");
+    TwinWorld world(loaded.scenario, loaded.world, seed, Hsr());
+    world.StepFor(300.0);
+    int out = 0;
+    for (const auto& p : world.people())
+      out += p.out;
+    EXPECT_EQ(out, 20) << "seed " << seed;
+  }
+}
+
 TEST(EvacueesTest, SomeoneWhoCannotOperateTheDoorWaitsAtItAndTheRestGoOn) {
   // Wheelchair users alone: half of them cannot operate an actuator (mobility.h).
   int stuck = 0, through = 0;

@@ -281,11 +281,30 @@ void TwinWorld::Impl::UpdatePeople() {
     p.walker.final_target = p.route.size() == 1;
     p.walker.desired_speed = p.speed;
     const int gate = GateDoor(p);
-    if (gate >= 0 && (doors[gate].angle < config.door_crossed_open_angle_deg * kDegToRad ||
-                      DoorwayTaken(p, gate))) {
+    // Someone waiting goes on only once the leaf is a few degrees past the threshold: a leaf
+    // held right at it (by someone behind it) would otherwise set them walking into it and
+    // stopping again, step after step.
+    const double open_enough =
+        (config.door_crossed_open_angle_deg +
+         (p.state.phase == PersonPhase::kWaitingForDoor ? kResumeMarginDeg : 0.0)) *
+        kDegToRad;
+    if (gate >= 0 && (doors[gate].angle < open_enough || DoorwayTaken(p, gate))) {
       p.state.phase = PersonPhase::kWaitingForDoor;
       p.walker.desired_speed = 0.0;
       if (OperateDoor(p, gate)) continue;
+      // Waiting in the sweep of a leaf that opens towards them, people step back out of it as
+      // it comes (standing there they would hold shut the door they wait for).
+      const Door& d = doors[std::size_t(gate)];
+      const Eigen::Vector2d hinge = d.fixed->desc->p_WH.head<2>();
+      const Eigen::Vector2d from_hinge = p.walker.position - hinge;
+      const double clear = d.fixed->reach + p.walker.radius + kSweepMarginM;
+      if (d.op && d.op->phase() != DoorPhase::kClosed && d.fixed->swing_side != 0.0 &&
+          from_hinge.dot(d.fixed->normal) * d.fixed->swing_side > 0.0 &&
+          from_hinge.norm() < clear && from_hinge.norm() > 1e-6) {
+        p.walker.target = hinge + from_hinge.normalized() * clear;
+        p.walker.final_target = true;
+        p.walker.desired_speed = p.speed;
+      }
     } else if (p.state.phase == PersonPhase::kWaitingForDoor) {
       p.state.phase = PersonPhase::kWalking;
       p.operating = -1;

@@ -47,6 +47,14 @@ constexpr double kStuckSec =
 // (0.25 m) and a margin
 constexpr double kStepRoundLeaf = 0.45;
 constexpr double kKeepRight = 0.2;  // [m] off the doorway axis, clear of a 0.9 m door's jambs
+// [m] People wait this far beyond the reach of a leaf that opens towards them: a wide body
+// (0.3 m) and a margin.
+constexpr double kClearOfSweepM = 0.45;
+// [m] A waiting person steps this far (plus their radius) beyond the reach of a leaf opening
+// towards them.
+constexpr double kSweepMarginM = 0.1;
+// [deg] A waiting person goes on once the leaf is this far past the open-enough angle.
+constexpr double kResumeMarginDeg = 5.0;
 constexpr int kMaskPerson = kGDoor | kGBase | kGArm | kGPayload;
 constexpr int kMaskPayload = kGStatic | kGFloor | kGDoor | kGBase | kGArm | kGPerson | kGPayload;
 

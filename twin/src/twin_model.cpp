@@ -103,6 +103,10 @@ void CompileDoors(const Scenario& scenario, const WorldDescription& world, TwinM
     door.along = (edge - d.p_WH).head<2>().normalized();
     door.centre = d.p_WH.head<2>() + door.along * door.reach / 2;
     door.normal = Eigen::Vector2d(-door.along.y(), door.along.x());
+    if (d.max_open_angle > 0.0) {
+      const Eigen::Vector2d open_edge = d.CalcFreeEdge(std::min(d.max_open_angle, 0.5)).head<2>();
+      door.swing_side = (open_edge - door.centre).dot(door.normal) >= 0.0 ? 1.0 : -1.0;
+    }
     c->doors.push_back(std::move(door));
   }
 }

@@ -49,6 +49,9 @@ struct DoorModel {
   Eigen::Vector2d centre{Eigen::Vector2d::Zero()};  // doorway centre
   Eigen::Vector2d normal{Eigen::Vector2d::Zero()};  // doorway plane normal
   Eigen::Vector2d along{Eigen::Vector2d::Zero()};   // hinge → latch direction (closed)
+  // The side of the doorway plane (+1: along `normal`, −1: against) the leaf opens into; 0 for
+  // a leaf that cannot open.
+  double swing_side{0.0};
 };
 
 }  // namespace world_detail

@@ -11,6 +11,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <vector>
 
 #include "egress/hsr_interface/geometry.h"
 #include "egress/hsr_interface/sensor_types.h"
@@ -18,6 +19,10 @@
 #include "egress/perception/world_state.h"
 
 namespace egress::behavior {
+
+/// [m] A laser return this far from every wall and door leaf of the costmap is off the map: three
+/// cells, more than the localizer's error at a wall.
+inline constexpr double kOffMapM = 0.15;
 
 struct Belief {
   Time now{};  ///< The robot clock at this step.
@@ -27,6 +32,11 @@ struct Belief {
   /// The fingers moved after the last gripper command and have come to rest (GraspMonitor).
   bool gripper_at_rest{false};
   std::optional<LaserScan> scan;  ///< The latest laser scan.
+  /// The latest scan's returns off the map (farther than kOffMapM from every wall and door leaf
+  /// of the costmap): people, and whatever else is not on the map. In M.
+  std::vector<Eigen::Vector2d> off_map_returns;
+  /// Those of them that moved (perception::ScanMotion): people walking. In M.
+  std::vector<Eigen::Vector2d> moving_returns;
   /// The latest head depth image, the camera in M when it was taken, and its intrinsics.
   std::optional<DepthImage> depth;
   Pose3 X_MC;

@@ -27,6 +27,7 @@
 #include "egress/perception/detection.h"
 #include "egress/perception/occupancy_map_3d.h"
 #include "egress/perception/particle_filter_localizer.h"
+#include "egress/perception/scan_motion.h"
 #include "egress/perception/world_state.h"
 #include "egress/planning/base_planner.h"
 
@@ -165,6 +166,8 @@ class Executive {
   std::vector<std::pair<double, double>> preemptions_;
   static constexpr double kPoseHistorySec = 1.0;     ///< Longer than the detector's latency.
   std::deque<std::pair<Time, Pose2>> pose_history_;  ///< Localized X_MB per control step.
+  perception::ScanMotion
+      scan_motion_;  ///< Which returns off the map moved (belief_.moving_returns).
 };
 
 }  // namespace egress::behavior

@@ -13,6 +13,7 @@
 /// Updates are local: a scan recomputes only the window it touched plus the inflation margin.
 
 #include <cstdint>
+#include <initializer_list>
 #include <map>
 #include <optional>
 #include <string>
@@ -61,6 +62,9 @@ class Costmap2D {
   /// Whether a cell of the static map, the laser's obstacle layer or a door leaf within
   /// `radius` of p_MQ is lethal: something the costmap knows without the projection layer.
   bool IsNearSensedObstacle(const Eigen::Vector2d& p_MQ, double radius) const;
+  /// Whether a lethal cell of the static map or of a door leaf is within `radius` of p_MQ: what
+  /// the building explains (a laser return beyond it is someone or something not on the map).
+  bool IsNearMappedObstacle(const Eigen::Vector2d& p_MQ, double radius) const;
   /// Clears the obstacle layer (e.g. after relocalization).
   void ClearObstacles();
 
@@ -91,6 +95,9 @@ class Costmap2D {
 
  private:
   void RecomputeWindow(int x0, int y0, int x1, int y1);
+  // Whether a lethal cell of any of `layers` is within `radius` of p_MQ.
+  bool IsNearLethal(const Eigen::Vector2d& p_MQ, double radius,
+                    std::initializer_list<const std::vector<std::uint8_t>*> layers) const;
   void MarkLeaf(const Doorway& doorway, double angle, std::uint8_t value);
 
   CostmapConfig config_;

@@ -1,0 +1,293 @@
+// The escort's task nodes (behavior/trees/evacuation_escort.xml): HoldForResidents keeps a door
+// open for the people being evacuated, from a spot beside the door out of their way;
+// IsNobodyComing breaks an operation off when they come.
+
+#include "task_node_support.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "egress/perception/door_estimation.h"
+
+namespace egress::behavior::detail {
+namespace {
+
+// [m] How far out from the doorway, on the robot's side, the robot looks for people coming.
+constexpr double kLookOutM = 2.0;
+// [rad] Facing the people's way in within this, the robot does not turn again.
+constexpr double kFacingToleranceRad = 20.0 * M_PI / 180.0;
+// [m] A person on the far side of the door line by more than this is through.
+constexpr double kThroughM = 0.3;
+// [m] The robot this near its wait spot is there.
+constexpr double kAtSpotM = 0.15;
+// [m/s] A tracked person faster than this is on the move.
+constexpr double kMovingMps = 0.2;
+// [m] The robot goes to its wait spot only with nobody this near it (or the way there).
+constexpr double kSpotClearM = 1.0;
+
+// Who is near a door on the robot's side (or in its doorway), and whether anyone there is on
+// the move: tracked people within `watch_radius` (moving: faster than kMovingMps) and the
+// laser's returns off the map within `near_door` (moving: Belief::moving_returns). The laser
+// sees all round, the camera only ahead.
+struct Surroundings {
+  bool near{false};
+  bool moving{false};
+};
+Surroundings LookAround(const Belief& belief, const DoorPass& pass, double watch_radius,
+                        double near_door) {
+  const auto this_side = [&](const Eigen::Vector2d& p, double radius) {
+    const Eigen::Vector2d d = p - pass.centre;
+    return d.dot(pass.n_M) > -kThroughM && d.norm() < radius;
+  };
+  Surroundings s;
+  for (const auto& entry : belief.world.people) {
+    if (!this_side(entry.person.p_MP, watch_radius)) continue;
+    s.near = true;
+    s.moving = s.moving || entry.person.v_MP.norm() > kMovingMps;
+  }
+  for (const Eigen::Vector2d& p : belief.off_map_returns)
+    s.near = s.near || this_side(p, near_door);
+  for (const Eigen::Vector2d& p : belief.moving_returns)
+    s.moving = s.moving || this_side(p, near_door);
+  return s;
+}
+
+// HoldForResidents: the watch between operations while the robot keeps a door open for the
+// residents being evacuated. Until anyone comes it waits at the actuator's standoff and
+// operates it every `every` seconds (inside the operator's hold window), so the door stands open
+// when the first of them arrives. Once someone comes — moves near the door on the robot's side:
+// laser returns off the map within `near_door` of the doorway that moved, or a tracked person
+// within `watch_radius` walking — it steps aside out of their flow, to `spot` (which it works out:
+// `aside` metres beyond the standoff along the wall, away from the doorway: the way in, and the
+// crowd funnelling into it, and the pocket behind a leaf that opens towards them, are on the
+// doorway's side), faces the way they come and watches; it goes back to the actuator only when an
+// operation is due and nobody is within `keep_clear` of the standoff or of its way there (a gap in
+// the flow) — it never walks into the queue to reach a button: the residents there can press it.
+// SUCCESS: operate now. FAILURE: the hold is over — someone came and nobody (moving or not; a
+// resident who cannot open the door waits still) has been near for `clear_for` seconds of
+// watching, or nobody at all was near for `wait_for` (they went ahead, or are elsewhere), or it
+// has held `max_hold`. RUNNING: watching.
+class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
+ public:
+  using TaskNode::TaskNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("door", "door held open for the residents"),
+            VisitPort(bt::PortDirection::kInput),
+            OutputPort<std::string>("spot", "where the robot waits beside the door (x;y;yaw)",
+                                    "{hold_spot}"),
+            InputPort<double>("aside", 0.8,
+                              "the wait spot, beyond the actuator's standoff along the wall away "
+                              "from the doorway [m]"),
+            InputPort<double>("every", 6.0,
+                              "operate again this long after the last operation, inside the "
+                              "operator's hold window [s]"),
+            InputPort<double>("near_door", 5.0,
+                              "a laser return off the map this close to the doorway, on the "
+                              "robot's side, is someone near (coming, if it moves) [m]"),
+            InputPort<double>("watch_radius", 6.0,
+                              "a tracked person this close to the doorway, on the robot's side, "
+                              "is coming [m]"),
+            InputPort<double>("keep_clear", 3.5,
+                              "go to (or wait at) the actuator only with nobody this close to its "
+                              "standoff or to the way there [m]"),
+            InputPort<double>("clear_for", 5.0,
+                              "the hold is over when nobody has been near for this long [s]"),
+            InputPort<double>("wait_for", 20.0,
+                              "the hold is over when nobody at all has been near for this long "
+                              "(they went ahead, or are elsewhere) [s]"),
+            InputPort<double>("max_hold", 600.0, "the longest the robot holds one door [s]")};
+  }
+
+  NodeStatus OnStart() override {
+    const std::string door = Door();
+    if (door != door_) {
+      door_ = door;
+      ResetHold();
+    }
+    last_tick_.reset();  // the time it was not watching (operating) does not count as clear
+    if (!started_) {
+      started_ = belief_.now;
+      if (!PlanSpot()) return NodeStatus::kFailure;
+    }
+    return OnRunning();
+  }
+
+  NodeStatus OnRunning() override {
+    const DoorPass pass = CalcDoorPass(*task_.map, door_, standoff_);
+    const double held = ToSeconds(belief_.now - *started_);
+    const Surroundings around =
+        LookAround(belief_, pass, Input<double>("watch_radius"), Input<double>("near_door"));
+    if (around.moving && !came_) {
+      Note("residents coming: stepping aside");
+      came_ = true;
+    }
+    if (around.near) {
+      unseen_ = 0.0;
+    } else if (last_tick_) {
+      unseen_ += ToSeconds(belief_.now - *last_tick_);
+    }
+    last_tick_ = belief_.now;
+    if (held > Input<double>("max_hold"))
+      return Release(StrCat("held for ", std::round(held), " s"));
+    if (!came_ && unseen_ > Input<double>("wait_for")) return Release("nobody about");
+    if (came_ && unseen_ > Input<double>("clear_for")) return Release("everyone is through");
+    if (task_.motion->base_moving()) return NodeStatus::kRunning;  // turning, or stepping aside
+    // An operation broken off (someone came) leaves the arm out: tucked before the base moves.
+    if (!ArmAt(task_.motion->arm_target(), TuckedArm(*task_.model))) {
+      task_.motion->MoveArm({{task_.config.arm_tuck_time, TuckedArm(*task_.model)}}, belief_.now);
+      Note("tucking the arm");
+    }
+    if (task_.motion->arm_moving(belief_.now)) return NodeStatus::kRunning;
+    if (task_.motion->base_failed()) task_.motion->StopBase();  // blocked: watch from here
+    // The actuator is reached only with nobody on the move near the door, and nobody, moving or
+    // standing, within keep_clear of the standoff or the way there: people standing that close
+    // may set off while the robot is at the actuator, beside the doorway they make for (and it
+    // takes the robot seconds to get out of their way).
+    const bool actuator_clear = !around.moving && WayClear(standoff_, Input<double>("keep_clear"));
+    if (OperateDue() && actuator_clear) return NodeStatus::kSuccess;
+    const Pose2& wait_at = came_ || !actuator_clear ? spot_ : standoff_;
+    if ((wait_at.translation() - belief_.X_MB.translation()).norm() > kAtSpotM &&
+        WayClear(wait_at, kSpotClearM)) {
+      Pose2 goal = wait_at;
+      if (came_) goal.yaw = LookYaw(pass, wait_at.translation());
+      if (StartPath(task_, goal, &wait_at == &spot_ ? "the spot beside the door" : "the actuator",
+                    [this](const std::string& t) { Note(t); }) == NodeStatus::kRunning)
+        return NodeStatus::kRunning;
+    }
+    // Aside, face the way the residents come (the camera sees only ahead; the laser all round).
+    if (came_) {
+      const double yaw = LookYaw(pass, belief_.X_MB.translation());
+      if (std::abs(std::remainder(yaw - belief_.X_MB.yaw, 2 * M_PI)) > kFacingToleranceRad) {
+        task_.motion->FollowPath({belief_.X_MB, Pose2{belief_.X_MB.x, belief_.X_MB.y, yaw}},
+                                 {false}, task_.motion->arm_target(), belief_.now);
+      }
+    }
+    return NodeStatus::kRunning;
+  }
+
+  void OnHalted() override { task_.motion->StopBase(); }
+
+ private:
+  // The heading from p_M to where the residents come from: kLookOutM out from the doorway.
+  static double LookYaw(const DoorPass& pass, const Eigen::Vector2d& p_M) {
+    const Eigen::Vector2d look = pass.centre + pass.n_M * kLookOutM - p_M;
+    return std::atan2(look.y(), look.x());
+  }
+
+  void ResetHold() {
+    started_.reset();
+    last_tick_.reset();
+    came_ = false;
+    unseen_ = 0.0;
+  }
+
+  NodeStatus Release(const std::string& why) {
+    Note(StrCat("releasing ", door_, ": ", why));
+    ResetHold();
+    return NodeStatus::kFailure;
+  }
+
+  // The actuator on the robot's side, its standoff, and the wait spot beside it; written to
+  // `spot`. False (noted) when the door has no actuator on this side.
+  bool PlanSpot() {
+    const MapActuator* actuator = task_.map->FindActuatorOf(door_, belief_.X_MB.translation());
+    if (actuator == nullptr) {
+      Note("door has no actuator on this side");
+      return false;
+    }
+    standoff_ = planning::MakeButtonTargets(actuator->p_M, actuator->n_M, actuator->type,
+                                            task_.config.buttons)
+                    .X_MB_standoff;
+    const DoorPass pass = CalcDoorPass(*task_.map, door_, standoff_);
+    const Eigen::Vector2d n = actuator->n_M.head<2>().normalized();
+    Eigen::Vector2d t(-n.y(), n.x());
+    if (t.dot(standoff_.translation() - pass.centre) < 0.0) t = -t;  // away from the doorway
+    const double aside = Input<double>("aside");
+    spot_ = standoff_;
+    bool found = aside <= 0.0;
+    // Nearer spots if the far one is blocked (a corner, furniture); the standoff itself last.
+    for (const double f : {1.0, 0.75, 0.5, 0.25}) {
+      if (found) break;
+      const Eigen::Vector2d p = standoff_.translation() + t * aside * f;
+      const Pose2 candidate{p.x(), p.y(), standoff_.yaw};
+      if (!task_.planner->IsValid(candidate)) continue;
+      spot_ = candidate;
+      found = true;
+    }
+    if (!found) Note("no free spot beside the actuator: waiting at its standoff");
+    this->SetOutput("spot", PosePortText(spot_));
+    return true;
+  }
+
+  bool OperateDue() const {
+    const std::optional<DoorVisit> visit = Shared<DoorVisit>("visit");
+    if (!visit || visit->door != door_ || !visit->operated_at || *visit->operated_at < *started_)
+      return true;  // not operated in this hold yet
+    for (const auto& d : belief_.world.doors) {
+      if (d.model.id != door_) continue;
+      if (d.state.observed && (d.state.motion == perception::DoorMotion::kClosing ||
+                               d.state.motion == perception::DoorMotion::kClosed))
+        return true;
+    }
+    return ToSeconds(belief_.now - *visit->operated_at) >= Input<double>("every");
+  }
+
+  // Nobody within `radius` of `goal` or of the straight way from the robot to it: no tracked
+  // person, no laser return off the map.
+  bool WayClear(const Pose2& goal, double radius) const {
+    const Eigen::Vector2d a = belief_.X_MB.translation(), b = goal.translation();
+    const auto near_way = [&](const Eigen::Vector2d& p) {
+      return (p - ClosestPointOnSegment(p, a, b)).norm() < radius;
+    };
+    for (const auto& entry : belief_.world.people)
+      if (near_way(entry.person.p_MP)) return false;
+    for (const Eigen::Vector2d& p : belief_.off_map_returns)
+      if (near_way(p)) return false;
+    return true;
+  }
+
+  std::string door_;
+  Pose2 standoff_;
+  Pose2 spot_;
+  std::optional<Time> started_;    // when this hold began
+  std::optional<Time> last_tick_;  // the previous tick of an unbroken watch
+  bool came_{false};               // someone came during this hold
+  double unseen_{0.0};             // [s] of watching since anyone was near
+};
+
+// IsNobodyComing: the guard of an operation during a hold (a ReactiveSequence above
+// ApproachButton and PressButton / WaveAtPlate): FAILURE as soon as someone moves near the door
+// on the robot's side (LookAround, as HoldForResidents sees them), so the robot breaks off
+// instead of standing at the actuator, beside the doorway, as the residents arrive.
+class IsNobodyComing final : public TaskNode<bt::ConditionNode> {
+ public:
+  using TaskNode::TaskNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("door", "door held open for the residents"),
+            InputPort<double>("near_door", 5.0,
+                              "laser returns off the map this close to the doorway, on the "
+                              "robot's side, are watched for motion [m]"),
+            InputPort<double>("watch_radius", 6.0,
+                              "tracked people this close to the doorway, on the robot's side, "
+                              "are watched [m]")};
+  }
+  NodeStatus Tick() override {
+    const std::string door = Door();
+    const DoorPass pass = CalcDoorPass(*task_.map, door, belief_.X_MB);
+    const Surroundings around =
+        LookAround(belief_, pass, Input<double>("watch_radius"), Input<double>("near_door"));
+    if (!around.moving) return NodeStatus::kSuccess;
+    Note(StrCat("someone coming to ", door, ": breaking off"));
+    return NodeStatus::kFailure;
+  }
+};
+
+}  // namespace
+
+void RegisterEscortNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services) {
+  Register<HoldForResidents>(factory, "HoldForResidents", services);
+  Register<IsNobodyComing>(factory, "IsNobodyComing", services);
+}
+
+}  // namespace egress::behavior::detail

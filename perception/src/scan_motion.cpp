@@ -1,0 +1,54 @@
+#include "egress/perception/scan_motion.h"
+
+#include <cmath>
+
+#include "egress/hsr_interface/error.h"
+
+namespace egress::perception {
+
+void ScanMotionConfig::Validate() const {
+  ThrowUnless(std::isfinite(window) && window > 0.0, "ScanMotionConfig: window must be > 0 (got ",
+              window, ")");
+  ThrowUnless(std::isfinite(step) && std::isfinite(reach) && step > 0.0 && step < reach,
+              "ScanMotionConfig: need 0 < step < reach (got step ", step, ", reach ", reach, ")");
+  ThrowUnless(std::isfinite(still_distance) && std::isfinite(still_angle) &&
+                  still_distance >= 0.0 && still_angle >= 0.0,
+              "ScanMotionConfig: still_distance and still_angle must be >= 0");
+}
+
+ScanMotion::ScanMotion(ScanMotionConfig config) : config_(config) {
+  config_.Validate();
+}
+
+const std::vector<Eigen::Vector2d>& ScanMotion::Update(Time stamp, const Pose2& X_ML,
+                                                       std::vector<Eigen::Vector2d> p_MR) {
+  ThrowUnless(history_.empty() || stamp >= history_.back().stamp,
+              "ScanMotion: a scan stamped before the last one");
+  ThrowUnless(X_ML.IsFinite(), "ScanMotion: non-finite laser pose");
+  // Seen from elsewhere, the earlier scans say nothing about motion: start again from here.
+  if (!history_.empty()) {
+    const Pose2& ref = history_.front().X_ML;
+    if ((ref.translation() - X_ML.translation()).norm() > config_.still_distance ||
+        std::abs(std::remainder(ref.yaw - X_ML.yaw, 2 * M_PI)) > config_.still_angle)
+      history_.clear();
+  }
+  // The reference: the newest scan at least `window` old (older ones are dropped).
+  while (history_.size() >= 2 && ToSeconds(stamp - history_[1].stamp) >= config_.window)
+    history_.pop_front();
+  moving_.clear();
+  if (!history_.empty() && ToSeconds(stamp - history_.front().stamp) >= config_.window &&
+      ToSeconds(stamp - history_.front().stamp) <= 3 * config_.window) {
+    const std::vector<Eigen::Vector2d>& before = history_.front().p_MR;
+    for (const Eigen::Vector2d& p : p_MR) {
+      double nearest = INFINITY;
+      for (const Eigen::Vector2d& q : before)
+        nearest = std::min(nearest, (p - q).squaredNorm());
+      if (nearest > config_.step * config_.step && nearest <= config_.reach * config_.reach)
+        moving_.push_back(p);
+    }
+  }
+  history_.push_back({stamp, X_ML, std::move(p_MR)});
+  return moving_;
+}
+
+}  // namespace egress::perception

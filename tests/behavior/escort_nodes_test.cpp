@@ -1,0 +1,125 @@
+// The escort's nodes (behavior/src/escort_nodes.cpp), ticked in one-node trees at the fixture's
+// lab door (wall y = 3, opening north; its push button south of it at x = 1.075).
+
+#include "task_node_fixture.h"
+
+#include "egress/planning/ik_solver.h"
+
+namespace egress::behavior {
+namespace {
+
+using bt::NodeStatus;
+using node_testing::At;
+using EscortNodesTest = node_testing::TaskNodeFixture;
+
+// Where the robot stands to press the lab button, and the spot beside it the hold uses (0.8 m
+// further along the wall, away from the doorway).
+Pose2 Standoff() {
+  TaskConfig config;
+  return planning::MakeButtonTargets({1.075, 2.93, 1.0}, {0.0, -1.0, 0.0},
+                                     planning::ButtonType::kPushButton, config.buttons)
+      .X_MB_standoff;
+}
+
+class HoldForResidentsTest : public EscortNodesTest {
+ protected:
+  HoldForResidentsTest() {
+    belief_.X_MB = Standoff();
+    belief_.now = At(1.0);
+  }
+  // The robot operated the button `ago` seconds before now.
+  void OperatedAgo(double ago) {
+    DoorVisit visit;
+    visit.door = "lab_door";
+    visit.operated_at = belief_.now - SecondsToDuration(ago);
+    blackboard_->Set("door_visit", bt::Any(visit));
+  }
+  bool NotedText(const std::string& text) const {
+    for (const auto& note : log_.pending())
+      if (note.text.find(text) != std::string::npos) return true;
+    return false;
+  }
+  bt::Blackboard::Ptr blackboard_ = bt::Blackboard::Create();
+  bt::Tree tree_ =
+      Tree(R"(<HoldForResidents door="lab_door" clear_for="3.0" wait_for="10.0"/>)", blackboard_);
+};
+
+TEST_F(HoldForResidentsTest, OperatesFirstAndWritesTheSpotBesideTheDoor) {
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // not operated in this hold yet
+  const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
+  EXPECT_NEAR(spot.x, Standoff().x + 0.8, 1e-6);  // away from the doorway (x = 0)
+  EXPECT_NEAR(spot.y, Standoff().y, 1e-6);
+}
+
+TEST_F(HoldForResidentsTest, ResidentsComingSendTheRobotAsideAndItLetsThemPass) {
+  tree_.TickOnce();
+  OperatedAgo(1.0);
+  belief_.now = At(2.0);
+  belief_.moving_returns = {{-0.5, 1.5}};  // walking towards the door, on the robot's side
+  belief_.off_map_returns = belief_.moving_returns;
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(NotedText("residents coming"));
+  ASSERT_GE(motion_.path().size(), 2u);
+  EXPECT_NEAR(motion_.path().back().x, Standoff().x + 0.8, 1e-6);
+  // Its operation due again, with people still on the move near the door: it stays aside.
+  belief_.X_MB = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
+  motion_.StopBase();
+  OperatedAgo(8.0);
+  belief_.now = At(3.0);
+  belief_.moving_returns = {{0.3, 2.3}};
+  belief_.off_map_returns = belief_.moving_returns;
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  // Through: the clear time counts while it watches; past clear_for the hold is over.
+  belief_.moving_returns.clear();
+  belief_.off_map_returns = {{0.2, 4.5}};  // beyond the door: not near on its side
+  for (double t = 3.5; t < 6.4; t += 0.5) {
+    belief_.now = At(t);
+    EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning) << "at " << t;
+  }
+  belief_.now = At(6.6);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kFailure);
+  EXPECT_TRUE(NotedText("everyone is through"));
+}
+
+TEST_F(HoldForResidentsTest, NeverGoesToTheActuatorWithSomeoneStandingByIt) {
+  tree_.TickOnce();
+  OperatedAgo(7.0);  // due
+  belief_.now = At(2.0);
+  belief_.off_map_returns = {{1.6, 1.8}};  // standing 0.7 m from the standoff
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  belief_.off_map_returns.clear();
+  belief_.now = At(2.5);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);
+}
+
+TEST_F(HoldForResidentsTest, WithNobodyAboutTheHoldEndsAfterWaitFor) {
+  tree_.TickOnce();
+  OperatedAgo(0.5);
+  for (double t = 1.5; t <= 10.5; t += 1.0) {
+    belief_.now = At(t);
+    OperatedAgo(0.5);  // kept open meanwhile
+    EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning) << "at " << t;
+  }
+  belief_.now = At(11.6);
+  OperatedAgo(0.5);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kFailure);
+  EXPECT_TRUE(NotedText("nobody about"));
+}
+
+TEST_F(EscortNodesTest, IsNobodyComingFailsWhenSomeoneMovesNearTheDoorOnTheRobotsSide) {
+  bt::Tree tree = Tree(R"(<IsNobodyComing door="lab_door"/>)");
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);
+  belief_.off_map_returns = {{-0.5, 1.5}};  // standing: not coming
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);
+  belief_.moving_returns = {{0.3, 4.5}};  // walking, beyond the door
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);
+  belief_.moving_returns = {{-0.5, 1.5}};
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
+  belief_.moving_returns.clear();
+  See({node_testing::Person({-1.0, 0.0}, perception::PersonIntent::kUnknown)});
+  belief_.world.people[0].person.v_MP = {0.5, 1.0};  // tracked, walking to the door
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
+}
+
+}  // namespace
+}  // namespace egress::behavior
