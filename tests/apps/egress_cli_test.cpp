@@ -21,6 +21,7 @@
 namespace {
 
 using ::testing::HasSubstr;
+using ::testing::Not;
 
 struct Result {
   int exit_code;
@@ -390,6 +391,20 @@ TEST(EgressCliTest, EvacStudyComparesTheThreeConditionsOnTheSameSeeds) {
                           (dir / "x").string());
   EXPECT_EQ(none.exit_code, 1);
   EXPECT_THAT(none.output, HasSubstr("no people with behavior evacuate"));
+  // One condition alone: the same rows as in the full study, the others absent.
+  Result robot = RunEgress("evac study " + scenario + " --trials 1 -q --conditions robot --out " +
+                           (dir / "robot").string());
+  ASSERT_EQ(robot.exit_code, 0) << robot.output;
+  const std::string rows = read("robot");
+  EXPECT_THAT(rows, Not(HasSubstr("no_robot,")));
+  const std::string full = read("one");
+  const std::size_t at = full.find("\nrobot,");
+  ASSERT_NE(at, std::string::npos);
+  EXPECT_THAT(rows, HasSubstr(full.substr(at + 1, full.find('\n', at + 1) - at)));
+  Result bad = RunEgress("evac study " + scenario + " -q --conditions nobody --out " +
+                         (dir / "bad").string());
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_THAT(bad.output, HasSubstr("nobody"));
   std::filesystem::remove_all(dir);
 }
 
