@@ -22,13 +22,15 @@ constexpr double kThroughM = 0.3;
 constexpr double kAtSpotM = 0.15;
 // [m/s] A tracked person faster than this is on the move.
 constexpr double kMovingMps = 0.2;
+// [s] Still this long after people came, those left near the door are waiting for it.
+constexpr double kStillForSec = 4.0;
 // [m] The robot goes to its wait spot only with nobody this near it (or the way there).
 constexpr double kSpotClearM = 1.0;
 
 // Who is near a door on the robot's side (or in its doorway), and whether anyone there is on
 // the move: tracked people within `watch_radius` (moving: faster than kMovingMps) and the
-// laser's returns off the map within `near_door` (moving: Belief::moving_returns). The laser
-// sees all round, the camera only ahead.
+// laser's moving returns within `near_door` (Belief::moving_returns). The laser sees all round,
+// the camera only ahead.
 struct Surroundings {
   bool near{false};
   bool moving{false};
@@ -45,10 +47,14 @@ Surroundings LookAround(const Belief& belief, const DoorPass& pass, double watch
     s.near = true;
     s.moving = s.moving || entry.person.v_MP.norm() > kMovingMps;
   }
-  for (const Eigen::Vector2d& p : belief.off_map_returns)
-    s.near = s.near || this_side(p, near_door);
-  for (const Eigen::Vector2d& p : belief.moving_returns)
-    s.moving = s.moving || this_side(p, near_door);
+  // Returns off the map that stand still are not counted as someone near: furniture not on the
+  // map (a bed, a cart) would hold the door for ever. Someone standing still is seen by the
+  // camera, which faces their way while the robot waits.
+  for (const Eigen::Vector2d& p : belief.moving_returns) {
+    if (!this_side(p, near_door)) continue;
+    s.near = true;
+    s.moving = true;
+  }
   return s;
 }
 
@@ -75,15 +81,15 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
             VisitPort(bt::PortDirection::kInput),
             OutputPort<std::string>("spot", "where the robot waits beside the door (x;y;yaw)",
                                     "{hold_spot}"),
-            InputPort<double>("aside", 0.8,
+            InputPort<double>("aside", 1.5,
                               "the wait spot, beyond the actuator's standoff along the wall away "
                               "from the doorway [m]"),
             InputPort<double>("every", 6.0,
                               "operate again this long after the last operation, inside the "
                               "operator's hold window [s]"),
             InputPort<double>("near_door", 5.0,
-                              "a laser return off the map this close to the doorway, on the "
-                              "robot's side, is someone near (coming, if it moves) [m]"),
+                              "a laser return off the map that moves this close to the doorway, "
+                              "on the robot's side, is someone coming [m]"),
             InputPort<double>("watch_radius", 6.0,
                               "a tracked person this close to the doorway, on the robot's side, "
                               "is coming [m]"),
@@ -121,6 +127,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
       Note("residents coming: stepping aside");
       came_ = true;
     }
+    if (around.moving) last_moving_ = belief_.now;
     if (around.near) {
       unseen_ = 0.0;
     } else if (last_tick_) {
@@ -143,7 +150,14 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // standing, within keep_clear of the standoff or the way there: people standing that close
     // may set off while the robot is at the actuator, beside the doorway they make for (and it
     // takes the robot seconds to get out of their way).
-    const bool actuator_clear = !around.moving && WayClear(standoff_, Input<double>("keep_clear"));
+    // Once they came and have all stood still for a while, whoever is left waits for the door
+    // (someone who cannot open it): the robot opens it for them, passing no nearer than
+    // kSpotClearM.
+    const bool all_waiting =
+        came_ && last_moving_ && ToSeconds(belief_.now - *last_moving_) > kStillForSec;
+    const bool actuator_clear =
+        !around.moving &&
+        WayClear(standoff_, all_waiting ? kSpotClearM : Input<double>("keep_clear"));
     if (OperateDue() && actuator_clear) return NodeStatus::kSuccess;
     const Pose2& wait_at = came_ || !actuator_clear ? spot_ : standoff_;
     if ((wait_at.translation() - belief_.X_MB.translation()).norm() > kAtSpotM &&
@@ -178,6 +192,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     started_.reset();
     last_tick_.reset();
     came_ = false;
+    last_moving_.reset();
     unseen_ = 0.0;
   }
 
@@ -249,10 +264,11 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   std::string door_;
   Pose2 standoff_;
   Pose2 spot_;
-  std::optional<Time> started_;    // when this hold began
-  std::optional<Time> last_tick_;  // the previous tick of an unbroken watch
-  bool came_{false};               // someone came during this hold
-  double unseen_{0.0};             // [s] of watching since anyone was near
+  std::optional<Time> started_;      // when this hold began
+  std::optional<Time> last_tick_;    // the previous tick of an unbroken watch
+  bool came_{false};                 // someone came during this hold
+  std::optional<Time> last_moving_;  // when someone near was last seen on the move
+  double unseen_{0.0};               // [s] of watching since anyone was near
 };
 
 // IsNobodyComing: the guard of an operation during a hold (a ReactiveSequence above

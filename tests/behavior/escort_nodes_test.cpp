@@ -12,7 +12,7 @@ using bt::NodeStatus;
 using node_testing::At;
 using EscortNodesTest = node_testing::TaskNodeFixture;
 
-// Where the robot stands to press the lab button, and the spot beside it the hold uses (0.8 m
+// Where the robot stands to press the lab button, and the spot beside it the hold uses (1.5 m
 // further along the wall, away from the doorway).
 Pose2 Standoff() {
   TaskConfig config;
@@ -47,7 +47,7 @@ class HoldForResidentsTest : public EscortNodesTest {
 TEST_F(HoldForResidentsTest, OperatesFirstAndWritesTheSpotBesideTheDoor) {
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // not operated in this hold yet
   const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
-  EXPECT_NEAR(spot.x, Standoff().x + 0.8, 1e-6);  // away from the doorway (x = 0)
+  EXPECT_NEAR(spot.x, Standoff().x + 1.5, 1e-6);  // away from the doorway (x = 0)
   EXPECT_NEAR(spot.y, Standoff().y, 1e-6);
 }
 
@@ -60,7 +60,7 @@ TEST_F(HoldForResidentsTest, ResidentsComingSendTheRobotAsideAndItLetsThemPass) 
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
   EXPECT_TRUE(NotedText("residents coming"));
   ASSERT_GE(motion_.path().size(), 2u);
-  EXPECT_NEAR(motion_.path().back().x, Standoff().x + 0.8, 1e-6);
+  EXPECT_NEAR(motion_.path().back().x, Standoff().x + 1.5, 1e-6);
   // Its operation due again, with people still on the move near the door: it stays aside.
   belief_.X_MB = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
   motion_.StopBase();
@@ -90,6 +90,26 @@ TEST_F(HoldForResidentsTest, NeverGoesToTheActuatorWithSomeoneStandingByIt) {
   belief_.off_map_returns.clear();
   belief_.now = At(2.5);
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);
+}
+
+TEST_F(HoldForResidentsTest, OpensTheDoorForSomeoneLeftWaitingAtIt) {
+  tree_.TickOnce();
+  OperatedAgo(1.0);
+  belief_.now = At(2.0);
+  belief_.moving_returns = {{-0.5, 1.5}};  // they come
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  motion_.StopBase();
+  belief_.moving_returns.clear();
+  // One stays, still, 1.5 m from the standoff (a wheelchair user who cannot press the button).
+  See({node_testing::Person({0.0, 1.9}, perception::PersonIntent::kStationary)});
+  OperatedAgo(12.0);  // the door has closed
+  belief_.now = At(4.0);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);  // still a moment ago: may set off
+  belief_.X_MB = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());  // aside now
+  motion_.StopBase();
+  belief_.now = At(6.5);
+  See(belief_.world.people);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // waiting: the robot opens it
 }
 
 TEST_F(HoldForResidentsTest, WithNobodyAboutTheHoldEndsAfterWaitFor) {
