@@ -29,8 +29,9 @@ constexpr double kSpotClearM = 1.0;
 
 // Who is near a door on the robot's side (or in its doorway), and whether anyone there is on
 // the move: tracked people within `watch_radius` (moving: faster than kMovingMps) and the
-// laser's moving returns within `near_door` (Belief::moving_returns). The laser sees all round,
-// the camera only ahead.
+// laser's returns off the map within `near_door` (moving: Belief::moving_returns). The laser
+// sees all round, the camera only ahead. (Furniture off the map near a door counts as someone
+// near: such a door is held until max_hold.)
 struct Surroundings {
   bool near{false};
   bool moving{false};
@@ -47,14 +48,10 @@ Surroundings LookAround(const Belief& belief, const DoorPass& pass, double watch
     s.near = true;
     s.moving = s.moving || entry.person.v_MP.norm() > kMovingMps;
   }
-  // Returns off the map that stand still are not counted as someone near: furniture not on the
-  // map (a bed, a cart) would hold the door for ever. Someone standing still is seen by the
-  // camera, which faces their way while the robot waits.
-  for (const Eigen::Vector2d& p : belief.moving_returns) {
-    if (!this_side(p, near_door)) continue;
-    s.near = true;
-    s.moving = true;
-  }
+  for (const Eigen::Vector2d& p : belief.off_map_returns)
+    s.near = s.near || this_side(p, near_door);
+  for (const Eigen::Vector2d& p : belief.moving_returns)
+    s.moving = s.moving || this_side(p, near_door);
   return s;
 }
 
@@ -88,8 +85,8 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
                               "operate again this long after the last operation, inside the "
                               "operator's hold window [s]"),
             InputPort<double>("near_door", 5.0,
-                              "a laser return off the map that moves this close to the doorway, "
-                              "on the robot's side, is someone coming [m]"),
+                              "a laser return off the map this close to the doorway, on the "
+                              "robot's side, is someone near (coming, if it moves) [m]"),
             InputPort<double>("watch_radius", 6.0,
                               "a tracked person this close to the doorway, on the robot's side, "
                               "is coming [m]"),
