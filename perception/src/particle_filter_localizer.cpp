@@ -69,6 +69,8 @@ double ParticleFilterLocalizer::BeamLogLikelihood(double d) const {
 }
 
 void ParticleFilterLocalizer::Initialize(const Pose2& X_MB, const Eigen::Matrix3d& covariance) {
+  estimate_.reset();
+  covariance_.reset();
   ThrowUnless(X_MB.IsFinite(), "Invalid initial pose: must be finite.");
   ThrowUnless(
       covariance.allFinite() && (covariance - covariance.transpose()).cwiseAbs().maxCoeff() < 1e-12,
@@ -89,6 +91,8 @@ void ParticleFilterLocalizer::Initialize(const Pose2& X_MB, const Eigen::Matrix3
 }
 
 void ParticleFilterLocalizer::Predict(const Pose2& X_OB_previous, const Pose2& X_OB_current) {
+  estimate_.reset();
+  covariance_.reset();
   ThrowUnless(X_OB_previous.IsFinite() && X_OB_current.IsFinite(),
               "Invalid odometry: poses must be finite.");
   ThrowUnless(initialized(), "ParticleFilterLocalizer::Predict: call Initialize first.");
@@ -148,6 +152,8 @@ double ParticleFilterLocalizer::LikelihoodFieldDistance(const Eigen::Vector2d& p
 }
 
 bool ParticleFilterLocalizer::Correct(const LaserScan& scan) {
+  estimate_.reset();
+  covariance_.reset();
   scan.Validate();
   ThrowUnless(initialized(), "ParticleFilterLocalizer::Correct: call Initialize first.");
   if (!moved_since_correction_) return false;
@@ -191,6 +197,8 @@ bool ParticleFilterLocalizer::Correct(const LaserScan& scan) {
 }
 
 void ParticleFilterLocalizer::Resample() {
+  estimate_.reset();
+  covariance_.reset();
   // Low-variance (systematic) resampling.
   const std::size_t n = particles_.size();
   std::vector<Particle> resampled;
@@ -216,6 +224,11 @@ void ParticleFilterLocalizer::Update(const Pose2& X_OB, const LaserScan& scan) {
 }
 
 Pose2 ParticleFilterLocalizer::Estimate() const {
+  if (!estimate_) estimate_ = CalcEstimate();
+  return *estimate_;
+}
+
+Pose2 ParticleFilterLocalizer::CalcEstimate() const {
   ThrowUnless(initialized(), "ParticleFilterLocalizer::Estimate: call Initialize first.");
   double x = 0, y = 0, c = 0, s = 0;
   for (const Particle& p : particles_) {
@@ -228,12 +241,14 @@ Pose2 ParticleFilterLocalizer::Estimate() const {
 }
 
 Eigen::Matrix3d ParticleFilterLocalizer::Covariance() const {
+  if (covariance_) return *covariance_;
   const Pose2 mean = Estimate();
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   for (const Particle& p : particles_) {
     const Eigen::Vector3d d(p.X_MB.x - mean.x, p.X_MB.y - mean.y, WrapAngle(p.X_MB.yaw - mean.yaw));
     covariance += p.weight * d * d.transpose();
   }
+  covariance_ = covariance;
   return covariance;
 }
 

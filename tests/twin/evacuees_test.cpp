@@ -132,8 +132,13 @@ TEST(EvacueesTest, AMixedGroupLeavesTheClinicThroughProppedDoors) {
     TwinWorld world(loaded.scenario, loaded.world, seed, Hsr());
     world.StepFor(300.0);
     int out = 0;
-    for (const auto& p : world.people())
+    for (const auto& p : world.people()) {
       out += p.out;
+      if (!p.out)
+        ADD_FAILURE() << "seed " << seed << ": " << p.name << " (" << p.mobility << ") at "
+                      << p.position.transpose() << " phase " << int(p.phase) << " reached "
+                      << p.doors_operated;
+    }
     EXPECT_EQ(out, 20) << "seed " << seed;
   }
 }

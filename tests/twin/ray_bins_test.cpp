@@ -61,6 +61,39 @@ TEST(RayBinsTest, ReturnsEveryBoxTheSegmentTouchesAscendingAndOnce) {
   EXPECT_GT(touched_total, 1000);  // the check above was exercised
 }
 
+TEST(RayBinsTest, SegmentsAlongCellLinesAndThroughCornersMissNothing) {
+  // Unit boxes on a unit grid, every other one, touching at corners; segments on the grid's
+  // lines, through its corners, and ending exactly on them: where a grid walk's rounding bites.
+  std::vector<Box> boxes;
+  for (int x = 0; x < 12; ++x) {
+    for (int y = 0; y < 12; ++y) {
+      if ((x + y) % 2 == 0)
+        boxes.emplace_back(Eigen::Vector2d(x, y), Eigen::Vector2d(x + 1, y + 1));
+    }
+  }
+  RayBins bins;
+  bins.Build(boxes, 1.0);
+  std::vector<int> got;
+  int touched = 0;
+  for (int x0 = 0; x0 <= 12; x0 += 3) {
+    for (int y0 = 0; y0 <= 12; y0 += 2) {
+      for (const Eigen::Vector2d& d :
+           {Eigen::Vector2d(5, 5), Eigen::Vector2d(-4, 4), Eigen::Vector2d(6, 0),
+            Eigen::Vector2d(0, -7), Eigen::Vector2d(3, 6), Eigen::Vector2d(-2.5, -7.5)}) {
+        const Eigen::Vector2d a(x0, y0), b = a + d;
+        bins.Query(a, b, &got);
+        for (std::size_t i = 0; i < boxes.size(); ++i) {
+          if (!SegmentTouchesBox(a, b, boxes[i])) continue;
+          ++touched;
+          ASSERT_TRUE(std::binary_search(got.begin(), got.end(), int(i)))
+              << "box " << i << " missed by (" << a.transpose() << ") - (" << b.transpose() << ")";
+        }
+      }
+    }
+  }
+  EXPECT_GT(touched, 500);
+}
+
 TEST(RayBinsTest, CullsBoxesFarFromTheSegment) {
   std::vector<Box> boxes;
   for (int i = 0; i < 100; ++i)

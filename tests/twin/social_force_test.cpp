@@ -1,5 +1,6 @@
 #include "egress/twin/social_force.h"
 
+#include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -88,6 +89,31 @@ TEST(SocialForceModelTest, ARobotDiscIsAvoided) {
 // Step's cell lists (walkers within the social cutoff, walls within reach) give bit for bit
 // the accelerations of summing over every walker and every wall, so runs do not change with
 // the crowd's size or the building's.
+TEST(SocialForceModelTest, ANeighbourPushesOnlyWithinItsReachAndFurtherWhenComingAtYou) {
+  // A standing walker at the origin (no drive), another at distance x: the push on the first.
+  SocialForceParams params;
+  params.field_of_view_deg = 360.0;  // every force in view: one weight
+  const SocialForceModel sfm(params);
+  auto push = [&](double x, double vx) {
+    std::vector<Walker> w(2);
+    w[0].desired_speed = 0.0;
+    w[1].position = {x, 0.0};
+    w[1].velocity = {vx, 0.0};
+    w[1].desired_speed = 0.0;
+    return sfm.CalcAcceleration(0, w, {}, {}).norm();
+  };
+  const double b_max = params.social_range * std::log(1000.0);  // 2.07 m
+  EXPECT_GT(push(b_max - 0.05, 0.0), 0.0);
+  EXPECT_EQ(push(b_max + 0.05, 0.0), 0.0);
+  // The push is continuous to within the dropped fraction of its contact value (with the
+  // keep-right share, 0.3 of it sideways, for someone ahead).
+  const double at_contact = params.drive_factor * params.social_strength / params.social_range;
+  EXPECT_LT(push(b_max - 1e-6, 0.0), 1.001e-3 * std::hypot(1.0, params.keep_right) * at_contact);
+  // Someone walking at you at 1.3 m/s is felt from further away (HM95's ellipse).
+  EXPECT_GT(push(b_max + 0.5, -1.3), 0.0);
+  EXPECT_EQ(push(b_max + 0.5, +1.3), 0.0);  // walking away
+}
+
 TEST(SocialForceModelTest, StepsCellListsMatchTheSumOverEverything) {
   std::mt19937_64 rng(11);
   std::uniform_real_distribution<double> pos(0.0, 40.0), unit(-1.0, 1.0), len(0.2, 8.0);
@@ -129,6 +155,44 @@ TEST(SocialForceModelTest, StepsCellListsMatchTheSumOverEverything) {
     pushed_by_walls += gap < 3.0;
   }
   EXPECT_GT(pushed_by_walls, 20);  // walls did act
+}
+
+TEST(SocialForceModelTest, BinnedFixedWallsAndMovingOnesStepAsAllTheWallsTogether) {
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> pos(0.0, 30.0), unit(-1.0, 1.0), len(0.2, 6.0);
+  std::vector<Walker> walkers(60);
+  for (auto& w : walkers) {
+    w.position = {pos(rng), pos(rng) / 3.0};
+    w.velocity = {unit(rng) * 0.5, unit(rng) * 0.5};
+    w.target = {pos(rng), pos(rng) / 3.0};
+  }
+  auto segments = [&](int n, bool obstacles) {
+    std::vector<WallSegment> out;
+    for (int k = 0; k < n; ++k) {
+      const Eigen::Vector2d a(pos(rng), pos(rng) / 3.0);
+      out.push_back({a, a + len(rng) * Eigen::Vector2d(unit(rng), unit(rng)).normalized(),
+                     obstacles && k % 3 ? k % 5 : -1});
+    }
+    return out;
+  };
+  const std::vector<WallSegment> fixed = segments(50, true), leaves = segments(4, false);
+  std::vector<WallSegment> together = fixed;
+  together.insert(together.end(), leaves.begin(), leaves.end());
+  const std::vector<DiscObstacle> discs = {{{15.0, 5.0}, {0.0, 0.3}, 0.25}};
+  SocialForceModel sfm;
+  std::vector<Walker> a = walkers, b = walkers;
+  const WallCells cells(fixed);
+  for (int step = 0; step < 50; ++step) {
+    sfm.Step(&a, discs, together, 1.0 / 240);
+    sfm.Step(&b, discs, cells, leaves, 1.0 / 240);
+  }
+  double moved = 0.0;
+  for (std::size_t i = 0; i < walkers.size(); ++i) {
+    EXPECT_EQ(a[i].position, b[i].position) << "walker " << i;
+    EXPECT_EQ(a[i].velocity, b[i].velocity) << "walker " << i;
+    moved += (a[i].position - walkers[i].position).norm();
+  }
+  EXPECT_GT(moved, 1.0);  // they walked
 }
 
 }  // namespace

@@ -48,35 +48,72 @@ void RayBins::Build(const std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d
 void RayBins::Query(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
                     std::vector<int>* out) const {
   out->assign(everywhere_.begin(), everywhere_.end());
-  if (nx_ > 0 && a.allFinite() && b.allFinite()) {
-    const Eigen::Vector2d lo = origin_, hi = origin_ + cell_ * Eigen::Vector2d(nx_, ny_);
-    const auto add_cells = [&](const Eigen::Vector2d& l, const Eigen::Vector2d& h) {
-      if (h.x() < lo.x() || h.y() < lo.y() || l.x() > hi.x() || l.y() > hi.y()) return;
-      const long x0 = CellX(l.x()), x1 = CellX(h.x()), y1 = CellY(h.y());
-      for (long y = CellY(l.y()); y <= y1; ++y)
-        for (long x = x0; x <= x1; ++x) {
-          const auto& bin = bins_[std::size_t(y * nx_ + x)];
-          out->insert(out->end(), bin.begin(), bin.end());
-        }
-    };
-    const Eigen::Vector2d l = a.cwiseMin(b), h = a.cwiseMax(b);
-    if ((h - l).maxCoeff() <= 3.0 * cell_) {
-      add_cells(l, h);  // a short segment: its bounding box is at most 4 x 4 cells
-    } else {
-      // A long one in pieces no longer than a cell: each piece's bounding box covers at most
-      // 2 x 2 cells, and together they cover every cell the segment touches.
-      const int pieces = 1 + int(std::min(1e6, std::ceil((b - a).norm() / cell_)));
-      Eigen::Vector2d p0 = a;
-      for (int k = 1; k <= pieces; ++k) {
-        const Eigen::Vector2d p1 =
-            k == pieces ? b : Eigen::Vector2d(a + (b - a) * (double(k) / pieces));
-        add_cells(p0.cwiseMin(p1), p0.cwiseMax(p1));
-        p0 = p1;
-      }
-    }
-  }
+  if (nx_ > 0 && a.allFinite() && b.allFinite()) WalkCells(a, b, out);
   std::sort(out->begin(), out->end());
   out->erase(std::unique(out->begin(), out->end()), out->end());
+}
+
+void RayBins::WalkCells(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                        std::vector<int>* out) const {
+  // The segment clipped to the grid's (closed) extent.
+  const Eigen::Vector2d lo = origin_, hi = origin_ + cell_ * Eigen::Vector2d(nx_, ny_);
+  const Eigen::Vector2d d = b - a;
+  double t0 = 0.0, t1 = 1.0;
+  for (int i = 0; i < 2; ++i) {
+    if (d[i] == 0.0) {
+      if (a[i] < lo[i] || a[i] > hi[i]) return;
+      continue;
+    }
+    double ta = (lo[i] - a[i]) / d[i], tb = (hi[i] - a[i]) / d[i];
+    if (ta > tb) std::swap(ta, tb);
+    t0 = std::max(t0, ta);
+    t1 = std::min(t1, tb);
+    if (t0 > t1) return;
+  }
+  const Eigen::Vector2d p = a + t0 * d, q = a + t1 * d, e = q - p;
+  const auto add = [&](long x, long y) {
+    if (x < 0 || y < 0 || x >= nx_ || y >= ny_) return;
+    const auto& bin = bins_[std::size_t(y * nx_ + x)];
+    out->insert(out->end(), bin.begin(), bin.end());
+  };
+  // Amanatides & Woo's grid walk from p's cell to q's, in steps of one cell; t in [0, 1] on
+  // p-q. Where the walk passes a corner (both crossings at once, to rounding) the two cells
+  // beside it are added too, so that no cell the segment touches is missed.
+  long x = CellX(p.x()), y = CellY(p.y());
+  const long x_end = CellX(q.x()), y_end = CellY(q.y());
+  const long step_x = e.x() > 0 ? 1 : (e.x() < 0 ? -1 : 0);
+  const long step_y = e.y() > 0 ? 1 : (e.y() < 0 ? -1 : 0);
+  const auto first_crossing = [&](long c, long step, double start, double extent, double origin) {
+    if (step == 0) return double(INFINITY);
+    return (origin + double(c + (step > 0 ? 1 : 0)) * cell_ - start) / extent;
+  };
+  double t_x = first_crossing(x, step_x, p.x(), e.x(), origin_.x());
+  double t_y = first_crossing(y, step_y, p.y(), e.y(), origin_.y());
+  const double dt_x = step_x != 0 ? cell_ / std::abs(e.x()) : INFINITY;
+  const double dt_y = step_y != 0 ? cell_ / std::abs(e.y()) : INFINITY;
+  constexpr double kCornerTol = 1e-9;  // crossings this close (in t) are one corner
+  add(x, y);
+  for (long left = std::abs(x_end - x) + std::abs(y_end - y); left > 0; --left) {
+    if (std::abs(t_x - t_y) <= kCornerTol) {
+      add(x + step_x, y);
+      add(x, y + step_y);
+      x += step_x;
+      y += step_y;
+      t_x += dt_x;
+      t_y += dt_y;
+      --left;  // two cells' worth of the count
+    } else if (t_x < t_y) {
+      x += step_x;
+      t_x += dt_x;
+    } else {
+      y += step_y;
+      t_y += dt_y;
+    }
+    add(x, y);
+    if (x == x_end && y == y_end) break;
+  }
+  // Rounding may stop the walk a cell short of q's: q's cell always counts.
+  if (x != x_end || y != y_end) add(x_end, y_end);
 }
 
 }  // namespace egress::twin::world_detail

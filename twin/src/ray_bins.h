@@ -29,6 +29,8 @@ class RayBins {
   static constexpr long kMaxCellsPerBox = 4096;
 
  private:
+  // Appends the boxes of every cell the segment a-b crosses (a grid walk).
+  void WalkCells(const Eigen::Vector2d& a, const Eigen::Vector2d& b, std::vector<int>* out) const;
   long CellX(double x) const;
   long CellY(double y) const;
 

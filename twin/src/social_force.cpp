@@ -3,18 +3,29 @@
 #include "egress/hsr_interface/geometry.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <map>
 
 namespace egress::twin {
 namespace {
 
-// Beyond this centre distance another walker (or a disc) exerts no social force [m]; it is also
-// the cell size of Step's neighbour grid, so that the 3 x 3 cells round a walker hold everyone
-// within it. (At 6 m HM95's term is below 1e-8 of its contact value.)
-constexpr double kSocialCutoffM = 6.0;
-// Beyond this distance from its nearest point an obstacle exerts no force [m]; the cell size
-// of Step's wall lists.
+// A social term is dropped where it is below this fraction of its value at contact (b = 0): past
+// b = σ ln(1 / fraction), 2.1 m for HM95's σ = 0.3 m. Dropping the far terms is what lets a
+// walker meet only the walkers near it.
+constexpr double kSocialNegligibleFraction = 1e-3;
+// Two bodies closer than this may touch [m] (a wheelchair and a pushed one: well under 1 m).
+constexpr double kMaxBodyReachM = 1.0;
+
+// The farthest centre distance at which a walker whose step (its velocity over the social
+// horizon) is `step` long exerts a social term that is not dropped: b >= sqrt(r^2 - r |step|)
+// on the HM95 ellipse, so b > b_max wherever r > (|step| + sqrt(|step|^2 + 4 b_max^2)) / 2.
+double SocialReach(double step, double b_max) {
+  return 0.5 * (step + std::sqrt(step * step + 4.0 * b_max * b_max));
+}
+
+// Beyond this distance from its nearest point an obstacle exerts no force [m].
 constexpr double kWallCutoffM = 3.0;
 
 }  // namespace
@@ -28,13 +39,23 @@ Eigen::Vector2d ClosestPointOnSegment(const Eigen::Vector2d& p, const WallSegmen
 Eigen::Vector2d SocialForceModel::BodyForce(const Walker& w, const Eigen::Vector2d& other_p,
                                             const Eigen::Vector2d& other_v, double other_r) const {
   const Eigen::Vector2d d = w.position - other_p;
+  const double reach = w.radius + other_r;
+  if (d.squaredNorm() >= reach * reach) return Eigen::Vector2d::Zero();  // apart: no sqrt
   const double dist = d.norm();
-  const double overlap = w.radius + other_r - dist;
+  const double overlap = reach - dist;
   if (overlap <= 0.0 || dist < 1e-9) return Eigen::Vector2d::Zero();
   const Eigen::Vector2d n = d / dist;
   const Eigen::Vector2d t(-n.y(), n.x());
   const double dv_t = (other_v - w.velocity).dot(t);
   return params_.body_compression * overlap * n + params_.sliding_friction * overlap * dv_t * t;
+}
+
+double SocialForceModel::WalkerReach(const Walker& o) const {
+  // A hair more than the bound, so rounding never drops a term the sum over everyone keeps;
+  // and at least touching distance for the body force (the widest body is under 1 m across).
+  const double b_max = params_.social_range * std::log(1.0 / kSocialNegligibleFraction);
+  const double social = SocialReach(o.velocity.norm() * params_.social_horizon, b_max);
+  return std::max(social * (1.0 + 1e-9) + 1e-9, kMaxBodyReachM);
 }
 
 Eigen::Vector2d SocialForceModel::CalcAcceleration(std::size_t i,
@@ -75,9 +96,12 @@ Eigen::Vector2d SocialForceModel::CalcAccelerationAmong(
     const Eigen::Vector2d r = w.position - other_p;
     const Eigen::Vector2d step = other_v * P.social_horizon;
     const double r_norm = r.norm();
-    if (r_norm < 1e-6 || r_norm > kSocialCutoffM) return Eigen::Vector2d(Eigen::Vector2d::Zero());
+    if (r_norm < 1e-6) return Eigen::Vector2d(Eigen::Vector2d::Zero());
     const double s = r_norm + (r - step).norm();
     const double b = 0.5 * std::sqrt(std::max(s * s - step.squaredNorm(), 1e-12));
+    if (b > range * std::log(1.0 / kSocialNegligibleFraction)) {
+      return Eigen::Vector2d(Eigen::Vector2d::Zero());
+    }
     const Eigen::Vector2d n = r / r_norm;
     Eigen::Vector2d f = (strength / range) * std::exp(-b / range) * n;
     // Turn part of it to the walker's right when the other is ahead: people keep right.
@@ -90,6 +114,9 @@ Eigen::Vector2d SocialForceModel::CalcAccelerationAmong(
     const std::size_t j = near.walkers ? (*near.walkers)[k] : k;
     if (j == i) continue;
     const Walker& o = walkers[j];
+    // Beyond its reach (and touching distance) another walker does nothing: no square roots.
+    const double reach = near.reach ? (*near.reach)[j] : WalkerReach(o);
+    if ((w.position - o.position).squaredNorm() > reach * reach) continue;
     // Social terms scale with the drive (their balance is what HM95 tuned); walls do not.
     a += social(o.position, o.velocity, P.drive_factor * P.social_strength, P.social_range);
     a += BodyForce(w, o.position, o.velocity, o.radius) / P.mass;
@@ -145,57 +172,104 @@ Eigen::Vector2d SocialForceModel::CalcAccelerationAmong(
   return a;
 }
 
-void SocialForceModel::Step(std::vector<Walker>* walkers, const std::vector<DiscObstacle>& discs,
-                            const std::vector<WallSegment>& walls, double dt) const {
-  // A uniform grid of kSocialCutoffM cells (a cell list): each walker meets only the walkers
-  // of the 3 x 3 cells round it, in ascending index as over the whole crowd, so the sums (and
-  // the run) are the same as without the grid, in O(n) instead of O(n^2).
-  const std::vector<Walker>& all = *walkers;
-  std::vector<Eigen::Vector2d> accelerations(all.size());
-  std::map<std::pair<long, long>, std::vector<std::size_t>> cells;
-  const auto cell_of = [](const Eigen::Vector2d& p) {
-    return std::pair<long, long>(long(std::floor(p.x() / kSocialCutoffM)),
-                                 long(std::floor(p.y() / kSocialCutoffM)));
-  };
-  for (std::size_t i = 0; i < all.size(); ++i)
-    cells[cell_of(all[i].position)].push_back(i);
-  // Walls in cells of kWallCutoffM: each segment is listed in every cell its bounding box,
-  // grown by the cutoff, overlaps, so a walker's own cell lists every segment within reach.
-  const auto wall_cell_of = [](double x, double y) {
-    return std::pair<long, long>(long(std::floor(x / kWallCutoffM)),
-                                 long(std::floor(y / kWallCutoffM)));
-  };
-  std::map<std::pair<long, long>, std::vector<std::size_t>> wall_cells;
-  std::vector<std::size_t> wall_rank(walls.size());
+namespace {
+// The cells of WallCells [m]: smaller than the reach, so that a walker's cell lists few walls
+// beyond it.
+constexpr double kWallCellM = 1.0;
+std::pair<long, long> WallCellOf(double x, double y) {
+  return {long(std::floor(x / kWallCellM)), long(std::floor(y / kWallCellM))};
+}
+}  // namespace
+
+WallCells::WallCells(std::vector<WallSegment> walls) : walls_(std::move(walls)) {
+  // Each segment is listed in every cell its bounding box, grown by the reach, overlaps, so a
+  // walker's own cell lists every segment within reach.
+  rank_.resize(walls_.size());
   std::map<int, std::size_t> first_of_obstacle;
-  for (std::size_t s = 0; s < walls.size(); ++s) {
-    const WallSegment& wall = walls[s];
-    wall_rank[s] =
-        wall.obstacle < 0 ? s : first_of_obstacle.emplace(wall.obstacle, s).first->second;
+  for (std::size_t s = 0; s < walls_.size(); ++s) {
+    const WallSegment& wall = walls_[s];
+    rank_[s] = wall.obstacle < 0 ? s : first_of_obstacle.emplace(wall.obstacle, s).first->second;
     const Eigen::Vector2d lo = wall.a.cwiseMin(wall.b).array() - kWallCutoffM;
     const Eigen::Vector2d hi = wall.a.cwiseMax(wall.b).array() + kWallCutoffM;
     if (!lo.allFinite() || !hi.allFinite()) continue;
-    const auto [x0, y0] = wall_cell_of(lo.x(), lo.y());
-    const auto [x1, y1] = wall_cell_of(hi.x(), hi.y());
+    const auto [x0, y0] = WallCellOf(lo.x(), lo.y());
+    const auto [x1, y1] = WallCellOf(hi.x(), hi.y());
     for (long cx = x0; cx <= x1; ++cx)
       for (long cy = y0; cy <= y1; ++cy)
-        wall_cells[{cx, cy}].push_back(s);
+        cells_[{cx, cy}].push_back(s);
   }
-  const std::vector<std::size_t> no_walls;
-  std::vector<std::size_t> near;
-  for (std::size_t i = 0; i < all.size(); ++i) {
-    const auto [cx, cy] = cell_of(all[i].position);
-    near.clear();
+}
+
+const std::vector<std::size_t>& WallCells::Near(const Eigen::Vector2d& p) const {
+  const auto it = cells_.find(WallCellOf(p.x(), p.y()));
+  return it != cells_.end() ? it->second : none_;
+}
+
+void SocialForceModel::Step(std::vector<Walker>* walkers, const std::vector<DiscObstacle>& discs,
+                            const std::vector<WallSegment>& walls, double dt) const {
+  Step(walkers, discs, WallCells(walls), {}, dt);
+}
+
+void SocialForceModel::Step(std::vector<Walker>* walkers, const std::vector<DiscObstacle>& discs,
+                            const WallCells& fixed, const std::vector<WallSegment>& moving,
+                            double dt) const {
+  // A uniform grid (a cell list): each walker meets only the walkers of the 3 x 3 cells round
+  // it, in ascending index as over the whole crowd, so the sums (and the run) are the same as
+  // without the grid, in O(n) instead of O(n^2).
+  const std::vector<Walker>& all = *walkers;
+  std::vector<Eigen::Vector2d> accelerations(all.size());
+  // Cells as wide as the farthest reach, so that the 3 x 3 round a walker hold all who reach it.
+  std::vector<double> reach(all.size());
+  double cell = kMaxBodyReachM;
+  for (std::size_t j = 0; j < all.size(); ++j) {
+    reach[j] = WalkerReach(all[j]);
+    if (std::isfinite(reach[j])) cell = std::max(cell, reach[j]);
+  }
+  const auto cell_of = [cell](const Eigen::Vector2d& p) {
+    return std::pair<long, long>(long(std::floor(p.x() / cell)), long(std::floor(p.y() / cell)));
+  };
+  std::map<std::pair<long, long>, std::vector<std::size_t>> cells;
+  for (std::size_t i = 0; i < all.size(); ++i)
+    cells[cell_of(all[i].position)].push_back(i);
+  // The 3 x 3 block round each occupied cell, looked up once per cell rather than per walker.
+  std::map<std::pair<long, long>, std::vector<const std::vector<std::size_t>*>> blocks;
+  for (const auto& [c, members] : cells) {
+    auto& block = blocks[c];
     for (long dx = -1; dx <= 1; ++dx) {
       for (long dy = -1; dy <= 1; ++dy) {
-        const auto it = cells.find({cx + dx, cy + dy});
-        if (it != cells.end()) near.insert(near.end(), it->second.begin(), it->second.end());
+        const auto it = cells.find({c.first + dx, c.second + dy});
+        if (it != cells.end()) block.push_back(&it->second);
       }
     }
-    std::sort(near.begin(), near.end());
-    const auto walls_here = wall_cells.find(wall_cell_of(all[i].position.x(), all[i].position.y()));
-    const Neighbours neighbours{
-        &near, walls_here != wall_cells.end() ? &walls_here->second : &no_walls, &wall_rank};
+  }
+  // The fixed walls, then the moving ones (few: every walker meets each).
+  std::vector<WallSegment> walls = fixed.walls();
+  walls.insert(walls.end(), moving.begin(), moving.end());
+  std::vector<std::size_t> wall_rank = fixed.rank();
+  for (std::size_t s = fixed.walls().size(); s < walls.size(); ++s)
+    wall_rank.push_back(s);
+  std::vector<std::size_t> near_walls;
+  // A walker's neighbours in ascending index without sorting: mark the members of its block in
+  // a bit set, then read the set bits in order.
+  std::vector<std::uint64_t> marked((all.size() + 63) / 64, 0);
+  std::vector<std::size_t> near;
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const auto& block = blocks.find(cell_of(all[i].position))->second;
+    for (const auto* members : block) {
+      for (const std::size_t j : *members)
+        marked[j / 64] |= std::uint64_t{1} << (j % 64);
+    }
+    near.clear();
+    for (std::size_t word = 0; word < marked.size(); ++word) {
+      for (std::uint64_t bits = marked[word]; bits != 0; bits &= bits - 1)
+        near.push_back(word * 64 + std::size_t(std::countr_zero(bits)));
+      marked[word] = 0;
+    }
+    const std::vector<std::size_t>& fixed_near = fixed.Near(all[i].position);
+    near_walls.assign(fixed_near.begin(), fixed_near.end());
+    for (std::size_t s = fixed.walls().size(); s < walls.size(); ++s)
+      near_walls.push_back(s);
+    const Neighbours neighbours{&near, &near_walls, &wall_rank, &reach};
     accelerations[i] = CalcAccelerationAmong(i, all, neighbours, discs, walls);
   }
   for (std::size_t i = 0; i < walkers->size(); ++i) {

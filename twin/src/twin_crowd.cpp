@@ -301,7 +301,14 @@ void TwinWorld::Impl::UpdatePeople() {
       if (d.op && d.op->phase() != DoorPhase::kClosed && d.fixed->swing_side != 0.0 &&
           from_hinge.dot(d.fixed->normal) * d.fixed->swing_side > 0.0 &&
           from_hinge.norm() < clear && from_hinge.norm() > 1e-6) {
-        p.walker.target = hinge + from_hinge.normalized() * clear;
+        // Behind the leaf (it stands between them and the doorway, in the pocket it makes with
+        // the wall), out past its free edge: stepping straight back keeps them in the pocket,
+        // leaning on the leaf that cannot open for them.
+        const Eigen::Vector2d edge = d.fixed->desc->CalcFreeEdge(d.angle).head<2>();
+        const bool behind = SegmentsCross(p.walker.position, d.fixed->centre, hinge, edge);
+        p.walker.target = hinge + (behind ? Eigen::Vector2d((edge - hinge).normalized())
+                                          : from_hinge.normalized()) *
+                                      clear;
         p.walker.final_target = true;
         p.walker.desired_speed = p.speed;
       }
@@ -336,20 +343,26 @@ void TwinWorld::Impl::UpdatePeople() {
         (p.walker.position - p.route.front()).norm() < kNearEnoughM) {
       p.route.front() = p.walker.position;
     }
-    if (p.blocked_for > kStuckSec) {
+    // People see an open leaf across their way and walk round it at once (pressed against its
+    // back they would be in a local minimum of the social forces, the pocket between leaf and
+    // wall); a closed leaf is the gate's business.
+    if (p.state.phase == PersonPhase::kWalking) {
       for (const auto& d : doors) {
+        if (d.angle <= AdaDoorOperator::kClosedAngle) continue;
         const Eigen::Vector2d hinge = d.fixed->desc->p_WH.head<2>();
         const Eigen::Vector2d edge = d.fixed->desc->CalcFreeEdge(d.angle).head<2>();
         if (!SegmentsCross(p.walker.position, p.route.front(), hinge, edge)) continue;
-        p.route.insert(p.route.begin(), edge + (edge - hinge).normalized() * kStepRoundLeaf);
+        const Eigen::Vector2d round = edge + (edge - hinge).normalized() * kStepRoundLeaf;
+        if (SegmentsCross(p.walker.position, round, hinge, edge)) continue;
+        p.route.insert(p.route.begin(), round);
         --p.reached;  // a detour, not a waypoint of the route
         p.walker.target = p.route.front();
         p.walker.final_target = false;
         AddEvent("person_steps_round_leaf", p.state.name, d.fixed->desc->name);
         break;
       }
-      p.blocked_for = 0.0;
     }
+    if (p.blocked_for > kStuckSec) p.blocked_for = 0.0;
     // An evacuee is at the assembly point anywhere near its goal (the others there would keep
     // them off its exact spot).
     const double reached_radius =
@@ -370,16 +383,16 @@ void TwinWorld::Impl::UpdatePeople() {
     walkers.push_back(people[i].walker);
     walker_of.push_back(i);
   }
-  std::vector<WallSegment> all_walls = fixed.walls;
+  std::vector<WallSegment> leaves;
   for (const auto& d : doors) {
-    all_walls.push_back(
+    leaves.push_back(
         {d.fixed->desc->p_WH.head<2>(), d.fixed->desc->CalcFreeEdge(d.angle).head<2>()});
   }
   const Twist2 V_B = RobotVelocity();
   const Eigen::Vector2d v_W = X_WB.rotation() * Eigen::Vector2d(V_B.vx, V_B.vy);
   const std::vector<DiscObstacle> discs = {{X_WB.translation(), v_W, robot_radius}};
   // Standing people do not integrate (they would drift under wall forces).
-  sfm.Step(&walkers, discs, all_walls, dt);
+  sfm.Step(&walkers, discs, fixed.wall_cells, leaves, dt);
   for (std::size_t k = 0; k < walkers.size(); ++k) {
     Person& p = people[walker_of[k]];
     if (!p.state.started) continue;

@@ -38,7 +38,9 @@ enum Group : int {
 // social force model keeps them off walls), yet cost a convex-mesh test per person per step.
 constexpr int kMaskStatic = kGBase | kGArm | kGPayload;
 constexpr int kMaskFloor = kGPayload;
-constexpr int kMaskDoor = kGBase | kGArm | kGPerson | kGPayload;
+// People are not in the leaves' collisions: the social forces keep them off a leaf, and a leaf
+// that swings into someone stops (TwinWorld::Impl::LeafSwingsIntoSomeone).
+constexpr int kMaskDoor = kGBase | kGArm | kGPayload;
 constexpr int kMaskBase = kGStatic | kGDoor | kGPerson | kGPayload;
 constexpr int kMaskArm = kGStatic | kGDoor | kGPerson | kGPayload;
 constexpr double kStuckSec =
@@ -55,7 +57,11 @@ constexpr double kClearOfSweepM = 0.45;
 constexpr double kSweepMarginM = 0.1;
 // [deg] A waiting person goes on once the leaf is this far past the open-enough angle.
 constexpr double kResumeMarginDeg = 5.0;
-constexpr int kMaskPerson = kGDoor | kGBase | kGArm | kGPayload;
+// [m] A leaf this close to a person's body (beyond touching) counts as touching them.
+constexpr double kLeafTouchMarginM = 0.02;
+// [N m] What stops a leaf that swings into someone (far above any operator's stall torque).
+constexpr double kLeafBrakeTorqueNm = 2000.0;
+constexpr int kMaskPerson = kGBase | kGArm | kGPayload;
 constexpr int kMaskPayload = kGStatic | kGFloor | kGDoor | kGBase | kGArm | kGPerson | kGPayload;
 
 constexpr double kPersonHeight = 1.7;  // [m]

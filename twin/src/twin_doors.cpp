@@ -93,6 +93,24 @@ double TwinWorld::Impl::MeasureDoorAngle(const Door& d) const {
   return std::max(0.0, d.fixed->desc->open_sign * about_axis);
 }
 
+bool TwinWorld::Impl::LeafSwingsIntoSomeone(const Door& d) const {
+  const Eigen::Vector2d hinge = d.fixed->desc->p_WH.head<2>();
+  const Eigen::Vector2d edge = d.fixed->desc->CalcFreeEdge(d.angle).head<2>();
+  const double omega_z = d.leaf->getAngularVelocity().z();  // about W's z [rad/s]
+  if (std::abs(omega_z) < 1e-9) return false;
+  for (const auto& p : people) {
+    if (p.state.out) continue;
+    const Eigen::Vector2d q = egress::ClosestPointOnSegment(p.walker.position, hinge, edge);
+    const Eigen::Vector2d from_leaf = p.walker.position - q;
+    if (from_leaf.norm() > p.walker.radius + kLeafTouchMarginM) continue;
+    // The leaf's point q moves at omega x (q - hinge): into the person, or away.
+    const Eigen::Vector2d r = q - hinge;
+    const Eigen::Vector2d v_q = omega_z * Eigen::Vector2d(-r.y(), r.x());
+    if (v_q.dot(from_leaf) > 0.0) return true;
+  }
+  return false;
+}
+
 void TwinWorld::Impl::UpdateDoors() {
   for (std::size_t i = 0; i < doors.size(); ++i) {
     Door& d = doors[i];
@@ -111,6 +129,14 @@ void TwinWorld::Impl::UpdateDoors() {
       d.hinge->enableAngularMotor(true, d.motor_sign * closer_rate, 15.0 * d.fixed->reach * dt);
     }
     const btVector3 axis = ToBt(d.fixed->desc->axis_W * d.fixed->desc->open_sign);
+    if (LeafSwingsIntoSomeone(d)) {
+      // People are not in the leaves' collisions (kMaskDoor): the social forces keep them off a
+      // leaf, and a crowd leaning on an open leaf would otherwise shove it shut. A leaf that
+      // swings into someone stops there (they stand their ground; an operator stops on an
+      // obstruction).
+      d.leaf->setAngularVelocity(btVector3(0, 0, 0));
+      d.hinge->enableAngularMotor(true, 0.0, kLeafBrakeTorqueNm * dt);
+    }
     const double omega = d.leaf->getAngularVelocity().dot(axis);
     btVector3 torque = -d.fixed->desc->damping * omega * axis;
     // People holding this door push it towards their hold angle.

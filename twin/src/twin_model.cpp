@@ -75,6 +75,7 @@ void CompileStatics(const Scenario& scenario, const WorldDescription& world,
     ground.kind = ShapeKind::kPlane;
     add(ground);
   }
+  c->wall_cells = WallCells(c->walls);
   std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> box_extents;
   for (const RayBox& box : c->ray_boxes) {
     const Eigen::Vector2d half_W = (box.R_SW.transpose().cwiseAbs() * box.half).head<2>();

@@ -75,6 +75,7 @@ struct TwinModel::Compiled {
   std::vector<world_detail::StaticConvex> convex_statics;
   // Outline of walls and furniture at body height, for the people's wall forces.
   std::vector<WallSegment> walls;
+  WallCells wall_cells;                        // the same, binned for the social force model
   std::vector<world_detail::DoorModel> doors;  // in the world's door order
   // One model per people behaviour the scenario uses.
   std::map<PersonBehavior, std::unique_ptr<people::PersonBehaviorModel>> behavior_models;

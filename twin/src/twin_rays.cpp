@@ -24,18 +24,25 @@ class TwinRayCallback : public btCollisionWorld::RayResultCallback {
     const int entity =
         entity_of_(r.m_collisionObject,
                    r.m_localShapeInfo != nullptr ? r.m_localShapeInfo->m_triangleIndex : -1);
+    return Offer(r.m_hitFraction, n, r.m_collisionObject, entity) ? r.m_hitFraction
+                                                                  : m_closestHitFraction;
+  }
+
+  // A hit at `fraction` of the ray on a face of normal n_W of `entity`: kept unless the ray
+  // passes through it (glass); false when passed. The caller has checked it is the closest.
+  bool Offer(btScalar fraction, const btVector3& n_W, const btCollisionObject* object, int entity) {
     const bool glass = is_glass_(entity);
     if (glass && (mode_ == GlassMode::kTransparent ||
                   (mode_ == GlassMode::kLaser &&
-                   std::abs(n.normalized().dot(dir_)) < std::cos(glass_max_incidence_)))) {
-      return m_closestHitFraction;  // the ray passes through the glass
+                   std::abs(n_W.normalized().dot(dir_)) < std::cos(glass_max_incidence_)))) {
+      return false;  // the ray passes through the glass
     }
-    m_closestHitFraction = r.m_hitFraction;
-    m_collisionObject = r.m_collisionObject;
-    normal = n;
+    m_closestHitFraction = fraction;
+    m_collisionObject = object;
+    normal = n_W;
     this->entity = entity;
     this->glass = glass;
-    return r.m_hitFraction;
+    return true;
   }
 
   btVector3 normal{0, 0, 0};
@@ -92,8 +99,8 @@ RayHit TwinWorld::Impl::CastSegment(const Eigen::Vector3d& from, const Eigen::Ve
   // targets (the ground plane, and every other target whose bounding box the ray still crosses
   // before its closest hit so far), then the static triangle mesh on the ray clipped just past
   // that hit: the mesh's BVH walk costs in proportion to the ray's length. Dynamic bodies are
-  // cast as triangle proxies of their shapes (see BuildRayProxies): Bullet's triangle ray test
-  // is exact and much cheaper than its iterative convex cast.
+  // cast as convex polytopes of their shapes (see BuildRayProxies): exact, and much cheaper than
+  // Bullet's iterative convex cast or a BVH walk of their triangles.
   // Only the targets and boxes the ray's ground track may cross, in index order as over all.
   thread_local std::vector<int> near;
   const btTransform from_T(btMatrix3x3::getIdentity(), a), to_T(btMatrix3x3::getIdentity(), b);
@@ -107,6 +114,22 @@ RayHit TwinWorld::Impl::CastSegment(const Eigen::Vector3d& from, const Eigen::Ve
     if (!plane &&
         !btRayAabb(a, b, ray_target_aabbs[i].first, ray_target_aabbs[i].second, param, normal))
       continue;
+    if (const world_detail::ConvexPolytope* body = ray_target_polytopes[i]) {
+      // A moving body: its faces analytically, in its own frame. The nearer crossing first; the
+      // far one counts when the near one is glass the ray passes through.
+      const btTransform& X_WT = target->getWorldTransform();
+      const Eigen::Vector3d o = FromBt(X_WT.invXform(a));
+      const Eigen::Vector3d v = FromBt((b - a) * X_WT.getBasis());  // R^T (b - a)
+      std::array<world_detail::ConvexPolytope::Crossing, 2> crossings;
+      const int n = body->Cross(o, v, &crossings);
+      const int entity = ray_entity_of(target, -1);
+      for (int k = 0; k < n; ++k) {
+        const auto& c = crossings[std::size_t(k)];
+        if (c.t >= cb.m_closestHitFraction) break;
+        if (cb.Offer(btScalar(c.t), X_WT.getBasis() * ToBt(c.normal), target, entity)) break;
+      }
+      continue;
+    }
     btCollisionWorld::rayTestSingle(from_T, to_T, const_cast<btCollisionObject*>(target),
                                     target->getCollisionShape(), target->getWorldTransform(), cb);
   }

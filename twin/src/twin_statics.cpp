@@ -6,6 +6,7 @@ void TwinWorld::Impl::BuildStatics() {
   for (const StaticConvex& c : fixed.convex_statics) {
     ray_targets.push_back(AddBodyWithShape(c.shape.get(), c.X_WS, 0.0, c.floor ? kGFloor : kGStatic,
                                            c.floor ? kMaskFloor : kMaskStatic, c.entity));
+    ray_target_polytopes.push_back(nullptr);
   }
   if (fixed.static_mesh_shape) {
     static_mesh_body = AddBodyWithShape(fixed.static_mesh_shape.get(), Pose3(), 0.0, kGStatic,
@@ -15,17 +16,26 @@ void TwinWorld::Impl::BuildStatics() {
 
 void TwinWorld::Impl::AddRayProxy(const btCollisionObject* source,
                                   const std::vector<btVector3>& triangles_local) {
+  // The triangles give the proxy's bounds (its mesh shape's AABB, for the ray bins); rays are
+  // cast at the polytope they bound.
   auto mesh = std::make_unique<btTriangleMesh>(true, false);
+  std::vector<Eigen::Vector3d> vertices;
+  vertices.reserve(triangles_local.size());
   for (std::size_t i = 0; i + 2 < triangles_local.size(); i += 3) {
     mesh->addTriangle(triangles_local[i], triangles_local[i + 1], triangles_local[i + 2]);
+    for (std::size_t k = i; k < i + 3; ++k)
+      vertices.push_back(FromBt(triangles_local[k]));
   }
   auto shape = std::make_unique<btBvhTriangleMeshShape>(mesh.get(), true);
   auto proxy = std::make_unique<btCollisionObject>();
   proxy->setCollisionShape(shape.get());
   proxy->setUserIndex(source->getUserIndex());
   proxy->setWorldTransform(source->getWorldTransform());
+  auto body = std::make_unique<world_detail::ConvexPolytope>(
+      world_detail::ConvexPolytope::FromTriangles(vertices));
   ray_targets.push_back(proxy.get());
-  ray_proxies.push_back({std::move(proxy), source});
+  ray_target_polytopes.push_back(body.get());
+  ray_proxies.push_back({std::move(proxy), source, std::move(body)});
   meshes.push_back(std::move(mesh));
   shapes.push_back(std::move(shape));
 }
@@ -77,8 +87,8 @@ void TwinWorld::Impl::BuildRayProxies() {
 
 void TwinWorld::Impl::SyncRayProxies() const {
   ray_proxies_stale = false;
-  for (auto& [proxy, source] : ray_proxies)
-    proxy->setWorldTransform(source->getWorldTransform());
+  for (auto& p : ray_proxies)
+    p.proxy->setWorldTransform(p.source->getWorldTransform());
   ray_target_aabbs.resize(ray_targets.size());
   for (std::size_t i = 0; i < ray_targets.size(); ++i) {
     ray_targets[i]->getCollisionShape()->getAabb(

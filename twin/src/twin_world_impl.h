@@ -6,6 +6,7 @@
 // twin_robot_body.cpp (base, arm, gripper, payloads), twin_rays.cpp (ray casting for the
 // sensors).
 
+#include "ray_convex.h"
 #include "twin_model_compiled.h"
 
 namespace egress::twin {
@@ -179,6 +180,8 @@ struct TwinWorld::Impl {
   double MeasureDoorAngle(const Door& d) const;
 
   void UpdateDoors();
+  // Whether door d's leaf, as it turns now, swings into someone touching it.
+  bool LeafSwingsIntoSomeone(const Door& d) const;
 
   void RecordContacts();
 
@@ -218,9 +221,12 @@ struct TwinWorld::Impl {
   struct RayProxy {
     std::unique_ptr<btCollisionObject> proxy;
     const btCollisionObject* source;
+    std::unique_ptr<world_detail::ConvexPolytope> body;  // its shape, in the source's frame
   };
   std::vector<RayProxy> ray_proxies;
   std::vector<const btCollisionObject*> ray_targets;  // cast one by one in CastRay
+  // Per ray target: the proxy's polytope, cast analytically; null for Bullet shapes.
+  std::vector<const world_detail::ConvexPolytope*> ray_target_polytopes;
   mutable std::vector<std::pair<btVector3, btVector3>> ray_target_aabbs;  // their world bounds
   mutable world_detail::RayBins ray_target_bins;  // which ray_targets a ray may cross
   mutable bool ray_proxies_stale{true};           // bodies moved since the proxies were posed

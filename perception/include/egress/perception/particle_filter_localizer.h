@@ -9,6 +9,7 @@
 /// fraction of N. Deterministic for a given seed.
 
 #include <cstdint>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -81,6 +82,7 @@ class ParticleFilterLocalizer {
   /// (an end point off the map: the uniform part only), from a table.
   double BeamLogLikelihood(double d) const;
   void Resample();
+  Pose2 CalcEstimate() const;
 
   LocalizerConfig config_;
   GridGeometry geometry_;
@@ -96,6 +98,10 @@ class ParticleFilterLocalizer {
   double moved_angle_{0.0};
   bool moved_since_correction_{true};
   int resample_count_{0};
+  // Estimate and Covariance of the particles as they are (the executive asks at its own rate,
+  // 8x the scans'); emptied by whatever moves or reweighs a particle.
+  mutable std::optional<Pose2> estimate_;
+  mutable std::optional<Eigen::Matrix3d> covariance_;
 };
 
 }  // namespace egress::perception

@@ -3,8 +3,12 @@
 /// Our Social Force Model for people (Helbing & Molnár 1995 social and wall repulsion, with the
 /// body compression and sliding friction of Helbing, Farkas & Vicsek 2000 when bodies touch;
 /// constants from social_sim_notes §1.1). Planar, in W, independent of physics: the twin moves
-/// kinematic capsules to the positions it integrates.
+/// kinematic capsules to the positions it integrates. A social term below 1e-3 of its value at
+/// contact is dropped (HM95's b beyond σ ln 1000, 2.1 m), so that a walker meets only the
+/// walkers within a few metres of it (Step's cell lists), whatever the crowd's size.
 
+#include <map>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -72,6 +76,27 @@ struct WallSegment {
 /// Closest point to p on segment ab.
 Eigen::Vector2d ClosestPointOnSegment(const Eigen::Vector2d& p, const WallSegment& s);
 
+/// Walls binned in a uniform grid (a cell list) so that a walker meets only the segments within
+/// the model's wall reach. Built once for the walls that do not move (a building's).
+class WallCells {
+ public:
+  WallCells() = default;
+  explicit WallCells(std::vector<WallSegment> walls);
+
+  const std::vector<WallSegment>& walls() const { return walls_; }
+  /// Indices into walls() of every segment within the wall reach of p (and maybe a few more),
+  /// ascending.
+  const std::vector<std::size_t>& Near(const Eigen::Vector2d& p) const;
+  /// Per wall: the index of the first wall of its obstacle (the order obstacles are summed).
+  const std::vector<std::size_t>& rank() const { return rank_; }
+
+ private:
+  std::vector<WallSegment> walls_;
+  std::vector<std::size_t> rank_;
+  std::map<std::pair<long, long>, std::vector<std::size_t>> cells_;
+  std::vector<std::size_t> none_;
+};
+
 class SocialForceModel {
  public:
   explicit SocialForceModel(SocialForceParams params = {}) : params_(params) {}
@@ -83,6 +108,10 @@ class SocialForceModel {
   /// Advances every walker by dt [s] (semi-implicit Euler, speed clipped to v_max).
   void Step(std::vector<Walker>* walkers, const std::vector<DiscObstacle>& discs,
             const std::vector<WallSegment>& walls, double dt) const;
+  /// The same, with the walls that do not move binned beforehand (`fixed`) and those that do
+  /// (door leaves) given as `moving`: the same sums as Step over fixed.walls() then `moving`.
+  void Step(std::vector<Walker>* walkers, const std::vector<DiscObstacle>& discs,
+            const WallCells& fixed, const std::vector<WallSegment>& moving, double dt) const;
 
   const SocialForceParams& params() const { return params_; }
 
@@ -93,7 +122,10 @@ class SocialForceModel {
     const std::vector<std::size_t>* walls{nullptr};    // indices, ascending
     // Per wall: the index of the first wall of its obstacle (the order obstacles are summed).
     const std::vector<std::size_t>* wall_rank{nullptr};
+    const std::vector<double>* reach{nullptr};  // per walker: WalkerReach
   };
+  // How far from its centre walker o's social and body terms reach [m].
+  double WalkerReach(const Walker& o) const;
   Eigen::Vector2d CalcAccelerationAmong(std::size_t i, const std::vector<Walker>& walkers,
                                         const Neighbours& near,
                                         const std::vector<DiscObstacle>& discs,
