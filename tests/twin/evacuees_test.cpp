@@ -55,16 +55,26 @@ std::string LabDoorFlow(int count, const std::string& mobility = "") {
 }
 
 TEST(EvacueesTest, DenseFlowThroughAFullyOpenDoorIsWithinTheHydraulicBand) {
-  auto loaded = LoadText(LabDoorFlow(30), WorldsDir() / "lab");
-  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
-  const std::vector<double> t = CrossingTimes(world, 3.0, 90.0);
-  ASSERT_EQ(t.size(), 30u);
-  // Steady flow: from the 5th to the 25th crossing (the group's head and tail left out).
-  const double flow = 20.0 / (t[24] - t[4]);
   // Clear width 0.95 m: SFPE 1.3 /(s m) x (0.95 - 0.3) = 0.85 /s; IMO 1.3 x 0.95 = 1.24 /s.
-  RecordProperty("flow_persons_per_s", std::to_string(flow));
-  EXPECT_GT(flow, 0.85 * 0.8);
-  EXPECT_LT(flow, 1.24 * 1.2);
+  // Steady flow: 5th to 25th crossing (the group's head and tail left out). The mean over
+  // twelve groups is in the band; one group of 30 varies widely (seeds 1-12: 0.61 to 1.20 /s),
+  // so each is only held to within 40 % of the band: far outside it is a model bug.
+  double sum = 0.0;
+  constexpr int kGroups = 12;
+  for (std::uint64_t seed = 1; seed <= kGroups; ++seed) {
+    auto loaded = LoadText(LabDoorFlow(30), WorldsDir() / "lab");
+    TwinWorld world(loaded.scenario, loaded.world, seed, Hsr());
+    const std::vector<double> t = CrossingTimes(world, 3.0, 90.0);
+    ASSERT_EQ(t.size(), 30u) << "seed " << seed;
+    const double flow = 20.0 / (t[24] - t[4]);
+    RecordProperty("flow_persons_per_s_seed_" + std::to_string(seed), std::to_string(flow));
+    EXPECT_GT(flow, 0.85 * 0.6) << "seed " << seed;
+    EXPECT_LT(flow, 1.24 * 1.4) << "seed " << seed;
+    sum += flow;
+  }
+  RecordProperty("flow_persons_per_s_mean", std::to_string(sum / kGroups));
+  EXPECT_GT(sum / kGroups, 0.85);
+  EXPECT_LT(sum / kGroups, 1.24);
 }
 
 // The office: room 1 (x < 5), door_a (x = 5, push buttons), room 2, door_b (x = 9, glass,
@@ -139,6 +149,28 @@ TEST(EvacueesTest, AMixedGroupLeavesTheClinicThroughProppedDoors) {
                       << p.position.transpose() << " phase " << int(p.phase) << " reached "
                       << p.doors_operated;
     }
+    EXPECT_EQ(out, 20) << "seed " << seed;
+  }
+}
+
+TEST(EvacueesTest, AMixedGroupOpensTheClinicsShutDoorsItself) {
+  // No robot, every door shut: the residents who can operate the actuators (the exit's is on
+  // the inside only). Seeds 5 and 9 left all 20 at a shut door before: each waiting resident
+  // deferred to someone nearer the actuator who was not in reach of it.
+  const std::string text =
+      "world: clinic.sdf\n"
+      "robot: {start: {x: 80.0, y: 0.0}}\n"
+      "people:\n"
+      "  - {name: r, behavior: evacuate, route: [door_d, door_e, exit_door], start: [2.8, -3.0],"
+      " goal: [21.0, 11.5], count: 20, trigger: {at: 5.0},"
+      " mobility: {walker: 10, cane: 3, frame: 3, wheelchair: 2, wheelchair_pushed: 2}}\n";
+  for (const std::uint64_t seed : {5, 9}) {
+    auto loaded = LoadText(text, WorldsDir() / "clinic");
+    TwinWorld world(loaded.scenario, loaded.world, seed, Hsr());
+    world.StepFor(360.0);
+    int out = 0;
+    for (const auto& p : world.people())
+      out += p.out;
     EXPECT_EQ(out, 20) << "seed " << seed;
   }
 }

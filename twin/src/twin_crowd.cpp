@@ -347,18 +347,33 @@ void TwinWorld::Impl::UpdatePeople() {
     // back they would be in a local minimum of the social forces, the pocket between leaf and
     // wall); a closed leaf is the gate's business.
     if (p.state.phase == PersonPhase::kWalking) {
-      for (const auto& d : doors) {
+      for (std::size_t k = 0; k < doors.size(); ++k) {
+        const Door& d = doors[k];
         if (d.angle <= AdaDoorOperator::kClosedAngle) continue;
         const Eigen::Vector2d hinge = d.fixed->desc->p_WH.head<2>();
         const Eigen::Vector2d edge = d.fixed->desc->CalcFreeEdge(d.angle).head<2>();
-        if (!SegmentsCross(p.walker.position, p.route.front(), hinge, edge)) continue;
-        const Eigen::Vector2d round = edge + (edge - hinge).normalized() * kStepRoundLeaf;
-        if (SegmentsCross(p.walker.position, round, hinge, edge)) continue;
-        p.route.insert(p.route.begin(), round);
-        --p.reached;  // a detour, not a waypoint of the route
+        // Past the free edge and a shoulder to the side of the leaf the waypoint is on: from
+        // there the way on does not cross the leaf again.
+        const Eigen::Vector2d along = (edge - hinge).normalized();
+        const Eigen::Vector2d across(-along.y(), along.x());
+        const Eigen::Vector2d& next =
+            p.round_leaf == int(k) && p.route.size() > 1 ? p.route[1] : p.route.front();
+        const double to_next = across.dot(next - hinge) >= 0.0 ? 1.0 : -1.0;
+        const Eigen::Vector2d round =
+            edge + along * kStepRoundLeaf + across * to_next * p.walker.radius;
+        if (p.round_leaf == int(k)) {
+          p.route.front() = round;  // the leaf moves: so does the way round it
+        } else {
+          if (!SegmentsCross(p.walker.position, p.route.front(), hinge, edge)) continue;
+          if (SegmentsCross(p.walker.position, round, hinge, edge)) continue;
+          if (p.round_leaf >= 0) continue;  // one leaf at a time
+          p.route.insert(p.route.begin(), round);
+          --p.reached;  // a detour, not a waypoint of the route
+          p.round_leaf = int(k);
+          AddEvent("person_steps_round_leaf", p.state.name, d.fixed->desc->name);
+        }
         p.walker.target = p.route.front();
         p.walker.final_target = false;
-        AddEvent("person_steps_round_leaf", p.state.name, d.fixed->desc->name);
         break;
       }
     }
@@ -372,6 +387,7 @@ void TwinWorld::Impl::UpdatePeople() {
         p.state.phase != PersonPhase::kWaitingForDoor) {
       p.route.erase(p.route.begin());
       ++p.reached;
+      p.round_leaf = -1;
     }
   }
   // Social forces: the robot is a disc to avoid; door leaves are walls.
@@ -466,8 +482,12 @@ bool TwinWorld::Impl::OperateDoor(Person& p, int gate) {
     const double mine = (p.walker.position - *spot).norm();
     for (const auto& other : people) {
       if (other.operating == gate) return false;
+      // Someone nearer who would go: on this side, within reach (deferring to anyone nearer,
+      // whether or not they could go, left a crowd waiting at a shut door for ever).
       if (&other != &p && other.can_operate && !other.state.out && GateDoor(other) == gate &&
           other.state.phase == PersonPhase::kWaitingForDoor && time >= other.operate_retry_at &&
+          (other.walker.position - d.fixed->centre).norm() <= kOperateReachM &&
+          (other.walker.position - d.fixed->centre).dot(d.fixed->normal) * side >= 0.0 &&
           (other.walker.position - *spot).norm() < mine)
         return false;
     }

@@ -42,6 +42,7 @@ struct Person {
   int reached{0};                // waypoints reached so far
   double stuck_for{0.0};         // [s] wanting to walk but not moving
   bool realigned{false};         // stepped back onto the door's axis once
+  int round_leaf{-1};            // the door whose leaf the route's first waypoint goes round
   bool stepped_aside{false};     // walked to the side of the corridor at the end of its route
   std::optional<Eigen::Vector2d> aside_spot;  // where it then stands (held against the walls' push)
   double blocked_for{0.0};                    // [s] walking but not moving (any leg of the route)
