@@ -69,8 +69,7 @@ double ParticleFilterLocalizer::BeamLogLikelihood(double d) const {
 }
 
 void ParticleFilterLocalizer::Initialize(const Pose2& X_MB, const Eigen::Matrix3d& covariance) {
-  estimate_.reset();
-  covariance_.reset();
+  ForgetSummary();
   ThrowUnless(X_MB.IsFinite(), "Invalid initial pose: must be finite.");
   ThrowUnless(
       covariance.allFinite() && (covariance - covariance.transpose()).cwiseAbs().maxCoeff() < 1e-12,
@@ -91,8 +90,7 @@ void ParticleFilterLocalizer::Initialize(const Pose2& X_MB, const Eigen::Matrix3
 }
 
 void ParticleFilterLocalizer::Predict(const Pose2& X_OB_previous, const Pose2& X_OB_current) {
-  estimate_.reset();
-  covariance_.reset();
+  ForgetSummary();
   ThrowUnless(X_OB_previous.IsFinite() && X_OB_current.IsFinite(),
               "Invalid odometry: poses must be finite.");
   ThrowUnless(initialized(), "ParticleFilterLocalizer::Predict: call Initialize first.");
@@ -152,8 +150,7 @@ double ParticleFilterLocalizer::LikelihoodFieldDistance(const Eigen::Vector2d& p
 }
 
 bool ParticleFilterLocalizer::Correct(const LaserScan& scan) {
-  estimate_.reset();
-  covariance_.reset();
+  ForgetSummary();
   scan.Validate();
   ThrowUnless(initialized(), "ParticleFilterLocalizer::Correct: call Initialize first.");
   if (!moved_since_correction_) return false;
@@ -197,8 +194,7 @@ bool ParticleFilterLocalizer::Correct(const LaserScan& scan) {
 }
 
 void ParticleFilterLocalizer::Resample() {
-  estimate_.reset();
-  covariance_.reset();
+  ForgetSummary();
   // Low-variance (systematic) resampling.
   const std::size_t n = particles_.size();
   std::vector<Particle> resampled;
@@ -221,6 +217,11 @@ void ParticleFilterLocalizer::Update(const Pose2& X_OB, const LaserScan& scan) {
   if (last_odometry_) Predict(*last_odometry_, X_OB);
   last_odometry_ = X_OB;
   Correct(scan);
+}
+
+void ParticleFilterLocalizer::ForgetSummary() {
+  estimate_.reset();
+  covariance_.reset();
 }
 
 Pose2 ParticleFilterLocalizer::Estimate() const {

@@ -18,6 +18,11 @@ constexpr double kSocialNegligibleFraction = 1e-3;
 // Two bodies closer than this may touch [m] (a wheelchair and a pushed one: well under 1 m).
 constexpr double kMaxBodyReachM = 1.0;
 
+// The ellipse's semi-minor axis b beyond which a social term of range σ is dropped [m].
+double NegligibleBeyond(double range) {
+  return range * std::log(1.0 / kSocialNegligibleFraction);
+}
+
 // The farthest centre distance at which a walker whose step (its velocity over the social
 // horizon) is `step` long exerts a social term that is not dropped: b >= sqrt(r^2 - r |step|)
 // on the HM95 ellipse, so b > b_max wherever r > (|step| + sqrt(|step|^2 + 4 b_max^2)) / 2.
@@ -53,8 +58,8 @@ Eigen::Vector2d SocialForceModel::BodyForce(const Walker& w, const Eigen::Vector
 double SocialForceModel::WalkerReach(const Walker& o) const {
   // A hair more than the bound, so rounding never drops a term the sum over everyone keeps;
   // and at least touching distance for the body force (the widest body is under 1 m across).
-  const double b_max = params_.social_range * std::log(1.0 / kSocialNegligibleFraction);
-  const double social = SocialReach(o.velocity.norm() * params_.social_horizon, b_max);
+  const double social = SocialReach(o.velocity.norm() * params_.social_horizon,
+                                    NegligibleBeyond(params_.social_range));
   return std::max(social * (1.0 + 1e-9) + 1e-9, kMaxBodyReachM);
 }
 
@@ -99,9 +104,7 @@ Eigen::Vector2d SocialForceModel::CalcAccelerationAmong(
     if (r_norm < 1e-6) return Eigen::Vector2d(Eigen::Vector2d::Zero());
     const double s = r_norm + (r - step).norm();
     const double b = 0.5 * std::sqrt(std::max(s * s - step.squaredNorm(), 1e-12));
-    if (b > range * std::log(1.0 / kSocialNegligibleFraction)) {
-      return Eigen::Vector2d(Eigen::Vector2d::Zero());
-    }
+    if (b > NegligibleBeyond(range)) return Eigen::Vector2d(Eigen::Vector2d::Zero());
     const Eigen::Vector2d n = r / r_norm;
     Eigen::Vector2d f = (strength / range) * std::exp(-b / range) * n;
     // Turn part of it to the walker's right when the other is ahead: people keep right.

@@ -83,6 +83,8 @@ class ParticleFilterLocalizer {
   double BeamLogLikelihood(double d) const;
   void Resample();
   Pose2 CalcEstimate() const;
+  // Empties the cached Estimate and Covariance: the particles moved or were reweighed.
+  void ForgetSummary();
 
   LocalizerConfig config_;
   GridGeometry geometry_;
