@@ -40,6 +40,8 @@ constexpr double kReferencePaceMps = 1.24;
 constexpr double kReferenceBodyRadiusM = 0.23;
 // Within this of an open door's centre an evacuee skips the queueing spot before it [m].
 constexpr double kSkipQueueSpotM = 2.5;
+// A walker this near a waypoint before the last one has reached it [m].
+constexpr double kWaypointReachedM = 0.4;
 // Where the body of a person who has left the scene is put (below the floor: no ray, no contact).
 constexpr double kOutOfSceneZ = -50.0;
 
@@ -161,6 +163,7 @@ void TwinWorld::Impl::BuildPeople() {
       // cannot be reached: it moves out to where the walker fits.
       for (auto& waypoint : p.route)
         waypoint = ClearOfWalls(waypoint, spec.radius + kWaypointWallMarginM);
+      if (!p.doorway_waypoints.empty()) p.planned_route = p.route;
       const int e = AddEntity(EntityKind::kPerson, p.state.name, int(people.size()));
       const Pose3 X_W(
           Eigen::Vector3d(p.walker.position.x(), p.walker.position.y(), kPersonHeight / 2));
@@ -337,6 +340,7 @@ void TwinWorld::Impl::UpdatePeople() {
     p.blocked_for = p.state.phase == PersonPhase::kWalking && p.walker.velocity.norm() < 0.05
                         ? p.blocked_for + dt
                         : 0.0;
+    if (p.blocked_for > kStuckSec) RewindIfPushedBack(p);
     // Held off its last waypoint by the walls round it (a hold spot in a corner: the social
     // forces balance short of it), a walker who is near enough has arrived.
     if (p.route.size() == 1 && p.blocked_for > kStuckSec &&
@@ -349,7 +353,17 @@ void TwinWorld::Impl::UpdatePeople() {
     if (p.state.phase == PersonPhase::kWalking) {
       for (std::size_t k = 0; k < doors.size(); ++k) {
         const Door& d = doors[k];
-        if (d.angle <= AdaDoorOperator::kClosedAngle) continue;
+        if (d.angle <= AdaDoorOperator::kClosedAngle) {
+          // The leaf they were going round has shut: the way round it (now likely through the
+          // wall beside the doorway) is no way at all.
+          if (p.round_leaf == int(k)) {
+            p.route.erase(p.route.begin());
+            ++p.reached;
+            p.round_leaf = -1;
+            p.walker.target = p.route.front();
+          }
+          continue;
+        }
         const Eigen::Vector2d hinge = d.fixed->desc->p_WH.head<2>();
         const Eigen::Vector2d edge = d.fixed->desc->CalcFreeEdge(d.angle).head<2>();
         // Past the free edge and a shoulder to the side of the leaf the waypoint is on: from
@@ -367,6 +381,9 @@ void TwinWorld::Impl::UpdatePeople() {
           if (!SegmentsCross(p.walker.position, p.route.front(), hinge, edge)) continue;
           if (SegmentsCross(p.walker.position, round, hinge, edge)) continue;
           if (p.round_leaf >= 0) continue;  // one leaf at a time
+          // At the edge already: a detour there would be reached at once, and inserted again
+          // the next step.
+          if ((round - p.walker.position).norm() < kWaypointReachedM) continue;
           p.route.insert(p.route.begin(), round);
           --p.reached;  // a detour, not a waypoint of the route
           p.round_leaf = int(k);
@@ -382,7 +399,7 @@ void TwinWorld::Impl::UpdatePeople() {
     // them off its exact spot).
     const double reached_radius =
         p.route.size() == 1 ? (p.state.behavior == PersonBehavior::kEvacuate ? kNearEnoughM : 0.25)
-                            : 0.4;
+                            : kWaypointReachedM;
     if ((p.walker.position - p.route.front()).norm() < reached_radius &&
         p.state.phase != PersonPhase::kWaitingForDoor) {
       p.route.erase(p.route.begin());
@@ -419,6 +436,33 @@ void TwinWorld::Impl::UpdatePeople() {
                         btVector3(p.walker.position.x(), p.walker.position.y(), kPersonHeight / 2));
     p.body->getMotionState()->setWorldTransform(T);
     p.body->setWorldTransform(T);
+  }
+}
+
+void TwinWorld::Impl::RewindIfPushedBack(Person& p) {
+  if (p.planned_route.empty() || p.route.empty()) return;
+  const Eigen::Vector2d& at = p.walker.position;
+  const auto wall_between = [&](const Eigen::Vector2d& to) {
+    return std::any_of(fixed.walls.begin(), fixed.walls.end(),
+                       [&](const WallSegment& w) { return SegmentsCross(at, to, w.a, w.b); });
+  };
+  if (!wall_between(p.route.front())) return;
+  // The latest doorway already passed that they stand before again: on its waiting side, in
+  // sight of the waypoint before it (the drive towards the next waypoint may have slid them
+  // along the walls far from the doorway).
+  for (auto it = p.doorway_waypoints.rbegin(); it != p.doorway_waypoints.rend(); ++it) {
+    const int centre = it->first;
+    if (centre >= p.reached || centre < 1) continue;
+    const DoorModel& d = *doors[std::size_t(it->second)].fixed;
+    const Eigen::Vector2d& before = p.planned_route[std::size_t(centre - 1)];
+    if ((at - d.centre).dot(d.normal) * (before - d.centre).dot(d.normal) <= 0.0) continue;
+    if (wall_between(before)) continue;
+    p.route.assign(p.planned_route.begin() + (centre - 1), p.planned_route.end());
+    p.reached = centre - 1;
+    p.round_leaf = -1;
+    p.walker.target = p.route.front();
+    AddEvent("person_rewinds_route", p.state.name, d.desc->name);
+    return;
   }
 }
 
@@ -494,22 +538,28 @@ bool TwinWorld::Impl::OperateDoor(Person& p, int gate) {
     p.operating = gate;
     p.operate_spot = *spot;
     p.operate_elapsed = 0.0;
-    p.operate_started = time;
+    p.operate_progress_at = time;
   }
-  // Kept off the actuator by the queue for too long: they give up for a while, someone else
-  // (nearer now) may get there.
-  if (time - p.operate_started > kOperateGiveUpSec && p.operate_elapsed == 0.0) {
+  const double away = (p.walker.position - p.operate_spot).norm();
+  // At the actuator (or as near as the queue lets them: within reach and not getting closer).
+  const bool there = away < kAtActuatorM || (away < kArmReachM && p.walker.velocity.norm() < 0.05);
+  // Kept off the actuator by the queue for too long, or pushed off it part-way through: they
+  // give up for a while and someone else (nearer now) may go. (Counting only a wait that never
+  // reached it, someone pushed off after a second at it stayed the door's operator for ever,
+  // and everyone else waited for them.)
+  if (!there && time - p.operate_progress_at > kOperateGiveUpSec) {
     p.operating = -1;
+    p.operate_elapsed = 0.0;
     p.operate_retry_at = time + kOperateGiveUpSec;
     return false;
   }
   p.walker.target = p.operate_spot;
   p.walker.final_target = true;
-  const double away = (p.walker.position - p.operate_spot).norm();
-  // At the actuator (or as near as the queue lets them: within reach and not getting closer).
-  const bool there = away < kAtActuatorM || (away < kArmReachM && p.walker.velocity.norm() < 0.05);
   p.walker.desired_speed = there ? 0.0 : p.speed;
-  if (there) p.operate_elapsed += dt;
+  if (there) {
+    p.operate_elapsed += dt;
+    p.operate_progress_at = time;
+  }
   if (p.operate_elapsed >= p.operate_time) {
     d.op->Trigger(time);
     ++p.state.doors_operated;

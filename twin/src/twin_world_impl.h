@@ -37,6 +37,9 @@ struct Person {
   double trigger_delay{0.0};
   double speed{1.3};
   std::vector<Eigen::Vector2d> route;  // waypoints still to go
+  // An exit route's waypoints as planned (route rewinds to them when the crowd pushes someone
+  // back through a doorway they had passed).
+  std::vector<Eigen::Vector2d> planned_route;
   int door{-1};
   int wait_before_waypoint{-1};  // route index (counted from the start) of the doorway centre
   int reached{0};                // waypoints reached so far
@@ -57,9 +60,9 @@ struct Person {
   double operate_time{1.5};  // [s] at the actuator until the door triggers
   int operating{-1};         // the door whose actuator they are going to or operating
   Eigen::Vector2d operate_spot{Eigen::Vector2d::Zero()};
-  double operate_elapsed{0.0};                           // [s] at the actuator so far
-  double operate_started{0.0};                           // [s] when they set off for the actuator
-  double operate_retry_at{0.0};                          // [s] not before this (after giving up)
+  double operate_elapsed{0.0};      // [s] at the actuator so far
+  double operate_progress_at{0.0};  // [s] when they set off for the actuator or were last at it
+  double operate_retry_at{0.0};     // [s] not before this (after giving up)
   const people::PersonBehaviorModel* behavior{nullptr};  // the model's behaviour
   btRigidBody* body{nullptr};
 };
@@ -149,6 +152,10 @@ struct TwinWorld::Impl {
   // An evacuee past a doorway of their route (pushed through by the crowd) resumes their route
   // beyond it.
   void AdvancePastDoorways(Person& p) const;
+  // An evacuee stuck with a wall between them and their next waypoint, on the near side of a
+  // doorway of their route they had passed (the crowd pushed them back through it), takes up
+  // their route again from before that doorway.
+  void RewindIfPushedBack(Person& p);
   // The door whose doorway centre is the person's next waypoint, or -1.
   static int GateDoor(const Person& p);
   // Where a person on `side` (+1/-1 along the door's normal) stands to operate door `door`'s
