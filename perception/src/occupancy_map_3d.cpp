@@ -17,6 +17,8 @@ void OccupancyMap3DConfig::Validate() const {
   ThrowUnless(prob_hit > 0.5 && prob_hit < 1.0 && prob_miss > 0.0 && prob_miss < 0.5,
               "Invalid OccupancyMap3DConfig: prob_hit must be in (0.5, 1) and prob_miss in "
               "(0, 0.5).");
+  ThrowUnless(decay_s >= 0.0 && std::isfinite(decay_s), "Invalid OccupancyMap3DConfig: decay_s (",
+              decay_s, ") must be finite and >= 0.");
   ThrowUnless(max_obstacle_height > min_obstacle_height,
               "Invalid OccupancyMap3DConfig: max_obstacle_height must exceed min_obstacle_height.");
 }
@@ -71,8 +73,21 @@ std::size_t OccupancyMap3D::InsertDepthImage(const DepthImage& depth,
   for (const auto& key : free) {
     if (occupied.count(key) == 0) tree_->updateNode(key, false, /*lazy_eval=*/true);
   }
-  for (const auto& key : occupied)
+  const double now = ToSeconds(depth.stamp);
+  for (const auto& key : occupied) {
     tree_->updateNode(key, true, /*lazy_eval=*/true);
+    marked_at_[key] = now;
+  }
+  if (config_.decay_s > 0.0) {
+    for (auto it = marked_at_.begin(); it != marked_at_.end();) {
+      if (now - it->second <= config_.decay_s) {
+        ++it;
+        continue;
+      }
+      tree_->setNodeValue(it->first, 0.0f, /*lazy_eval=*/true);  // even odds: as if unseen
+      it = marked_at_.erase(it);
+    }
+  }
   tree_->updateInnerOccupancy();
   return inserted;
 }

@@ -35,9 +35,20 @@ DepthImage RenderFace(const CameraIntrinsics& K, const Pose3& X_MC, double face_
   return image;
 }
 
-// The face lies on a voxel boundary (x = 2.0): accept the voxel on either side.
-bool OccupiedAtFace(const OccupancyMap3D& map, double y, double z) {
-  return map.IsOccupied({1.98, y, z}) || map.IsOccupied({2.02, y, z});
+// The face lies on a voxel boundary (x = face_x, a whole number of voxels): accept the voxel on
+// either side.
+bool OccupiedAtFace(const OccupancyMap3D& map, double y, double z, double face_x = 2.0) {
+  return map.IsOccupied({face_x - 0.02, y, z}) || map.IsOccupied({face_x + 0.02, y, z});
+}
+
+// Someone 3 m ahead (beyond clearing_range: no ray clears them), and an image with no return.
+DepthImage PersonAhead(const CameraIntrinsics& K) {
+  return RenderFace(K, ForwardCamera(), 3.0, -0.2, 0.2, 0.3, 1.4);
+}
+DepthImage NothingInView(const CameraIntrinsics& K, double t) {
+  DepthImage empty = RenderFace(K, ForwardCamera(), 3.0, 5.0, 5.0, 0.0, 0.0);
+  empty.stamp = SecondsToDuration(t);
+  return empty;
 }
 
 TEST(OccupancyMap3DTest, SyntheticBoxIsOccupiedAndTheSpaceBeforeItFree) {
@@ -75,6 +86,45 @@ TEST(OccupancyMap3DTest, OverheadObstaclesAreNotProjected) {
     map.InsertDepthImage(RenderFace(K, X_MC, 2.0, -0.3, 0.3, 1.6, 1.9), K, X_MC);
   EXPECT_TRUE(OccupiedAtFace(map, 0.0, 1.7));
   EXPECT_TRUE(map.ProjectObstacles().empty());
+}
+
+TEST(OccupancyMap3DTest, AVoxelNotMarkedAgainForTheDecayTimeIsForgotten) {
+  const CameraIntrinsics K = CameraIntrinsics::FromHorizontalFov(80, 60, 1.047);
+  const Pose3 X_MC = ForwardCamera();
+  OccupancyMap3DConfig config;
+  config.decay_s = 10.0;
+  OccupancyMap3D map(config);
+  DepthImage person = PersonAhead(K);  // seen for 1 s
+  for (int frame = 0; frame < 5; ++frame) {
+    person.stamp = SecondsToDuration(0.2 * frame);
+    map.InsertDepthImage(person, K, X_MC);
+  }
+  ASSERT_TRUE(OccupiedAtFace(map, 0.0, 0.8, 3.0));
+  // Then the camera sees nothing there (it looks elsewhere).
+  map.InsertDepthImage(NothingInView(K, 9.0), K, X_MC);
+  EXPECT_TRUE(OccupiedAtFace(map, 0.0, 0.8, 3.0)) << "kept within the decay time";
+  map.InsertDepthImage(NothingInView(K, 10.9), K, X_MC);
+  EXPECT_FALSE(OccupiedAtFace(map, 0.0, 0.8, 3.0));
+  EXPECT_TRUE(map.ProjectObstacles().empty());
+  // Seen again: marked again (three sightings, as at first).
+  for (int frame = 0; frame < 3; ++frame) {
+    person.stamp = SecondsToDuration(11.0 + 0.2 * frame);
+    map.InsertDepthImage(person, K, X_MC);
+  }
+  EXPECT_TRUE(OccupiedAtFace(map, 0.0, 0.8, 3.0));
+}
+
+TEST(OccupancyMap3DTest, ADecayOfZeroKeepsVoxelsForEver) {
+  const CameraIntrinsics K = CameraIntrinsics::FromHorizontalFov(80, 60, 1.047);
+  OccupancyMap3DConfig config;
+  config.decay_s = 0.0;
+  OccupancyMap3D map(config);
+  for (int frame = 0; frame < 3; ++frame)
+    map.InsertDepthImage(PersonAhead(K), K, ForwardCamera());
+  map.InsertDepthImage(NothingInView(K, 1000.0), K, ForwardCamera());
+  EXPECT_TRUE(OccupiedAtFace(map, 0.0, 0.8, 3.0));
+  config.decay_s = -1.0;
+  EXPECT_THROW(config.Validate(), InvalidArgument);
 }
 
 TEST(OccupancyMap3DTest, AFilterKeepsPointsFromMarkingButNotFromCarving) {

@@ -6,6 +6,7 @@
 
 #include <functional>
 #include <memory>
+#include <unordered_map>
 #include <vector>
 
 #include <octomap/OcTree.h>
@@ -36,6 +37,13 @@ struct OccupancyMap3DConfig {
   double occupied_threshold{0.9};
   double min_obstacle_height{0.05};  ///< Projection band in M's z [m]: the floor is below it,
   double max_obstacle_height{1.5};   ///< and what the robot passes under is above it.
+  /// An occupied voxel no image has marked for this long is forgotten [s] (0: never). Beyond
+  /// clearing_range no ray clears a voxel, and people the tracker does not hold (the detector
+  /// misses some in a crowd) are marked where they stood: without decay the robot would never
+  /// again plan through a doorway a queue stood in while it looked away (Nav2's
+  /// spatio-temporal voxel layer decays its voxels for the same reason). Anything still there
+  /// is marked again as soon as the camera faces it.
+  double decay_s{20.0};
   void Validate() const;
 };
 
@@ -63,6 +71,8 @@ class OccupancyMap3D {
  private:
   OccupancyMap3DConfig config_;
   std::shared_ptr<octomap::OcTree> tree_;
+  /// [s] When each voxel was last marked (the image's stamp), for decay_s.
+  std::unordered_map<octomap::OcTreeKey, double, octomap::OcTreeKey::KeyHash> marked_at_;
 };
 
 }  // namespace egress::perception
