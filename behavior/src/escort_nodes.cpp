@@ -6,6 +6,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <optional>
+#include <vector>
 
 #include "egress/perception/door_estimation.h"
 
@@ -26,6 +29,18 @@ constexpr double kMovingMps = 0.2;
 constexpr double kStillForSec = 4.0;
 // [m] The robot goes to its wait spot only with nobody this near it (or the way there).
 constexpr double kSpotClearM = 1.0;
+// [m] With everyone near waiting still, the robot goes to the actuator with nobody this near its
+// standoff (or the last kSpotClearM of the way there).
+constexpr double kStandoffFreeM = 0.5;
+// [m] Someone (a laser return off the map, a tracked person) this near the robot's edge is too
+// near: it makes room. Inside personal space (0.45-1.2 m), beyond a crowd's elbow room.
+constexpr double kMakeRoomGapM = 0.35;
+// [m] How far it looks round for room, and the steps it considers.
+constexpr double kRoomLookM = 2.5;
+constexpr double kRoomStepsM[] = {0.3, 0.6};
+constexpr int kRoomHeadings = 16;
+// [m] A step that gains less room than this is not worth taking.
+constexpr double kRoomGainM = 0.1;
 
 // Who is near a door on the robot's side (or in its doorway), and whether anyone there is on
 // the move: tracked people within `watch_radius` (moving: faster than kMovingMps) and the
@@ -135,6 +150,19 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
       return Release(StrCat("held for ", std::round(held), " s"));
     if (!came_ && unseen_ > Input<double>("wait_for")) return Release("nobody about");
     if (came_ && unseen_ > Input<double>("clear_for")) return Release("everyone is through");
+    // Someone too near: the robot steps away from them first, whatever it was doing (a crowd
+    // funnelling into the doorway spreads along the wall it waits by).
+    if (!making_room_ || !task_.motion->base_moving()) {
+      making_room_ = false;
+      if (const std::optional<Pose2> room = FindRoom(pass)) {
+        // At the door speed (the quickest the trajectories go): a resident walks at 1 m/s.
+        task_.motion->FollowPath({belief_.X_MB, *room}, {true}, task_.motion->arm_target(),
+                                 belief_.now);
+        making_room_ = true;
+        Note(StrCat("making room: stepping to ", PoseText(*room)));
+        return NodeStatus::kRunning;
+      }
+    }
     if (task_.motion->base_moving()) return NodeStatus::kRunning;  // turning, or stepping aside
     // An operation broken off (someone came) leaves the arm out: tucked before the base moves.
     if (!ArmAt(task_.motion->arm_target(), TuckedArm(*task_.model))) {
@@ -150,11 +178,14 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // Once they came and have all stood still for a while, whoever is left waits for the door
     // (someone who cannot open it): the robot opens it for them, passing no nearer than
     // kSpotClearM.
+    // (Still since the hold began counts: a resident who cannot open the door may be waiting
+    // at it before the robot arrives, and never move while it watches.)
+    const std::optional<Time> still_since = last_moving_ ? last_moving_ : started_;
     const bool all_waiting =
-        came_ && last_moving_ && ToSeconds(belief_.now - *last_moving_) > kStillForSec;
+        around.near && !around.moving && ToSeconds(belief_.now - *still_since) > kStillForSec;
     const bool actuator_clear =
-        !around.moving &&
-        WayClear(standoff_, all_waiting ? kSpotClearM : Input<double>("keep_clear"));
+        !around.moving && (all_waiting ? WayClear(standoff_, kStandoffFreeM, kSpotClearM)
+                                       : WayClear(standoff_, Input<double>("keep_clear")));
     if (OperateDue() && actuator_clear) return NodeStatus::kSuccess;
     const Pose2& wait_at = came_ || !actuator_clear ? spot_ : standoff_;
     if ((wait_at.translation() - belief_.X_MB.translation()).norm() > kAtSpotM &&
@@ -176,13 +207,67 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     return NodeStatus::kRunning;
   }
 
-  void OnHalted() override { task_.motion->StopBase(); }
+  void OnHalted() override {
+    task_.motion->StopBase();
+    making_room_ = false;
+  }
 
  private:
   // The heading from p_M to where the residents come from: kLookOutM out from the doorway.
   static double LookYaw(const DoorPass& pass, const Eigen::Vector2d& p_M) {
     const Eigen::Vector2d look = pass.centre + pass.n_M * kLookOutM - p_M;
     return std::atan2(look.y(), look.x());
+  }
+
+  // Where to step to make room when someone is within kMakeRoomGapM of the robot's edge: of
+  // the free poses a step away (the same heading), not in the doorway, the one farthest from
+  // everyone near, if it gains kRoomGainM. nullopt: nobody that near, or no better place.
+  std::optional<Pose2> FindRoom(const DoorPass& pass) const {
+    const Eigen::Vector2d at = belief_.X_MB.translation();
+    std::vector<Eigen::Vector2d> near;
+    for (const Eigen::Vector2d& p : belief_.off_map_returns)
+      if ((p - at).norm() < kRoomLookM) near.push_back(p);
+    // A tracked person where they are and where they are forecast to be (the tracker's
+    // prediction: someone walking at the robot is too near before they arrive), each centre
+    // pulled in to their edge towards the robot.
+    for (const auto& entry : belief_.world.people) {
+      std::vector<Eigen::Vector2d> where = entry.person.forecast;
+      where.push_back(entry.person.p_MP);
+      for (const Eigen::Vector2d& p_MP : where) {
+        const Eigen::Vector2d d = p_MP - at;
+        if (d.norm() < kRoomLookM && d.norm() > 1e-6)
+          near.push_back(p_MP - d.normalized() * task_.config.person_radius);
+      }
+    }
+    const auto room_at = [&](const Eigen::Vector2d& q) {
+      double room = std::numeric_limits<double>::infinity();
+      for (const Eigen::Vector2d& p : near)
+        room = std::min(room, (p - q).norm());
+      return room;
+    };
+    const double now = room_at(at);
+    if (now > task_.config.footprint_radius + kMakeRoomGapM) return std::nullopt;
+    const Eigen::Vector2d t(-pass.n_M.y(), pass.n_M.x());
+    const auto in_doorway = [&](const Eigen::Vector2d& q) {
+      const Eigen::Vector2d d = q - pass.centre;
+      return std::abs(d.dot(pass.n_M)) < task_.config.footprint_radius + kThroughM &&
+             std::abs(d.dot(t)) < pass.width / 2 + task_.config.footprint_radius;
+    };
+    std::optional<Pose2> best;
+    double best_room = now + kRoomGainM;
+    for (const double step : kRoomStepsM) {
+      for (int k = 0; k < kRoomHeadings; ++k) {
+        const double a = 2 * M_PI * k / kRoomHeadings;
+        const Eigen::Vector2d q = at + step * Eigen::Vector2d(std::cos(a), std::sin(a));
+        const double room = room_at(q);
+        if (room <= best_room || in_doorway(q)) continue;
+        const Pose2 candidate{q.x(), q.y(), belief_.X_MB.yaw};
+        if (!task_.planner->IsValid(candidate)) continue;
+        best = candidate;
+        best_room = room;
+      }
+    }
+    return best;
   }
 
   void ResetHold() {
@@ -245,9 +330,13 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   }
 
   // Nobody within `radius` of `goal` or of the straight way from the robot to it: no tracked
-  // person, no laser return off the map.
-  bool WayClear(const Pose2& goal, double radius) const {
-    const Eigen::Vector2d a = belief_.X_MB.translation(), b = goal.translation();
+  // person, no laser return off the map. With `only_within`, only the last `only_within` metres
+  // of the way count (a far robot's straight line says nothing of the path it will take).
+  bool WayClear(const Pose2& goal, double radius, double only_within = -1.0) const {
+    Eigen::Vector2d a = belief_.X_MB.translation();
+    const Eigen::Vector2d b = goal.translation();
+    if (only_within >= 0.0 && (a - b).norm() > only_within)
+      a = b + (a - b).normalized() * only_within;
     const auto near_way = [&](const Eigen::Vector2d& p) {
       return (p - ClosestPointOnSegment(p, a, b)).norm() < radius;
     };
@@ -266,6 +355,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   bool came_{false};                 // someone came during this hold
   std::optional<Time> last_moving_;  // when someone near was last seen on the move
   double unseen_{0.0};               // [s] of watching since anyone was near
+  bool making_room_{false};          // stepping away from someone too near
 };
 
 // IsNobodyComing: the guard of an operation during a hold (a ReactiveSequence above
