@@ -220,8 +220,8 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   }
 
   // Where to step to make room when someone is within kMakeRoomGapM of the robot's edge: of
-  // the free poses a step away (the same heading), not in the doorway, the one farthest from
-  // everyone near, if it gains kRoomGainM. nullopt: nobody that near, or no better place.
+  // the poses a free straight step away (the same heading), not in the doorway, the one farthest
+  // from everyone near, if it gains kRoomGainM. nullopt: nobody that near, or no better place.
   std::optional<Pose2> FindRoom(const DoorPass& pass) const {
     const Eigen::Vector2d at = belief_.X_MB.translation();
     std::vector<Eigen::Vector2d> near;
@@ -262,7 +262,8 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
         const double room = room_at(q);
         if (room <= best_room || in_doorway(q)) continue;
         const Pose2 candidate{q.x(), q.y(), belief_.X_MB.yaw};
-        if (!task_.planner->IsValid(candidate)) continue;
+        // The straight step, not only where it ends: a free pose may lie beyond a wall.
+        if (!task_.planner->IsPathValid({belief_.X_MB, candidate})) continue;
         best = candidate;
         best_room = room;
       }

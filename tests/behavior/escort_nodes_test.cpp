@@ -112,6 +112,47 @@ TEST_F(HoldForResidentsTest, OpensTheDoorForSomeoneLeftWaitingAtIt) {
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // waiting: the robot opens it
 }
 
+TEST_F(HoldForResidentsTest, OpensTheDoorForSomeoneFoundWaitingAtIt) {
+  // The robot comes from the far end of the room; someone who cannot press the button has
+  // been waiting by it all along (0.45 m from the standoff), and never moves.
+  belief_.X_MB = {6.0, 0.5, 0.0};
+  tree_.TickOnce();
+  OperatedAgo(12.0);  // the door has closed
+  belief_.off_map_returns = {{Standoff().x + 0.1, Standoff().y - 0.45}};
+  belief_.now = At(2.0);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);  // still only a moment: may set off
+  belief_.now = At(6.0);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);  // right at the standoff: not yet clear
+  belief_.off_map_returns = {{Standoff().x - 0.2, Standoff().y - 0.6}};  // 0.6 m off it
+  belief_.now = At(6.5);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // waiting: the robot goes to open it
+}
+
+TEST_F(HoldForResidentsTest, MakesRoomForSomeoneWhoComesTooNear) {
+  tree_.TickOnce();
+  OperatedAgo(1.0);
+  const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
+  belief_.X_MB = spot;
+  belief_.now = At(2.0);
+  // Someone 0.4 m from the robot's centre, on the doorway's side of it.
+  const Eigen::Vector2d them{spot.x - 0.4, spot.y};
+  belief_.off_map_returns = {them};
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(NotedText("making room"));
+  ASSERT_GE(motion_.path().size(), 2u);
+  const Eigen::Vector2d to = motion_.path().back().translation();
+  EXPECT_GT((to - them).norm(), 0.4 + 0.1);  // farther from them by a real step
+  EXPECT_TRUE(planner_.IsPathValid(motion_.path()));
+  // Someone at arm's length (a metre) is not too near: no step.
+  motion_.StopBase();
+  log_.Take();
+  belief_.X_MB = spot;
+  belief_.off_map_returns = {{spot.x - 1.0, spot.y}};
+  belief_.now = At(2.5);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_FALSE(NotedText("making room"));
+}
+
 TEST_F(HoldForResidentsTest, WithNobodyAboutTheHoldEndsAfterWaitFor) {
   tree_.TickOnce();
   OperatedAgo(0.5);
