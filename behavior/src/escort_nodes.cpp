@@ -308,7 +308,9 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
       if (found) break;
       const Eigen::Vector2d p = standoff_.translation() + t * aside * f;
       const Pose2 candidate{p.x(), p.y(), standoff_.yaw};
-      if (!task_.planner->IsValid(candidate)) continue;
+      // Reached along the wall from the standoff: a free pose past a corner may be in the next
+      // room.
+      if (!task_.planner->IsPathValid({standoff_, candidate})) continue;
       spot_ = candidate;
       found = true;
     }
