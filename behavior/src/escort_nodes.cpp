@@ -29,8 +29,10 @@ constexpr double kMovingMps = 0.2;
 constexpr double kStillForSec = 4.0;
 // [m] The robot goes to its wait spot only with nobody this near it (or the way there).
 constexpr double kSpotClearM = 1.0;
-// [m] With everyone near waiting still, the robot goes to the actuator with nobody this near its
-// standoff (or the last kSpotClearM of the way there).
+// [m] Someone this near the doorway's centre, on the robot's side, stands by the door.
+constexpr double kAtDoorwayM = 1.5;
+// [m] For someone found waiting by the door, the robot goes to the actuator with nobody this near
+// its standoff (or the last kSpotClearM of the way there).
 constexpr double kStandoffFreeM = 0.5;
 // [m] Someone (a laser return off the map, a tracked person) this near the robot's edge is too
 // near: it makes room. Inside personal space (0.45-1.2 m), beyond a crowd's elbow room.
@@ -178,14 +180,20 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // Once they came and have all stood still for a while, whoever is left waits for the door
     // (someone who cannot open it): the robot opens it for them, passing no nearer than
     // kSpotClearM.
-    // (Still since the hold began counts: a resident who cannot open the door may be waiting
-    // at it before the robot arrives, and never move while it watches.)
-    const std::optional<Time> still_since = last_moving_ ? last_moving_ : started_;
     const bool all_waiting =
-        around.near && !around.moving && ToSeconds(belief_.now - *still_since) > kStillForSec;
+        came_ && last_moving_ && ToSeconds(belief_.now - *last_moving_) > kStillForSec;
+    // Someone who cannot open the door may be waiting right at it before the robot arrives, and
+    // never move while it watches: nobody near has moved since the hold began, and someone
+    // stands by the doorway. (Not anyone still within the watch radius: residents standing in
+    // the room when the alarm sounds set off as the robot reaches the actuator among them.)
+    const bool found_waiting = !came_ && !last_moving_ && !around.moving &&
+                               ToSeconds(belief_.now - *started_) > kStillForSec &&
+                               LookAround(belief_, pass, kAtDoorwayM, kAtDoorwayM).near;
     const bool actuator_clear =
-        !around.moving && (all_waiting ? WayClear(standoff_, kStandoffFreeM, kSpotClearM)
-                                       : WayClear(standoff_, Input<double>("keep_clear")));
+        !around.moving &&
+        (found_waiting
+             ? WayClear(standoff_, kStandoffFreeM, kSpotClearM)
+             : WayClear(standoff_, all_waiting ? kSpotClearM : Input<double>("keep_clear")));
     if (OperateDue() && actuator_clear) return NodeStatus::kSuccess;
     const Pose2& wait_at = came_ || !actuator_clear ? spot_ : standoff_;
     if ((wait_at.translation() - belief_.X_MB.translation()).norm() > kAtSpotM &&
@@ -220,8 +228,9 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   }
 
   // Where to step to make room when someone is within kMakeRoomGapM of the robot's edge: of
-  // the poses a free straight step away (the same heading), not in the doorway, the one farthest
-  // from everyone near, if it gains kRoomGainM. nullopt: nobody that near, or no better place.
+  // the poses a free straight step away (the same heading), not in the residents' way in, the one
+  // farthest from everyone near, if it gains kRoomGainM. nullopt: nobody that near, or no better
+  // place.
   std::optional<Pose2> FindRoom(const DoorPass& pass) const {
     const Eigen::Vector2d at = belief_.X_MB.translation();
     std::vector<Eigen::Vector2d> near;
@@ -248,10 +257,16 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     const double now = room_at(at);
     if (now > task_.config.footprint_radius + kMakeRoomGapM) return std::nullopt;
     const Eigen::Vector2d t(-pass.n_M.y(), pass.n_M.x());
-    const auto in_doorway = [&](const Eigen::Vector2d& q) {
+    // The residents' way in: the doorway and the lane before it, as wide as the opening plus
+    // the robot and a resident, kLookOutM out on the robot's side. A step never goes into it,
+    // nor nearer the doorway (the flow funnels there).
+    const double lane = pass.width / 2 + task_.config.footprint_radius + task_.config.person_radius;
+    const auto in_the_way = [&](const Eigen::Vector2d& q) {
       const Eigen::Vector2d d = q - pass.centre;
-      return std::abs(d.dot(pass.n_M)) < task_.config.footprint_radius + kThroughM &&
-             std::abs(d.dot(t)) < pass.width / 2 + task_.config.footprint_radius;
+      const double out = d.dot(pass.n_M);
+      return (out > -(task_.config.footprint_radius + kThroughM) && out < kLookOutM &&
+              std::abs(d.dot(t)) < lane) ||
+             d.norm() < (at - pass.centre).norm();
     };
     std::optional<Pose2> best;
     double best_room = now + kRoomGainM;
@@ -260,7 +275,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
         const double a = 2 * M_PI * k / kRoomHeadings;
         const Eigen::Vector2d q = at + step * Eigen::Vector2d(std::cos(a), std::sin(a));
         const double room = room_at(q);
-        if (room <= best_room || in_doorway(q)) continue;
+        if (room <= best_room || in_the_way(q)) continue;
         const Pose2 candidate{q.x(), q.y(), belief_.X_MB.yaw};
         // The straight step, not only where it ends: a free pose may lie beyond a wall.
         if (!task_.planner->IsPathValid({belief_.X_MB, candidate})) continue;

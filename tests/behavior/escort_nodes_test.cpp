@@ -87,8 +87,12 @@ TEST_F(HoldForResidentsTest, NeverGoesToTheActuatorWithSomeoneStandingByIt) {
   belief_.now = At(2.0);
   belief_.off_map_returns = {{1.6, 1.8}};  // standing 0.7 m from the standoff
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  // Still there, never moving, 2 m from the doorway: standing in the room (they may set off
+  // any moment), not waiting at the door.
+  belief_.now = At(7.0);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
   belief_.off_map_returns.clear();
-  belief_.now = At(2.5);
+  belief_.now = At(7.5);
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);
 }
 
@@ -114,16 +118,16 @@ TEST_F(HoldForResidentsTest, OpensTheDoorForSomeoneLeftWaitingAtIt) {
 
 TEST_F(HoldForResidentsTest, OpensTheDoorForSomeoneFoundWaitingAtIt) {
   // The robot comes from the far end of the room; someone who cannot press the button has
-  // been waiting by it all along (0.45 m from the standoff), and never moves.
+  // been waiting by the doorway all along (0.4 m from the standoff), and never moves.
   belief_.X_MB = {6.0, 0.5, 0.0};
   tree_.TickOnce();
   OperatedAgo(12.0);  // the door has closed
-  belief_.off_map_returns = {{Standoff().x + 0.1, Standoff().y - 0.45}};
+  belief_.off_map_returns = {{0.7, 2.2}};
   belief_.now = At(2.0);
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);  // still only a moment: may set off
   belief_.now = At(6.0);
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);  // right at the standoff: not yet clear
-  belief_.off_map_returns = {{Standoff().x - 0.2, Standoff().y - 0.6}};  // 0.6 m off it
+  belief_.off_map_returns = {{0.5, 2.2}};  // 0.6 m off it, still by the doorway
   belief_.now = At(6.5);
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // waiting: the robot goes to open it
 }
