@@ -31,7 +31,7 @@ constexpr double kStillForSec = 4.0;
 constexpr double kSpotClearM = 1.0;
 // [m] Someone this near the doorway's centre, on the robot's side, stands by the door.
 constexpr double kAtDoorwayM = 1.5;
-// [m] For someone found waiting by the door, the robot goes to the actuator with nobody this near
+// [m] For residents waiting at the door, the robot goes to the actuator with nobody this near
 // its standoff (or the last kSpotClearM of the way there).
 constexpr double kStandoffFreeM = 0.5;
 // [m] Someone (a laser return off the map, a tracked person) this near the robot's edge is too
@@ -191,9 +191,8 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
                                LookAround(belief_, pass, kAtDoorwayM, kAtDoorwayM).near;
     const bool actuator_clear =
         !around.moving &&
-        (found_waiting
-             ? WayClear(standoff_, kStandoffFreeM, kSpotClearM)
-             : WayClear(standoff_, all_waiting ? kSpotClearM : Input<double>("keep_clear")));
+        (found_waiting || all_waiting ? WayClear(standoff_, kStandoffFreeM, kSpotClearM)
+                                      : WayClear(standoff_, Input<double>("keep_clear")));
     if (OperateDue() && actuator_clear) return NodeStatus::kSuccess;
     const Pose2& wait_at = came_ || !actuator_clear ? spot_ : standoff_;
     if ((wait_at.translation() - belief_.X_MB.translation()).norm() > kAtSpotM &&
