@@ -186,9 +186,14 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // never move while it watches: nobody near has moved since the hold began, and someone
     // stands by the doorway. (Not anyone still within the watch radius: residents standing in
     // the room when the alarm sounds set off as the robot reaches the actuator among them.)
+    // Only they: with others standing further out near the actuator, this is a group that has
+    // not set off yet (office seed 21: its front row stood 1.4 m from the doorway; the robot,
+    // its back to them to press the button, was walked into when they set off — the laser's
+    // blind sector is behind it).
     const bool found_waiting = !came_ && !last_moving_ && !around.moving &&
                                ToSeconds(belief_.now - *started_) > kStillForSec &&
-                               LookAround(belief_, pass, kAtDoorwayM, kAtDoorwayM).near;
+                               LookAround(belief_, pass, kAtDoorwayM, kAtDoorwayM).near &&
+                               OnlyByTheDoorway(pass, Input<double>("keep_clear"));
     const bool actuator_clear =
         !around.moving &&
         (found_waiting || all_waiting ? WayClear(standoff_, kStandoffFreeM, kSpotClearM)
@@ -344,6 +349,20 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
         return true;
     }
     return ToSeconds(belief_.now - *visit->operated_at) >= Input<double>("every");
+  }
+
+  // Everyone (tracked people, laser returns off the map) within `radius` of the standoff stands
+  // within kAtDoorwayM of the doorway.
+  bool OnlyByTheDoorway(const DoorPass& pass, double radius) const {
+    const auto by_doorway = [&](const Eigen::Vector2d& p) {
+      return (p - standoff_.translation()).norm() >= radius ||
+             (p - pass.centre).norm() < kAtDoorwayM;
+    };
+    for (const auto& entry : belief_.world.people)
+      if (!by_doorway(entry.person.p_MP)) return false;
+    for (const Eigen::Vector2d& p : belief_.off_map_returns)
+      if (!by_doorway(p)) return false;
+    return true;
   }
 
   // Nobody within `radius` of `goal` or of the straight way from the robot to it: no tracked

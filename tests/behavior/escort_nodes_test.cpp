@@ -127,9 +127,25 @@ TEST_F(HoldForResidentsTest, OpensTheDoorForSomeoneFoundWaitingAtIt) {
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);  // still only a moment: may set off
   belief_.now = At(6.0);
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);  // right at the standoff: not yet clear
-  belief_.off_map_returns = {{0.5, 2.2}};  // 0.6 m off it, still by the doorway
+  belief_.off_map_returns = {{0.5, 2.2}};             // 0.6 m off it, still by the doorway
   belief_.now = At(6.5);
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // waiting: the robot goes to open it
+}
+
+TEST_F(HoldForResidentsTest, DoesNotTakeAGroupYetToSetOffForSomeoneWaiting) {
+  // The same as above, with others of the group standing further out in the room near the
+  // actuator: they have not set off yet, and may as the robot presses with its back to them.
+  belief_.X_MB = {6.0, 0.5, 0.0};
+  tree_.TickOnce();
+  OperatedAgo(12.0);
+  belief_.off_map_returns = {{0.5, 2.2}, {0.3, 0.9}};  // the second 2.1 m from the doorway
+  for (double t = 2.0; t < 20.0; t += 1.0) {
+    belief_.now = At(t);
+    EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning) << "at " << t;
+  }
+  belief_.off_map_returns = {{0.5, 2.2}};  // only the one by the doorway now
+  belief_.now = At(20.5);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);
 }
 
 TEST_F(HoldForResidentsTest, MakesRoomForSomeoneWhoComesTooNear) {
