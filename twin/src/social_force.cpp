@@ -216,10 +216,15 @@ void SocialForceModel::Step(std::vector<Walker>* walkers, const std::vector<Disc
 void SocialForceModel::Step(std::vector<Walker>* walkers, const std::vector<DiscObstacle>& discs,
                             const WallCells& fixed, const std::vector<WallSegment>& moving,
                             double dt) const {
+  Integrate(walkers, CalcAccelerations(*walkers, discs, fixed, moving), dt);
+}
+
+std::vector<Eigen::Vector2d> SocialForceModel::CalcAccelerations(
+    const std::vector<Walker>& all, const std::vector<DiscObstacle>& discs, const WallCells& fixed,
+    const std::vector<WallSegment>& moving) const {
   // A uniform grid (a cell list): each walker meets only the walkers of the 3 x 3 cells round
   // it, in ascending index as over the whole crowd, so the sums (and the run) are the same as
   // without the grid, in O(n) instead of O(n^2).
-  const std::vector<Walker>& all = *walkers;
   std::vector<Eigen::Vector2d> accelerations(all.size());
   // Cells as wide as the farthest reach, so that the 3 x 3 round a walker hold all who reach it.
   std::vector<double> reach(all.size());
@@ -275,6 +280,12 @@ void SocialForceModel::Step(std::vector<Walker>* walkers, const std::vector<Disc
     const Neighbours neighbours{&near, &near_walls, &wall_rank, &reach};
     accelerations[i] = CalcAccelerationAmong(i, all, neighbours, discs, walls);
   }
+  return accelerations;
+}
+
+void SocialForceModel::Integrate(std::vector<Walker>* walkers,
+                                 const std::vector<Eigen::Vector2d>& accelerations,
+                                 double dt) const {
   for (std::size_t i = 0; i < walkers->size(); ++i) {
     Walker& w = (*walkers)[i];
     w.velocity += accelerations[i] * dt;

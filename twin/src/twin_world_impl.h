@@ -33,6 +33,9 @@ struct Door {
 struct Person {
   PersonState state;
   Walker walker;
+  // [m/s²] The social forces' acceleration, summed every few steps and held between
+  // (TwinConfig::crowd_force_rate_hz).
+  Eigen::Vector2d acceleration{Eigen::Vector2d::Zero()};
   TriggerSpec trigger;
   double trigger_delay{0.0};
   double speed{1.3};

@@ -113,6 +113,16 @@ class SocialForceModel {
   void Step(std::vector<Walker>* walkers, const std::vector<DiscObstacle>& discs,
             const WallCells& fixed, const std::vector<WallSegment>& moving, double dt) const;
 
+  /// Every walker's acceleration [m/s²]: what the Step above integrates, the same sums.
+  std::vector<Eigen::Vector2d> CalcAccelerations(const std::vector<Walker>& walkers,
+                                                 const std::vector<DiscObstacle>& discs,
+                                                 const WallCells& fixed,
+                                                 const std::vector<WallSegment>& moving) const;
+  /// Advances every walker by dt [s] under `accelerations` (one per walker), as Step does: a
+  /// caller may hold accelerations over several steps (the forces are the costly part).
+  void Integrate(std::vector<Walker>* walkers, const std::vector<Eigen::Vector2d>& accelerations,
+                 double dt) const;
+
   const SocialForceParams& params() const { return params_; }
 
  private:

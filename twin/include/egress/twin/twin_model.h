@@ -23,6 +23,10 @@ namespace egress::twin {
 /// Physics and robot-body settings.
 struct TwinConfig {
   double physics_rate_hz{240.0};
+  /// The people's social forces are summed at this rate and held between (each physics step
+  /// still integrates them) [Hz]: the sums are most of a crowd's cost, and forces with a 0.5 s
+  /// relaxation time change little in 1/60 s. At most physics_rate_hz.
+  double crowd_force_rate_hz{120.0};
   double base_max_linear_acceleration{1.0};   ///< [m/s²]
   double base_max_angular_acceleration{2.0};  ///< [rad/s²]
   double base_max_linear_speed{0.8};          ///< [m/s] (HSR: ~3 km/h)
@@ -33,8 +37,8 @@ struct TwinConfig {
   double grasp_tolerance{0.02};               ///< Lateral centring error a grasp accepts [m]
   double person_hold_force{100.0};            ///< Force a person holds a door with [N]
   double door_crossed_open_angle_deg{60.0};   ///< "Open when crossed" threshold [deg]
-  /// @throws InvalidArgument naming the field for a physics rate below 60 Hz or a non-positive
-  /// or non-finite limit.
+  /// @throws InvalidArgument naming the field for a physics rate below 60 Hz, a crowd force rate
+  /// above it, or a non-positive or non-finite limit.
   void Validate() const;
 };
 
