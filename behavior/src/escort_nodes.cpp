@@ -31,6 +31,9 @@ constexpr double kStillForSec = 4.0;
 constexpr double kSpotClearM = 1.0;
 // [m] Someone this near the doorway's centre, on the robot's side, stands by the door.
 constexpr double kAtDoorwayM = 1.5;
+// [m] Laser returns closer than this to one another are on one body (returns 0.25 degrees
+// apart are centimetres apart on it; people in a group stand further apart than this).
+constexpr double kSameBodyM = 0.15;
 // [m] For residents waiting at the door, the robot goes to the actuator with nobody this near
 // its standoff (or the last kSpotClearM of the way there).
 constexpr double kStandoffFreeM = 0.5;
@@ -192,7 +195,6 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // blind sector is behind it).
     const bool found_waiting = !came_ && !last_moving_ && !around.moving &&
                                ToSeconds(belief_.now - *started_) > kStillForSec &&
-                               LookAround(belief_, pass, kAtDoorwayM, kAtDoorwayM).near &&
                                OnlyByTheDoorway(pass, Input<double>("keep_clear"));
     const bool actuator_clear =
         !around.moving &&
@@ -260,17 +262,10 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     };
     const double now = room_at(at);
     if (now > task_.config.footprint_radius + kMakeRoomGapM) return std::nullopt;
-    const Eigen::Vector2d t(-pass.n_M.y(), pass.n_M.x());
-    // The residents' way in: the doorway and the lane before it, as wide as the opening plus
-    // the robot and a resident, kLookOutM out on the robot's side. A step never goes into it,
-    // nor nearer the doorway (the flow funnels there).
-    const double lane = pass.width / 2 + task_.config.footprint_radius + task_.config.person_radius;
+    // A step never goes into the residents' way in, nor nearer the doorway (the flow funnels
+    // there).
     const auto in_the_way = [&](const Eigen::Vector2d& q) {
-      const Eigen::Vector2d d = q - pass.centre;
-      const double out = d.dot(pass.n_M);
-      return (out > -(task_.config.footprint_radius + kThroughM) && out < kLookOutM &&
-              std::abs(d.dot(t)) < lane) ||
-             d.norm() < (at - pass.centre).norm();
+      return InTheLane(pass, q) || (q - pass.centre).norm() < (at - pass.centre).norm();
     };
     std::optional<Pose2> best;
     double best_room = now + kRoomGainM;
@@ -351,18 +346,55 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     return ToSeconds(belief_.now - *visit->operated_at) >= Input<double>("every");
   }
 
-  // Everyone (tracked people, laser returns off the map) within `radius` of the standoff stands
-  // within kAtDoorwayM of the doorway.
+  // The residents' way in: the doorway and the lane before it, as wide as the opening plus the
+  // robot and a resident, kLookOutM out on the robot's side.
+  bool InTheLane(const DoorPass& pass, const Eigen::Vector2d& q) const {
+    const Eigen::Vector2d d = q - pass.centre;
+    const double out = d.dot(pass.n_M);
+    const Eigen::Vector2d t(-pass.n_M.y(), pass.n_M.x());
+    const double lane = pass.width / 2 + task_.config.footprint_radius + task_.config.person_radius;
+    return out > -(task_.config.footprint_radius + kThroughM) && out < kLookOutM &&
+           std::abs(d.dot(t)) < lane;
+  }
+
+  // Someone stands by the doorway, and everyone within `radius` of the standoff does: each
+  // tracked person within kAtDoorwayM (plus a body) of the doorway's centre, and each laser
+  // return off the map on a body that does — the returns linked to one within kAtDoorwayM by
+  // steps of under kSameBodyM (one body's outline; its far side may be further out).
   bool OnlyByTheDoorway(const DoorPass& pass, double radius) const {
-    const auto by_doorway = [&](const Eigen::Vector2d& p) {
-      return (p - standoff_.translation()).norm() >= radius ||
-             (p - pass.centre).norm() < kAtDoorwayM;
+    const Eigen::Vector2d& p_MS = standoff_.translation();
+    const auto by_doorway = [&](const Eigen::Vector2d& p, double within) {
+      const Eigen::Vector2d d = p - pass.centre;
+      return d.norm() < within && d.dot(pass.n_M) > -kThroughM;  // on the robot's side
     };
-    for (const auto& entry : belief_.world.people)
-      if (!by_doorway(entry.person.p_MP)) return false;
+    bool someone = false;
+    for (const auto& entry : belief_.world.people) {
+      const bool by = by_doorway(entry.person.p_MP, kAtDoorwayM + task_.config.person_radius);
+      if (!by && (entry.person.p_MP - p_MS).norm() < radius) return false;
+      someone = someone || by;
+    }
+    std::vector<Eigen::Vector2d> near;
     for (const Eigen::Vector2d& p : belief_.off_map_returns)
-      if (!by_doorway(p)) return false;
-    return true;
+      if ((p - p_MS).norm() < radius || by_doorway(p, kAtDoorwayM)) near.push_back(p);
+    std::vector<bool> linked(near.size(), false);
+    std::vector<std::size_t> frontier;
+    for (std::size_t i = 0; i < near.size(); ++i) {
+      if (by_doorway(near[i], kAtDoorwayM)) {
+        linked[i] = true;
+        frontier.push_back(i);
+      }
+    }
+    someone = someone || !frontier.empty();
+    while (!frontier.empty()) {
+      const std::size_t i = frontier.back();
+      frontier.pop_back();
+      for (std::size_t j = 0; j < near.size(); ++j) {
+        if (linked[j] || (near[j] - near[i]).norm() >= kSameBodyM) continue;
+        linked[j] = true;
+        frontier.push_back(j);
+      }
+    }
+    return someone && std::all_of(linked.begin(), linked.end(), [](bool b) { return b; });
   }
 
   // Nobody within `radius` of `goal` or of the straight way from the robot to it: no tracked

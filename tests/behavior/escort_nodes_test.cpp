@@ -148,6 +148,32 @@ TEST_F(HoldForResidentsTest, DoesNotTakeAGroupYetToSetOffForSomeoneWaiting) {
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);
 }
 
+TEST_F(HoldForResidentsTest, SomeoneWaitingIsOneBodyWhoseOutlineReachesFurtherOut) {
+  // A wheelchair user waiting by the doorway, off to the side away from the actuator: the
+  // laser's returns on their outline run from 0.9 m to 1.6 m from the doorway's centre (office
+  // seed 34: one such was left behind).
+  belief_.X_MB = {6.0, 0.5, 0.0};
+  tree_.TickOnce();
+  OperatedAgo(12.0);
+  std::vector<Eigen::Vector2d> outline;
+  for (double x = -0.6; x > -1.42; x -= 0.04)
+    outline.push_back({x, 2.3});
+  belief_.off_map_returns = outline;
+  belief_.now = At(6.0);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);
+  // Someone else 0.3 m beyond them (a gap between two bodies): a group, not one waiting.
+  tree_.TickOnce();
+  OperatedAgo(12.0);
+  belief_.off_map_returns = outline;
+  belief_.off_map_returns.push_back({-1.7, 2.3});
+  belief_.now = At(7.0);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  // Only the one beside the lane: nobody waits at the door.
+  belief_.off_map_returns = {{-1.7, 2.3}};
+  belief_.now = At(8.0);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+}
+
 TEST_F(HoldForResidentsTest, MakesRoomForSomeoneWhoComesTooNear) {
   tree_.TickOnce();
   OperatedAgo(1.0);
