@@ -193,7 +193,14 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // not set off yet (office seed 21: its front row stood 1.4 m from the doorway; the robot,
     // its back to them to press the button, was walked into when they set off — the laser's
     // blind sector is behind it).
-    const bool found_waiting = !came_ && !last_moving_ && !around.moving &&
+    // And not once the door has stood open before them while they stayed (someone waiting for
+    // it goes through; office seeds 20, 24, 31, 33: the group's back rows hidden behind the
+    // front one, the robot saw only the front row).
+    const auto open_since = belief_.door_open_since.find(door_);
+    if (open_since != belief_.door_open_since.end() &&
+        ToSeconds(belief_.now - open_since->second) > kStillForSec)
+      stood_open_ = true;
+    const bool found_waiting = !came_ && !last_moving_ && !around.moving && !stood_open_ &&
                                ToSeconds(belief_.now - *started_) > kStillForSec &&
                                OnlyByTheDoorway(pass, Input<double>("keep_clear"));
     const bool actuator_clear =
@@ -205,13 +212,16 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     if ((wait_at.translation() - belief_.X_MB.translation()).norm() > kAtSpotM &&
         WayClear(wait_at, kSpotClearM)) {
       Pose2 goal = wait_at;
-      if (came_) goal.yaw = LookYaw(pass, wait_at.translation());
+      goal.yaw = LookYaw(pass, wait_at.translation());
       if (StartPath(task_, goal, &wait_at == &spot_ ? "the spot beside the door" : "the actuator",
                     [this](const std::string& t) { Note(t); }) == NodeStatus::kRunning)
         return NodeStatus::kRunning;
     }
-    // Aside, face the way the residents come (the camera sees only ahead; the laser all round).
-    if (came_) {
+    // Waiting, at the actuator as aside, face the way the residents come: the camera sees only
+    // ahead, and the laser's blind sector is behind (facing the wall at the actuator, it is the
+    // room: office seeds 20, 24, 31, 33 — a group it did not see stood behind it, set off and
+    // walked into it).
+    {
       const double yaw = LookYaw(pass, belief_.X_MB.translation());
       if (std::abs(std::remainder(yaw - belief_.X_MB.yaw, 2 * M_PI)) > kFacingToleranceRad) {
         task_.motion->FollowPath({belief_.X_MB, Pose2{belief_.X_MB.x, belief_.X_MB.y, yaw}},
@@ -291,6 +301,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     came_ = false;
     last_moving_.reset();
     unseen_ = 0.0;
+    stood_open_ = false;
   }
 
   NodeStatus Release(const std::string& why) {
@@ -424,6 +435,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   std::optional<Time> last_moving_;  // when someone near was last seen on the move
   double unseen_{0.0};               // [s] of watching since anyone was near
   bool making_room_{false};          // stepping away from someone too near
+  bool stood_open_{false};  // the door stood open kStillForSec in this hold with nobody moving
 };
 
 // IsNobodyComing: the guard of an operation during a hold (a ReactiveSequence above

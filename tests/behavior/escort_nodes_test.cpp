@@ -81,6 +81,22 @@ TEST_F(HoldForResidentsTest, ResidentsComingSendTheRobotAsideAndItLetsThemPass) 
   EXPECT_TRUE(NotedText("everyone is through"));
 }
 
+TEST_F(HoldForResidentsTest, WaitingAtTheActuatorItFacesTheWayTheResidentsCome) {
+  // Pressed, with nobody about: it waits at the actuator, but turned from the wall to the room
+  // (the laser's blind sector, behind it, would otherwise be the room).
+  tree_.TickOnce();
+  belief_.now = At(2.0);
+  OperatedAgo(1.0);  // in this hold: not due again
+  motion_.StopBase();
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  ASSERT_GE(motion_.path().size(), 2u);
+  const Pose2 to = motion_.path().back();
+  EXPECT_LT((to.translation() - Standoff().translation()).norm(), 1e-6);  // turns in place
+  // Towards 2 m out from the doorway (0, 3) on the robot's side.
+  const Eigen::Vector2d look = (Eigen::Vector2d(0.0, 1.0) - to.translation()).normalized();
+  EXPECT_GT(look.dot(Eigen::Vector2d(std::cos(to.yaw), std::sin(to.yaw))), 0.99);
+}
+
 TEST_F(HoldForResidentsTest, NeverGoesToTheActuatorWithSomeoneStandingByIt) {
   tree_.TickOnce();
   OperatedAgo(7.0);  // due
@@ -93,6 +109,7 @@ TEST_F(HoldForResidentsTest, NeverGoesToTheActuatorWithSomeoneStandingByIt) {
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
   belief_.off_map_returns.clear();
   belief_.now = At(7.5);
+  motion_.StopBase();  // done turning to face the way they come
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);
 }
 
@@ -129,6 +146,7 @@ TEST_F(HoldForResidentsTest, OpensTheDoorForSomeoneFoundWaitingAtIt) {
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);  // right at the standoff: not yet clear
   belief_.off_map_returns = {{0.5, 2.2}};             // 0.6 m off it, still by the doorway
   belief_.now = At(6.5);
+  motion_.StopBase();
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // waiting: the robot goes to open it
 }
 
@@ -145,6 +163,7 @@ TEST_F(HoldForResidentsTest, DoesNotTakeAGroupYetToSetOffForSomeoneWaiting) {
   }
   belief_.off_map_returns = {{0.5, 2.2}};  // only the one by the doorway now
   belief_.now = At(20.5);
+  motion_.StopBase();
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);
 }
 
@@ -160,6 +179,7 @@ TEST_F(HoldForResidentsTest, SomeoneWaitingIsOneBodyWhoseOutlineReachesFurtherOu
     outline.push_back({x, 2.3});
   belief_.off_map_returns = outline;
   belief_.now = At(6.0);
+  motion_.StopBase();
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);
   // Someone else 0.3 m beyond them (a gap between two bodies): a group, not one waiting.
   tree_.TickOnce();
