@@ -57,10 +57,8 @@ std::string LabDoorFlow(int count, const std::string& mobility = "") {
 TEST(EvacueesTest, DenseFlowThroughAFullyOpenDoorIsWithinTheHydraulicBand) {
   // Clear width 0.95 m: SFPE 1.3 /(s m) x (0.95 - 0.3) = 0.85 /s; IMO 1.3 x 0.95 = 1.24 /s.
   // Steady flow: 5th to 25th crossing (the group's head and tail left out). The mean over
-  // twelve groups is in the band; one group of 30 varies widely (60 groups: 0.50 to 1.26 /s,
-  // mean 0.91, with the social forces summed at 120 Hz; 0.59 to 1.27, mean 0.88, at 240 Hz: a
-  // group that clogs the doorway for a few seconds is a real crowd's behaviour), so each is only
-  // held to within half of the band: far outside it is a model bug.
+  // twelve groups is in the band; one group of 30 varies widely (seeds 1-12: 0.61 to 1.20 /s),
+  // so each is only held to within 40 % of the band: far outside it is a model bug.
   double sum = 0.0;
   constexpr int kGroups = 12;
   for (std::uint64_t seed = 1; seed <= kGroups; ++seed) {
@@ -70,8 +68,8 @@ TEST(EvacueesTest, DenseFlowThroughAFullyOpenDoorIsWithinTheHydraulicBand) {
     ASSERT_EQ(t.size(), 30u) << "seed " << seed;
     const double flow = 20.0 / (t[24] - t[4]);
     RecordProperty("flow_persons_per_s_seed_" + std::to_string(seed), std::to_string(flow));
-    EXPECT_GT(flow, 0.85 * 0.5) << "seed " << seed;
-    EXPECT_LT(flow, 1.24 * 1.5) << "seed " << seed;
+    EXPECT_GT(flow, 0.85 * 0.6) << "seed " << seed;
+    EXPECT_LT(flow, 1.24 * 1.4) << "seed " << seed;
     sum += flow;
   }
   RecordProperty("flow_persons_per_s_mean", std::to_string(sum / kGroups));
@@ -166,11 +164,11 @@ TEST(EvacueesTest, AMixedGroupOpensTheClinicsShutDoorsItself) {
       "  - {name: r, behavior: evacuate, route: [door_d, door_e, exit_door], start: [2.8, -3.0],"
       " goal: [21.0, 11.5], count: 20, trigger: {at: 5.0},"
       " mobility: {walker: 10, cane: 3, frame: 3, wheelchair: 2, wheelchair_pushed: 2}}\n";
-  // In seed 47 the crowd pushes someone back into the ward through door_d after they passed
+  // In seed 17 the crowd pushes someone back into the ward through door_d after they passed
   // it: they take up their route from before it (they slid along the ward's wall towards the
   // next waypoint, beyond it, and stood there for ever).
   int rewinds = 0;
-  for (const std::uint64_t seed : {5, 9, 47}) {
+  for (const std::uint64_t seed : {5, 9, 17}) {
     auto loaded = LoadText(text, WorldsDir() / "clinic");
     TwinWorld world(loaded.scenario, loaded.world, seed, Hsr());
     world.StepFor(360.0);
