@@ -193,9 +193,9 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // not set off yet (office seed 21: its front row stood 1.4 m from the doorway; the robot,
     // its back to them to press the button, was walked into when they set off — the laser's
     // blind sector is behind it).
-    // And not once the door has stood open before them while they stayed (someone waiting for
-    // it goes through; office seeds 20, 24, 31, 33: the group's back rows hidden behind the
-    // front one, the robot saw only the front row).
+    // And not once the door has stood open before them while they stayed: someone waiting for
+    // it goes through when it opens; a group yet to set off stays (and its back rows may be
+    // hidden behind the front one).
     const auto open_since = belief_.door_open_since.find(door_);
     if (open_since != belief_.door_open_since.end() &&
         ToSeconds(belief_.now - open_since->second) > kStillForSec)

@@ -150,6 +150,23 @@ TEST_F(HoldForResidentsTest, OpensTheDoorForSomeoneFoundWaitingAtIt) {
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // waiting: the robot goes to open it
 }
 
+TEST_F(HoldForResidentsTest, SomeoneWhoStayedWhileTheDoorStoodOpenIsNotWaitingForIt) {
+  // As OpensTheDoorForSomeoneFoundWaitingAtIt, but the door stood open before them for 5 s in
+  // this hold and they did not go through: not waiting for the door.
+  belief_.X_MB = {6.0, 0.5, 0.0};
+  tree_.TickOnce();
+  OperatedAgo(12.0);
+  belief_.off_map_returns = {{0.5, 2.2}};
+  belief_.door_open_since["lab_door"] = At(1.0);
+  belief_.now = At(6.5);
+  motion_.StopBase();
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  belief_.door_open_since.clear();  // shut again: still not taken for someone waiting
+  belief_.now = At(12.0);
+  motion_.StopBase();
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+}
+
 TEST_F(HoldForResidentsTest, DoesNotTakeAGroupYetToSetOffForSomeoneWaiting) {
   // The same as above, with others of the group standing further out in the room near the
   // actuator: they have not set off yet, and may as the robot presses with its back to them.
