@@ -34,6 +34,13 @@ class HoldForResidentsTest : public EscortNodesTest {
     visit.operated_at = belief_.now - SecondsToDuration(ago);
     blackboard_->Set("door_visit", bt::Any(visit));
   }
+  // The hold begins with the robot at the far end of the room (6, 0.5) and the door shut (the
+  // robot's last operation long past).
+  void BeginFarFromAShutDoor() {
+    belief_.X_MB = {6.0, 0.5, 0.0};
+    tree_.TickOnce();
+    OperatedAgo(12.0);
+  }
   bool NotedText(const std::string& text) const {
     for (const auto& note : log_.pending())
       if (note.text.find(text) != std::string::npos) return true;
@@ -136,9 +143,7 @@ TEST_F(HoldForResidentsTest, OpensTheDoorForSomeoneLeftWaitingAtIt) {
 TEST_F(HoldForResidentsTest, OpensTheDoorForSomeoneFoundWaitingAtIt) {
   // The robot comes from the far end of the room; someone who cannot press the button has
   // been waiting by the doorway all along (0.4 m from the standoff), and never moves.
-  belief_.X_MB = {6.0, 0.5, 0.0};
-  tree_.TickOnce();
-  OperatedAgo(12.0);  // the door has closed
+  BeginFarFromAShutDoor();
   belief_.off_map_returns = {{0.7, 2.2}};
   belief_.now = At(2.0);
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);  // still only a moment: may set off
@@ -153,9 +158,7 @@ TEST_F(HoldForResidentsTest, OpensTheDoorForSomeoneFoundWaitingAtIt) {
 TEST_F(HoldForResidentsTest, SomeoneWhoStayedWhileTheDoorStoodOpenIsNotWaitingForIt) {
   // As OpensTheDoorForSomeoneFoundWaitingAtIt, but the door stood open before them for 5 s in
   // this hold and they did not go through: not waiting for the door.
-  belief_.X_MB = {6.0, 0.5, 0.0};
-  tree_.TickOnce();
-  OperatedAgo(12.0);
+  BeginFarFromAShutDoor();
   belief_.off_map_returns = {{0.5, 2.2}};
   belief_.door_open_since["lab_door"] = At(1.0);
   belief_.now = At(6.5);
@@ -170,9 +173,7 @@ TEST_F(HoldForResidentsTest, SomeoneWhoStayedWhileTheDoorStoodOpenIsNotWaitingFo
 TEST_F(HoldForResidentsTest, DoesNotTakeAGroupYetToSetOffForSomeoneWaiting) {
   // The same as above, with others of the group standing further out in the room near the
   // actuator: they have not set off yet, and may as the robot presses with its back to them.
-  belief_.X_MB = {6.0, 0.5, 0.0};
-  tree_.TickOnce();
-  OperatedAgo(12.0);
+  BeginFarFromAShutDoor();
   belief_.off_map_returns = {{0.5, 2.2}, {0.3, 0.9}};  // the second 2.1 m from the doorway
   for (double t = 2.0; t < 20.0; t += 1.0) {
     belief_.now = At(t);
@@ -188,9 +189,7 @@ TEST_F(HoldForResidentsTest, SomeoneWaitingIsOneBodyWhoseOutlineReachesFurtherOu
   // A wheelchair user waiting by the doorway, off to the side away from the actuator: the
   // laser's returns on their outline run from 0.9 m to 1.6 m from the doorway's centre (office
   // seed 34: one such was left behind).
-  belief_.X_MB = {6.0, 0.5, 0.0};
-  tree_.TickOnce();
-  OperatedAgo(12.0);
+  BeginFarFromAShutDoor();
   std::vector<Eigen::Vector2d> outline;
   for (double x = -0.6; x > -1.42; x -= 0.04)
     outline.push_back({x, 2.3});
