@@ -6,7 +6,9 @@
 // Writes crowd_bench.json in the working directory.
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <random>
 #include <string>
@@ -83,7 +85,17 @@ std::string ClinicCrowd(int n, bool sensors) {
 
 int main(int argc, char** argv) {
   using namespace egress;
-  const double seconds = argc > 1 ? std::stod(argv[1]) : 30.0;
+  double seconds = 30.0;
+  if (argc > 1) {
+    // The whole argument a positive, finite number of seconds, or a clear error.
+    char* end = nullptr;
+    seconds = std::strtod(argv[1], &end);
+    if (end == argv[1] || *end != '\0' || !std::isfinite(seconds) || seconds <= 0.0) {
+      std::fprintf(stderr, "crowd_bench: SECONDS must be a positive number, got '%s'\n", argv[1]);
+      std::fprintf(stderr, "usage: crowd_bench [SECONDS]\n");
+      return 2;
+    }
+  }
   nlohmann::json out = {
       {"seconds", seconds}, {"sfm", nlohmann::json::array()}, {"twin", nlohmann::json::array()}};
   std::printf("social force model alone (30 m x 15 m hall), 1 core:\n");

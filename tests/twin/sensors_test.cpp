@@ -88,6 +88,34 @@ TEST(LaserSimulatorTest, GlassReturnsOnlyNearNormalIncidence) {
   EXPECT_GT(g.ranges[oblique], 3.0);
 }
 
+TEST(TwinWorldRayTest, ADownwardRayMeetsAPersonBeforeTheFloorBehindThem) {
+  // Only the floor's crossing bounds how far a ray looks for what it meets first: a person (a
+  // moving body) standing short of it is hit, wherever along the ray the crossing lies.
+  auto loaded = LoadText(At("lab.sdf", -1.5, 0.0, 0.0,
+                            "people:\n  - {name: p, behavior: walk_past, start: [2.5, 0.0], goal: "
+                            "[2.5, 2.0], trigger: {at: 100.0}}\n"),
+                         WorldsDir() / "lab");
+  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+  const Eigen::Vector3d from(0.0, 0.0, 1.2);
+  const RayHit level = world.CastRay(from, {5.0, 0.0, 1.2}, GlassMode::kOpaque);
+  ASSERT_TRUE(level.hit);
+  const double face = level.point.x();
+  ASSERT_NEAR(face, 2.5 - world.people().front().radius, 0.05) << "the level ray meets the person";
+  for (const double past : {0.3, 0.6, 1.0}) {
+    // Aimed at the floor `past` beyond the person's face, and on for as long again.
+    const Eigen::Vector3d floor(face + past, 0.0, 0.0);
+    const RayHit hit = world.CastRay(from, from + 2.0 * (floor - from), GlassMode::kOpaque);
+    ASSERT_TRUE(hit.hit) << "past " << past;
+    EXPECT_GT(hit.point.z(), 0.01) << "the floor, not the person, past " << past;
+    EXPECT_LT(hit.distance, (floor - from).norm()) << "past " << past;
+  }
+  // Aimed at the floor short of the person: the floor.
+  const Eigen::Vector3d short_of(face - 0.3, 0.0, 0.0);
+  const RayHit floor_hit = world.CastRay(from, from + 2.0 * (short_of - from), GlassMode::kOpaque);
+  ASSERT_TRUE(floor_hit.hit);
+  EXPECT_NEAR(floor_hit.distance, (short_of - from).norm(), 1e-4);
+}
+
 TEST(DepthCameraSimulatorTest, DepthEqualsTheAnalyticDistanceAndGlassIsInvalid) {
   auto loaded = LoadText(At("lab.sdf", -1.5, 0.0, 0.0), WorldsDir() / "lab");
   TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());

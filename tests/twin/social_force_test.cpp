@@ -157,6 +157,41 @@ TEST(SocialForceModelTest, StepsCellListsMatchTheSumOverEverything) {
   EXPECT_GT(pushed_by_walls, 20);  // walls did act
 }
 
+TEST(SocialForceModelTest, CellListsMatchTheSumOverEverythingWhateverTheSpeedsAndSpread) {
+  // Fast walkers reach farther (their step ellipse) than slow ones: each cell lists everyone
+  // whose own reach overlaps it. A crowd spread over more cells than the grid holds densely
+  // (two walkers 2e7 m apart) is summed as one cell: the same sums, only slower.
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> pos(0.0, 12.0), unit(-1.0, 1.0);
+  for (const double far : {0.0, 1e7}) {
+    std::vector<Walker> walkers(60);
+    for (std::size_t i = 0; i < walkers.size(); ++i) {
+      Walker& w = walkers[i];
+      w.position = {pos(rng), pos(rng) / 3.0};
+      const double speed = i % 4 == 0 ? 1.6 : 0.2;  // a quarter at a run
+      w.velocity = speed * Eigen::Vector2d(unit(rng), unit(rng)).normalized();
+      w.target = {pos(rng), pos(rng) / 3.0};
+      w.desired_speed = 1.2;
+    }
+    if (far > 0.0) {
+      walkers.front().position.x() = -far;
+      walkers.back().position.x() = far;
+    }
+    SocialForceModel sfm;
+    const std::vector<Eigen::Vector2d> grid =
+        sfm.CalcAccelerations(walkers, {}, WallCells(std::vector<WallSegment>{}), {});
+    int pushed = 0;
+    for (std::size_t i = 0; i < walkers.size(); ++i) {
+      const Eigen::Vector2d all = sfm.CalcAcceleration(i, walkers, {}, {});
+      EXPECT_EQ(grid[i].x(), all.x()) << "walker " << i << ", spread " << far;
+      EXPECT_EQ(grid[i].y(), all.y()) << "walker " << i << ", spread " << far;
+      Walker alone = walkers[i];
+      pushed += (all - SocialForceModel().CalcAcceleration(0, {alone}, {}, {})).norm() > 1e-3;
+    }
+    EXPECT_GT(pushed, 30) << "the walkers did push each other";
+  }
+}
+
 TEST(SocialForceModelTest, BinnedFixedWallsAndMovingOnesStepAsAllTheWallsTogether) {
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> pos(0.0, 30.0), unit(-1.0, 1.0), len(0.2, 6.0);

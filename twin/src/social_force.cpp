@@ -3,9 +3,10 @@
 #include "egress/hsr_interface/geometry.h"
 
 #include <algorithm>
-#include <bit>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <map>
 
 namespace egress::twin {
@@ -222,33 +223,59 @@ void SocialForceModel::Step(std::vector<Walker>* walkers, const std::vector<Disc
 std::vector<Eigen::Vector2d> SocialForceModel::CalcAccelerations(
     const std::vector<Walker>& all, const std::vector<DiscObstacle>& discs, const WallCells& fixed,
     const std::vector<WallSegment>& moving) const {
-  // A uniform grid (a cell list): each walker meets only the walkers of the 3 x 3 cells round
-  // it, in ascending index as over the whole crowd, so the sums (and the run) are the same as
-  // without the grid, in O(n) instead of O(n^2).
+  // A uniform grid over the walkers: each cell lists, in ascending index, every walker whose
+  // reach (a disc round it) overlaps the cell, so a walker meets only those that may reach it,
+  // in the order of the whole crowd: the sums (and the run) are the same as without the grid,
+  // in O(n) instead of O(n^2).
   std::vector<Eigen::Vector2d> accelerations(all.size());
-  // Cells as wide as the farthest reach, so that the 3 x 3 round a walker hold all who reach it.
   std::vector<double> reach(all.size());
-  double cell = kMaxBodyReachM;
-  for (std::size_t j = 0; j < all.size(); ++j) {
+  for (std::size_t j = 0; j < all.size(); ++j)
     reach[j] = WalkerReach(all[j]);
-    if (std::isfinite(reach[j])) cell = std::max(cell, reach[j]);
+  // The grid spans the walkers' bounding box (a crowd spans tens of metres at most). Walkers that
+  // are not finite, or a box too large to hold densely, make it one cell (everyone meets
+  // everyone in it, as without the grid).
+  constexpr double kCellM = kMaxBodyReachM;
+  constexpr double kMaxGridCells = 1 << 20;
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector2d hi = -lo;
+  bool finite = true;
+  for (std::size_t j = 0; j < all.size(); ++j) {
+    finite = finite && all[j].position.allFinite() && std::isfinite(reach[j]);
+    lo = lo.cwiseMin(all[j].position);
+    hi = hi.cwiseMax(all[j].position);
   }
-  const auto cell_of = [cell](const Eigen::Vector2d& p) {
-    return std::pair<long, long>(long(std::floor(p.x() / cell)), long(std::floor(p.y() / cell)));
+  const double span_x = (hi.x() - lo.x()) / kCellM + 1.0, span_y = (hi.y() - lo.y()) / kCellM + 1.0;
+  const bool dense = finite && !all.empty() && span_x * span_y < kMaxGridCells;
+  const long nx = dense ? long(span_x) + 1 : 1, ny = dense ? long(span_y) + 1 : 1;
+  const auto cell_x = [&](double x) {
+    return dense ? std::clamp(long(std::floor((x - lo.x()) / kCellM)), 0L, nx - 1) : 0L;
   };
-  std::map<std::pair<long, long>, std::vector<std::size_t>> cells;
-  for (std::size_t i = 0; i < all.size(); ++i)
-    cells[cell_of(all[i].position)].push_back(i);
-  // The 3 x 3 block round each occupied cell, looked up once per cell rather than per walker.
-  std::map<std::pair<long, long>, std::vector<const std::vector<std::size_t>*>> blocks;
-  for (const auto& [c, members] : cells) {
-    auto& block = blocks[c];
-    for (long dx = -1; dx <= 1; ++dx) {
-      for (long dy = -1; dy <= 1; ++dy) {
-        const auto it = cells.find({c.first + dx, c.second + dy});
-        if (it != cells.end()) block.push_back(&it->second);
-      }
-    }
+  const auto cell_y = [&](double y) {
+    return dense ? std::clamp(long(std::floor((y - lo.y()) / kCellM)), 0L, ny - 1) : 0L;
+  };
+  // Each walker's reach as a block of cells [x0, x1] x [y0, y1]; then the lists by counting sort.
+  thread_local std::vector<std::array<long, 4>> blocks;
+  thread_local std::vector<std::size_t> start, fill, members;
+  blocks.resize(all.size());
+  start.assign(std::size_t(nx * ny) + 1, 0);
+  for (std::size_t j = 0; j < all.size(); ++j) {
+    const Eigen::Vector2d& p = all[j].position;
+    blocks[j] = {cell_x(p.x() - reach[j]), cell_x(p.x() + reach[j]), cell_y(p.y() - reach[j]),
+                 cell_y(p.y() + reach[j])};
+    const auto& [x0, x1, y0, y1] = blocks[j];
+    for (long y = y0; y <= y1; ++y)
+      for (long x = x0; x <= x1; ++x)
+        ++start[std::size_t(y * nx + x) + 1];
+  }
+  for (std::size_t c = 1; c < start.size(); ++c)
+    start[c] += start[c - 1];
+  fill.assign(start.begin(), start.end() - 1);
+  members.resize(start.back());
+  for (std::size_t j = 0; j < all.size(); ++j) {
+    const auto& [x0, x1, y0, y1] = blocks[j];
+    for (long y = y0; y <= y1; ++y)
+      for (long x = x0; x <= x1; ++x)
+        members[fill[std::size_t(y * nx + x)]++] = j;
   }
   // The fixed walls, then the moving ones (few: every walker meets each).
   std::vector<WallSegment> walls = fixed.walls();
@@ -256,23 +283,11 @@ std::vector<Eigen::Vector2d> SocialForceModel::CalcAccelerations(
   std::vector<std::size_t> wall_rank = fixed.rank();
   for (std::size_t s = fixed.walls().size(); s < walls.size(); ++s)
     wall_rank.push_back(s);
-  std::vector<std::size_t> near_walls;
-  // A walker's neighbours in ascending index without sorting: mark the members of its block in
-  // a bit set, then read the set bits in order.
-  std::vector<std::uint64_t> marked((all.size() + 63) / 64, 0);
-  std::vector<std::size_t> near;
+  std::vector<std::size_t> near_walls, near;
   for (std::size_t i = 0; i < all.size(); ++i) {
-    const auto& block = blocks.find(cell_of(all[i].position))->second;
-    for (const auto* members : block) {
-      for (const std::size_t j : *members)
-        marked[j / 64] |= std::uint64_t{1} << (j % 64);
-    }
-    near.clear();
-    for (std::size_t word = 0; word < marked.size(); ++word) {
-      for (std::uint64_t bits = marked[word]; bits != 0; bits &= bits - 1)
-        near.push_back(word * 64 + std::size_t(std::countr_zero(bits)));
-      marked[word] = 0;
-    }
+    const Eigen::Vector2d& p = all[i].position;
+    const std::size_t c = std::size_t(cell_y(p.y()) * nx + cell_x(p.x()));
+    near.assign(members.begin() + long(start[c]), members.begin() + long(start[c + 1]));
     const std::vector<std::size_t>& fixed_near = fixed.Near(all[i].position);
     near_walls.assign(fixed_near.begin(), fixed_near.end());
     for (std::size_t s = fixed.walls().size(); s < walls.size(); ++s)

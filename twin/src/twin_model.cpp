@@ -60,6 +60,7 @@ void CompileStatics(const Scenario& scenario, const WorldDescription& world,
                        : Eigen::Vector3d(s.plane_size.x() > 0 ? s.plane_size.x() / 2 : 50.0,
                                          s.plane_size.y() > 0 ? s.plane_size.y() / 2 : 50.0, 0.0);
         box.entity = e;
+        if (s.kind == ShapeKind::kPlane) c->ray_planes.push_back(c->ray_boxes.size());
         c->ray_boxes.push_back(box);
       } else {
         AppendTriangles(s, ray_mesh.get());

@@ -68,7 +68,8 @@ struct TwinModel::Compiled {
   // Rays test boxes and planes analytically (a slab test is far cheaper than a BVH walk over
   // their triangles) and only the meshes' triangles through their own BVH.
   std::vector<world_detail::RayBox> ray_boxes;
-  world_detail::RayBins ray_box_bins;  // which ray_boxes a ray may cross
+  world_detail::RayBins ray_box_bins;   // which ray_boxes a ray may cross
+  std::vector<std::size_t> ray_planes;  // the ray_boxes that are planes (floors), opaque
   std::unique_ptr<btTriangleMesh> ray_mesh;
   std::unique_ptr<btBvhTriangleMeshShape> ray_mesh_shape;  // null without static meshes
   std::vector<int> ray_triangle_entity;

@@ -91,6 +91,23 @@ class StaticMeshRayCallback : public btTriangleRaycastCallback {
 
 }  // namespace
 
+double TwinWorld::Impl::PlaneClip(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const {
+  double clip = 1.0;
+  for (const std::size_t k : fixed.ray_planes) {
+    const RayBox& plane = fixed.ray_boxes[k];
+    const Eigen::Vector3d o = plane.R_SW * (from - plane.p_WS);
+    const Eigen::Vector3d v = plane.R_SW * (to - from);
+    if (std::abs(v.z()) < 1e-12) continue;  // along the plane
+    const double t = -o.z() / v.z();
+    if (t < 0.0 || t >= clip) continue;
+    const Eigen::Vector2d q = o.head<2>() + t * v.head<2>();
+    if (std::abs(q.x()) > plane.half.x() || std::abs(q.y()) > plane.half.y()) continue;
+    // A margin as the mesh's clip has: the plane's own test must still meet it.
+    clip = std::min(clip, t * 1.001 + 1e-6);
+  }
+  return std::min(clip, 1.0);
+}
+
 RayHit TwinWorld::Impl::CastSegment(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
                                     GlassMode mode, double glass_max_incidence) const {
   const btVector3 a = ToBt(from), b = ToBt(to);
@@ -104,7 +121,10 @@ RayHit TwinWorld::Impl::CastSegment(const Eigen::Vector3d& from, const Eigen::Ve
   // Only the targets and boxes the ray's ground track may cross, in index order as over all.
   thread_local std::vector<int> near;
   const btTransform from_T(btMatrix3x3::getIdentity(), a), to_T(btMatrix3x3::getIdentity(), b);
-  ray_target_bins.Query(from.head<2>(), to.head<2>(), &near);
+  // Nothing past an opaque plane's crossing can be the closest hit: the ground track is walked
+  // only that far (most of a downward camera's rays end on the floor a few metres out).
+  const double plane_clip = PlaneClip(from, to);
+  ray_target_bins.Query(from.head<2>(), from.head<2>() + (to - from).head<2>() * plane_clip, &near);
   for (const int k : near) {
     const std::size_t i = std::size_t(k);
     const btCollisionObject* target = ray_targets[i];
@@ -136,7 +156,10 @@ RayHit TwinWorld::Impl::CastSegment(const Eigen::Vector3d& from, const Eigen::Ve
   // Static boxes and planes: slab tests in each shape's frame, on the ray as a segment t in
   // [0, 1]. A ray starting inside a box hits its far side (as the triangles' did).
   const Eigen::Vector3d d = to - from;
-  fixed.ray_box_bins.Query(from.head<2>(), to.head<2>(), &near);
+  // Nor can a box past the closest hit so far be closer (the same margin).
+  const double box_clip = std::min(1.0, double(cb.m_closestHitFraction) * 1.001 + 1e-6);
+  fixed.ray_box_bins.Query(from.head<2>(),
+                           from.head<2>() + d.head<2>() * std::min(box_clip, plane_clip), &near);
   for (const int k : near) {
     const RayBox& box = fixed.ray_boxes[std::size_t(k)];
     const Eigen::Vector3d o = box.R_SW * (from - box.p_WS);

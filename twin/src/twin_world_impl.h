@@ -242,6 +242,10 @@ struct TwinWorld::Impl {
   mutable world_detail::RayBins ray_target_bins;  // which ray_targets a ray may cross
   mutable bool ray_proxies_stale{true};           // bodies moved since the proxies were posed
 
+  // The fraction of the segment from-to (W) past which a static plane (a floor) hides
+  // everything, with a small margin; 1 when it crosses none.
+  double PlaneClip(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const;
+
   RayHit CastSegment(const Eigen::Vector3d& from, const Eigen::Vector3d& to, GlassMode mode,
                      double glass_max_incidence) const;
   // The ray callbacks' views of the entities, made once rather than per ray.
