@@ -138,7 +138,6 @@ nlohmann::json RunStudyTrial(const twin::Scenario& scenario, const twin::WorldDe
         for (const auto& p : twin_world.people()) {
           if (!IsEvacuee(p) || !p.started || p.out) continue;
           resident_near = resident_near || (p.position - p_WB).norm() < kDoorwayBlockRadiusM;
-          const DoorLine* nearest = nullptr;
           for (const auto& l : lines) {
             const Eigen::Vector2d rel = p.position - l.centre;
             const double side = rel.dot(l.normal);
@@ -147,9 +146,11 @@ nlohmann::json RunStudyTrial(const twin::Scenario& scenario, const twin::WorldDe
                 std::abs(rel.dot(l.along)) <= l.half_width + 0.1)
               crossings[l.name].push_back(t);
             last = side;
-            if (!nearest || rel.norm() < (p.position - nearest->centre).norm()) nearest = &l;
           }
-          if (p.phase == twin::PersonPhase::kWaitingForDoor && nearest) queue[nearest->name] += dt;
+          // Their wait is the door's they wait for (not the nearest one's: in a ward beside
+          // another room, the nearest door may be one they never use).
+          if (p.phase == twin::PersonPhase::kWaitingForDoor && !p.waiting_for.empty())
+            queue[p.waiting_for] += dt;
         }
         if (robot_in_doorway && resident_near) blocking += dt;
         return !all_out();

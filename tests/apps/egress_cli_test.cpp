@@ -367,8 +367,12 @@ TEST(EgressCliTest, EvacStudyComparesTheThreeConditionsOnTheSameSeeds) {
     by[c.at("condition").get<std::string>()] = c;
   // Everyone out in every condition; doors propped open are the fastest (the upper bound), and
   // nobody is out faster than with them.
-  for (const auto& [name, c] : by)
+  for (const auto& [name, c] : by) {
     EXPECT_EQ(c.at("left_behind").get<int>(), 0) << name;
+    // Only the door on the route: waits count for the door waited for.
+    ASSERT_EQ(c.at("doors").size(), 1u) << name << ": " << c.at("doors").dump();
+    EXPECT_TRUE(c.at("doors").contains("lab_door")) << name;
+  }
   EXPECT_LE(by["propped_open"].at("t_evac_median_s").get<double>(),
             by["no_robot"].at("t_evac_median_s").get<double>());
   EXPECT_EQ(by["robot"].at("contacts").get<int>(), 0);

@@ -195,9 +195,11 @@ TEST(EvacueesTest, SomeoneWhoCannotOperateTheDoorWaitsAtItAndTheRestGoOn) {
     if (p.can_operate) {
       EXPECT_TRUE(p.out) << "seed " << seed << " at " << p.position.transpose() << " phase "
                          << int(p.phase) << " operated " << p.doors_operated;
+      EXPECT_EQ(p.waiting_for, "") << "seed " << seed << ": out, waiting for nothing";
       ++through;
     } else {
       EXPECT_EQ(p.phase, PersonPhase::kWaitingForDoor) << "seed " << seed;
+      EXPECT_EQ(p.waiting_for, "door_a") << "seed " << seed;
       EXPECT_LT(p.position.x(), 5.0);
       EXPECT_EQ(CountEvents(world, "door_operated"), 0);
       ++stuck;

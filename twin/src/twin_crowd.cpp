@@ -228,6 +228,7 @@ void TwinWorld::Impl::UpdatePeople() {
         if (p.state.behavior == PersonBehavior::kEvacuate) {
           p.state.out = true;
           p.state.phase = PersonPhase::kDone;
+          p.state.waiting_for.clear();
           const btTransform T(btQuaternion::getIdentity(), btVector3(0, 0, kOutOfSceneZ));
           p.body->getMotionState()->setWorldTransform(T);
           p.body->setWorldTransform(T);
@@ -293,6 +294,7 @@ void TwinWorld::Impl::UpdatePeople() {
         kDegToRad;
     if (gate >= 0 && (doors[gate].angle < open_enough || DoorwayTaken(p, gate))) {
       p.state.phase = PersonPhase::kWaitingForDoor;
+      p.state.waiting_for = doors[std::size_t(gate)].fixed->desc->name;
       p.walker.desired_speed = 0.0;
       if (OperateDoor(p, gate)) continue;
       // Waiting in the sweep of a leaf that opens towards them, people step back out of it as
@@ -317,6 +319,7 @@ void TwinWorld::Impl::UpdatePeople() {
       }
     } else if (p.state.phase == PersonPhase::kWaitingForDoor) {
       p.state.phase = PersonPhase::kWalking;
+      p.state.waiting_for.clear();
       p.operating = -1;
     }
     // Pushed against a jamb (a social-force local minimum, e.g. after making way for the

@@ -92,6 +92,7 @@ struct PersonState {
   double arrived_at{-1.0};  ///< When they reached the end of their route [s]; -1: not yet.
   int doors_operated{0};    ///< How often they operated a door's actuator.
   bool can_operate{false};  ///< Operates a door's actuator when they wait at it (evacuees).
+  std::string waiting_for;  ///< The door they wait at (phase kWaitingForDoor), else empty.
   /// An evacuee who reached the assembly point beyond the exit: left the scene (no body, no
   /// forces); `position` stays where they arrived.
   bool out{false};
