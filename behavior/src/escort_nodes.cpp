@@ -209,8 +209,12 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
                                       : WayClear(standoff_, Input<double>("keep_clear")));
     if (OperateDue() && actuator_clear) return NodeStatus::kSuccess;
     const Pose2& wait_at = came_ || !actuator_clear ? spot_ : standoff_;
+    // Only the spot and the last kSpotClearM of the way there: from far back, the straight line
+    // to it passes people it will never meet on its path (clinic: a resident waiting at door_e
+    // kept the robot 14 m back from its spot, and the door shut, until max_hold). On the way, the
+    // navigation yields to people as everywhere.
     if ((wait_at.translation() - belief_.X_MB.translation()).norm() > kAtSpotM &&
-        WayClear(wait_at, kSpotClearM)) {
+        WayClear(wait_at, kSpotClearM, kSpotClearM)) {
       Pose2 goal = wait_at;
       goal.yaw = LookYaw(pass, wait_at.translation());
       if (StartPath(task_, goal, &wait_at == &spot_ ? "the spot beside the door" : "the actuator",

@@ -210,6 +210,33 @@ TEST_F(HoldForResidentsTest, SomeoneWaitingIsOneBodyWhoseOutlineReachesFurtherOu
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
 }
 
+TEST_F(HoldForResidentsTest, GoesToItsSpotPastSomeoneFarFromItOnTheStraightLine) {
+  // From the far end of the room, residents coming: someone standing on the straight line to
+  // its spot but 1.2 m short of the line's last metre does not keep it from the spot (it will
+  // pass them on its path, yielding as everywhere); someone at the spot does.
+  BeginFarFromAShutDoor();
+  OperatedAgo(1.0);  // not due
+  belief_.X_MB = {2.7, -0.7, 0.0};  // the room's far corner, 3.1 m from the spot
+  const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
+  const Eigen::Vector2d robot = belief_.X_MB.translation();
+  const Eigen::Vector2d on_the_line = robot + 0.3 * (spot.translation() - robot);
+  belief_.now = At(2.0);
+  belief_.moving_returns = {{-0.5, 1.5}};  // they come
+  belief_.off_map_returns = {{-0.5, 1.5}, on_the_line};
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(NotedText("driving to the spot beside the door"));
+  ASSERT_GE(motion_.path().size(), 2u);
+  EXPECT_LT((motion_.path().back().translation() - spot.translation()).norm(), 1e-6);
+  // Someone standing 0.5 m from the spot: it waits where it is.
+  motion_.StopBase();
+  log_.Take();
+  belief_.now = At(2.5);
+  belief_.moving_returns.clear();
+  belief_.off_map_returns = {{spot.x - 0.5, spot.y}};
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_FALSE(NotedText("driving to the spot"));
+}
+
 TEST_F(HoldForResidentsTest, MakesRoomForSomeoneWhoComesTooNear) {
   tree_.TickOnce();
   OperatedAgo(1.0);
