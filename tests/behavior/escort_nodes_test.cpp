@@ -215,7 +215,7 @@ TEST_F(HoldForResidentsTest, GoesToItsSpotPastSomeoneFarFromItOnTheStraightLine)
   // its spot but 1.2 m short of the line's last metre does not keep it from the spot (it will
   // pass them on its path, yielding as everywhere); someone at the spot does.
   BeginFarFromAShutDoor();
-  OperatedAgo(1.0);  // not due
+  OperatedAgo(1.0);                 // not due
   belief_.X_MB = {2.7, -0.7, 0.0};  // the room's far corner, 3.1 m from the spot
   const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
   const Eigen::Vector2d robot = belief_.X_MB.translation();
@@ -260,6 +260,26 @@ TEST_F(HoldForResidentsTest, MakesRoomForSomeoneWhoComesTooNear) {
   belief_.now = At(2.5);
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
   EXPECT_FALSE(NotedText("making room"));
+}
+
+TEST_F(HoldForResidentsTest, MakesRoomToTheSideOfSomeoneWalkingAtIt) {
+  // Someone 1.5 m away walking straight at the robot at 1 m/s: it steps out of their path, to
+  // the side, not ahead of them along it (where they catch up with a robot stepping at 0.4 m/s).
+  tree_.TickOnce();
+  OperatedAgo(1.0);
+  belief_.X_MB = {-1.8, 1.0, 0.0};
+  belief_.now = At(2.0);
+  auto walker = node_testing::Person({-1.8, -0.5}, perception::PersonIntent::kApproaching);
+  walker.person.v_MP = {0.0, 1.0};
+  for (int k = 1; k <= 4; ++k)
+    walker.person.forecast.push_back(walker.person.p_MP + walker.person.v_MP * (0.2 * k));
+  See({walker});
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  ASSERT_TRUE(NotedText("making room"));
+  ASSERT_GE(motion_.path().size(), 2u);
+  const Eigen::Vector2d step = motion_.path().back().translation() - belief_.X_MB.translation();
+  EXPECT_GT(std::abs(step.x()), std::abs(step.y())) << "step " << step.transpose();
+  EXPECT_GT(std::abs(motion_.path().back().x - -1.8), 0.5) << "off their path";
 }
 
 TEST_F(HoldForResidentsTest, WithNobodyAboutTheHoldEndsAfterWaitFor) {
