@@ -44,8 +44,9 @@ constexpr double kMakeRoomGapM = 0.35;
 constexpr double kRoomLookM = 2.5;
 constexpr double kRoomStepsM[] = {0.3, 0.6};
 constexpr int kRoomHeadings = 16;
-// [s] Making room keeps clear of where people will be this far ahead (at their velocity past
-// the tracker's forecast), in steps of kRoomHorizonStepSec: about the time a 0.6 m step takes.
+// [s] Making room keeps clear of where people will be up to this far ahead (besides the
+// tracker's own forecast, their positions at their velocity every kRoomHorizonStepSec): about
+// the time a 0.6 m step takes.
 constexpr double kRoomHorizonSec = 2.0;
 constexpr double kRoomHorizonStepSec = 0.2;
 // [m] A step that gains less room than this is not worth taking.
