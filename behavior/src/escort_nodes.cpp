@@ -44,9 +44,9 @@ constexpr double kMakeRoomGapM = 0.35;
 constexpr double kRoomLookM = 2.5;
 constexpr double kRoomStepsM[] = {0.3, 0.6};
 constexpr int kRoomHeadings = 16;
-// [s] Making room keeps clear of where people will be up to this far ahead (besides the
-// tracker's own forecast, their positions at their velocity every kRoomHorizonStepSec): about
-// the time a 0.6 m step takes.
+// [s] Making room keeps clear of where people will be up to this far ahead (their positions at
+// their velocity every kRoomHorizonStepSec; the tracker's own forecast is the first 0.8 s of
+// these): about the time a 0.6 m step takes.
 constexpr double kRoomHorizonSec = 2.0;
 constexpr double kRoomHorizonStepSec = 0.2;
 // [m] A step that gains less room than this is not worth taking.
@@ -261,15 +261,13 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     std::vector<Eigen::Vector2d> near;
     for (const Eigen::Vector2d& p : belief_.off_map_returns)
       if ((p - at).norm() < kRoomLookM) near.push_back(p);
-    // A tracked person where they are and where they are forecast to be (the tracker's
-    // prediction, and on at their velocity up to kRoomHorizonSec: someone walking at the robot
-    // is too near before they arrive, and a step that keeps clear of them for only the tracker's
-    // 0.8 s is a step along their path — clinic seed 4, a resident pushed along the wall by the
-    // crowd caught up with the robot stepping ahead of them), each centre pulled in to their
-    // edge towards the robot.
+    // A tracked person where they are and where they will be at their velocity up to
+    // kRoomHorizonSec (someone walking at the robot is too near before they arrive, and a step
+    // that keeps clear of them for only the tracker's 0.8 s forecast is a step along their path
+    // — clinic seed 4, a resident pushed along the wall by the crowd caught up with the robot
+    // stepping ahead of them), each centre pulled in to their edge towards the robot.
     for (const auto& entry : belief_.world.people) {
-      std::vector<Eigen::Vector2d> where = entry.person.forecast;
-      where.push_back(entry.person.p_MP);
+      std::vector<Eigen::Vector2d> where = {entry.person.p_MP};
       for (int k = 1; k * kRoomHorizonStepSec <= kRoomHorizonSec + 1e-9; ++k)
         where.push_back(entry.person.p_MP + entry.person.v_MP * (k * kRoomHorizonStepSec));
       for (const Eigen::Vector2d& p_MP : where) {
