@@ -1,10 +1,34 @@
 #include "egress/perception/occupancy_map_3d.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "egress/hsr_interface/error.h"
 
 namespace egress::perception {
+namespace {
+// A key's bits interleaved from the top (x lowest in each group of three): the order of a
+// depth-first walk of the tree visiting children 0..7, and each group of three a child index.
+constexpr int kKeyBits = 16;  // OctoMap's tree depth
+std::uint64_t MortonCode(const octomap::OcTreeKey& key) {
+  std::uint64_t code = 0;
+  for (int b = kKeyBits - 1; b >= 0; --b) {
+    code = (code << 3) | ((key[0] >> b) & 1u) | (((key[1] >> b) & 1u) << 1) |
+           (((key[2] >> b) & 1u) << 2);
+  }
+  return code;
+}
+octomap::OcTreeKey KeyOfMortonCode(std::uint64_t code) {
+  octomap::OcTreeKey key(0, 0, 0);
+  for (int b = 0; b < kKeyBits; ++b) {
+    const unsigned group = unsigned(code >> (3 * b)) & 7u;
+    key[0] = octomap::key_type(key[0] | ((group & 1u) << b));
+    key[1] = octomap::key_type(key[1] | (((group >> 1) & 1u) << b));
+    key[2] = octomap::key_type(key[2] | (((group >> 2) & 1u) << b));
+  }
+  return key;
+}
+}  // namespace
 
 void OccupancyMap3DConfig::Validate() const {
   ThrowUnless(resolution > 0.0 && std::isfinite(resolution),
@@ -70,12 +94,27 @@ std::size_t OccupancyMap3D::InsertDepthImage(const DepthImage& depth,
       }
     }
   }
+  // Every leaf written is noted (its occupancy may have changed): the inner nodes above them are
+  // brought up to date, and the occupied leaves kept, without walking the whole tree.
+  std::vector<std::uint64_t> touched;
+  touched.reserve(free.size() + occupied.size());
+  const auto note = [&](const octomap::OcTreeKey& key, const octomap::OcTreeNode* leaf) {
+    const std::uint64_t code = MortonCode(key);
+    touched.push_back(code);
+    const double z = tree_->keyToCoord(key[2]);
+    if (leaf != nullptr && tree_->isNodeOccupied(leaf) && z >= config_.min_obstacle_height &&
+        z <= config_.max_obstacle_height) {
+      occupied_in_band_.insert(code);
+    } else {
+      occupied_in_band_.erase(code);
+    }
+  };
   for (const auto& key : free) {
-    if (occupied.count(key) == 0) tree_->updateNode(key, false, /*lazy_eval=*/true);
+    if (occupied.count(key) == 0) note(key, tree_->updateNode(key, false, /*lazy_eval=*/true));
   }
   const double now = ToSeconds(depth.stamp);
   for (const auto& key : occupied) {
-    tree_->updateNode(key, true, /*lazy_eval=*/true);
+    note(key, tree_->updateNode(key, true, /*lazy_eval=*/true));
     marked_at_[key] = now;
   }
   if (config_.decay_s > 0.0) {
@@ -84,34 +123,57 @@ std::size_t OccupancyMap3D::InsertDepthImage(const DepthImage& depth,
         ++it;
         continue;
       }
-      tree_->setNodeValue(it->first, 0.0f, /*lazy_eval=*/true);  // even odds: as if unseen
+      // Even odds: as if unseen.
+      note(it->first, tree_->setNodeValue(it->first, 0.0f, /*lazy_eval=*/true));
       it = marked_at_.erase(it);
     }
   }
-  tree_->updateInnerOccupancy();
+  std::sort(touched.begin(), touched.end());
+  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+  if (tree_->getRoot() != nullptr) UpdateInnerNodes(tree_->getRoot(), 0, touched);
   return inserted;
 }
 
 std::vector<Eigen::Vector2d> OccupancyMap3D::ProjectObstacles() const {
+  // Ascending Morton codes: the order of the tree's own leaf iterator.
+  std::vector<std::uint64_t> codes(occupied_in_band_.begin(), occupied_in_band_.end());
+  std::sort(codes.begin(), codes.end());
   std::vector<Eigen::Vector2d> points;
-  for (auto it = tree_->begin_leafs(), end = tree_->end_leafs(); it != end; ++it) {
-    if (!tree_->isNodeOccupied(*it)) continue;
-    const double z = it.getZ();
-    if (z < config_.min_obstacle_height || z > config_.max_obstacle_height) continue;
-    // The leaf's whole footprint, not its centre: a point at the centre of a 5 cm voxel may lie
+  points.reserve(codes.size() * 9);
+  for (const std::uint64_t code : codes) {
+    const octomap::OcTreeKey key = KeyOfMortonCode(code);
+    // The voxel's whole footprint, not its centre: a point at the centre of a 5 cm voxel may lie
     // 2.5 cm inside the obstacle's true edge, and the costmap cell it falls in adds its own
-    // rounding. Its corners and centres at voxel spacing mark every cell the leaf overlaps
-    // (a coarse leaf covers several voxels).
-    const double size = it.getSize();
-    const int n = std::max(1, static_cast<int>(std::round(size / config_.resolution)));
-    const double x0 = it.getX() - size / 2, y0 = it.getY() - size / 2;
+    // rounding. Its corners, edge midpoints and centre mark every cell the voxel overlaps.
     const double step = config_.resolution / 2;
-    for (int i = 0; i <= 2 * n; ++i) {
-      for (int j = 0; j <= 2 * n; ++j)
+    const double x0 = tree_->keyToCoord(key[0]) - step, y0 = tree_->keyToCoord(key[1]) - step;
+    for (int i = 0; i <= 2; ++i) {
+      for (int j = 0; j <= 2; ++j)
         points.emplace_back(x0 + i * step, y0 + j * step);
     }
   }
   return points;
+}
+
+void OccupancyMap3D::UpdateInnerNodes(octomap::OcTreeNode* node, int depth,
+                                      std::span<const std::uint64_t> codes) {
+  // As OcTree::updateInnerOccupancy (an inner node holds its children's maximum), but only
+  // along the paths to the leaves just written: everything else already holds.
+  if (!tree_->nodeHasChildren(node)) return;
+  if (depth < int(tree_->getTreeDepth())) {
+    const int shift = 3 * (int(tree_->getTreeDepth()) - 1 - depth);
+    for (std::size_t begin = 0; begin < codes.size();) {
+      const unsigned child = unsigned(codes[begin] >> shift) & 7u;
+      std::size_t end = begin + 1;
+      while (end < codes.size() && (unsigned(codes[end] >> shift) & 7u) == child)
+        ++end;
+      if (tree_->nodeChildExists(node, child))
+        UpdateInnerNodes(tree_->getNodeChild(node, child), depth + 1,
+                         codes.subspan(begin, end - begin));
+      begin = end;
+    }
+  }
+  node->updateOccupancyChildren();
 }
 
 bool OccupancyMap3D::IsOccupied(const Eigen::Vector3d& p_MQ) const {

@@ -168,6 +168,49 @@ TEST(OccupancyMap3DTest, WhatIsSeenOnceOrTwiceIsNoObstacle) {
   EXPECT_THROW(OccupancyMap3D{bad}, InvalidArgument);
 }
 
+// What a full pass over the tree gives (OctoMap's updateInnerOccupancy, its leaf iterator):
+// the inner nodes and the projection kept up along the written paths must equal them, frame
+// after frame, as faces appear, move, decay and are carved away.
+TEST(OccupancyMap3DTest, IncrementalUpkeepEqualsAFullPassOverTheTree) {
+  const CameraIntrinsics K = CameraIntrinsics::FromHorizontalFov(80, 60, 1.047);
+  OccupancyMap3DConfig config;
+  config.decay_s = 1.0;
+  config.min_obstacle_height = 0.3;  // some voxels of each face below the band
+  OccupancyMap3D map(config);
+  int frames_with_obstacles = 0;
+  for (int frame = 0; frame < 24; ++frame) {
+    // The camera turns and steps; faces near (carved over) and far, some moving, some still.
+    const double yaw = 0.1 * std::sin(0.7 * frame);
+    const Pose3 X_MC = Pose3::FromXyzRpy({0.01 * frame, 0.01 * frame, 1.0},
+                                         {-std::numbers::pi / 2, 0.0, -std::numbers::pi / 2 + yaw});
+    const double y = 0.3 * (frame / 4) - 0.6;
+    DepthImage image =
+        frame % 7 == 6 ? NothingInView(K, 0.0)
+                       : RenderFace(K, X_MC, frame < 12 ? 1.3 : 2.5, y - 0.3, y + 0.3, 0.1, 1.3);
+    image.stamp = SecondsToDuration(0.2 * frame);
+    map.InsertDepthImage(image, K, X_MC);
+
+    octomap::OcTree full(*map.tree());
+    full.updateInnerOccupancy();
+    ASSERT_TRUE(full == *map.tree()) << "inner nodes differ at frame " << frame;
+    std::vector<Eigen::Vector2d> expected;
+    for (auto it = full.begin_leafs(), end = full.end_leafs(); it != end; ++it) {
+      ASSERT_EQ(it.getDepth(), full.getTreeDepth()) << "a pruned leaf";
+      if (!full.isNodeOccupied(*it) || it.getZ() < config.min_obstacle_height ||
+          it.getZ() > config.max_obstacle_height)
+        continue;
+      const double step = config.resolution / 2;
+      for (int i = 0; i <= 2; ++i) {
+        for (int j = 0; j <= 2; ++j)
+          expected.emplace_back(it.getX() - step + i * step, it.getY() - step + j * step);
+      }
+    }
+    EXPECT_EQ(map.ProjectObstacles(), expected) << "frame " << frame;
+    frames_with_obstacles += expected.empty() ? 0 : 1;
+  }
+  EXPECT_GT(frames_with_obstacles, 10);
+}
+
 TEST(OccupancyMap3DTest, MalformedInput) {
   const CameraIntrinsics K = CameraIntrinsics::FromHorizontalFov(80, 60, 1.047);
   OccupancyMap3D map;

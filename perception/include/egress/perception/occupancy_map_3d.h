@@ -4,9 +4,12 @@
 /// laser misses (table tops, overhangs), with a projection into the costmap and the tree itself
 /// for FCL collision checks.
 
+#include <cstdint>
 #include <functional>
 #include <memory>
+#include <span>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include <octomap/OcTree.h>
@@ -71,6 +74,12 @@ class OccupancyMap3D {
  private:
   OccupancyMap3DConfig config_;
   std::shared_ptr<octomap::OcTree> tree_;
+  /// Brings the inner nodes on the paths from `node` (at `depth`, the root's 0) to the leaves
+  /// `codes` (ascending Morton codes) up to date.
+  void UpdateInnerNodes(octomap::OcTreeNode* node, int depth, std::span<const std::uint64_t> codes);
+  /// The occupied leaves within the obstacle band, by Morton code. The tree is never pruned
+  /// (every write is lazy), so every leaf is a voxel at the finest resolution.
+  std::unordered_set<std::uint64_t> occupied_in_band_;
   /// [s] When each voxel was last marked (the image's stamp), for decay_s.
   std::unordered_map<octomap::OcTreeKey, double, octomap::OcTreeKey::KeyHash> marked_at_;
 };

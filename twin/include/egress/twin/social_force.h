@@ -7,6 +7,7 @@
 /// contact is dropped (HM95's b beyond σ ln 1000, 2.1 m), so that a walker meets only the
 /// walkers within a few metres of it (Step's cell lists), whatever the crowd's size.
 
+#include <cmath>
 #include <map>
 #include <utility>
 #include <vector>
@@ -99,7 +100,8 @@ class WallCells {
 
 class SocialForceModel {
  public:
-  explicit SocialForceModel(SocialForceParams params = {}) : params_(params) {}
+  explicit SocialForceModel(SocialForceParams params = {})
+      : params_(params), cos_half_fov_(std::cos(params.field_of_view_deg * M_PI / 360.0)) {}
 
   /// Acceleration of walker i [m/s²] from its goal, the other walkers, discs and walls.
   Eigen::Vector2d CalcAcceleration(std::size_t i, const std::vector<Walker>& walkers,
@@ -143,6 +145,7 @@ class SocialForceModel {
   Eigen::Vector2d BodyForce(const Walker& w, const Eigen::Vector2d& other_p,
                             const Eigen::Vector2d& other_v, double other_r) const;
   SocialForceParams params_;
+  double cos_half_fov_;  ///< cos(field_of_view_deg / 2): once, not per walker and step
 };
 
 }  // namespace egress::twin
