@@ -54,6 +54,20 @@ if(NOT urdfdom_VERSION)
   set(urdfdom_VERSION "unknown")
 endif()
 
+# --- hsr_interface/ros2: the real robot over ROS 2's middleware (Fast DDS, ROS 2's default),
+# types generated from ROS 2 message IDL by fastddsgen; Cyclone DDS only for the interop test
+# (a second DDS implementation no one here wrote).
+egress_require(fastcdr APT libfastcdr-dev)
+egress_require(fastrtps APT libfastrtps-dev)
+find_program(EGRESS_FASTDDSGEN fastddsgen)
+if(NOT EGRESS_FASTDDSGEN)
+  message(FATAL_ERROR "egress: fastddsgen not found. Install the Debian package 'fastddsgen':\n"
+    "    apt-get install fastddsgen\nor run `./egress.sh deps` as root.")
+endif()
+if(EGRESS_BUILD_TESTS)
+  egress_require(CycloneDDS APT "cyclonedds-dev cyclonedds-tools")
+endif()
+
 # --- twin
 # Bullet in double precision: the robot model and every other module compute in double, and the
 # twin's determinism and contact accuracy at door hinges benefit from it. Debian ships the
