@@ -1,5 +1,6 @@
 #include "egress/ros2/conversions.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -108,14 +109,14 @@ namespace {
 // Checks an image's size fields against its data for `bytes_per_pixel`; returns width, height.
 std::pair<int, int> CheckImage(const sensor_msgs::msg::Image& msg, std::size_t bytes_per_pixel) {
   const std::string& e = msg.encoding();
-  ThrowUnless(msg.width() > 0 && msg.height() > 0 && msg.width() < (1u << 16) &&
-                  msg.height() < (1u << 16),
-              "sensor_msgs/Image (", e, "): size ", msg.width(), "x", msg.height(),
-              " must be positive and below 65536");
+  ThrowUnless(
+      msg.width() > 0 && msg.height() > 0 && msg.width() < (1u << 16) && msg.height() < (1u << 16),
+      "sensor_msgs/Image (", e, "): size ", msg.width(), "x", msg.height(),
+      " must be positive and below 65536");
   ThrowUnless(msg.step() >= msg.width() * bytes_per_pixel, "sensor_msgs/Image (", e, "): step (",
               msg.step(), ") is shorter than a row (", msg.width() * bytes_per_pixel, " bytes)");
-  ThrowUnless(msg.data().size() == std::size_t(msg.step()) * msg.height(), "sensor_msgs/Image (",
-              e, "): data holds ", msg.data().size(), " bytes, step x height is ",
+  ThrowUnless(msg.data().size() == std::size_t(msg.step()) * msg.height(), "sensor_msgs/Image (", e,
+              "): data holds ", msg.data().size(), " bytes, step x height is ",
               std::size_t(msg.step()) * msg.height());
   ThrowUnless(msg.is_bigendian() == 0 || bytes_per_pixel == 1 || e == "bgr8" || e == "rgb8",
               "sensor_msgs/Image (", e, "): big-endian data is not supported");
@@ -266,8 +267,9 @@ nav_msgs::msg::Odometry ToRos(const Odometry& odometry) {
 namespace {
 double YawOf(const geometry_msgs::msg::Quaternion& q, std::string_view what) {
   const double n = q.x() * q.x() + q.y() * q.y() + q.z() * q.z() + q.w() * q.w();
-  ThrowUnless(n > 1e-12 && std::isfinite(n), what, ": the orientation quaternion is zero or "
-                                                   "not finite");
+  ThrowUnless(n > 1e-12 && std::isfinite(n), what,
+              ": the orientation quaternion is zero or "
+              "not finite");
   // Yaw of the rotation (ZYX convention), in a form that holds for any scale of q.
   return std::atan2(2.0 * (q.w() * q.z() + q.x() * q.y()),
                     q.w() * q.w() + q.x() * q.x() - q.y() * q.y() - q.z() * q.z());
@@ -321,8 +323,8 @@ Pose3 FromRos(const geometry_msgs::msg::Transform& msg) {
   const Eigen::Quaterniond q(r.w(), r.x(), r.y(), r.z());
   ThrowUnless(q.norm() > 1e-6 && std::isfinite(q.norm()),
               "geometry_msgs/Transform: the rotation quaternion is zero or not finite");
-  return Pose3(q.normalized(),
-               Eigen::Vector3d(msg.translation().x(), msg.translation().y(), msg.translation().z()));
+  return Pose3(q.normalized(), Eigen::Vector3d(msg.translation().x(), msg.translation().y(),
+                                               msg.translation().z()));
 }
 
 trajectory_msgs::msg::JointTrajectory ToRos(const JointTrajectory& trajectory) {
@@ -345,10 +347,97 @@ JointTrajectory FromRos(const trajectory_msgs::msg::JointTrajectory& msg) {
   trajectory.start = FromRos(msg.header().stamp());
   trajectory.joint_names = msg.joint_names();
   for (const auto& p : msg.points()) {
-    trajectory.points.push_back({p.positions(), p.velocities(), p.accelerations(),
-                                 FromRos(p.time_from_start())});
+    trajectory.points.push_back(
+        {p.positions(), p.velocities(), p.accelerations(), FromRos(p.time_from_start())});
   }
   return trajectory;
+}
+
+trajectory_msgs::msg::JointTrajectory GripperToRos(const GripperCommand& command) {
+  trajectory_msgs::msg::JointTrajectory msg;
+  msg.joint_names({"hand_motor_joint"});
+  trajectory_msgs::msg::JointTrajectoryPoint point;
+  switch (command.mode) {
+    case GripperCommand::Mode::kOpen:
+      point.positions({kHandOpenRad});
+      break;
+    case GripperCommand::Mode::kPosition:
+      point.positions({command.position});
+      break;
+    case GripperCommand::Mode::kGrasp:
+      point.effort({command.effort});
+      break;
+  }
+  msg.points().push_back(std::move(point));
+  return msg;
+}
+
+GripperCommand GripperFromRos(const trajectory_msgs::msg::JointTrajectory& msg) {
+  ThrowUnless(msg.joint_names().size() == 1 && msg.joint_names()[0] == "hand_motor_joint" &&
+                  msg.points().size() == 1,
+              "gripper trajectory: expected one point of hand_motor_joint");
+  const auto& p = msg.points()[0];
+  GripperCommand command;
+  if (p.positions().empty()) {
+    ThrowUnless(p.effort().size() == 1,
+                "gripper trajectory: a grasp (no position) needs one effort");
+    command.mode = GripperCommand::Mode::kGrasp;
+    command.effort = p.effort()[0];
+  } else {
+    ThrowUnless(p.positions().size() == 1, "gripper trajectory: expected one position");
+    command.position = p.positions()[0];
+    command.mode = command.position >= kHandOpenRad - 1e-9 ? GripperCommand::Mode::kOpen
+                                                           : GripperCommand::Mode::kPosition;
+  }
+  return command;
+}
+
+vision_msgs::msg::Detection2DArray ToRos(const std::vector<Detection2D>& detections, Time stamp,
+                                         std::string_view frame_id) {
+  vision_msgs::msg::Detection2DArray msg;
+  msg.header(MakeHeader(stamp, frame_id));
+  for (const Detection2D& d : detections) {
+    vision_msgs::msg::Detection2D out;
+    out.header(MakeHeader(d.stamp, d.frame_id));
+    vision_msgs::msg::ObjectHypothesisWithPose hypothesis;
+    hypothesis.hypothesis().class_id(d.label);
+    hypothesis.hypothesis().score(d.confidence);
+    out.results().push_back(hypothesis);
+    out.bbox().center().position().x(0.5 * (d.box.u_min + d.box.u_max));
+    out.bbox().center().position().y(0.5 * (d.box.v_min + d.box.v_max));
+    out.bbox().size_x(d.box.width());
+    out.bbox().size_y(d.box.height());
+    msg.detections().push_back(std::move(out));
+  }
+  return msg;
+}
+
+std::vector<Detection2D> FromRos(const vision_msgs::msg::Detection2DArray& msg) {
+  std::vector<Detection2D> detections;
+  for (std::size_t i = 0; i < msg.detections().size(); ++i) {
+    const auto& in = msg.detections()[i];
+    ThrowUnless(!in.results().empty(), "vision_msgs/Detection2DArray: detection ", i,
+                " has no hypothesis (results is empty)");
+    ThrowUnless(in.bbox().center().theta() == 0.0, "vision_msgs/Detection2DArray: detection ", i,
+                " has a rotated box (theta ", in.bbox().center().theta(), ")");
+    // The best hypothesis.
+    const auto& best = *std::max_element(in.results().begin(), in.results().end(),
+                                         [](const auto& a, const auto& b) {
+                                           return a.hypothesis().score() < b.hypothesis().score();
+                                         });
+    Detection2D d;
+    d.label = best.hypothesis().class_id();
+    d.confidence = best.hypothesis().score();
+    const double cx = in.bbox().center().position().x(), cy = in.bbox().center().position().y();
+    d.box = {cx - in.bbox().size_x() / 2, cy - in.bbox().size_y() / 2, cx + in.bbox().size_x() / 2,
+             cy + in.bbox().size_y() / 2};
+    // A detection without its own stamp or frame is the array's image's.
+    const bool own_stamp = in.header().stamp().sec() != 0 || in.header().stamp().nanosec() != 0;
+    d.stamp = FromRos(own_stamp ? in.header().stamp() : msg.header().stamp());
+    d.frame_id = in.header().frame_id().empty() ? msg.header().frame_id() : in.header().frame_id();
+    detections.push_back(std::move(d));
+  }
+  return detections;
 }
 
 }  // namespace egress::ros2

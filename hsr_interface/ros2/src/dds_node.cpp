@@ -19,8 +19,8 @@ std::string DdsTopicName(std::string_view ros_topic) {
     const char c = ros_topic[i];
     ThrowUnless(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '/',
                 "ROS 2 topic '", ros_topic, "': character '", c, "' is not allowed");
-    ThrowUnless(!(c == '/' && i + 1 < ros_topic.size() && ros_topic[i + 1] == '/'),
-                "ROS 2 topic '", ros_topic, "' has an empty level (//)");
+    ThrowUnless(!(c == '/' && i + 1 < ros_topic.size() && ros_topic[i + 1] == '/'), "ROS 2 topic '",
+                ros_topic, "' has an empty level (//)");
   }
   return "rt" + std::string(ros_topic);
 }
@@ -45,8 +45,7 @@ DdsNode::DdsNode(std::string_view name, int domain_id) : name_(name) {
               " must be in [0, 232] (ROS_DOMAIN_ID)");
   dds::DomainParticipantQos qos = dds::PARTICIPANT_QOS_DEFAULT;
   qos.name(name_);
-  participant_ =
-      dds::DomainParticipantFactory::get_instance()->create_participant(domain_id, qos);
+  participant_ = dds::DomainParticipantFactory::get_instance()->create_participant(domain_id, qos);
   if (participant_ == nullptr)
     throw std::runtime_error("DDS: cannot create participant '" + name_ + "' on domain " +
                              std::to_string(domain_id));

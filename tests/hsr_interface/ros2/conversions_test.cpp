@@ -120,9 +120,9 @@ TEST(Ros2ConversionsTest, OdometryPoseTwistAndCovarianceBlock) {
   const auto msg = ToRos(odometry);
   EXPECT_EQ(msg.header().frame_id(), "odom");
   EXPECT_EQ(msg.child_frame_id(), std::string(frames::kBase));
-  EXPECT_DOUBLE_EQ(msg.pose().covariance()[5], 0.003);       // (x, yaw)
-  EXPECT_DOUBLE_EQ(msg.pose().covariance()[35], 0.05);       // (yaw, yaw)
-  EXPECT_GT(msg.pose().covariance()[14], 1e3);               // z: unknown
+  EXPECT_DOUBLE_EQ(msg.pose().covariance()[5], 0.003);  // (x, yaw)
+  EXPECT_DOUBLE_EQ(msg.pose().covariance()[35], 0.05);  // (yaw, yaw)
+  EXPECT_GT(msg.pose().covariance()[14], 1e3);          // z: unknown
   const Odometry back = FromRos(msg);
   EXPECT_NEAR(back.X_OB.yaw, 2.5, 1e-12);
   EXPECT_DOUBLE_EQ(back.X_OB.y, -2.0);

@@ -7,8 +7,8 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <sensor_msgs/msg/LaserScanPubSubTypes.h>
 #include <geometry_msgs/msg/TwistPubSubTypes.h>
+#include <sensor_msgs/msg/LaserScanPubSubTypes.h>
 
 namespace egress::ros2 {
 namespace {
@@ -52,8 +52,8 @@ TEST(DdsNodeTest, AScanCrossesBetweenTwoParticipants) {
         const std::lock_guard<std::mutex> lock(mutex);
         received.push_back(m);
       });
-  auto pub = robot.CreatePublisher<sensor_msgs::msg::LaserScanPubSubType>(
-      "/scan", QosProfile::SensorData());
+  auto pub = robot.CreatePublisher<sensor_msgs::msg::LaserScanPubSubType>("/scan",
+                                                                          QosProfile::SensorData());
   ASSERT_TRUE(WaitFor([&] { return pub->MatchedSubscriptions() == 1; }));
   sensor_msgs::msg::LaserScan scan;
   scan.header().frame_id("base_range_sensor_link");
@@ -87,7 +87,8 @@ TEST(DdsNodeTest, ReliableCommandsArriveInOrderAndATopicKeepsOneType) {
       });
   auto pub = brain.CreatePublisher<geometry_msgs::msg::TwistPubSubType>(
       "/omni_base_controller/cmd_vel", QosProfile::Default());
-  ASSERT_TRUE(WaitFor([&] { return pub->MatchedSubscriptions() == 1 && sub->MatchedPublications() == 1; }));
+  ASSERT_TRUE(
+      WaitFor([&] { return pub->MatchedSubscriptions() == 1 && sub->MatchedPublications() == 1; }));
   for (int i = 0; i < 5; ++i) {
     geometry_msgs::msg::Twist t;
     t.linear().x(0.1 * i);

@@ -14,6 +14,7 @@
 /// ordered) are the RobotPort boundary's (SensorSnapshot::Validate).
 
 #include <string_view>
+#include <vector>
 
 #include <builtin_interfaces/msg/Duration.h>
 #include <builtin_interfaces/msg/Time.h>
@@ -25,6 +26,7 @@
 #include <sensor_msgs/msg/JointState.h>
 #include <sensor_msgs/msg/LaserScan.h>
 #include <trajectory_msgs/msg/JointTrajectory.h>
+#include <vision_msgs/msg/Detection2DArray.h>
 
 #include "egress/hsr_interface/command_types.h"
 #include "egress/hsr_interface/geometry.h"
@@ -79,5 +81,21 @@ Pose3 FromRos(const geometry_msgs::msg::Transform& msg);
 /// header.stamp is the trajectory's start (0: as soon as received, as in ROS).
 trajectory_msgs::msg::JointTrajectory ToRos(const JointTrajectory& trajectory);
 JointTrajectory FromRos(const trajectory_msgs::msg::JointTrajectory& msg);
+
+/// The HSR's hand_motor_joint fully open [rad] (its URDF's upper limit).
+inline constexpr double kHandOpenRad = 1.24;
+
+/// The gripper command as a trajectory of hand_motor_joint with one point: open is the open
+/// position, a position is that position, a grasp is no position and the grip force in
+/// `effort` [N]. @throws InvalidArgument (FromRos) for any other trajectory.
+trajectory_msgs::msg::JointTrajectory GripperToRos(const GripperCommand& command);
+GripperCommand GripperFromRos(const trajectory_msgs::msg::JointTrajectory& msg);
+
+/// Detections of one image (all with its capture stamp): one Detection2D per box, its label the
+/// hypothesis' class_id and its confidence the score.
+vision_msgs::msg::Detection2DArray ToRos(const std::vector<Detection2D>& detections, Time stamp,
+                                         std::string_view frame_id);
+/// @throws InvalidArgument for a detection without a hypothesis or with a rotated box.
+std::vector<Detection2D> FromRos(const vision_msgs::msg::Detection2DArray& msg);
 
 }  // namespace egress::ros2

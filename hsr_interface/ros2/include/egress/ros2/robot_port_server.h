@@ -1,0 +1,48 @@
+#pragma once
+/// @file
+/// RobotPortServer: serves any RobotPort (the twin's, in `egress twin serve --ros2`) as a ROS 2
+/// robot: what its Sense() returns is published on the robot's topics (Ros2Topics), with
+/// /clock and the camera's transform on /tf; commands received on cmd_vel and the trajectory
+/// topics are applied to it. The port is not thread-safe: commands are queued as they arrive
+/// and applied on the caller's thread by ApplyCommands().
+
+#include <chrono>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "egress/hsr_interface/robot_port.h"
+#include "egress/ros2/ros2_topics.h"
+
+namespace egress::ros2 {
+
+class RobotPortServer {
+ public:
+  /// Joins the DDS domain as node `node_name`. @throws InvalidArgument for bad topics,
+  /// std::runtime_error if DDS cannot start.
+  RobotPortServer(RobotPort& robot, Ros2Topics topics, int domain_id,
+                  std::string_view node_name = "egress_twin");
+  ~RobotPortServer();
+
+  /// Reads the robot (Sense()) and publishes what is new, stamped as the robot stamped it,
+  /// after /clock at the robot's time.
+  void PublishSensors();
+  /// Applies to the robot the commands received since the last call, in arrival order.
+  /// Returns how many.
+  int ApplyCommands();
+  /// Waits (wall time, bounded) until the brain reports the control step at `t` done.
+  bool WaitForStepDone(Time t, std::chrono::milliseconds timeout);
+  /// The brain's last status (egress robot publishes its tree's), if any.
+  std::optional<std::string> brain_status() const;
+  /// Whether a brain subscribes to the sensors (for waiting until it is there).
+  bool BrainConnected() const;
+  /// Commands that could not be applied (malformed), with why; cleared by the call.
+  std::vector<std::string> TakeRejected();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace egress::ros2

@@ -1,0 +1,77 @@
+#pragma once
+/// @file
+/// Ros2RobotPort: the RobotPort of a robot that speaks ROS 2 (the HSR, or a twin served by
+/// RobotPortServer), over Fast DDS. Sensor messages are taken as they arrive (Fast DDS's
+/// threads) and handed to the brain at the next Sense(); commands are published at once.
+///
+/// Safety: Fault() names a sensor that went stale (no scan for scan_timeout_s, no odometry for
+/// odometry_timeout_s, no joint states for joints_timeout_s, by the port's clock since the last
+/// one arrived) or an e-stop; while it does, the port sends only zero base velocities, whatever
+/// the brain asks. The caller halts the tree (egress robot does, within one control step).
+
+#include <chrono>
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "egress/hsr_interface/clock.h"
+#include "egress/hsr_interface/robot_port.h"
+#include "egress/ros2/ros2_topics.h"
+
+namespace egress::ros2 {
+
+struct Ros2RobotPortConfig {
+  Ros2Topics topics;
+  int domain_id{0};          ///< ROS_DOMAIN_ID
+  bool use_sim_time{false};  ///< The clock is /clock's (a simulation), else the system clock.
+  double scan_timeout_s{0.3};
+  double odometry_timeout_s{0.2};
+  double joints_timeout_s{0.5};
+  /// @throws InvalidArgument naming the field.
+  void Validate() const;
+};
+
+/// Nanoseconds since the UNIX epoch: the stamps of a real ROS 2 robot.
+class SystemClock final : public Clock {
+ public:
+  Time Now() const override;
+};
+
+class Ros2RobotPort final : public RobotPort {
+ public:
+  /// Joins the DDS domain as node `node_name`. @throws InvalidArgument for a bad config,
+  /// std::runtime_error if DDS cannot start.
+  explicit Ros2RobotPort(Ros2RobotPortConfig config, std::string_view node_name = "egress_brain");
+  ~Ros2RobotPort() override;
+
+  const Clock& clock() const override;
+  /// Why the base must not move (a stale sensor, an e-stop), or nullopt.
+  std::optional<std::string> Fault() const;
+  /// Waits until a scan, odometry and joint states have all arrived (and, with sim time, the
+  /// clock). Returns false on timeout, naming in `missing` what never came.
+  bool WaitForSensors(std::chrono::milliseconds timeout, std::string* missing = nullptr);
+  /// With sim time: blocks until the clock reaches `t` or `timeout` passes (wall time); returns
+  /// whether it did. Without sim time: sleeps until `t`.
+  bool WaitUntil(Time t, std::chrono::milliseconds timeout);
+  /// The mission tree's status, for whoever watches (lock-step simulation ends on it).
+  void PublishStatus(std::string_view status);
+  /// The time of the control step just finished (lock-step simulation waits for it).
+  void PublishStepDone(Time t);
+  /// Publishes an e-stop (true) or its release, as any node may.
+  void PublishEstop(bool stop);
+
+ protected:
+  SensorSnapshot DoSense() override;
+  void DoSendBaseVelocity(const Twist2& V_B) override;
+  void DoSendArmTrajectory(const JointTrajectory& trajectory) override;
+  void DoSendGripperCommand(const GripperCommand& command) override;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace egress::ros2
