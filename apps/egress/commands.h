@@ -41,6 +41,9 @@ void AddSimCommand(CLI::App& app);
 /// `egress evac study SCENARIO`: evacuation time with no robot, the robot escorting, and every
 /// door propped open, on the same seeds.
 void AddEvacCommand(CLI::App& app);
+/// `egress twin serve --ros2 SCENARIO` (the twin as a ROS 2 robot) and `egress robot --ros2`
+/// (the brain against a robot over ROS 2).
+void AddRos2Commands(CLI::App& app);
 /// A sub-command reserved for a capability that is not built yet: it is listed in --help with
 /// what it will do, and running it fails with a clear message.
 void AddPlannedCommand(CLI::App& app, const std::string& name, const std::string& description,

@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   egress::apps::AddBenchCommand(app);
   egress::apps::AddSimCommand(app);
   egress::apps::AddEvacCommand(app);
+  egress::apps::AddRos2Commands(app);
 
   try {
     app.parse(argc, argv);

@@ -537,4 +537,19 @@ bool Executive::Step(RobotPort& port) {
   return !m.finished;
 }
 
+void Executive::Halt(RobotPort& port, const std::string& reason) {
+  Impl& m = *impl_;
+  if (m.finished) return;
+  port.SendBaseVelocity(Twist2{});  // the base first: halting the tree may take a moment
+  m.motion.StopBase();
+  m.tree->HaltTree();
+  m.finished = true;
+  status_ = bt::NodeStatus::kIdle;
+  decisions_.push_back({ToSeconds(port.clock().Now()), "halted: " + reason, DecisionEvent::kNote});
+}
+
+bool Executive::finished() const {
+  return impl_->finished;
+}
+
 }  // namespace egress::behavior

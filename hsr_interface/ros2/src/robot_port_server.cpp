@@ -1,5 +1,6 @@
 #include "egress/ros2/robot_port_server.h"
 
+#include <algorithm>
 #include <condition_variable>
 #include <deque>
 #include <functional>
@@ -46,6 +47,11 @@ struct RobotPortServer::Impl {
   std::unique_ptr<Publisher<vision_msgs::msg::Detection2DArrayPubSubType>> detections;
   std::vector<std::unique_ptr<eprosima::fastdds::dds::DataReaderListener>> subscriptions;
   std::optional<Time> last_odometry, last_joints;
+  // The latest of each, for RepublishLatest().
+  std::optional<sensor_msgs::msg::LaserScan> scan_msg;
+  std::optional<nav_msgs::msg::Odometry> odometry_msg;
+  std::optional<sensor_msgs::msg::JointState> joints_msg;
+  std::optional<rosgraph_msgs::msg::Clock> clock_msg;
 
   Impl(RobotPort& r, Ros2Topics t, int domain, std::string_view name)
       : robot(r), topics(std::move(t)), node(name, domain) {}
@@ -122,27 +128,30 @@ RobotPortServer::~RobotPortServer() = default;
 void RobotPortServer::PublishSensors() {
   Impl& m = *impl_;
   const SensorSnapshot s = m.robot.Sense();
-  rosgraph_msgs::msg::Clock clock;
-  clock.clock(ToRos(s.stamp));
-  m.clock->Publish(clock);
-  if (s.scan) m.scan->Publish(ToRos(*s.scan));
+  if (s.scan) {
+    m.scan_msg = ToRos(*s.scan);
+    m.scan->Publish(*m.scan_msg);
+  }
   if (!m.last_odometry || s.odometry.stamp != *m.last_odometry) {
-    m.odometry->Publish(ToRos(s.odometry));
+    m.odometry_msg = ToRos(s.odometry);
+    m.odometry->Publish(*m.odometry_msg);
     m.last_odometry = s.odometry.stamp;
   }
   if (!m.last_joints || s.joints.stamp != *m.last_joints) {
-    // The gripper's state rides on the joint states, as the HSR's does.
+    // The gripper's state rides on the joint states, as the HSR's does: hand_motor_joint's
+    // position and, as its effort, the grip force.
     JointState joints = s.joints;
-    if (!joints.Position("hand_motor_joint")) {
+    auto it = std::find(joints.names.begin(), joints.names.end(), "hand_motor_joint");
+    if (it == joints.names.end()) {
       joints.names.push_back("hand_motor_joint");
       joints.positions.push_back(s.gripper.hand_motor_position);
       if (!joints.velocities.empty()) joints.velocities.push_back(0.0);
-      if (!joints.efforts.empty() || s.gripper.effort != 0.0) {
-        joints.efforts.resize(joints.positions.size() - 1, 0.0);
-        joints.efforts.push_back(s.gripper.effort);
-      }
+      it = joints.names.end() - 1;
     }
-    m.joints->Publish(ToRos(joints));
+    joints.efforts.resize(joints.names.size(), 0.0);
+    joints.efforts[std::size_t(it - joints.names.begin())] = s.gripper.effort;
+    m.joints_msg = ToRos(joints);
+    m.joints->Publish(*m.joints_msg);
     m.last_joints = s.joints.stamp;
   }
   if (s.depth) {
@@ -172,6 +181,19 @@ void RobotPortServer::PublishSensors() {
       begin = i;
     }
   }
+  // The clock last: a brain that steps when its clock moves finds this step's readings there.
+  rosgraph_msgs::msg::Clock clock;
+  clock.clock(ToRos(s.stamp));
+  m.clock->Publish(clock);
+  m.clock_msg = clock;
+}
+
+void RobotPortServer::RepublishLatest() {
+  Impl& m = *impl_;
+  if (m.scan_msg) m.scan->Publish(*m.scan_msg);
+  if (m.odometry_msg) m.odometry->Publish(*m.odometry_msg);
+  if (m.joints_msg) m.joints->Publish(*m.joints_msg);
+  if (m.clock_msg) m.clock->Publish(*m.clock_msg);
 }
 
 int RobotPortServer::ApplyCommands() {

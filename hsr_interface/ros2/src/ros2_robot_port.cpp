@@ -59,6 +59,8 @@ struct Ros2RobotPort::Impl {
   std::optional<Odometry> odometry;
   std::optional<JointState> joints;
   std::optional<Time> scan_at, odometry_at, joints_at;
+  // When WaitForSensors found the robot up: a sensor that never sent counts as stale from then.
+  std::optional<Time> ready_at;
   bool clock_seen{false};
   bool estop{false};
   std::string bad_message;  // the last message that could not be converted
@@ -189,7 +191,8 @@ std::optional<std::string> Ros2RobotPort::Fault() const {
   const Time now = m.clock().Now();
   const auto stale = [&](const std::optional<Time>& at, double timeout, const std::string& topic,
                          const char* what) -> std::optional<std::string> {
-    if (at && ToSeconds(now - *at) <= timeout) return std::nullopt;
+    const std::optional<Time> since = at ? at : m.ready_at;
+    if (since && ToSeconds(now - *since) <= timeout) return std::nullopt;
     std::string reason = std::string(what) + " stale: " +
                          (at ? "nothing on " + topic + " for " +
                                    std::to_string(ToSeconds(now - *at)).substr(0, 5) + " s"
@@ -211,16 +214,17 @@ std::optional<std::string> Ros2RobotPort::Fault() const {
 bool Ros2RobotPort::WaitForSensors(std::chrono::milliseconds timeout, std::string* missing) {
   Impl& m = *impl_;
   std::unique_lock<std::mutex> lock(m.mutex);
+  // Odometry and joint states (and the clock): a laser's first sweep may come a period later.
   const auto ready = [&] {
-    return m.scan_at && m.odometry_at && m.joints_at && (!m.config.use_sim_time || m.clock_seen);
+    return m.odometry_at && m.joints_at && (!m.config.use_sim_time || m.clock_seen);
   };
   const bool ok = m.changed.wait_for(lock, timeout, ready);
+  if (ok && !m.ready_at) m.ready_at = m.clock().Now();
   if (!ok && missing != nullptr) {
     std::string what;
     const auto add = [&](bool have, const std::string& topic) {
       if (!have) what += (what.empty() ? "" : ", ") + topic;
     };
-    add(bool(m.scan_at), m.config.topics.scan);
     add(bool(m.odometry_at), m.config.topics.odometry);
     add(bool(m.joints_at), m.config.topics.joint_states);
     if (m.config.use_sim_time) add(m.clock_seen, m.config.topics.clock);

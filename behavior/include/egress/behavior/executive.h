@@ -119,6 +119,12 @@ class Executive {
   /// robot is then commanded to stand still.
   bool Step(RobotPort& port);
 
+  /// Stops everything at once, for a reason from outside the tree (a stale sensor, an e-stop,
+  /// SIGINT): the base is commanded to zero first, then the tree is halted and the reason
+  /// logged. Step() then only keeps the base still. Returns at once if already finished.
+  void Halt(RobotPort& port, const std::string& reason);
+  /// Whether the mission ended (success, failure, or Halt).
+  bool finished() const;
   bt::NodeStatus status() const { return status_; }
   const std::vector<Decision>& decisions() const { return decisions_; }
   /// Runs `detector` on every colour image the port gives (a robot that sends images, not

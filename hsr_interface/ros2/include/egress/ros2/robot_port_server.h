@@ -25,9 +25,12 @@ class RobotPortServer {
                   std::string_view node_name = "egress_twin");
   ~RobotPortServer();
 
-  /// Reads the robot (Sense()) and publishes what is new, stamped as the robot stamped it,
-  /// after /clock at the robot's time.
+  /// Reads the robot (Sense()) and publishes what is new, stamped as the robot stamped it, then
+  /// /clock at the robot's time.
   void PublishSensors();
+  /// Publishes again the latest scan, odometry, joint states and clock (a brain that joined
+  /// after they went out, before the robot moves on: best-effort data is not kept for it).
+  void RepublishLatest();
   /// Applies to the robot the commands received since the last call, in arrival order.
   /// Returns how many.
   int ApplyCommands();

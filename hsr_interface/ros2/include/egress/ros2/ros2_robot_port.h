@@ -50,8 +50,9 @@ class Ros2RobotPort final : public RobotPort {
   const Clock& clock() const override;
   /// Why the base must not move (a stale sensor, an e-stop), or nullopt.
   std::optional<std::string> Fault() const;
-  /// Waits until a scan, odometry and joint states have all arrived (and, with sim time, the
-  /// clock). Returns false on timeout, naming in `missing` what never came.
+  /// Waits until odometry and joint states have arrived (and, with sim time, the clock): the
+  /// robot is up. A sensor that has not sent by then is stale once its timeout has passed from
+  /// this moment. Returns false on timeout, naming in `missing` what never came.
   bool WaitForSensors(std::chrono::milliseconds timeout, std::string* missing = nullptr);
   /// With sim time: blocks until the clock reaches `t` or `timeout` passes (wall time); returns
   /// whether it did. Without sim time: sleeps until `t`.

@@ -1,0 +1,268 @@
+// `egress twin serve --ros2 SCENARIO` and `egress robot --ros2 --scenario SCENARIO`: the robot
+// brain and the twin in two processes, over ROS 2's wire format (Fast DDS). The same brain drives
+// a real HSR through the same port (README "Running on an HSR").
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <fstream>
+#include <iostream>
+#include <thread>
+
+#include <fmt/format.h>
+
+#include "brain_trial.h"
+#include "commands.h"
+#include "egress/hsr_interface/error.h"
+#include "egress/ros2/robot_port_server.h"
+#include "egress/ros2/ros2_robot_port.h"
+#include "egress/twin/scenario_judge.h"
+#include "egress/twin/sdf_world_loader.h"
+#include "egress/twin/twin_run.h"
+
+namespace egress::apps {
+namespace {
+
+std::atomic<bool> g_interrupted{false};
+extern "C" void OnSigint(int) {
+  g_interrupted = true;
+}
+
+struct Ros2Options {
+  bool ros2{false};
+  std::string scenario;
+  std::optional<std::uint64_t> seed;
+  int domain{0};
+  std::string topics;
+  bool lockstep{false};
+  double speed{1.0};
+  double duration{0.0};
+  double wait_s{30.0};
+  std::string json;
+  bool sim_time{false};
+  bool quiet{false};
+};
+
+ros2::Ros2Topics TopicsOf(const Ros2Options& o) {
+  return o.topics.empty() ? ros2::Ros2Topics{} : ros2::Ros2Topics::FromYamlFile(o.topics);
+}
+
+void RequireRos2(const Ros2Options& o, const char* command) {
+  if (!o.ros2)
+    throw CommandFailed(fmt::format(
+        "{}: only --ros2 is built (ROS 2's wire format over Fast DDS); pass --ros2", command));
+}
+
+// The twin, served as a ROS 2 robot until the brain says its mission ended, the time limit, or
+// SIGINT; then judged as `sim run` judges.
+void ServeTwin(const Ros2Options& o) {
+  RequireRos2(o, "twin serve");
+  const twin::Scenario scenario = twin::LoadScenario(o.scenario);
+  const twin::WorldDescription world = twin::LoadSdfWorld(scenario.world_file);
+  const std::uint64_t seed = o.seed.value_or(scenario.seed);
+  auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
+  auto twin_model = std::make_shared<const twin::TwinModel>(scenario, world, model);
+  if (twin_model->scenario().randomize.DrawsVariants()) {
+    twin_model = std::make_shared<const twin::TwinModel>(
+        twin::DrawScenarioVariant(twin_model->scenario(), twin_model->building(), seed),
+        twin_model->world(), twin_model->robot_model(), twin_model->config());
+  }
+  twin::TwinWorld twin_world(twin_model, seed);
+  twin::TwinRobot robot(&twin_world);
+  ros2::RobotPortServer server(robot, TopicsOf(o), o.domain);
+  if (!o.quiet)
+    fmt::print("serving   {} (seed {}) on ROS 2 domain {}, {}\n", o.scenario, seed, o.domain,
+               o.lockstep ? "lock-step with the brain" : fmt::format("{:g}x real time", o.speed));
+  std::signal(SIGINT, OnSigint);
+  // The brain first: the scenario's clock starts once a brain has taken its first step on the
+  // robot's first readings (it says RUNNING).
+  const auto wait_until =
+      std::chrono::steady_clock::now() + std::chrono::duration<double>(o.wait_s);
+  server.PublishSensors();
+  while (!server.brain_status()) {
+    server.RepublishLatest();
+    if (g_interrupted) throw CommandFailed("interrupted before a brain connected");
+    if (std::chrono::steady_clock::now() > wait_until)
+      throw CommandFailed(
+          fmt::format("no brain on ROS 2 domain {} within {:g} s (start `egress "
+                      "robot --ros2` there)",
+                      o.domain, o.wait_s));
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  behavior::ExecutiveConfig executive;  // the brain's control period: the twin steps by it
+  twin::RunOptions run;
+  run.duration = o.duration;
+  run.control_period = 1.0 / executive.control_rate_hz;
+  const auto started = std::chrono::steady_clock::now();
+  std::string ended_by = "the time limit";
+  const twin::RunResult result = twin::RunScenario(
+      robot,
+      [&](RobotPort& port) {
+        const Time now = port.clock().Now();
+        server.PublishSensors();
+        if (o.lockstep) {
+          if (!server.WaitForStepDone(now, std::chrono::milliseconds(int(o.wait_s * 1000)))) {
+            throw CommandFailed(
+                fmt::format("lock-step: the brain did not finish its step at "
+                            "{:.2f} s within {:g} s",
+                            ToSeconds(now), o.wait_s));
+          }
+        } else {
+          std::this_thread::sleep_until(started +
+                                        std::chrono::duration<double>(ToSeconds(now) / o.speed));
+        }
+        server.ApplyCommands();
+        for (const auto& rejected : server.TakeRejected())
+          fmt::print(stderr, "rejected  {}\n", rejected);
+        if (g_interrupted) {
+          ended_by = "SIGINT";
+          return false;
+        }
+        const auto status = server.brain_status();
+        if (status && (status->starts_with("SUCCESS") || status->starts_with("FAILURE") ||
+                       status->starts_with("HALTED"))) {
+          ended_by = "the brain: " + *status;
+          return false;
+        }
+        return true;
+      },
+      run);
+  if (!o.quiet)
+    fmt::print("ran       {:.1f} s simulated, ended by {}\n", result.simulated_time, ended_by);
+  std::cout << twin::FormatVerdict(result.verdict);
+  if (!o.json.empty()) {
+    std::ofstream out(o.json);
+    out << twin::VerdictToJson(result.verdict) << "\n";
+    if (!out) throw CommandFailed(fmt::format("cannot write '{}'", o.json));
+  }
+  if (!result.verdict.success) throw CommandFailed("");
+}
+
+// The brain for a scenario's mission (its map, tree and start pose for the seed: what an
+// operator gives a robot), driving whatever robot answers on ROS 2.
+void RunRobot(const Ros2Options& o) {
+  RequireRos2(o, "robot");
+  if (o.scenario.empty())
+    throw CommandFailed("robot --ros2: --scenario FILE is required (the mission, map and start)");
+  const twin::Scenario scenario = twin::LoadScenario(o.scenario);
+  const twin::WorldDescription world = twin::LoadSdfWorld(scenario.world_file);
+  const std::uint64_t seed = o.seed.value_or(scenario.seed);
+  auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
+  auto twin_model = std::make_shared<const twin::TwinModel>(scenario, world, model);
+  if (twin_model->scenario().randomize.DrawsVariants()) {
+    twin_model = std::make_shared<const twin::TwinModel>(
+        twin::DrawScenarioVariant(twin_model->scenario(), twin_model->building(), seed),
+        twin_model->world(), twin_model->robot_model(), twin_model->config());
+  }
+  // Only the start pose is read of this world (the operator's initial pose estimate).
+  const twin::TwinWorld start(twin_model, seed);
+  behavior::ExecutiveConfig config;
+  auto brain =
+      MakeScenarioExecutive(twin_model->scenario(), twin_model->world(), start, model, config);
+  ros2::Ros2RobotPortConfig port_config;
+  port_config.topics = TopicsOf(o);
+  port_config.domain_id = o.domain;
+  port_config.use_sim_time = o.sim_time || o.lockstep;
+  ros2::Ros2RobotPort port(port_config);
+  std::signal(SIGINT, OnSigint);
+  std::string missing;
+  if (!port.WaitForSensors(std::chrono::milliseconds(int(o.wait_s * 1000)), &missing))
+    throw CommandFailed(fmt::format("no robot on ROS 2 domain {} within {:g} s: nothing on {}",
+                                    o.domain, o.wait_s, missing));
+  if (!o.quiet) fmt::print("brain     {} on ROS 2 domain {}\n", o.scenario, o.domain);
+  const Duration period = SecondsToDuration(1.0 / config.control_rate_hz);
+  const auto timeout = std::chrono::milliseconds(int(o.wait_s * 1000));
+  Time next = port.clock().Now();
+  std::string last_status;
+  const auto publish_status = [&](const std::string& status) {
+    if (status == last_status) return;
+    port.PublishStatus(status);
+    last_status = status;
+    if (!o.quiet) fmt::print("status    {:8.2f}  {}\n", ToSeconds(port.clock().Now()), status);
+  };
+  std::string outcome;
+  while (true) {
+    if (!port.WaitUntil(next, timeout)) {
+      brain->Halt(port, "the clock stopped");
+      outcome = fmt::format("HALTED: no {} for {:g} s", port_config.topics.clock, o.wait_s);
+      break;
+    }
+    const Time now = port.clock().Now();
+    if (g_interrupted) {
+      brain->Halt(port, "SIGINT");
+      outcome = "HALTED: SIGINT";
+      break;
+    }
+    if (const auto fault = port.Fault()) {
+      brain->Halt(port, *fault);
+      outcome = "HALTED: " + *fault;
+      break;
+    }
+    const bool more = brain->Step(port);
+    port.PublishStepDone(now);
+    if (!more) {
+      outcome = brain->status() == bt::NodeStatus::kSuccess ? "SUCCESS" : "FAILURE";
+      break;
+    }
+    publish_status("RUNNING");
+    // Real time: a step that overran starts the next one now rather than bunching up.
+    next = std::max(next + period, o.sim_time || o.lockstep ? next + period : now);
+  }
+  // Said more than once: the watcher may have missed the first (it ends on it).
+  for (int i = 0; i < 3; ++i) {
+    publish_status(outcome);
+    last_status.clear();
+    port.PublishStepDone(port.clock().Now() + SecondsToDuration(3600.0));
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  if (!o.quiet) {
+    for (const auto& d : brain->decisions())
+      fmt::print("  {:7.2f}  {}\n", d.time, d.text);
+  }
+  if (outcome != "SUCCESS") throw CommandFailed(outcome);
+}
+
+}  // namespace
+
+void AddRos2Commands(CLI::App& app) {
+  auto o = std::make_shared<Ros2Options>();
+  auto* twin = app.add_subcommand("twin", "The digital twin as a robot for another process");
+  twin->require_subcommand(1);
+  auto* serve = twin->add_subcommand(
+      "serve", "Serve a twin scenario as a ROS 2 HSR (its topics, /clock), judge it at the end");
+  serve->add_flag("--ros2", o->ros2, "Over ROS 2's wire format (Fast DDS)")->required();
+  serve->add_option("scenario", o->scenario, "Scenario YAML")->required()->check(CLI::ExistingFile);
+  serve->add_option("--seed", o->seed, "Seed (default: the scenario's)");
+  serve->add_option("--domain", o->domain, "ROS_DOMAIN_ID")->check(CLI::Range(0, 232));
+  serve->add_option("--topics", o->topics, "Topic map YAML (default: the HSR's ROS 2 names)")
+      ->check(CLI::ExistingFile);
+  serve->add_flag("--lockstep", o->lockstep,
+                  "Step the twin only once the brain has finished each control step (tests)");
+  serve->add_option("--speed", o->speed, "Real-time factor without --lockstep")
+      ->check(CLI::Range(0.01, 100.0));
+  serve->add_option("--duration", o->duration, "Simulated seconds (default: the time limit)")
+      ->check(CLI::NonNegativeNumber);
+  serve->add_option("--wait", o->wait_s, "Seconds to wait for the brain (and each lock-step)")
+      ->check(CLI::Range(0.1, 3600.0));
+  serve->add_option("--json", o->json, "Write the verdict as JSON");
+  serve->add_flag("-q,--quiet", o->quiet, "Only the verdict");
+  serve->callback([o] { ServeTwin(*o); });
+
+  auto* robot = app.add_subcommand(
+      "robot", "Run the robot brain against a robot over ROS 2 (a real HSR, or `twin serve`)");
+  robot->add_flag("--ros2", o->ros2, "Over ROS 2's wire format (Fast DDS)")->required();
+  robot->add_option("--scenario", o->scenario, "Scenario YAML: the mission, map and start pose")
+      ->check(CLI::ExistingFile);
+  robot->add_option("--seed", o->seed, "The scenario's seed (its start pose and variant)");
+  robot->add_option("--domain", o->domain, "ROS_DOMAIN_ID")->check(CLI::Range(0, 232));
+  robot->add_option("--topics", o->topics, "Topic map YAML (default: the HSR's ROS 2 names)")
+      ->check(CLI::ExistingFile);
+  robot->add_flag("--sim-time", o->sim_time, "Run on /clock (use_sim_time) rather than the wall");
+  robot->add_flag("--lockstep", o->lockstep, "With `twin serve --lockstep` (implies --sim-time)");
+  robot->add_option("--wait", o->wait_s, "Seconds to wait for the robot's sensors and clock")
+      ->check(CLI::Range(0.1, 3600.0));
+  robot->add_flag("-q,--quiet", o->quiet, "Only errors");
+  robot->callback([o] { RunRobot(*o); });
+}
+
+}  // namespace egress::apps
