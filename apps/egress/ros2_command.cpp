@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <thread>
@@ -69,7 +70,7 @@ void ServeTwin(const Ros2Options& o) {
   }
   twin::TwinWorld twin_world(twin_model, seed);
   twin::TwinRobot robot(&twin_world);
-  ros2::RobotPortServer server(robot, TopicsOf(o), o.domain);
+  ros2::RobotPortServer server(robot, TopicsOf(o), o.domain, /*reliable_sensors=*/o.lockstep);
   if (!o.quiet)
     fmt::print("serving   {} (seed {}) on ROS 2 domain {}, {}\n", o.scenario, seed, o.domain,
                o.lockstep ? "lock-step with the brain" : fmt::format("{:g}x real time", o.speed));
@@ -163,6 +164,7 @@ void RunRobot(const Ros2Options& o) {
   port_config.topics = TopicsOf(o);
   port_config.domain_id = o.domain;
   port_config.use_sim_time = o.sim_time || o.lockstep;
+  port_config.reliable_sensors = o.lockstep;
   ros2::Ros2RobotPort port(port_config);
   std::signal(SIGINT, OnSigint);
   std::string missing;
@@ -178,7 +180,10 @@ void RunRobot(const Ros2Options& o) {
     if (status == last_status) return;
     port.PublishStatus(status);
     last_status = status;
-    if (!o.quiet) fmt::print("status    {:8.2f}  {}\n", ToSeconds(port.clock().Now()), status);
+    if (!o.quiet) {
+      fmt::print("status    {:8.2f}  {}\n", ToSeconds(port.clock().Now()), status);
+      std::fflush(stdout);  // watched live (a log file is block-buffered)
+    }
   };
   std::string outcome;
   while (true) {

@@ -74,14 +74,15 @@ struct RobotPortServer::Impl {
 };
 
 RobotPortServer::RobotPortServer(RobotPort& robot, Ros2Topics topics, int domain_id,
-                                 std::string_view node_name) {
+                                 bool reliable_sensors, std::string_view node_name) {
   topics.Validate();
   impl_ = std::make_unique<Impl>(robot, std::move(topics), domain_id, node_name);
   Impl& m = *impl_;
   const Ros2Topics& t = m.topics;
-  const QosProfile sensor = QosProfile::SensorData(), reliable = QosProfile::Default();
-  m.clock =
-      m.node.CreatePublisher<rosgraph_msgs::msg::ClockPubSubType>(t.clock, QosProfile::Clock());
+  const QosProfile reliable = QosProfile::Default();
+  const QosProfile sensor = reliable_sensors ? reliable : QosProfile::SensorData();
+  m.clock = m.node.CreatePublisher<rosgraph_msgs::msg::ClockPubSubType>(
+      t.clock, reliable_sensors ? reliable : QosProfile::Clock());
   m.scan = m.node.CreatePublisher<sensor_msgs::msg::LaserScanPubSubType>(t.scan, sensor);
   m.odometry = m.node.CreatePublisher<nav_msgs::msg::OdometryPubSubType>(t.odometry, sensor);
   m.joints = m.node.CreatePublisher<sensor_msgs::msg::JointStatePubSubType>(t.joint_states, sensor);

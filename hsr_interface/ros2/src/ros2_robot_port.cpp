@@ -96,7 +96,8 @@ Ros2RobotPort::Ros2RobotPort(Ros2RobotPortConfig config, std::string_view node_n
   impl_ = std::make_unique<Impl>(std::move(config), node_name);
   Impl& m = *impl_;
   const Ros2Topics& t = m.config.topics;
-  const QosProfile sensor = QosProfile::SensorData(), reliable = QosProfile::Default();
+  const QosProfile reliable = QosProfile::Default();
+  const QosProfile sensor = m.config.reliable_sensors ? reliable : QosProfile::SensorData();
   auto add = [&](auto subscription) { m.subscriptions.push_back(std::move(subscription)); };
   add(m.node.CreateSubscription<sensor_msgs::msg::LaserScanPubSubType>(
       t.scan, sensor, [&m, &t](const sensor_msgs::msg::LaserScan& msg) {
@@ -153,7 +154,8 @@ Ros2RobotPort::Ros2RobotPort(Ros2RobotPortConfig config, std::string_view node_n
       }));
   if (m.config.use_sim_time) {
     add(m.node.CreateSubscription<rosgraph_msgs::msg::ClockPubSubType>(
-        t.clock, QosProfile::Clock(), [&m, &t](const rosgraph_msgs::msg::Clock& msg) {
+        t.clock, m.config.reliable_sensors ? reliable : QosProfile::Clock(),
+        [&m, &t](const rosgraph_msgs::msg::Clock& msg) {
           m.Take(t.clock, [&] {
             const Time now = FromRos(msg.clock());
             if (now > m.sim_clock.Now()) m.sim_clock.AdvanceTo(now);

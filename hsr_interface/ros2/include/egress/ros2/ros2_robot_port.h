@@ -30,6 +30,10 @@ struct Ros2RobotPortConfig {
   double scan_timeout_s{0.3};
   double odometry_timeout_s{0.2};
   double joints_timeout_s{0.5};
+  /// Subscribe to the sensors reliably, not with ROS 2's sensor-data QoS (best effort): for a
+  /// lock-step simulation, where a dropped reading would make a sensor look stale. A real
+  /// robot's best-effort sensor publishers do not match reliable subscribers: leave it off.
+  bool reliable_sensors{false};
   /// @throws InvalidArgument naming the field.
   void Validate() const;
 };

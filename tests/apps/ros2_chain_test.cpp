@@ -1,0 +1,155 @@
+// The whole chain across two processes over real DDS: `egress twin serve --ros2` (the twin as a
+// ROS 2 robot) and `egress robot --ros2` (the brain), as a user runs them.
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "test_paths.h"
+
+extern char** environ;
+
+namespace {
+
+using ::testing::HasSubstr;
+
+// A child process writing stdout and stderr to a file.
+class Child {
+ public:
+  Child(const std::vector<std::string>& args, const std::filesystem::path& log) : log_(log) {
+    std::vector<char*> argv;
+    argv.push_back(const_cast<char*>(EGRESS_CLI_PATH));
+    for (const auto& a : args)
+      argv.push_back(const_cast<char*>(a.c_str()));
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_adddup2(&actions, 1, 2);
+    if (posix_spawn(&pid_, EGRESS_CLI_PATH, &actions, nullptr, argv.data(), environ) != 0)
+      pid_ = -1;
+    posix_spawn_file_actions_destroy(&actions);
+  }
+  ~Child() {
+    if (pid_ > 0 && !done_) {
+      ::kill(pid_, SIGKILL);
+      ::waitpid(pid_, nullptr, 0);
+    }
+  }
+  // Waits (bounded: a hung chain fails the test, it does not hang ctest) for the exit code.
+  int Wait(std::chrono::seconds limit = std::chrono::seconds(240)) {
+    const auto until = std::chrono::steady_clock::now() + limit;
+    while (std::chrono::steady_clock::now() < until) {
+      int status = 0;
+      if (::waitpid(pid_, &status, WNOHANG) == pid_) {
+        done_ = true;
+        return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    return -2;
+  }
+  void Signal(int sig) { ::kill(pid_, sig); }
+  std::string Output() const {
+    std::ifstream in(log_);
+    std::stringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+  bool started() const { return pid_ > 0; }
+
+ private:
+  pid_t pid_{-1};
+  bool done_{false};
+  std::filesystem::path log_;
+};
+
+std::string Domain(int offset) {
+  return std::to_string(10 + int(::getpid() % 40) * 2 + offset);
+}
+
+const std::string kS1 = std::string(EGRESS_SOURCE_DIR) + "/worlds/scenarios/s1_nominal.yaml";
+
+nlohmann::json ReadJson(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  return nlohmann::json::parse(in, nullptr, /*allow_exceptions=*/false);
+}
+
+// S1 with the brain in its own process: the same verdict as in-process, within a control step
+// or two of the same time (lock-step: the twin waits for each brain step).
+TEST(Ros2ChainTest, S1AcrossTwoProcessesMatchesInProcess) {
+  using egress::testing::TestTempPath;
+  const std::string domain = Domain(0);
+  const auto dds_json = TestTempPath("dds.json"), local_json = TestTempPath("local.json");
+  Child serve({"twin", "serve", "--ros2", kS1, "--lockstep", "--domain", domain, "--json",
+               dds_json.string()},
+              TestTempPath("serve.log"));
+  Child robot({"robot", "--ros2", "--scenario", kS1, "--lockstep", "--domain", domain},
+              TestTempPath("robot.log"));
+  ASSERT_TRUE(serve.started() && robot.started());
+  EXPECT_EQ(robot.Wait(), 0) << robot.Output();
+  EXPECT_EQ(serve.Wait(), 0) << serve.Output();
+  EXPECT_THAT(serve.Output(), HasSubstr("ended by the brain: SUCCESS"));
+  Child local({"sim", "run", kS1, "-q", "--json", local_json.string()}, TestTempPath("local.log"));
+  ASSERT_EQ(local.Wait(), 0) << local.Output();
+  const auto dds = ReadJson(dds_json), in_process = ReadJson(local_json);
+  ASSERT_TRUE(dds.is_object() && in_process.is_object()) << serve.Output();
+  EXPECT_EQ(dds["success"], in_process["success"]);
+  EXPECT_NEAR(dds["metrics"]["time_to_goal"].get<double>(),
+              in_process["metrics"]["time_to_goal"].get<double>(), 1.0);
+  std::filesystem::remove(dds_json);
+  std::filesystem::remove(local_json);
+}
+
+// SIGINT to the brain mid-run: it stops the base, says why, and the robot's server ends on it.
+TEST(Ros2ChainTest, SigintHaltsTheBrainAndTheServerEndsOnIt) {
+  using egress::testing::TestTempPath;
+  const std::string domain = Domain(1);
+  Child serve({"twin", "serve", "--ros2", kS1, "--domain", domain}, TestTempPath("serve.log"));
+  Child robot({"robot", "--ros2", "--scenario", kS1, "--sim-time", "--domain", domain},
+              TestTempPath("robot.log"));
+  // Running (its status said so) for a moment of real time, then interrupted.
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (robot.Output().find("RUNNING") == std::string::npos &&
+         std::chrono::steady_clock::now() < until)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  std::this_thread::sleep_for(std::chrono::seconds(1));
+  robot.Signal(SIGINT);
+  EXPECT_EQ(robot.Wait(), 1);
+  EXPECT_THAT(robot.Output(), HasSubstr("HALTED: SIGINT"));
+  EXPECT_THAT(robot.Output(), HasSubstr("halted: SIGINT"));  // the decision log
+  serve.Wait();
+  EXPECT_THAT(serve.Output(), HasSubstr("ended by the brain: HALTED: SIGINT"));
+}
+
+TEST(Ros2ChainTest, NoPeerIsAClearErrorNotAHang) {
+  using egress::testing::TestTempPath;
+  Child robot({"robot", "--ros2", "--scenario", kS1, "--domain", Domain(2), "--wait", "1"},
+              TestTempPath("robot.log"));
+  EXPECT_EQ(robot.Wait(std::chrono::seconds(60)), 1);
+  EXPECT_THAT(robot.Output(), HasSubstr("no robot on ROS 2 domain"));
+  EXPECT_THAT(robot.Output(), HasSubstr("/omni_base_controller/wheel_odom"));
+  Child serve({"twin", "serve", "--ros2", kS1, "--domain", Domain(3), "--wait", "1"},
+              TestTempPath("serve.log"));
+  EXPECT_EQ(serve.Wait(std::chrono::seconds(60)), 1);
+  EXPECT_THAT(serve.Output(), HasSubstr("no brain on ROS 2 domain"));
+  Child no_flag({"robot", "--scenario", kS1}, TestTempPath("noflag.log"));
+  EXPECT_NE(no_flag.Wait(std::chrono::seconds(60)), 0);
+  EXPECT_THAT(no_flag.Output(), HasSubstr("--ros2"));
+}
+
+}  // namespace
