@@ -66,6 +66,12 @@ if(NOT EGRESS_FASTDDSGEN)
 endif()
 if(EGRESS_BUILD_TESTS)
   egress_require(CycloneDDS APT "cyclonedds-dev cyclonedds-tools")
+  find_program(EGRESS_IDLC idlc)
+  if(NOT EGRESS_IDLC)
+    message(FATAL_ERROR "egress: idlc (Cyclone DDS's IDL compiler) not found. Install the Debian "
+      "package 'cyclonedds-tools':\n    apt-get install cyclonedds-tools\nor run "
+      "`./egress.sh deps` as root.")
+  endif()
 endif()
 
 # --- twin

@@ -2,6 +2,7 @@
 
 #include <cctype>
 
+#include <fastdds/rtps/transport/UDPv4TransportDescriptor.h>
 #include <fastdds/dds/domain/DomainParticipantFactory.hpp>
 #include <fastdds/dds/domain/qos/DomainParticipantQos.hpp>
 #include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
@@ -40,11 +41,16 @@ void Apply(const QosProfile& profile, Qos* qos) {
 }
 }  // namespace
 
-DdsNode::DdsNode(std::string_view name, int domain_id) : name_(name) {
+DdsNode::DdsNode(std::string_view name, int domain_id, bool udp_only) : name_(name) {
   ThrowUnless(domain_id >= 0 && domain_id <= 232, "DDS domain id ", domain_id,
               " must be in [0, 232] (ROS_DOMAIN_ID)");
   dds::DomainParticipantQos qos = dds::PARTICIPANT_QOS_DEFAULT;
   qos.name(name_);
+  if (udp_only) {
+    qos.transport().use_builtin_transports = false;
+    qos.transport().user_transports.push_back(
+        std::make_shared<eprosima::fastdds::rtps::UDPv4TransportDescriptor>());
+  }
   participant_ = dds::DomainParticipantFactory::get_instance()->create_participant(domain_id, qos);
   if (participant_ == nullptr)
     throw std::runtime_error("DDS: cannot create participant '" + name_ + "' on domain " +

@@ -53,8 +53,8 @@ struct RobotPortServer::Impl {
   std::optional<sensor_msgs::msg::JointState> joints_msg;
   std::optional<rosgraph_msgs::msg::Clock> clock_msg;
 
-  Impl(RobotPort& r, Ros2Topics t, int domain, std::string_view name)
-      : robot(r), topics(std::move(t)), node(name, domain) {}
+  Impl(RobotPort& r, Ros2Topics t, int domain, bool udp_only, std::string_view name)
+      : robot(r), topics(std::move(t)), node(name, domain, udp_only) {}
 
   template <class F>
   void Queue(const std::string& topic, F apply) {
@@ -76,7 +76,8 @@ struct RobotPortServer::Impl {
 RobotPortServer::RobotPortServer(RobotPort& robot, Ros2Topics topics, int domain_id,
                                  bool reliable_sensors, std::string_view node_name) {
   topics.Validate();
-  impl_ = std::make_unique<Impl>(robot, std::move(topics), domain_id, node_name);
+  impl_ = std::make_unique<Impl>(robot, std::move(topics), domain_id,
+                                 /*udp_only=*/reliable_sensors, node_name);
   Impl& m = *impl_;
   const Ros2Topics& t = m.topics;
   const QosProfile reliable = QosProfile::Default();

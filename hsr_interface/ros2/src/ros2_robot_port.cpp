@@ -73,7 +73,7 @@ struct Ros2RobotPort::Impl {
   std::unique_ptr<Publisher<std_msgs::msg::BoolPubSubType>> estop_pub;
 
   Impl(Ros2RobotPortConfig c, std::string_view name)
-      : config(std::move(c)), node(name, config.domain_id) {}
+      : config(std::move(c)), node(name, config.domain_id, /*udp_only=*/config.reliable_sensors) {}
 
   // Runs `convert` on a received message under the lock; a message that cannot be converted is
   // dropped and remembered (Fault() names it if it makes a sensor go stale).

@@ -110,8 +110,11 @@ class Subscription final : public eprosima::fastdds::dds::DataReaderListener {
 /// One DDS participant (a "node"). Not copyable; create endpoints from one thread.
 class DdsNode {
  public:
+  /// `udp_only`: UDP (loopback included) without Fast DDS's shared-memory transport. Lock-step
+  /// simulation needs it: under its bursts, Fast DDS 2.9's shared memory dropped samples, and a
+  /// reliable reader then holds every later sample until the repair (a 3 s heartbeat away).
   /// @throws std::runtime_error if the participant cannot be created (e.g. no network interface).
-  explicit DdsNode(std::string_view name, int domain_id = 0);
+  explicit DdsNode(std::string_view name, int domain_id = 0, bool udp_only = false);
   ~DdsNode();
   DdsNode(const DdsNode&) = delete;
   DdsNode& operator=(const DdsNode&) = delete;

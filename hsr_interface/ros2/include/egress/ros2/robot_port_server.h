@@ -22,7 +22,7 @@ class RobotPortServer {
   /// Joins the DDS domain as node `node_name`. @throws InvalidArgument for bad topics,
   /// std::runtime_error if DDS cannot start.
   /// `reliable_sensors`: publish the sensors reliably (a lock-step simulation; a reliable
-  /// writer also serves ROS 2's best-effort sensor subscribers).
+  /// writer also serves ROS 2's best-effort sensor subscribers), over UDP only (DdsNode).
   RobotPortServer(RobotPort& robot, Ros2Topics topics, int domain_id, bool reliable_sensors = false,
                   std::string_view node_name = "egress_twin");
   ~RobotPortServer();

@@ -33,6 +33,7 @@ struct Ros2RobotPortConfig {
   /// Subscribe to the sensors reliably, not with ROS 2's sensor-data QoS (best effort): for a
   /// lock-step simulation, where a dropped reading would make a sensor look stale. A real
   /// robot's best-effort sensor publishers do not match reliable subscribers: leave it off.
+  /// Implies UDP without shared memory (DdsNode's udp_only).
   bool reliable_sensors{false};
   /// @throws InvalidArgument naming the field.
   void Validate() const;
