@@ -2,6 +2,9 @@
 // brain and the twin in two processes, over ROS 2's wire format (Fast DDS). The same brain drives
 // a real HSR through the same port (README "Running on an HSR").
 
+#include <sys/resource.h>
+
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -80,7 +83,7 @@ void ServeTwin(const Ros2Options& o) {
   const auto wait_until =
       std::chrono::steady_clock::now() + std::chrono::duration<double>(o.wait_s);
   server.PublishSensors();
-  while (!server.brain_status()) {
+  while (!server.brain_status() || !server.BrainConnected()) {
     server.RepublishLatest();
     if (g_interrupted) throw CommandFailed("interrupted before a brain connected");
     if (std::chrono::steady_clock::now() > wait_until)
@@ -128,8 +131,23 @@ void ServeTwin(const Ros2Options& o) {
         return true;
       },
       run);
-  if (!o.quiet)
-    fmt::print("ran       {:.1f} s simulated, ended by {}\n", result.simulated_time, ended_by);
+  if (!o.quiet) {
+    const double wall =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    fmt::print("ran       {:.1f} s simulated in {:.1f} s, ended by {}\n", result.simulated_time,
+               wall, ended_by);
+    std::vector<double> latency = server.TakeCommandLatencies();
+    if (!latency.empty()) {
+      std::sort(latency.begin(), latency.end());
+      const auto at = [&](double q) {
+        return latency[std::min(latency.size() - 1, std::size_t(q * double(latency.size())))];
+      };
+      fmt::print(
+          "latency   sensors published -> base command received: median {:.2f} ms, p99 "
+          "{:.2f} ms, max {:.2f} ms ({} commands)\n",
+          1e3 * at(0.5), 1e3 * at(0.99), 1e3 * latency.back(), latency.size());
+    }
+  }
   std::cout << twin::FormatVerdict(result.verdict);
   if (!o.json.empty()) {
     std::ofstream out(o.json);
@@ -145,6 +163,7 @@ void RunRobot(const Ros2Options& o) {
   RequireRos2(o, "robot");
   if (o.scenario.empty())
     throw CommandFailed("robot --ros2: --scenario FILE is required (the mission, map and start)");
+  const auto began = std::chrono::steady_clock::now();
   const twin::Scenario scenario = twin::LoadScenario(o.scenario);
   const twin::WorldDescription world = twin::LoadSdfWorld(scenario.world_file);
   const std::uint64_t seed = o.seed.value_or(scenario.seed);
@@ -223,6 +242,15 @@ void RunRobot(const Ros2Options& o) {
   if (!o.quiet) {
     for (const auto& d : brain->decisions())
       fmt::print("  {:7.2f}  {}\n", d.time, d.text);
+    // The brain's CPU per second of its life (both cores' worth counts: DDS threads included).
+    rusage usage{};
+    ::getrusage(RUSAGE_SELF, &usage);
+    const double cpu = double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) +
+                       1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+    const double wall =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - began).count();
+    fmt::print("cpu       {:.2f} s of CPU in {:.1f} s of wall time ({:.0f} % of one core)\n", cpu,
+               wall, 100.0 * cpu / std::max(wall, 1e-9));
   }
   if (outcome != "SUCCESS") throw CommandFailed(outcome);
 }

@@ -35,6 +35,9 @@ struct RobotPortServer::Impl {
   std::deque<std::function<void()>> commands;  // applied on the caller's thread
   std::vector<std::string> rejected;
   std::optional<Time> step_done;
+  // Wall time of the last PublishSensors, and the delay from it to each base command's receipt.
+  std::chrono::steady_clock::time_point published_at{};
+  std::vector<double> command_latencies;
   std::optional<std::string> status;
 
   std::unique_ptr<Publisher<rosgraph_msgs::msg::ClockPubSubType>> clock;
@@ -96,6 +99,12 @@ RobotPortServer::RobotPortServer(RobotPort& robot, Ros2Topics topics, int domain
       m.node.CreatePublisher<vision_msgs::msg::Detection2DArrayPubSubType>(t.detections, reliable);
   m.subscriptions.push_back(m.node.CreateSubscription<geometry_msgs::msg::TwistPubSubType>(
       t.cmd_vel, reliable, [&m](const geometry_msgs::msg::Twist& msg) {
+        {
+          const std::lock_guard<std::mutex> lock(m.mutex);
+          m.command_latencies.push_back(
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - m.published_at)
+                  .count());
+        }
         m.Queue(m.topics.cmd_vel, [&m, V = FromRos(msg)] { m.robot.SendBaseVelocity(V); });
       }));
   m.subscriptions.push_back(
@@ -188,6 +197,13 @@ void RobotPortServer::PublishSensors() {
   clock.clock(ToRos(s.stamp));
   m.clock->Publish(clock);
   m.clock_msg = clock;
+  const std::lock_guard<std::mutex> lock(m.mutex);
+  m.published_at = std::chrono::steady_clock::now();
+}
+
+std::vector<double> RobotPortServer::TakeCommandLatencies() {
+  const std::lock_guard<std::mutex> lock(impl_->mutex);
+  return std::exchange(impl_->command_latencies, {});
 }
 
 void RobotPortServer::RepublishLatest() {
@@ -222,7 +238,17 @@ std::optional<std::string> RobotPortServer::brain_status() const {
 }
 
 bool RobotPortServer::BrainConnected() const {
-  return impl_->scan->MatchedSubscriptions() > 0 && impl_->odometry->MatchedSubscriptions() > 0;
+  // Every sensor topic read and the base command written: a brain matched on some topics only
+  // would miss the first readings of the others (volatile topics keep nothing for late readers).
+  const Impl& m = *impl_;
+  const bool sensors =
+      m.scan->MatchedSubscriptions() > 0 && m.odometry->MatchedSubscriptions() > 0 &&
+      m.joints->MatchedSubscriptions() > 0 && m.depth->MatchedSubscriptions() > 0 &&
+      m.camera_info->MatchedSubscriptions() > 0 && m.tf->MatchedSubscriptions() > 0 &&
+      m.clock->MatchedSubscriptions() > 0;
+  const auto* cmd_vel = dynamic_cast<const Subscription<geometry_msgs::msg::TwistPubSubType>*>(
+      m.subscriptions.front().get());
+  return sensors && cmd_vel != nullptr && cmd_vel->MatchedPublications() > 0;
 }
 
 std::vector<std::string> RobotPortServer::TakeRejected() {

@@ -11,6 +11,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "egress/hsr_interface/robot_port.h"
 #include "egress/ros2/ros2_topics.h"
@@ -40,8 +41,12 @@ class RobotPortServer {
   bool WaitForStepDone(Time t, std::chrono::milliseconds timeout);
   /// The brain's last status (egress robot publishes its tree's), if any.
   std::optional<std::string> brain_status() const;
-  /// Whether a brain subscribes to the sensors (for waiting until it is there).
+  /// Whether a brain reads every sensor topic and writes the base command (for waiting until
+  /// it is fully there).
   bool BrainConnected() const;
+  /// Wall-clock delays [s] from the latest PublishSensors to each base velocity command's
+  /// arrival (the brain's reaction over DDS, end to end); cleared by the call.
+  std::vector<double> TakeCommandLatencies();
   /// Commands that could not be applied (malformed), with why; cleared by the call.
   std::vector<std::string> TakeRejected();
 
