@@ -59,6 +59,8 @@ endif()
 # (a second DDS implementation no one here wrote).
 egress_require(fastcdr APT libfastcdr-dev)
 egress_require(fastrtps APT libfastrtps-dev)
+# rosbag2's storage (sqlite3 .db3) for recorded runs.
+egress_require(SQLite3 APT libsqlite3-dev)
 find_program(EGRESS_FASTDDSGEN fastddsgen)
 if(NOT EGRESS_FASTDDSGEN)
   message(FATAL_ERROR "egress: fastddsgen not found. Install the Debian package 'fastddsgen':\n"

@@ -55,6 +55,8 @@ struct BrainTrialOptions {
   twin::RunOptions run;
   /// Called after every control step (ground-truth probes, debugging output).
   std::function<void(const twin::TwinWorld&, const behavior::Executive&)> after_step;
+  /// Called with what the brain reads of the robot at each step (recording a run as a bag).
+  std::function<void(const SensorSnapshot&)> on_sense;
   /// What each trace sample shows of the brain (the running action, its path, the costmap).
   std::function<twin::TraceAnnotation(const twin::TwinWorld&, const behavior::Executive&)> annotate;
 };

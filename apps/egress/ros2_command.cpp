@@ -217,6 +217,8 @@ void RunRobot(const Ros2Options& o) {
       outcome = "HALTED: SIGINT";
       break;
     }
+    // Lock-step: the twin waits for this step, so a reading still in flight is waited for.
+    if (o.lockstep && port.Fault()) port.WaitUntilHealthy(std::chrono::seconds(2));
     if (const auto fault = port.Fault()) {
       brain->Halt(port, *fault);
       outcome = "HALTED: " + *fault;

@@ -17,6 +17,7 @@
 
 #include <fmt/format.h>
 
+#include "bag_recorder.h"
 #include "batch.h"
 #include "brain_trial.h"
 #include "commands.h"
@@ -67,6 +68,7 @@ struct SimOptions {
   bool overwrite{false};
   bool quiet{false};
   bool no_octomap{false};
+  std::string bag;
 };
 
 void RefuseOverwrite(const std::string& path, bool overwrite) {
@@ -205,8 +207,31 @@ void RunSim(const SimOptions& o) {
   std::unique_ptr<twin::TwinWorld> world_owner;
   std::unique_ptr<behavior::Executive> brain;
   twin::RunResult result;
+  std::unique_ptr<BagRecorder> bag;
+  if (!o.bag.empty()) {
+    if (driver != "brain")
+      throw CommandFailed("--bag records a brain run (the driver is " + driver + ")");
+    // A bag folder is replaced only with --overwrite, and only if it is a bag.
+    if (std::filesystem::exists(o.bag)) {
+      if (!o.overwrite)
+        throw CommandFailed(fmt::format("'{}' exists; pass --overwrite to replace it", o.bag));
+      if (!std::filesystem::exists(std::filesystem::path(o.bag) / "metadata.yaml"))
+        throw CommandFailed(
+            fmt::format("'{}' exists and is not a rosbag2 bag (no metadata.yaml): "
+                        "not replaced",
+                        o.bag));
+      std::filesystem::remove_all(o.bag);
+    }
+    bag = std::make_unique<BagRecorder>(o.bag);
+  }
   if (driver == "brain") {
     BrainTrialOptions trial_options;
+    if (bag) {
+      trial_options.on_sense = [&](const SensorSnapshot& s) { bag->OnSense(s); };
+      trial_options.after_step = [&](const twin::TwinWorld& w, const behavior::Executive& b) {
+        bag->AfterStep(w.now(), b);
+      };
+    }
     trial_options.config.use_octomap = !o.no_octomap;
     trial_options.run = options;
     // The video shows the running action, the planned path and, once a second, the costmap
@@ -260,6 +285,10 @@ void RunSim(const SimOptions& o) {
     if (!out) throw CommandFailed(fmt::format("cannot write '{}'", o.json));
     fmt::print("verdict   {}\n", o.json);
   }
+  if (bag) {
+    const std::size_t messages = bag->Close();
+    fmt::print("bag       {} (rosbag2, sqlite3: {} messages)\n", o.bag, messages);
+  }
   if (!o.png.empty() || !o.mp4.empty()) {
     // Render from the trace text itself, exactly as `egress render` would from the file.
     std::istringstream text(result.trace->ToJsonLines());
@@ -310,6 +339,9 @@ void AddSimCommand(CLI::App& app) {
   sim->add_option("--json", o->json, "write the verdict as JSON");
   sim->add_option("--png", o->png, "draw the run (paths, final state) into this PNG");
   sim->add_option("--video,--mp4", o->mp4, "render the run to this top-down MP4");
+  sim->add_option("--bag", o->bag,
+                  "record the brain's run as a rosbag2 bag in this folder (sqlite3 .db3 + "
+                  "metadata.yaml: /scan /odom /tf /map /plan /people /egress/status)");
   sim->add_flag("--overwrite", o->overwrite, "replace existing output files");
   sim->add_flag("-q,--quiet", o->quiet, "print only the verdict");
   sim->add_flag("--no-octomap", o->no_octomap,

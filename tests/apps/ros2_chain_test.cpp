@@ -152,4 +152,41 @@ TEST(Ros2ChainTest, NoPeerIsAClearErrorNotAHang) {
   EXPECT_THAT(no_flag.Output(), HasSubstr("--ros2"));
 }
 
+// A twin run by the brain, recorded as a rosbag2 bag: the topics a ROS 2 tool expects, with
+// messages on each; an existing bag is not replaced without --overwrite, nor a folder that is
+// not a bag even with it.
+TEST(Ros2ChainTest, SimRunRecordsARosbag2Bag) {
+  using egress::testing::TestTempPath;
+  const auto dir = TestTempPath("bag");
+  std::filesystem::remove_all(dir);
+  Child run({"sim", "run", kS1, "-q", "--bag", dir.string()}, TestTempPath("run.log"));
+  ASSERT_EQ(run.Wait(), 0) << run.Output();
+  EXPECT_THAT(run.Output(), HasSubstr("rosbag2, sqlite3"));
+  std::ifstream in(dir / "metadata.yaml");
+  std::stringstream meta;
+  meta << in.rdbuf();
+  for (const char* topic : {"name: /scan\n        type: sensor_msgs/msg/LaserScan",
+                            "name: /odom\n        type: nav_msgs/msg/Odometry",
+                            "name: /tf\n        type: tf2_msgs/msg/TFMessage",
+                            "name: /map\n        type: nav_msgs/msg/OccupancyGrid",
+                            "name: /plan\n        type: nav_msgs/msg/Path",
+                            "name: /people\n        type: geometry_msgs/msg/PoseArray",
+                            "name: /egress/status\n        type: std_msgs/msg/String"})
+    EXPECT_THAT(meta.str(), HasSubstr(topic));
+  EXPECT_THAT(meta.str(), HasSubstr("storage_identifier: sqlite3"));
+  EXPECT_TRUE(std::filesystem::file_size(dir / (dir.filename().string() + "_0.db3")) > 10000);
+  Child again({"sim", "run", kS1, "-q", "--bag", dir.string()}, TestTempPath("again.log"));
+  EXPECT_EQ(again.Wait(), 1);
+  EXPECT_THAT(again.Output(), HasSubstr("--overwrite"));
+  const auto not_a_bag = TestTempPath("notabag");
+  std::filesystem::create_directories(not_a_bag);
+  Child refuse({"sim", "run", kS1, "-q", "--overwrite", "--bag", not_a_bag.string()},
+               TestTempPath("refuse.log"));
+  EXPECT_EQ(refuse.Wait(), 1);
+  EXPECT_THAT(refuse.Output(), HasSubstr("not a rosbag2 bag"));
+  EXPECT_TRUE(std::filesystem::exists(not_a_bag));
+  std::filesystem::remove_all(dir);
+  std::filesystem::remove_all(not_a_bag);
+}
+
 }  // namespace

@@ -41,7 +41,8 @@ void Apply(const QosProfile& profile, Qos* qos) {
 }
 }  // namespace
 
-DdsNode::DdsNode(std::string_view name, int domain_id, bool udp_only) : name_(name) {
+DdsNode::DdsNode(std::string_view name, int domain_id, bool udp_only)
+    : name_(name), udp_only_(udp_only) {
   ThrowUnless(domain_id >= 0 && domain_id <= 232, "DDS domain id ", domain_id,
               " must be in [0, 232] (ROS_DOMAIN_ID)");
   dds::DomainParticipantQos qos = dds::PARTICIPANT_QOS_DEFAULT;
@@ -93,6 +94,9 @@ dds::DataWriter* DdsNode::CreateWriter(const std::string& topic,
   dds::Topic* t = TopicFor(topic, std::move(type));
   dds::DataWriterQos qos = dds::DATAWRITER_QOS_DEFAULT;
   Apply(profile, &qos);
+  // Lock-step: a lost sample is repaired within 20 ms, not Fast DDS's default 3 s heartbeat
+  // (a reliable reader holds every later sample until then).
+  if (udp_only_) qos.reliable_writer_qos().times.heartbeatPeriod = {0, 20'000'000};
   dds::DataWriter* writer = publisher_->create_datawriter(t, qos);
   if (writer == nullptr) throw std::runtime_error("DDS: cannot create a writer on " + topic);
   return writer;

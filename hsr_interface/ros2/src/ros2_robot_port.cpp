@@ -72,6 +72,8 @@ struct Ros2RobotPort::Impl {
   std::unique_ptr<Publisher<rosgraph_msgs::msg::ClockPubSubType>> step_done;
   std::unique_ptr<Publisher<std_msgs::msg::BoolPubSubType>> estop_pub;
 
+  std::optional<std::string> FaultLocked() const;  // with `mutex` held
+
   Impl(Ros2RobotPortConfig c, std::string_view name)
       : config(std::move(c)), node(name, config.domain_id, /*udp_only=*/config.reliable_sensors) {}
 
@@ -187,8 +189,18 @@ const Clock& Ros2RobotPort::clock() const {
 }
 
 std::optional<std::string> Ros2RobotPort::Fault() const {
-  const Impl& m = *impl_;
-  const std::lock_guard<std::mutex> lock(m.mutex);
+  const std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->FaultLocked();
+}
+
+bool Ros2RobotPort::WaitUntilHealthy(std::chrono::milliseconds timeout) {
+  Impl& m = *impl_;
+  std::unique_lock<std::mutex> lock(m.mutex);
+  return m.changed.wait_for(lock, timeout, [&] { return !m.FaultLocked(); });
+}
+
+std::optional<std::string> Ros2RobotPort::Impl::FaultLocked() const {
+  const Impl& m = *this;
   if (m.estop) return "e-stop (" + m.config.topics.estop + ")";
   const Time now = m.clock().Now();
   const auto stale = [&](const std::optional<Time>& at, double timeout, const std::string& topic,

@@ -112,7 +112,8 @@ class DdsNode {
  public:
   /// `udp_only`: UDP (loopback included) without Fast DDS's shared-memory transport. Lock-step
   /// simulation needs it: under its bursts, Fast DDS 2.9's shared memory dropped samples, and a
-  /// reliable reader then holds every later sample until the repair (a 3 s heartbeat away).
+  /// reliable reader then holds every later sample until the repair (a 3 s heartbeat away;
+  /// 20 ms for this node's reliable writers).
   /// @throws std::runtime_error if the participant cannot be created (e.g. no network interface).
   explicit DdsNode(std::string_view name, int domain_id = 0, bool udp_only = false);
   ~DdsNode();
@@ -156,6 +157,7 @@ class DdsNode {
       const std::string& topic, std::unique_ptr<eprosima::fastdds::dds::TopicDataType> type);
 
   std::string name_;
+  bool udp_only_{false};
   eprosima::fastdds::dds::DomainParticipant* participant_{nullptr};
   eprosima::fastdds::dds::Publisher* publisher_{nullptr};
   eprosima::fastdds::dds::Subscriber* subscriber_{nullptr};

@@ -55,6 +55,10 @@ class Ros2RobotPort final : public RobotPort {
   const Clock& clock() const override;
   /// Why the base must not move (a stale sensor, an e-stop), or nullopt.
   std::optional<std::string> Fault() const;
+  /// Waits (wall time, bounded) until Fault() clears; returns whether it did. For lock-step
+  /// simulation: the world waits for the brain, so a reading still in flight (a reliable
+  /// sample being repaired) is waited for before the sensor is called stale.
+  bool WaitUntilHealthy(std::chrono::milliseconds timeout);
   /// Waits until odometry and joint states have arrived (and, with sim time, the clock): the
   /// robot is up. A sensor that has not sent by then is stale once its timeout has passed from
   /// this moment. Returns false on timeout, naming in `missing` what never came.

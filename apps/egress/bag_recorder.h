@@ -1,0 +1,36 @@
+#pragma once
+/// @file
+/// A twin run by the brain recorded as a rosbag2 bag (`sim run --bag DIR`): what the brain read
+/// and believed, on the topics a ROS 2 robot would have, for Foxglove or `ros2 bag play`.
+
+#include <filesystem>
+#include <memory>
+
+#include "egress/behavior/executive.h"
+#include "egress/hsr_interface/robot_port.h"
+#include "egress/ros2/rosbag2_writer.h"
+
+namespace egress::apps {
+
+/// Topics: /scan and /odom (as read), /tf (map -> base_footprint: the brain's localized pose,
+/// 10 Hz), /map (the building map, nav_msgs/OccupancyGrid, once, latched), /plan (the planned
+/// path, nav_msgs/Path, when it changes), /people (tracked people, geometry_msgs/PoseArray,
+/// 10 Hz), /egress/status (the running action and the tree's status, when they change).
+class BagRecorder {
+ public:
+  /// @throws InvalidArgument if `dir` exists (see Rosbag2Writer).
+  explicit BagRecorder(const std::filesystem::path& dir);
+  void OnSense(const SensorSnapshot& s);
+  void AfterStep(Time now, const behavior::Executive& brain);
+  /// Writes metadata.yaml; returns the number of messages.
+  std::size_t Close();
+
+ private:
+  ros2::Rosbag2Writer bag_;
+  bool map_written_{false};
+  Time last_odometry_{-1}, next_sample_{0};
+  std::size_t last_path_hash_{0};
+  std::string last_status_;
+};
+
+}  // namespace egress::apps
