@@ -87,6 +87,15 @@ std::unique_ptr<behavior::Executive> MakeScenarioExecutive(
   }
 }
 
+std::shared_ptr<const twin::TwinModel> TwinModelForSeed(
+    std::shared_ptr<const twin::TwinModel> twin_model, std::uint64_t seed) {
+  // A scenario family: this seed's variant is a scenario of its own.
+  if (!twin_model->scenario().randomize.DrawsVariants()) return twin_model;
+  return std::make_shared<const twin::TwinModel>(
+      twin::DrawScenarioVariant(twin_model->scenario(), twin_model->building(), seed),
+      twin_model->world(), twin_model->robot_model(), twin_model->config());
+}
+
 BrainTrial RunBrainTrial(const twin::Scenario& scenario, const twin::WorldDescription& world,
                          std::uint64_t seed, std::shared_ptr<const RobotModel> model,
                          const BrainTrialOptions& options) {
@@ -97,12 +106,7 @@ BrainTrial RunBrainTrial(const twin::Scenario& scenario, const twin::WorldDescri
 BrainTrial RunBrainTrial(std::shared_ptr<const twin::TwinModel> twin_model, std::uint64_t seed,
                          const BrainTrialOptions& options) {
   ThrowUnless(twin_model != nullptr, "RunBrainTrial: the twin model is null");
-  // A scenario family: this seed's variant is a scenario of its own.
-  if (twin_model->scenario().randomize.DrawsVariants()) {
-    twin_model = std::make_shared<const twin::TwinModel>(
-        twin::DrawScenarioVariant(twin_model->scenario(), twin_model->building(), seed),
-        twin_model->world(), twin_model->robot_model(), twin_model->config());
-  }
+  twin_model = TwinModelForSeed(std::move(twin_model), seed);
   BrainTrial trial;
   trial.world = std::make_unique<twin::TwinWorld>(twin_model, seed);
   trial.brain = MakeScenarioExecutive(twin_model->scenario(), twin_model->world(), *trial.world,

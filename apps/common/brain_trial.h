@@ -61,6 +61,11 @@ struct BrainTrialOptions {
   std::function<twin::TraceAnnotation(const twin::TwinWorld&, const behavior::Executive&)> annotate;
 };
 
+/// The model a trial of `seed` runs: `twin_model` itself, or for a scenario family (randomize)
+/// the seed's variant of it.
+std::shared_ptr<const twin::TwinModel> TwinModelForSeed(
+    std::shared_ptr<const twin::TwinModel> twin_model, std::uint64_t seed);
+
 /// The twin, the brain and the judge's verdict of one trial.
 struct BrainTrial {
   std::unique_ptr<twin::TwinWorld> world;

@@ -57,20 +57,23 @@ void RequireRos2(const Ros2Options& o, const char* command) {
         "{}: only --ros2 is built (ROS 2's wire format over Fast DDS); pass --ros2", command));
 }
 
+// The scenario's twin model for the run's seed (its variant, for a scenario family) and the seed.
+std::pair<std::shared_ptr<const twin::TwinModel>, std::uint64_t> LoadScenarioForSeed(
+    const Ros2Options& o) {
+  const twin::Scenario scenario = twin::LoadScenario(o.scenario);
+  const std::uint64_t seed = o.seed.value_or(scenario.seed);
+  auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
+  return {TwinModelForSeed(std::make_shared<const twin::TwinModel>(
+                               scenario, twin::LoadSdfWorld(scenario.world_file), model),
+                           seed),
+          seed};
+}
+
 // The twin, served as a ROS 2 robot until the brain says its mission ended, the time limit, or
 // SIGINT; then judged as `sim run` judges.
 void ServeTwin(const Ros2Options& o) {
   RequireRos2(o, "twin serve");
-  const twin::Scenario scenario = twin::LoadScenario(o.scenario);
-  const twin::WorldDescription world = twin::LoadSdfWorld(scenario.world_file);
-  const std::uint64_t seed = o.seed.value_or(scenario.seed);
-  auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
-  auto twin_model = std::make_shared<const twin::TwinModel>(scenario, world, model);
-  if (twin_model->scenario().randomize.DrawsVariants()) {
-    twin_model = std::make_shared<const twin::TwinModel>(
-        twin::DrawScenarioVariant(twin_model->scenario(), twin_model->building(), seed),
-        twin_model->world(), twin_model->robot_model(), twin_model->config());
-  }
+  const auto [twin_model, seed] = LoadScenarioForSeed(o);
   twin::TwinWorld twin_world(twin_model, seed);
   twin::TwinRobot robot(&twin_world);
   ros2::RobotPortServer server(robot, TopicsOf(o), o.domain, /*reliable_sensors=*/o.lockstep);
@@ -164,21 +167,12 @@ void RunRobot(const Ros2Options& o) {
   if (o.scenario.empty())
     throw CommandFailed("robot --ros2: --scenario FILE is required (the mission, map and start)");
   const auto began = std::chrono::steady_clock::now();
-  const twin::Scenario scenario = twin::LoadScenario(o.scenario);
-  const twin::WorldDescription world = twin::LoadSdfWorld(scenario.world_file);
-  const std::uint64_t seed = o.seed.value_or(scenario.seed);
-  auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
-  auto twin_model = std::make_shared<const twin::TwinModel>(scenario, world, model);
-  if (twin_model->scenario().randomize.DrawsVariants()) {
-    twin_model = std::make_shared<const twin::TwinModel>(
-        twin::DrawScenarioVariant(twin_model->scenario(), twin_model->building(), seed),
-        twin_model->world(), twin_model->robot_model(), twin_model->config());
-  }
+  const auto [twin_model, seed] = LoadScenarioForSeed(o);
   // Only the start pose is read of this world (the operator's initial pose estimate).
   const twin::TwinWorld start(twin_model, seed);
   behavior::ExecutiveConfig config;
-  auto brain =
-      MakeScenarioExecutive(twin_model->scenario(), twin_model->world(), start, model, config);
+  auto brain = MakeScenarioExecutive(twin_model->scenario(), twin_model->world(), start,
+                                     twin_model->robot_model(), config);
   ros2::Ros2RobotPortConfig port_config;
   port_config.topics = TopicsOf(o);
   port_config.domain_id = o.domain;

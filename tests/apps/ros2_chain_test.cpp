@@ -19,6 +19,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "dds_domain.h"
 #include "test_paths.h"
 
 extern char** environ;
@@ -78,10 +79,6 @@ class Child {
   std::filesystem::path log_;
 };
 
-std::string Domain(int offset) {
-  return std::to_string(10 + int(::getpid() % 40) * 2 + offset);
-}
-
 const std::string kS1 = std::string(EGRESS_SOURCE_DIR) + "/worlds/scenarios/s1_nominal.yaml";
 
 nlohmann::json ReadJson(const std::filesystem::path& path) {
@@ -93,7 +90,8 @@ nlohmann::json ReadJson(const std::filesystem::path& path) {
 // or two of the same time (lock-step: the twin waits for each brain step).
 TEST(Ros2ChainTest, S1AcrossTwoProcessesMatchesInProcess) {
   using egress::testing::TestTempPath;
-  const std::string domain = Domain(0);
+  const egress::testing::DdsDomain claim;
+  const std::string domain = claim.str();
   const auto dds_json = TestTempPath("dds.json"), local_json = TestTempPath("local.json");
   Child serve({"twin", "serve", "--ros2", kS1, "--lockstep", "--domain", domain, "--json",
                dds_json.string()},
@@ -118,7 +116,8 @@ TEST(Ros2ChainTest, S1AcrossTwoProcessesMatchesInProcess) {
 // SIGINT to the brain mid-run: it stops the base, says why, and the robot's server ends on it.
 TEST(Ros2ChainTest, SigintHaltsTheBrainAndTheServerEndsOnIt) {
   using egress::testing::TestTempPath;
-  const std::string domain = Domain(1);
+  const egress::testing::DdsDomain claim;
+  const std::string domain = claim.str();
   Child serve({"twin", "serve", "--ros2", kS1, "--domain", domain}, TestTempPath("serve.log"));
   Child robot({"robot", "--ros2", "--scenario", kS1, "--sim-time", "--domain", domain},
               TestTempPath("robot.log"));
@@ -138,12 +137,13 @@ TEST(Ros2ChainTest, SigintHaltsTheBrainAndTheServerEndsOnIt) {
 
 TEST(Ros2ChainTest, NoPeerIsAClearErrorNotAHang) {
   using egress::testing::TestTempPath;
-  Child robot({"robot", "--ros2", "--scenario", kS1, "--domain", Domain(2), "--wait", "1"},
+  const egress::testing::DdsDomain robot_domain, serve_domain;
+  Child robot({"robot", "--ros2", "--scenario", kS1, "--domain", robot_domain.str(), "--wait", "1"},
               TestTempPath("robot.log"));
   EXPECT_EQ(robot.Wait(std::chrono::seconds(60)), 1);
   EXPECT_THAT(robot.Output(), HasSubstr("no robot on ROS 2 domain"));
   EXPECT_THAT(robot.Output(), HasSubstr("/omni_base_controller/wheel_odom"));
-  Child serve({"twin", "serve", "--ros2", kS1, "--domain", Domain(3), "--wait", "1"},
+  Child serve({"twin", "serve", "--ros2", kS1, "--domain", serve_domain.str(), "--wait", "1"},
               TestTempPath("serve.log"));
   EXPECT_EQ(serve.Wait(std::chrono::seconds(60)), 1);
   EXPECT_THAT(serve.Output(), HasSubstr("no brain on ROS 2 domain"));

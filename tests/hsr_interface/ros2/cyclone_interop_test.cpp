@@ -16,8 +16,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "dds_domain.h"
 #include "egress/hsr_interface/frames.h"
 #include "egress/ros2/robot_port_server.h"
+#include "hsr_interface/ros2/scripted_robot.h"
 
 extern char** environ;
 
@@ -27,23 +29,10 @@ namespace {
 using ::testing::HasSubstr;
 using namespace std::chrono_literals;
 
-class Robot final : public RobotPort {
- public:
-  SensorSnapshot next;
-  std::vector<Twist2> velocities;
-  SimClock sim_clock;
-  const Clock& clock() const override { return sim_clock; }
-
- protected:
-  SensorSnapshot DoSense() override { return next; }
-  void DoSendBaseVelocity(const Twist2& V) override { velocities.push_back(V); }
-  void DoSendArmTrajectory(const JointTrajectory&) override {}
-  void DoSendGripperCommand(const GripperCommand&) override {}
-};
-
 TEST(CycloneInteropTest, ACycloneNodeReadsOurScanAndOdometryAndDrivesOurBase) {
-  const int domain = 200 + int(::getpid() % 16);
-  Robot robot;
+  const egress::testing::DdsDomain claim;
+  const int domain = claim.id();
+  test_support::ScriptedRobot robot;
   RobotPortServer server(robot, Ros2Topics{}, domain);
   const std::string log =
       ::testing::TempDir() + "/cyclone_peer_" + std::to_string(::getpid()) + ".log";

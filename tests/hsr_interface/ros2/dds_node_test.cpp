@@ -8,18 +8,15 @@
 #include <gtest/gtest.h>
 
 #include <geometry_msgs/msg/TwistPubSubTypes.h>
+
 #include <sensor_msgs/msg/LaserScanPubSubTypes.h>
+#include "dds_domain.h"
 
 namespace egress::ros2 {
 namespace {
 
 using ::testing::HasSubstr;
 using ::testing::ThrowsMessage;
-
-// Each test its own DDS domain, so parallel ctest runs never hear each other.
-int TestDomain(int offset) {
-  return 100 + int(::getpid() % 50) * 2 + offset;
-}
 
 // Waits (bounded: a broken discovery fails the test, it does not hang it) for `done`.
 template <class Pred>
@@ -43,7 +40,8 @@ TEST(DdsNodeTest, TopicNamesFollowRos2) {
 // Two participants (as two processes would be): a scan published by one arrives whole at the
 // other, over DDS discovery and the network stack (loopback or shared memory).
 TEST(DdsNodeTest, AScanCrossesBetweenTwoParticipants) {
-  const int domain = TestDomain(0);
+  const egress::testing::DdsDomain claim;
+  const int domain = claim.id();
   DdsNode robot("robot", domain), brain("brain", domain);
   std::mutex mutex;
   std::vector<sensor_msgs::msg::LaserScan> received;
@@ -75,7 +73,8 @@ TEST(DdsNodeTest, AScanCrossesBetweenTwoParticipants) {
 }
 
 TEST(DdsNodeTest, ReliableCommandsArriveInOrderAndATopicKeepsOneType) {
-  const int domain = TestDomain(1);
+  const egress::testing::DdsDomain claim;
+  const int domain = claim.id();
   DdsNode robot("robot", domain), brain("brain", domain);
   std::mutex mutex;
   std::vector<double> vx;

@@ -8,9 +8,11 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "dds_domain.h"
 #include "egress/hsr_interface/error.h"
 #include "egress/hsr_interface/frames.h"
 #include "egress/ros2/robot_port_server.h"
+#include "hsr_interface/ros2/scripted_robot.h"
 
 namespace egress::ros2 {
 namespace {
@@ -18,27 +20,7 @@ namespace {
 using ::testing::HasSubstr;
 using namespace std::chrono_literals;
 
-int TestDomain(int offset) {
-  return 150 + int(::getpid() % 40) * 2 + offset;
-}
-
-// A robot whose sensors the test writes and whose commands it reads: the DDS bridge between it
-// and the brain's port is what is under test.
-class ScriptedRobot final : public RobotPort {
- public:
-  SensorSnapshot next;
-  std::vector<Twist2> velocities;
-  std::vector<JointTrajectory> trajectories;
-  std::vector<GripperCommand> gripper;
-  SimClock sim_clock;
-  const Clock& clock() const override { return sim_clock; }
-
- protected:
-  SensorSnapshot DoSense() override { return std::exchange(next, {}); }
-  void DoSendBaseVelocity(const Twist2& V) override { velocities.push_back(V); }
-  void DoSendArmTrajectory(const JointTrajectory& t) override { trajectories.push_back(t); }
-  void DoSendGripperCommand(const GripperCommand& c) override { gripper.push_back(c); }
-};
+using test_support::ScriptedRobot;
 
 SensorSnapshot Sensors(Time t) {
   SensorSnapshot s;
@@ -102,7 +84,8 @@ struct Bridge {
 };
 
 TEST(Ros2RobotPortTest, SensorsAndCommandsCrossTheBridge) {
-  Bridge b(TestDomain(0));
+  const egress::testing::DdsDomain claim;
+  Bridge b(claim.id());
   SensorSnapshot s = Sensors(Time{1'000'000'000});
   DepthImage depth;
   depth.stamp = s.stamp;
@@ -167,7 +150,8 @@ TEST(Ros2RobotPortTest, SensorsAndCommandsCrossTheBridge) {
 // A laser that goes quiet while the clock runs on: within its 0.3 s the port says so, and from
 // then the base gets only zero, whatever the brain asks. The e-stop does the same.
 TEST(Ros2RobotPortTest, AStaleSensorOrAnEstopStopsTheBase) {
-  Bridge b(TestDomain(1));
+  const egress::testing::DdsDomain claim;
+  Bridge b(claim.id());
   b.Deliver(Sensors(Time{1'000'000'000}));
   EXPECT_EQ(b.brain.Fault(), std::nullopt);
   // 0.4 s on: odometry and joints keep coming, the scan does not.
