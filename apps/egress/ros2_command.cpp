@@ -23,6 +23,7 @@
 #include "egress/twin/scenario_judge.h"
 #include "egress/twin/sdf_world_loader.h"
 #include "egress/twin/twin_run.h"
+#include "goal_scenario.h"
 
 namespace egress::apps {
 namespace {
@@ -43,6 +44,9 @@ struct Ros2Options {
   double duration{0.0};
   double wait_s{30.0};
   std::string json;
+  std::string map, start, goal;  // a world file and a goal instead of a scenario
+  std::string tree{std::string(EGRESS_TREES_DIR) + "/go_to.xml"};
+  double time_limit{600.0};
   bool sim_time{false};
   bool quiet{false};
 };
@@ -60,7 +64,12 @@ void RequireRos2(const Ros2Options& o, const char* command) {
 // The scenario's twin model for the run's seed (its variant, for a scenario family) and the seed.
 std::pair<std::shared_ptr<const twin::TwinModel>, std::uint64_t> LoadScenarioForSeed(
     const Ros2Options& o) {
-  const twin::Scenario scenario = twin::LoadScenario(o.scenario);
+  const std::string& file = o.map.empty() ? o.scenario : o.map;
+  if (!IsWorldFile(file) && (!o.goal.empty() || !o.start.empty()))
+    throw CommandFailed("--start and --goal go with a world file (.sdf/.world), not a scenario");
+  const twin::Scenario scenario = IsWorldFile(file)
+                                      ? GoalScenario({file, o.start, o.goal, o.time_limit, o.tree})
+                                      : twin::LoadScenario(file);
   const std::uint64_t seed = o.seed.value_or(scenario.seed);
   auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
   return {TwinModelForSeed(std::make_shared<const twin::TwinModel>(
@@ -164,8 +173,10 @@ void ServeTwin(const Ros2Options& o) {
 // operator gives a robot), driving whatever robot answers on ROS 2.
 void RunRobot(const Ros2Options& o) {
   RequireRos2(o, "robot");
-  if (o.scenario.empty())
-    throw CommandFailed("robot --ros2: --scenario FILE is required (the mission, map and start)");
+  if (o.scenario.empty() == o.map.empty())
+    throw CommandFailed(
+        "robot --ros2: give --scenario FILE (mission, map and start) or --map WORLD.sdf --goal "
+        "PLACE [--start PLACE|x;y;yaw] [--tree T.xml]");
   const auto began = std::chrono::steady_clock::now();
   const auto [twin_model, seed] = LoadScenarioForSeed(o);
   // Only the start pose is read of this world (the operator's initial pose estimate).
@@ -260,7 +271,12 @@ void AddRos2Commands(CLI::App& app) {
   auto* serve = twin->add_subcommand(
       "serve", "Serve a twin scenario as a ROS 2 HSR (its topics, /clock), judge it at the end");
   serve->add_flag("--ros2", o->ros2, "Over ROS 2's wire format (Fast DDS)")->required();
-  serve->add_option("scenario", o->scenario, "Scenario YAML")->required()->check(CLI::ExistingFile);
+  serve->add_option("scenario", o->scenario, "Scenario YAML, or an SDF world with --goal")
+      ->required()
+      ->check(CLI::ExistingFile);
+  serve->add_option("--start", o->start, "With a world: the robot's start (place or x;y;yaw)");
+  serve->add_option("--goal", o->goal, "With a world: the goal (place or x;y;yaw)");
+  serve->add_option("--tree", o->tree, "With a world: the mission tree")->check(CLI::ExistingFile);
   serve->add_option("--seed", o->seed, "Seed (default: the scenario's)");
   serve->add_option("--domain", o->domain, "ROS_DOMAIN_ID")->check(CLI::Range(0, 232));
   serve->add_option("--topics", o->topics, "Topic map YAML (default: the HSR's ROS 2 names)")
@@ -281,6 +297,12 @@ void AddRos2Commands(CLI::App& app) {
       "robot", "Run the robot brain against a robot over ROS 2 (a real HSR, or `twin serve`)");
   robot->add_flag("--ros2", o->ros2, "Over ROS 2's wire format (Fast DDS)")->required();
   robot->add_option("--scenario", o->scenario, "Scenario YAML: the mission, map and start pose")
+      ->check(CLI::ExistingFile);
+  robot->add_option("--map", o->map, "The building (SDF world; its building YAML beside it)")
+      ->check(CLI::ExistingFile);
+  robot->add_option("--start", o->start, "With --map: the initial pose (place or x;y;yaw)");
+  robot->add_option("--goal", o->goal, "With --map: the goal (place or x;y;yaw)");
+  robot->add_option("--tree", o->tree, "With --map: the mission tree (default go_to.xml)")
       ->check(CLI::ExistingFile);
   robot->add_option("--seed", o->seed, "The scenario's seed (its start pose and variant)");
   robot->add_option("--domain", o->domain, "ROS_DOMAIN_ID")->check(CLI::Range(0, 232));

@@ -25,6 +25,7 @@
 #include "egress/hsr_interface/error.h"
 #include "egress/twin/sdf_world_loader.h"
 #include "egress/twin/twin_run.h"
+#include "goal_scenario.h"
 #include "trace_render.h"
 
 namespace egress::apps {
@@ -108,50 +109,9 @@ void ProgressBar(double fraction) {
   if (fraction >= 1.0) std::fprintf(stderr, "\n");
 }
 
-bool IsWorldFile(const std::string& path) {
-  const std::string ext = std::filesystem::path(path).extension().string();
-  return ext == ".sdf" || ext == ".world";
-}
-
-// "x;y;yaw" (or "x;y") as a YAML pose, or a place name as {place: ..}.
-std::string PoseOrPlaceYaml(const std::string& text, const char* option) {
-  if (text.find(';') == std::string::npos) {
-    if (text.empty() || text.find_first_of("{}[]:,#\"'") != std::string::npos)
-      throw CommandFailed(fmt::format("{} '{}': expected a place name or x;y;yaw", option, text));
-    return fmt::format("{{place: {}}}", text);
-  }
-  Pose2 X;
-  try {
-    X = behavior::ParsePose2(text);
-  } catch (const std::exception& e) {
-    throw CommandFailed(fmt::format("{}: {}", option, e.what()));
-  }
-  return fmt::format("{{x: {}, y: {}, yaw: {}}}", X.x, X.y, X.yaw);
-}
-
-// A world and a goal as a scenario: the building's doors with their operators (from the world
-// and its building YAML), the robot at --start, the mission GoTo --goal.
-twin::Scenario GoalScenario(const SimOptions& o) {
-  if (o.goal.empty()) throw CommandFailed("a world file needs --goal (a place or x;y;yaw)");
-  const std::filesystem::path world = std::filesystem::absolute(o.scenario);
-  std::string start = o.start;
-  if (start.empty()) {
-    const twin::BuildingDescription building = twin::DescribeBuilding(
-        twin::LoadSdfWorld(world), twin::FindBuildingYamlBeside(world).value_or(""));
-    if (building.places.empty())
-      throw CommandFailed(
-          fmt::format("{}: the building has no places; pass --start x;y;yaw", o.scenario));
-    start = building.places.front().name;
-  }
-  const std::string goal = PoseOrPlaceYaml(o.goal, "--goal");
-  const std::string yaml = fmt::format(
-      "name: '{} to {}'\nworld: '{}'\ntime_limit: {}\nrobot:\n  start: {}\n  goal: {}\n"
-      "mission:\n  tree: '{}'\n  blackboard: {{max_yields: \"5\"}}\n"
-      "success: [reach_goal, no_person_contact, no_door_strike]\n",
-      world.stem().string(), o.goal, world.string(), o.time_limit,
-      PoseOrPlaceYaml(start, "--start"), goal.substr(0, goal.size() - 1) + ", tolerance: 0.3}",
-      o.tree);
-  return twin::LoadScenarioFromString(yaml, o.scenario + " --goal " + o.goal, world.parent_path());
+// A world and a goal as a scenario (GoalScenario), from the command's options.
+twin::Scenario GoalScenarioOf(const SimOptions& o) {
+  return GoalScenario({o.scenario, o.start, o.goal, o.time_limit, o.tree});
 }
 
 void RunSim(const SimOptions& o) {
@@ -160,7 +120,7 @@ void RunSim(const SimOptions& o) {
   if (!IsWorldFile(o.scenario) && (!o.goal.empty() || !o.start.empty()))
     throw CommandFailed("--start and --goal go with a world file (.sdf/.world), not a scenario");
   const twin::Scenario scenario =
-      IsWorldFile(o.scenario) ? GoalScenario(o) : twin::LoadScenario(o.scenario);
+      IsWorldFile(o.scenario) ? GoalScenarioOf(o) : twin::LoadScenario(o.scenario);
   const twin::WorldDescription world_description = twin::LoadSdfWorld(scenario.world_file);
   const std::uint64_t seed = o.seed.value_or(scenario.seed);
   auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
