@@ -113,6 +113,23 @@ TEST(Ros2ChainTest, S1AcrossTwoProcessesMatchesInProcess) {
   std::filesystem::remove(local_json);
 }
 
+// A robot has no scenario: the brain takes the building's map, a start and a goal.
+TEST(Ros2ChainTest, TheBrainRunsFromAMapAndAGoal) {
+  using egress::testing::TestTempPath;
+  const egress::testing::DdsDomain claim;
+  const std::string lab = std::string(EGRESS_SOURCE_DIR) + "/worlds/lab/lab.sdf";
+  Child serve({"twin", "serve", "--ros2", lab, "--start", "room_south", "--goal", "room_north",
+               "--lockstep", "--domain", claim.str()},
+              TestTempPath("serve.log"));
+  Child robot({"robot", "--ros2", "--map", lab, "--start", "room_south", "--goal", "room_north",
+               "--lockstep", "--domain", claim.str()},
+              TestTempPath("robot.log"));
+  EXPECT_EQ(robot.Wait(), 0) << robot.Output();
+  EXPECT_EQ(serve.Wait(), 0) << serve.Output();
+  EXPECT_THAT(serve.Output(), HasSubstr("PASS  reach_goal"));
+  EXPECT_THAT(robot.Output(), HasSubstr("mission succeeded"));
+}
+
 // SIGINT to the brain mid-run: it stops the base, says why, and the robot's server ends on it.
 TEST(Ros2ChainTest, SigintHaltsTheBrainAndTheServerEndsOnIt) {
   using egress::testing::TestTempPath;
