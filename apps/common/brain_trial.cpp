@@ -118,30 +118,10 @@ BrainTrial RunBrainTrial(std::shared_ptr<const twin::TwinModel> twin_model, std:
   const behavior::Executive& brain = *trial.brain;
   if (options.annotate) run.annotate = [&] { return options.annotate(w, brain); };
   // With on_sense, the brain reads the robot through a port that shows each reading to it.
-  class Observed final : public RobotPort {
-   public:
-    Observed(RobotPort& robot, const std::function<void(const SensorSnapshot&)>& see)
-        : robot_(robot), see_(see) {}
-    const Clock& clock() const override { return robot_.clock(); }
-
-   protected:
-    SensorSnapshot DoSense() override {
-      SensorSnapshot s = robot_.Sense();
-      see_(s);
-      return s;
-    }
-    void DoSendBaseVelocity(const Twist2& V) override { robot_.SendBaseVelocity(V); }
-    void DoSendArmTrajectory(const JointTrajectory& t) override { robot_.SendArmTrajectory(t); }
-    void DoSendGripperCommand(const GripperCommand& c) override { robot_.SendGripperCommand(c); }
-
-   private:
-    RobotPort& robot_;
-    const std::function<void(const SensorSnapshot&)>& see_;
-  };
   trial.result = twin::RunScenario(
       robot,
       [&](RobotPort& port) {
-        Observed observed(port, options.on_sense);
+        ObservedPort observed(port, options.on_sense);
         const bool more =
             trial.brain->Step(options.on_sense ? static_cast<RobotPort&>(observed) : port);
         if (options.after_step) options.after_step(w, brain);

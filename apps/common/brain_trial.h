@@ -61,6 +61,29 @@ struct BrainTrialOptions {
   std::function<twin::TraceAnnotation(const twin::TwinWorld&, const behavior::Executive&)> annotate;
 };
 
+/// A RobotPort that passes everything to `robot` and shows each reading to `see` (recording a
+/// run). Both must outlive it.
+class ObservedPort final : public RobotPort {
+ public:
+  ObservedPort(RobotPort& robot, const std::function<void(const SensorSnapshot&)>& see)
+      : robot_(robot), see_(see) {}
+  const Clock& clock() const override { return robot_.clock(); }
+
+ protected:
+  SensorSnapshot DoSense() override {
+    SensorSnapshot s = robot_.Sense();
+    if (see_) see_(s);
+    return s;
+  }
+  void DoSendBaseVelocity(const Twist2& V) override { robot_.SendBaseVelocity(V); }
+  void DoSendArmTrajectory(const JointTrajectory& t) override { robot_.SendArmTrajectory(t); }
+  void DoSendGripperCommand(const GripperCommand& c) override { robot_.SendGripperCommand(c); }
+
+ private:
+  RobotPort& robot_;
+  const std::function<void(const SensorSnapshot&)>& see_;
+};
+
 /// The model a trial of `seed` runs: `twin_model` itself, or for a scenario family (randomize)
 /// the seed's variant of it.
 std::shared_ptr<const twin::TwinModel> TwinModelForSeed(

@@ -9,12 +9,15 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <thread>
 
 #include <fmt/format.h>
 
+#include "bag_recorder.h"
 #include "brain_trial.h"
 #include "commands.h"
 #include "egress/hsr_interface/error.h"
@@ -47,6 +50,8 @@ struct Ros2Options {
   std::string map, start, goal;  // a world file and a goal instead of a scenario
   std::string tree{std::string(EGRESS_TREES_DIR) + "/go_to.xml"};
   double time_limit{600.0};
+  std::string bag;
+  bool overwrite{false};
   bool sim_time{false};
   bool quiet{false};
 };
@@ -190,6 +195,21 @@ void RunRobot(const Ros2Options& o) {
   port_config.use_sim_time = o.sim_time || o.lockstep;
   port_config.reliable_sensors = o.lockstep;
   ros2::Ros2RobotPort port(port_config);
+  std::unique_ptr<BagRecorder> bag;
+  std::function<void(const SensorSnapshot&)> on_sense;
+  if (!o.bag.empty()) {
+    if (std::filesystem::exists(o.bag)) {
+      if (!o.overwrite)
+        throw CommandFailed(fmt::format("'{}' exists; pass --overwrite to replace it", o.bag));
+      if (!std::filesystem::exists(std::filesystem::path(o.bag) / "metadata.yaml"))
+        throw CommandFailed(fmt::format(
+            "'{}' exists and is not a rosbag2 bag (no metadata.yaml): not replaced", o.bag));
+      std::filesystem::remove_all(o.bag);
+    }
+    bag = std::make_unique<BagRecorder>(o.bag);
+    on_sense = [&](const SensorSnapshot& s) { bag->OnSense(s); };
+  }
+  ObservedPort observed(port, on_sense);
   std::signal(SIGINT, OnSigint);
   std::string missing;
   if (!port.WaitForSensors(std::chrono::milliseconds(int(o.wait_s * 1000)), &missing))
@@ -229,7 +249,8 @@ void RunRobot(const Ros2Options& o) {
       outcome = "HALTED: " + *fault;
       break;
     }
-    const bool more = brain->Step(port);
+    const bool more = brain->Step(observed);
+    if (bag) bag->AfterStep(now, *brain);
     port.PublishStepDone(now);
     if (!more) {
       outcome = brain->status() == bt::NodeStatus::kSuccess ? "SUCCESS" : "FAILURE";
@@ -245,6 +266,10 @@ void RunRobot(const Ros2Options& o) {
     last_status.clear();
     port.PublishStepDone(port.clock().Now() + SecondsToDuration(3600.0));
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  if (bag) {
+    const std::size_t messages = bag->Close();
+    if (!o.quiet) fmt::print("bag       {} (rosbag2, sqlite3: {} messages)\n", o.bag, messages);
   }
   if (!o.quiet) {
     for (const auto& d : brain->decisions())
@@ -308,6 +333,10 @@ void AddRos2Commands(CLI::App& app) {
   robot->add_option("--domain", o->domain, "ROS_DOMAIN_ID")->check(CLI::Range(0, 232));
   robot->add_option("--topics", o->topics, "Topic map YAML (default: the HSR's ROS 2 names)")
       ->check(CLI::ExistingFile);
+  robot->add_option("--bag", o->bag,
+                    "Record the run as a rosbag2 bag in this folder (what the brain read and "
+                    "believed: /scan /odom /tf /map /plan /people /egress/status)");
+  robot->add_flag("--overwrite", o->overwrite, "Replace an existing bag");
   robot->add_flag("--sim-time", o->sim_time, "Run on /clock (use_sim_time) rather than the wall");
   robot->add_flag("--lockstep", o->lockstep, "With `twin serve --lockstep` (implies --sim-time)");
   robot->add_option("--wait", o->wait_s, "Seconds to wait for the robot's sensors and clock")

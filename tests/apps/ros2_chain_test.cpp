@@ -96,10 +96,22 @@ TEST(Ros2ChainTest, S1AcrossTwoProcessesMatchesInProcess) {
   Child serve({"twin", "serve", "--ros2", kS1, "--lockstep", "--domain", domain, "--json",
                dds_json.string()},
               TestTempPath("serve.log"));
-  Child robot({"robot", "--ros2", "--scenario", kS1, "--lockstep", "--domain", domain},
+  // The brain records what it read over ROS 2 as a bag.
+  const auto bag = TestTempPath("robot_bag");
+  std::filesystem::remove_all(bag);
+  Child robot({"robot", "--ros2", "--scenario", kS1, "--lockstep", "--domain", domain, "--bag",
+               bag.string()},
               TestTempPath("robot.log"));
   ASSERT_TRUE(serve.started() && robot.started());
   EXPECT_EQ(robot.Wait(), 0) << robot.Output();
+  {
+    std::ifstream in(bag / "metadata.yaml");
+    std::stringstream meta;
+    meta << in.rdbuf();
+    EXPECT_THAT(meta.str(), HasSubstr("name: /scan\n        type: sensor_msgs/msg/LaserScan"));
+    EXPECT_THAT(meta.str(), HasSubstr("name: /tf\n"));
+  }
+  std::filesystem::remove_all(bag);
   EXPECT_EQ(serve.Wait(), 0) << serve.Output();
   EXPECT_THAT(serve.Output(), HasSubstr("ended by the brain: SUCCESS"));
   Child local({"sim", "run", kS1, "-q", "--json", local_json.string()}, TestTempPath("local.log"));
