@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "commands.h"
+#include "egress/ros2/asan_options.h"  // the program links Fast DDS
 
 int main(int argc, char** argv) {
   CLI::App app{

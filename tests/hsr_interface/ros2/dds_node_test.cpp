@@ -11,6 +11,7 @@
 
 #include <sensor_msgs/msg/LaserScanPubSubTypes.h>
 #include "dds_domain.h"
+#include "egress/ros2/asan_options.h"  // this test program runs Fast DDS
 
 namespace egress::ros2 {
 namespace {
