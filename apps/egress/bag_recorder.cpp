@@ -2,6 +2,8 @@
 
 #include <functional>
 
+#include <fmt/format.h>
+
 #include <geometry_msgs/msg/PoseArrayPubSubTypes.h>
 #include <nav_msgs/msg/OccupancyGridPubSubTypes.h>
 #include <nav_msgs/msg/OdometryPubSubTypes.h>
@@ -10,6 +12,7 @@
 #include <std_msgs/msg/StringPubSubTypes.h>
 #include <tf2_msgs/msg/TFMessagePubSubTypes.h>
 
+#include "commands.h"
 #include "egress/hsr_interface/frames.h"
 #include "egress/ros2/conversions.h"
 
@@ -35,6 +38,18 @@ geometry_msgs::msg::Pose PoseOf(const Pose2& X) {
 }  // namespace
 
 BagRecorder::BagRecorder(const std::filesystem::path& dir) : bag_(dir) {}
+
+std::unique_ptr<BagRecorder> BagRecorder::Open(const std::filesystem::path& dir, bool overwrite) {
+  if (std::filesystem::exists(dir)) {
+    if (!overwrite)
+      throw CommandFailed(fmt::format("'{}' exists; pass --overwrite to replace it", dir.string()));
+    if (!std::filesystem::exists(dir / "metadata.yaml"))
+      throw CommandFailed(fmt::format(
+          "'{}' exists and is not a rosbag2 bag (no metadata.yaml): not replaced", dir.string()));
+    std::filesystem::remove_all(dir);
+  }
+  return std::make_unique<BagRecorder>(dir);
+}
 
 void BagRecorder::OnSense(const SensorSnapshot& s) {
   if (s.scan)

@@ -20,6 +20,9 @@ class BagRecorder {
  public:
   /// @throws InvalidArgument if `dir` exists (see Rosbag2Writer).
   explicit BagRecorder(const std::filesystem::path& dir);
+  /// A recorder in `dir`: an existing folder is replaced only with `overwrite` and only if it is
+  /// a bag (has metadata.yaml). @throws CommandFailed otherwise.
+  static std::unique_ptr<BagRecorder> Open(const std::filesystem::path& dir, bool overwrite);
   void OnSense(const SensorSnapshot& s);
   void AfterStep(Time now, const behavior::Executive& brain);
   /// Writes metadata.yaml; returns the number of messages.

@@ -198,15 +198,7 @@ void RunRobot(const Ros2Options& o) {
   std::unique_ptr<BagRecorder> bag;
   std::function<void(const SensorSnapshot&)> on_sense;
   if (!o.bag.empty()) {
-    if (std::filesystem::exists(o.bag)) {
-      if (!o.overwrite)
-        throw CommandFailed(fmt::format("'{}' exists; pass --overwrite to replace it", o.bag));
-      if (!std::filesystem::exists(std::filesystem::path(o.bag) / "metadata.yaml"))
-        throw CommandFailed(fmt::format(
-            "'{}' exists and is not a rosbag2 bag (no metadata.yaml): not replaced", o.bag));
-      std::filesystem::remove_all(o.bag);
-    }
-    bag = std::make_unique<BagRecorder>(o.bag);
+    bag = BagRecorder::Open(o.bag, o.overwrite);
     on_sense = [&](const SensorSnapshot& s) { bag->OnSense(s); };
   }
   ObservedPort observed(port, on_sense);

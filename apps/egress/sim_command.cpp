@@ -171,18 +171,7 @@ void RunSim(const SimOptions& o) {
   if (!o.bag.empty()) {
     if (driver != "brain")
       throw CommandFailed("--bag records a brain run (the driver is " + driver + ")");
-    // A bag folder is replaced only with --overwrite, and only if it is a bag.
-    if (std::filesystem::exists(o.bag)) {
-      if (!o.overwrite)
-        throw CommandFailed(fmt::format("'{}' exists; pass --overwrite to replace it", o.bag));
-      if (!std::filesystem::exists(std::filesystem::path(o.bag) / "metadata.yaml"))
-        throw CommandFailed(
-            fmt::format("'{}' exists and is not a rosbag2 bag (no metadata.yaml): "
-                        "not replaced",
-                        o.bag));
-      std::filesystem::remove_all(o.bag);
-    }
-    bag = std::make_unique<BagRecorder>(o.bag);
+    bag = BagRecorder::Open(o.bag, o.overwrite);
   }
   if (driver == "brain") {
     BrainTrialOptions trial_options;
