@@ -1,6 +1,6 @@
 #include "bag_recorder.h"
 
-#include <functional>
+#include <algorithm>
 
 #include <fmt/format.h>
 
@@ -87,10 +87,10 @@ void BagRecorder::AfterStep(Time now, const behavior::Executive& brain) {
     map_written_ = true;
   }
   const auto& path = brain.services().motion->path();
-  std::size_t hash = path.size();
-  for (const Pose2& X : path)
-    hash = hash * 31 + std::hash<double>{}(X.x) * 7 + std::hash<double>{}(X.y);
-  if (hash != last_path_hash_) {
+  const auto same = [](const Pose2& a, const Pose2& b) {
+    return a.x == b.x && a.y == b.y && a.yaw == b.yaw;
+  };
+  if (!std::equal(path.begin(), path.end(), last_path_.begin(), last_path_.end(), same)) {
     nav_msgs::msg::Path plan;
     plan.header(Header(now, frames::kMap));
     for (const Pose2& X : path) {
@@ -100,7 +100,7 @@ void BagRecorder::AfterStep(Time now, const behavior::Executive& brain) {
       plan.poses().push_back(p);
     }
     bag_.Write<nav_msgs::msg::PathPubSubType>("/plan", plan, now);
-    last_path_hash_ = hash;
+    last_path_ = path;
   }
   const std::string status = std::string(bt::ToString(brain.status())) +
                              (brain.active_action().empty() ? "" : ": " + brain.active_action());

@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <vector>
 
 #include "egress/behavior/executive.h"
 #include "egress/hsr_interface/robot_port.h"
@@ -32,7 +33,7 @@ class BagRecorder {
   ros2::Rosbag2Writer bag_;
   bool map_written_{false};
   Time last_odometry_{-1}, next_sample_{0};
-  std::size_t last_path_hash_{0};
+  std::vector<Pose2> last_path_;  // the path last written to /plan
   std::string last_status_;
 };
 

@@ -249,8 +249,8 @@ void RunRobot(const Ros2Options& o) {
       break;
     }
     publish_status("RUNNING");
-    // Real time: a step that overran starts the next one now rather than bunching up.
-    next = std::max(next + period, o.sim_time || o.lockstep ? next + period : now);
+    // On the wall clock, a step that overran starts the next one now rather than bunching up.
+    next = port_config.use_sim_time ? next + period : std::max(next + period, now);
   }
   // Said more than once: the watcher may have missed the first (it ends on it).
   for (int i = 0; i < 3; ++i) {

@@ -48,6 +48,7 @@ struct RobotPortServer::Impl {
   std::unique_ptr<Publisher<sensor_msgs::msg::CameraInfoPubSubType>> camera_info;
   std::unique_ptr<Publisher<tf2_msgs::msg::TFMessagePubSubType>> tf;
   std::unique_ptr<Publisher<vision_msgs::msg::Detection2DArrayPubSubType>> detections;
+  std::unique_ptr<Subscription<geometry_msgs::msg::TwistPubSubType>> cmd_vel;
   std::vector<std::unique_ptr<eprosima::fastdds::dds::DataReaderListener>> subscriptions;
   std::optional<Time> last_odometry, last_joints;
   // The latest of each, for RepublishLatest().
@@ -97,7 +98,7 @@ RobotPortServer::RobotPortServer(RobotPort& robot, Ros2Topics topics, int domain
   m.tf = m.node.CreatePublisher<tf2_msgs::msg::TFMessagePubSubType>(t.tf, reliable);
   m.detections =
       m.node.CreatePublisher<vision_msgs::msg::Detection2DArrayPubSubType>(t.detections, reliable);
-  m.subscriptions.push_back(m.node.CreateSubscription<geometry_msgs::msg::TwistPubSubType>(
+  m.cmd_vel = m.node.CreateSubscription<geometry_msgs::msg::TwistPubSubType>(
       t.cmd_vel, reliable, [&m](const geometry_msgs::msg::Twist& msg) {
         {
           const std::lock_guard<std::mutex> lock(m.mutex);
@@ -106,7 +107,7 @@ RobotPortServer::RobotPortServer(RobotPort& robot, Ros2Topics topics, int domain
                   .count());
         }
         m.Queue(m.topics.cmd_vel, [&m, V = FromRos(msg)] { m.robot.SendBaseVelocity(V); });
-      }));
+      });
   m.subscriptions.push_back(
       m.node.CreateSubscription<trajectory_msgs::msg::JointTrajectoryPubSubType>(
           t.arm_trajectory, reliable, [&m](const trajectory_msgs::msg::JointTrajectory& msg) {
@@ -246,9 +247,7 @@ bool RobotPortServer::BrainConnected() const {
       m.joints->MatchedSubscriptions() > 0 && m.depth->MatchedSubscriptions() > 0 &&
       m.camera_info->MatchedSubscriptions() > 0 && m.tf->MatchedSubscriptions() > 0 &&
       m.clock->MatchedSubscriptions() > 0;
-  const auto* cmd_vel = dynamic_cast<const Subscription<geometry_msgs::msg::TwistPubSubType>*>(
-      m.subscriptions.front().get());
-  return sensors && cmd_vel != nullptr && cmd_vel->MatchedPublications() > 0;
+  return sensors && m.cmd_vel->MatchedPublications() > 0;
 }
 
 std::vector<std::string> RobotPortServer::TakeRejected() {
