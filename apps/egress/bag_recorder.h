@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "egress/behavior/executive.h"
@@ -13,10 +14,12 @@
 
 namespace egress::apps {
 
-/// Topics: /scan and /odom (as read), /tf (map -> base_footprint: the brain's localized pose,
-/// 10 Hz), /map (the building map, nav_msgs/OccupancyGrid, once, latched), /plan (the planned
-/// path, nav_msgs/Path, when it changes), /people (tracked people, geometry_msgs/PoseArray,
-/// 10 Hz), /egress/status (the running action and the tree's status, when they change).
+/// Topics: /scan and /odom (as read), /tf (10 Hz: map -> odom from the brain's localized pose,
+/// odom -> base_footprint from odometry, base_footprint -> head camera), /tf_static (the laser's
+/// mount, once, latched), /map (the building map, nav_msgs/OccupancyGrid, once, latched), /plan
+/// (the planned path, nav_msgs/Path, when it changes), /people (tracked people as
+/// visualization_msgs/MarkerArray: a cylinder, a velocity arrow and an id each; 10 Hz),
+/// /egress/status (the running action and the tree's status, when they change).
 class BagRecorder {
  public:
   /// @throws InvalidArgument if `dir` exists (see Rosbag2Writer).
@@ -31,7 +34,9 @@ class BagRecorder {
 
  private:
   ros2::Rosbag2Writer bag_;
-  bool map_written_{false};
+  bool map_written_{false}, static_written_{false};
+  Pose2 last_X_OB_;                 // odom -> base, from the latest odometry
+  std::optional<Pose3> last_X_BC_;  // base -> head camera, from the latest depth image
   Time last_odometry_{-1}, next_sample_{0};
   std::vector<Pose2> last_path_;  // the path last written to /plan
   std::string last_status_;

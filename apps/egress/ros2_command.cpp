@@ -46,6 +46,7 @@ struct Ros2Options {
   double speed{1.0};
   double duration{0.0};
   double wait_s{30.0};
+  double command_timeout_s{ros2::Ros2RobotPortConfig{}.command_timeout_s};
   std::string json;
   std::string map, start, goal;  // a world file and a goal instead of a scenario
   std::string tree{std::string(EGRESS_TREES_DIR) + "/go_to.xml"};
@@ -194,6 +195,7 @@ void RunRobot(const Ros2Options& o) {
   port_config.domain_id = o.domain;
   port_config.use_sim_time = o.sim_time || o.lockstep;
   port_config.reliable_sensors = o.lockstep;
+  port_config.command_timeout_s = o.command_timeout_s;
   ros2::Ros2RobotPort port(port_config);
   std::unique_ptr<BagRecorder> bag;
   std::function<void(const SensorSnapshot&)> on_sense;
@@ -264,6 +266,12 @@ void RunRobot(const Ros2Options& o) {
     if (!o.quiet) fmt::print("bag       {} (rosbag2, sqlite3: {} messages)\n", o.bag, messages);
   }
   if (!o.quiet) {
+    const auto [accepted, refused] = port.gripper_goals();
+    fmt::print(
+        "commands  {} base command(s) sent as zero for a stale Sense(), {} watchdog stop(s) "
+        "(command timeout {:g} s); gripper goals {} accepted, {} refused\n",
+        port.stale_base_commands(), port.watchdog_stops(), port_config.command_timeout_s, accepted,
+        refused);
     for (const auto& d : brain->decisions())
       fmt::print("  {:7.2f}  {}\n", d.time, d.text);
     // The brain's CPU per second of its life (both cores' worth counts: DDS threads included).
@@ -331,6 +339,11 @@ void AddRos2Commands(CLI::App& app) {
   robot->add_flag("--overwrite", o->overwrite, "Replace an existing bag");
   robot->add_flag("--sim-time", o->sim_time, "Run on /clock (use_sim_time) rather than the wall");
   robot->add_flag("--lockstep", o->lockstep, "With `twin serve --lockstep` (implies --sim-time)");
+  robot
+      ->add_option("--command-timeout", o->command_timeout_s,
+                   "Oldest a command may be when sent [s]: older goes out as zero (base) or "
+                   "not at all (arm); the base is stopped if the brain goes quiet this long")
+      ->check(CLI::PositiveNumber);
   robot->add_option("--wait", o->wait_s, "Seconds to wait for the robot's sensors and clock")
       ->check(CLI::Range(0.1, 3600.0));
   robot->add_flag("-q,--quiet", o->quiet, "Only errors");

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -17,6 +18,9 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <sqlite3.h>
+#include <tf2_msgs/msg/TFMessagePubSubTypes.h>
+#include <visualization_msgs/msg/MarkerArrayPubSubTypes.h>
 #include <nlohmann/json.hpp>
 
 #include "dds_domain.h"
@@ -80,6 +84,7 @@ class Child {
 };
 
 const std::string kS1 = std::string(EGRESS_SOURCE_DIR) + "/worlds/scenarios/s1_nominal.yaml";
+const std::string kS2 = std::string(EGRESS_SOURCE_DIR) + "/worlds/scenarios/s2_person_crosses.yaml";
 
 nlohmann::json ReadJson(const std::filesystem::path& path) {
   std::ifstream in(path);
@@ -181,6 +186,39 @@ TEST(Ros2ChainTest, NoPeerIsAClearErrorNotAHang) {
   EXPECT_THAT(no_flag.Output(), HasSubstr("--ros2"));
 }
 
+// The messages of `topic` in a bag's .db3, decoded as a rosbag2 reader would (CDR).
+template <class PubSubType>
+std::vector<typename PubSubType::type> ReadTopic(const std::filesystem::path& db3,
+                                                 const std::string& topic) {
+  std::vector<typename PubSubType::type> out;
+  sqlite3* db = nullptr;
+  if (sqlite3_open_v2(db3.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
+    ADD_FAILURE() << "cannot open " << db3;
+    sqlite3_close(db);
+    return out;
+  }
+  sqlite3_stmt* q = nullptr;
+  EXPECT_EQ(sqlite3_prepare_v2(db,
+                               "SELECT m.data FROM messages m JOIN topics t ON m.topic_id = t.id "
+                               "WHERE t.name = ?1 ORDER BY m.timestamp",
+                               -1, &q, nullptr),
+            SQLITE_OK);
+  sqlite3_bind_text(q, 1, topic.c_str(), -1, SQLITE_TRANSIENT);
+  PubSubType type;
+  while (sqlite3_step(q) == SQLITE_ROW) {
+    const int size = sqlite3_column_bytes(q, 0);
+    eprosima::fastrtps::rtps::SerializedPayload_t payload{std::uint32_t(size)};
+    std::memcpy(payload.data, sqlite3_column_blob(q, 0), std::size_t(size));
+    payload.length = std::uint32_t(size);
+    typename PubSubType::type msg;
+    EXPECT_TRUE(type.deserialize(&payload, &msg)) << topic;
+    out.push_back(std::move(msg));
+  }
+  sqlite3_finalize(q);
+  sqlite3_close(db);
+  return out;
+}
+
 // A twin run by the brain, recorded as a rosbag2 bag: the topics a ROS 2 tool expects, with
 // messages on each; an existing bag is not replaced without --overwrite, nor a folder that is
 // not a bag even with it.
@@ -188,7 +226,7 @@ TEST(Ros2ChainTest, SimRunRecordsARosbag2Bag) {
   using egress::testing::TestTempPath;
   const auto dir = TestTempPath("bag");
   std::filesystem::remove_all(dir);
-  Child run({"sim", "run", kS1, "-q", "--bag", dir.string()}, TestTempPath("run.log"));
+  Child run({"sim", "run", kS2, "-q", "--bag", dir.string()}, TestTempPath("run.log"));
   ASSERT_EQ(run.Wait(), 0) << run.Output();
   EXPECT_THAT(run.Output(), HasSubstr("rosbag2, sqlite3"));
   std::ifstream in(dir / "metadata.yaml");
@@ -199,11 +237,39 @@ TEST(Ros2ChainTest, SimRunRecordsARosbag2Bag) {
                             "name: /tf\n        type: tf2_msgs/msg/TFMessage",
                             "name: /map\n        type: nav_msgs/msg/OccupancyGrid",
                             "name: /plan\n        type: nav_msgs/msg/Path",
-                            "name: /people\n        type: geometry_msgs/msg/PoseArray",
+                            "name: /tf_static\n        type: tf2_msgs/msg/TFMessage",
+                            "name: /people\n        type: visualization_msgs/msg/MarkerArray",
                             "name: /egress/status\n        type: std_msgs/msg/String"})
     EXPECT_THAT(meta.str(), HasSubstr(topic));
   EXPECT_THAT(meta.str(), HasSubstr("storage_identifier: sqlite3"));
-  EXPECT_TRUE(std::filesystem::file_size(dir / (dir.filename().string() + "_0.db3")) > 10000);
+  const auto db3 = dir / (dir.filename().string() + "_0.db3");
+  EXPECT_TRUE(std::filesystem::file_size(db3) > 10000);
+  // The TF tree a viewer needs: map -> odom -> base_footprint, and the laser's mount latched.
+  const auto tf = ReadTopic<tf2_msgs::msg::TFMessagePubSubType>(db3, "/tf");
+  ASSERT_FALSE(tf.empty());
+  std::vector<std::string> edges;
+  for (const auto& T : tf.back().transforms())
+    edges.push_back(T.header().frame_id() + ">" + T.child_frame_id());
+  EXPECT_THAT(edges, ::testing::IsSupersetOf({"map>odom", "odom>base_footprint"}));
+  const auto tf_static = ReadTopic<tf2_msgs::msg::TFMessagePubSubType>(db3, "/tf_static");
+  ASSERT_EQ(tf_static.size(), 1u);
+  EXPECT_EQ(tf_static[0].transforms().at(0).child_frame_id(), "base_range_sensor_link");
+  // People as markers: each frame clears the last, then draws those tracked (S2's person
+  // crosses the door: a cylinder of a person's height, in the map frame, at some frame).
+  const auto people = ReadTopic<visualization_msgs::msg::MarkerArrayPubSubType>(db3, "/people");
+  ASSERT_FALSE(people.empty());
+  int bodies = 0;
+  for (const auto& frame : people) {
+    ASSERT_FALSE(frame.markers().empty());
+    EXPECT_EQ(frame.markers()[0].action(), 3);  // DELETEALL
+    for (const auto& m : frame.markers()) {
+      if (m.type() != 3) continue;  // CYLINDER
+      ++bodies;
+      EXPECT_EQ(m.header().frame_id(), "map");
+      EXPECT_GT(m.scale().z(), 1.0);
+    }
+  }
+  EXPECT_GT(bodies, 0);
   Child again({"sim", "run", kS1, "-q", "--bag", dir.string()}, TestTempPath("again.log"));
   EXPECT_EQ(again.Wait(), 1);
   EXPECT_THAT(again.Output(), HasSubstr("--overwrite"));

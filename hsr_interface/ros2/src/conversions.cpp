@@ -353,41 +353,40 @@ JointTrajectory FromRos(const trajectory_msgs::msg::JointTrajectory& msg) {
   return trajectory;
 }
 
-trajectory_msgs::msg::JointTrajectory GripperToRos(const GripperCommand& command) {
-  trajectory_msgs::msg::JointTrajectory msg;
-  msg.joint_names({"hand_motor_joint"});
-  trajectory_msgs::msg::JointTrajectoryPoint point;
+GripperGoal GripperToRos(const GripperCommand& command, double open_torque) {
+  GripperGoal out;
   switch (command.mode) {
     case GripperCommand::Mode::kOpen:
-      point.positions({kHandOpenRad});
-      break;
-    case GripperCommand::Mode::kPosition:
-      point.positions({command.position});
+      ThrowUnless(std::isfinite(open_torque) && open_torque > 0.0,
+                  "gripper: the opening torque must be > 0 Nm, not ", open_torque);
+      out.action = GripperGoal::Action::kGrasp;
+      out.goal.effort(open_torque);
       break;
     case GripperCommand::Mode::kGrasp:
-      point.effort({command.effort});
+      out.action = GripperGoal::Action::kApplyForce;
+      out.goal.effort(command.effort);
       break;
+    case GripperCommand::Mode::kPosition:
+      throw InvalidArgument(
+          "gripper: a position command has no HSR action here (the HSR takes positions as a "
+          "FollowJointTrajectory action, not built); send open or grasp");
   }
-  msg.points().push_back(std::move(point));
-  return msg;
+  out.goal.do_control_stop(false);
+  return out;
 }
 
-GripperCommand GripperFromRos(const trajectory_msgs::msg::JointTrajectory& msg) {
-  ThrowUnless(msg.joint_names().size() == 1 && msg.joint_names()[0] == "hand_motor_joint" &&
-                  msg.points().size() == 1,
-              "gripper trajectory: expected one point of hand_motor_joint");
-  const auto& p = msg.points()[0];
+GripperCommand GripperFromRos(const GripperGoal& goal) {
+  const double effort = goal.goal.effort();
+  ThrowUnless(std::isfinite(effort), "gripper goal: effort is not finite");
   GripperCommand command;
-  if (p.positions().empty()) {
-    ThrowUnless(p.effort().size() == 1,
-                "gripper trajectory: a grasp (no position) needs one effort");
+  if (goal.action == GripperGoal::Action::kApplyForce) {
+    ThrowUnless(effort >= 0.0, "gripper apply_force: the force must be >= 0 N, not ", effort);
     command.mode = GripperCommand::Mode::kGrasp;
-    command.effort = p.effort()[0];
+    command.effort = effort;
   } else {
-    ThrowUnless(p.positions().size() == 1, "gripper trajectory: expected one position");
-    command.position = p.positions()[0];
-    command.mode = command.position >= kHandOpenRad - 1e-9 ? GripperCommand::Mode::kOpen
-                                                           : GripperCommand::Mode::kPosition;
+    ThrowUnless(effort > 0.0, "gripper grasp: a closing torque (", effort,
+                " Nm) is not modelled; grip with apply_force and a force in N");
+    command.mode = GripperCommand::Mode::kOpen;
   }
   return command;
 }

@@ -26,6 +26,34 @@ std::string DdsTopicName(std::string_view ros_topic) {
   return "rt" + std::string(ros_topic);
 }
 
+std::pair<std::string, std::string> DdsServiceTopicNames(std::string_view ros_service) {
+  const std::string path = DdsTopicName(ros_service).substr(2);  // validated, "/a/b"
+  return {"rq" + path + "Request", "rr" + path + "Reply"};
+}
+
+std::string ActionSendGoalService(std::string_view ros_action) {
+  return std::string(ros_action) + "/_action/send_goal";
+}
+
+void MatchedReaders::on_publication_matched(dds::DataWriter*,
+                                            const dds::PublicationMatchedStatus& info) {
+  const auto reader = eprosima::fastrtps::rtps::iHandle2GUID(info.last_subscription_handle);
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (info.current_count_change > 0)
+      readers_.insert(reader);
+    else if (info.current_count_change < 0)
+      readers_.erase(reader);
+  }
+  changed_.notify_all();
+}
+
+bool MatchedReaders::WaitFor(const eprosima::fastrtps::rtps::GUID_t& reader,
+                             std::chrono::milliseconds timeout) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  return changed_.wait_for(lock, timeout, [&] { return readers_.count(reader) > 0; });
+}
+
 namespace {
 template <class Qos>
 void Apply(const QosProfile& profile, Qos* qos) {
@@ -90,14 +118,15 @@ dds::Topic* DdsNode::TopicFor(const std::string& topic,
 
 dds::DataWriter* DdsNode::CreateWriter(const std::string& topic,
                                        std::unique_ptr<dds::TopicDataType> type,
-                                       const QosProfile& profile) {
+                                       const QosProfile& profile,
+                                       dds::DataWriterListener* listener) {
   dds::Topic* t = TopicFor(topic, std::move(type));
   dds::DataWriterQos qos = dds::DATAWRITER_QOS_DEFAULT;
   Apply(profile, &qos);
   // Lock-step: a lost sample is repaired within 20 ms, not Fast DDS's default 3 s heartbeat
   // (a reliable reader holds every later sample until then).
   if (udp_only_) qos.reliable_writer_qos().times.heartbeatPeriod = {0, 20'000'000};
-  dds::DataWriter* writer = publisher_->create_datawriter(t, qos);
+  dds::DataWriter* writer = publisher_->create_datawriter(t, qos, listener);
   if (writer == nullptr) throw std::runtime_error("DDS: cannot create a writer on " + topic);
   return writer;
 }

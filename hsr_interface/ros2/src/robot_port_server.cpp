@@ -16,6 +16,7 @@
 #include <sensor_msgs/msg/LaserScanPubSubTypes.h>
 #include <std_msgs/msg/StringPubSubTypes.h>
 #include <tf2_msgs/msg/TFMessagePubSubTypes.h>
+#include <tmc_control_msgs/action/GripperApplyEffortPubSubTypes.h>
 #include <trajectory_msgs/msg/JointTrajectoryPubSubTypes.h>
 #include <vision_msgs/msg/Detection2DArrayPubSubTypes.h>
 
@@ -39,6 +40,7 @@ struct RobotPortServer::Impl {
   std::chrono::steady_clock::time_point published_at{};
   std::vector<double> command_latencies;
   std::optional<std::string> status;
+  Time robot_time{};  // the robot's time at the last PublishSensors (goal replies' stamps)
 
   std::unique_ptr<Publisher<rosgraph_msgs::msg::ClockPubSubType>> clock;
   std::unique_ptr<Publisher<sensor_msgs::msg::LaserScanPubSubType>> scan;
@@ -50,6 +52,10 @@ struct RobotPortServer::Impl {
   std::unique_ptr<Publisher<vision_msgs::msg::Detection2DArrayPubSubType>> detections;
   std::unique_ptr<Subscription<geometry_msgs::msg::TwistPubSubType>> cmd_vel;
   std::vector<std::unique_ptr<eprosima::fastdds::dds::DataReaderListener>> subscriptions;
+  using GripperGoalServer =
+      ServiceServer<tmc_control_msgs::action::GripperApplyEffort_SendGoal_RequestPubSubType,
+                    tmc_control_msgs::action::GripperApplyEffort_SendGoal_ResponsePubSubType>;
+  std::unique_ptr<GripperGoalServer> grasp_goals, apply_force_goals;
   std::optional<Time> last_odometry, last_joints;
   // The latest of each, for RepublishLatest().
   std::optional<sensor_msgs::msg::LaserScan> scan_msg;
@@ -114,12 +120,30 @@ RobotPortServer::RobotPortServer(RobotPort& robot, Ros2Topics topics, int domain
             m.Queue(m.topics.arm_trajectory,
                     [&m, msg] { m.robot.SendArmTrajectory(FromRos(msg)); });
           }));
-  m.subscriptions.push_back(
-      m.node.CreateSubscription<trajectory_msgs::msg::JointTrajectoryPubSubType>(
-          t.gripper_trajectory, reliable, [&m](const trajectory_msgs::msg::JointTrajectory& msg) {
-            m.Queue(m.topics.gripper_trajectory,
-                    [&m, msg] { m.robot.SendGripperCommand(GripperFromRos(msg)); });
-          }));
+  // The gripper controller's action goals: accepted (and queued) or refused with why.
+  const auto serve_goals = [&m](const std::string& action, GripperGoal::Action kind) {
+    return m.node.CreateServiceServer<
+        tmc_control_msgs::action::GripperApplyEffort_SendGoal_RequestPubSubType,
+        tmc_control_msgs::action::GripperApplyEffort_SendGoal_ResponsePubSubType>(
+        ActionSendGoalService(action),
+        [&m, action, kind](const tmc_control_msgs::action::GripperApplyEffort_SendGoal_Request& r) {
+          tmc_control_msgs::action::GripperApplyEffort_SendGoal_Response reply;
+          try {
+            const GripperCommand command = GripperFromRos({kind, r.goal()});
+            m.Queue(action, [&m, command] { m.robot.SendGripperCommand(command); });
+            reply.accepted(true);
+          } catch (const std::exception& e) {
+            const std::lock_guard<std::mutex> lock(m.mutex);
+            m.rejected.push_back(action + ": " + e.what());
+            reply.accepted(false);
+          }
+          const std::lock_guard<std::mutex> lock(m.mutex);
+          reply.stamp(ToRos(m.robot_time));
+          return reply;
+        });
+  };
+  m.grasp_goals = serve_goals(t.gripper_grasp_action, GripperGoal::Action::kGrasp);
+  m.apply_force_goals = serve_goals(t.gripper_apply_force_action, GripperGoal::Action::kApplyForce);
   m.subscriptions.push_back(m.node.CreateSubscription<rosgraph_msgs::msg::ClockPubSubType>(
       t.brain_clock, reliable, [&m](const rosgraph_msgs::msg::Clock& msg) {
         {
@@ -200,6 +224,7 @@ void RobotPortServer::PublishSensors() {
   m.clock_msg = clock;
   const std::lock_guard<std::mutex> lock(m.mutex);
   m.published_at = std::chrono::steady_clock::now();
+  m.robot_time = s.stamp;
 }
 
 std::vector<double> RobotPortServer::TakeCommandLatencies() {

@@ -1,6 +1,8 @@
 #include "egress/ros2/ros2_robot_port.h"
 
 #include <cmath>
+#include <cstring>
+#include <random>
 #include <thread>
 #include <vector>
 
@@ -14,6 +16,7 @@
 #include <std_msgs/msg/BoolPubSubTypes.h>
 #include <std_msgs/msg/StringPubSubTypes.h>
 #include <tf2_msgs/msg/TFMessagePubSubTypes.h>
+#include <tmc_control_msgs/action/GripperApplyEffortPubSubTypes.h>
 #include <trajectory_msgs/msg/JointTrajectoryPubSubTypes.h>
 #include <vision_msgs/msg/Detection2DArrayPubSubTypes.h>
 
@@ -28,7 +31,9 @@ void Ros2RobotPortConfig::Validate() const {
   topics.Validate();
   for (const auto& [name, value] : {std::pair{"scan_timeout_s", scan_timeout_s},
                                     std::pair{"odometry_timeout_s", odometry_timeout_s},
-                                    std::pair{"joints_timeout_s", joints_timeout_s}}) {
+                                    std::pair{"joints_timeout_s", joints_timeout_s},
+                                    std::pair{"command_timeout_s", command_timeout_s},
+                                    std::pair{"gripper_open_torque", gripper_open_torque}}) {
     ThrowUnless(std::isfinite(value) && value > 0.0, "Ros2RobotPortConfig: ", name, " (", value,
                 ") must be finite and > 0");
   }
@@ -64,15 +69,36 @@ struct Ros2RobotPort::Impl {
   bool clock_seen{false};
   bool estop{false};
   std::string bad_message;  // the last message that could not be converted
+  // Command freshness: when the brain last sensed, when it last sent a base command, and
+  // whether that command moves the base (the watchdog stops it if no other follows).
+  std::optional<Time> sensed_at, base_command_at;
+  bool base_moving{false};
+  int stale_base_commands{0}, watchdog_stops{0};
+  std::mutex publish_mutex;  // cmd_vel is written by the brain's thread and the watchdog
+  std::thread watchdog;
+  bool stopping{false};  // under `mutex`
 
   std::vector<std::unique_ptr<eprosima::fastdds::dds::DataReaderListener>> subscriptions;
   std::unique_ptr<Publisher<geometry_msgs::msg::TwistPubSubType>> cmd_vel;
-  std::unique_ptr<Publisher<trajectory_msgs::msg::JointTrajectoryPubSubType>> arm, gripper;
+  std::unique_ptr<Publisher<trajectory_msgs::msg::JointTrajectoryPubSubType>> arm;
+  using GripperGoalClient =
+      ServiceClient<tmc_control_msgs::action::GripperApplyEffort_SendGoal_RequestPubSubType,
+                    tmc_control_msgs::action::GripperApplyEffort_SendGoal_ResponsePubSubType>;
+  std::unique_ptr<GripperGoalClient> grasp_goals, apply_force_goals;
+  int gripper_goals_accepted{0}, gripper_goals_refused{0};  // under `mutex`
+  // Goal ids: a random 8-byte prefix per port and a counter (unique_identifier_msgs/UUID).
+  std::uint64_t goal_prefix{std::random_device{}() * 0x100000001ull};
+  std::uint64_t goals_sent{0};
   std::unique_ptr<Publisher<std_msgs::msg::StringPubSubType>> status;
   std::unique_ptr<Publisher<rosgraph_msgs::msg::ClockPubSubType>> step_done;
   std::unique_ptr<Publisher<std_msgs::msg::BoolPubSubType>> estop_pub;
 
   std::optional<std::string> FaultLocked() const;  // with `mutex` held
+  void PublishBase(const Twist2& V_B) {
+    const std::lock_guard<std::mutex> lock(publish_mutex);
+    cmd_vel->Publish(ToRos(V_B));
+  }
+  void Watch();
 
   Impl(Ros2RobotPortConfig c, std::string_view name)
       : config(std::move(c)), node(name, config.domain_id, /*udp_only=*/config.reliable_sensors) {}
@@ -168,18 +194,58 @@ Ros2RobotPort::Ros2RobotPort(Ros2RobotPortConfig config, std::string_view node_n
   m.cmd_vel = m.node.CreatePublisher<geometry_msgs::msg::TwistPubSubType>(t.cmd_vel, reliable);
   m.arm = m.node.CreatePublisher<trajectory_msgs::msg::JointTrajectoryPubSubType>(t.arm_trajectory,
                                                                                   reliable);
-  m.gripper = m.node.CreatePublisher<trajectory_msgs::msg::JointTrajectoryPubSubType>(
-      t.gripper_trajectory, reliable);
+  const auto goal_client = [&m](const std::string& action) {
+    return m.node.CreateServiceClient<
+        tmc_control_msgs::action::GripperApplyEffort_SendGoal_RequestPubSubType,
+        tmc_control_msgs::action::GripperApplyEffort_SendGoal_ResponsePubSubType>(
+        ActionSendGoalService(action),
+        [&m](std::int64_t,
+             const tmc_control_msgs::action::GripperApplyEffort_SendGoal_Response& r) {
+          {
+            const std::lock_guard<std::mutex> lock(m.mutex);
+            ++(r.accepted() ? m.gripper_goals_accepted : m.gripper_goals_refused);
+          }
+          m.changed.notify_all();
+        });
+  };
+  m.grasp_goals = goal_client(t.gripper_grasp_action);
+  m.apply_force_goals = goal_client(t.gripper_apply_force_action);
   m.status = m.node.CreatePublisher<std_msgs::msg::StringPubSubType>(t.status, reliable);
   m.step_done =
       m.node.CreatePublisher<rosgraph_msgs::msg::ClockPubSubType>(t.brain_clock, reliable);
   m.estop_pub = m.node.CreatePublisher<std_msgs::msg::BoolPubSubType>(t.estop, reliable);
+  m.watchdog = std::thread([&m] { m.Watch(); });
+}
+
+void Ros2RobotPort::Impl::Watch() {
+  // Checks a few times per timeout (wall time); the age is by the port's clock, so a paused
+  // simulation (lock-step) never trips it.
+  const auto period = std::chrono::duration_cast<std::chrono::milliseconds>(
+      std::chrono::duration<double>(config.command_timeout_s / 4.0));
+  std::unique_lock<std::mutex> lock(mutex);
+  while (!changed.wait_for(lock, std::max(period, std::chrono::milliseconds(1)),
+                           [&] { return stopping; })) {
+    if (!base_moving || !base_command_at ||
+        ToSeconds(clock().Now() - *base_command_at) <= config.command_timeout_s)
+      continue;
+    base_moving = false;
+    ++watchdog_stops;
+    lock.unlock();
+    PublishBase(Twist2{});
+    lock.lock();
+  }
 }
 
 Ros2RobotPort::~Ros2RobotPort() {
+  {
+    const std::lock_guard<std::mutex> lock(impl_->mutex);
+    impl_->stopping = true;
+  }
+  impl_->changed.notify_all();
+  impl_->watchdog.join();
   // The base stops when the brain goes: the last word on cmd_vel is zero.
   try {
-    impl_->cmd_vel->Publish(ToRos(Twist2{}));
+    impl_->PublishBase(Twist2{});
   } catch (...) {
   }
 }
@@ -282,6 +348,7 @@ SensorSnapshot Ros2RobotPort::DoSense() {
   const std::lock_guard<std::mutex> lock(m.mutex);
   SensorSnapshot s;
   s.stamp = m.clock().Now();
+  m.sensed_at = s.stamp;
   s.scan = std::exchange(m.scan, std::nullopt);
   // A depth image is usable with its intrinsics and the camera's pose in the base (the latest
   // transform: they come on other topics, and may arrive after the image; it waits for them).
@@ -308,16 +375,63 @@ SensorSnapshot Ros2RobotPort::DoSense() {
 }
 
 void Ros2RobotPort::DoSendBaseVelocity(const Twist2& V_B) {
-  // Faulted, the base gets only zero, whatever the brain asks.
-  impl_->cmd_vel->Publish(ToRos(Fault() ? Twist2{} : V_B));
+  Impl& m = *impl_;
+  Twist2 out = V_B;
+  {
+    const std::lock_guard<std::mutex> lock(m.mutex);
+    const Time now = m.clock().Now();
+    // Faulted, the base gets only zero, whatever the brain asks; so does a command decided
+    // from a Sense() older than the timeout (the brain acted on a world that has moved on).
+    if (m.FaultLocked()) {
+      out = Twist2{};
+    } else if (!m.sensed_at || ToSeconds(now - *m.sensed_at) > m.config.command_timeout_s) {
+      out = Twist2{};
+      ++m.stale_base_commands;
+    }
+    m.base_command_at = now;
+    m.base_moving = out.vx != 0.0 || out.vy != 0.0 || out.wz != 0.0;
+  }
+  m.PublishBase(out);
 }
 
 void Ros2RobotPort::DoSendArmTrajectory(const JointTrajectory& trajectory) {
+  // A start of 0 means "on receipt"; a set start must be recent, or the controller would
+  // truncate (or jump through) the part that lies in the past.
+  if (trajectory.start != Time{}) {
+    const double age = ToSeconds(clock().Now() - trajectory.start);
+    ThrowUnless(age <= impl_->config.command_timeout_s, "arm trajectory: start stamp is ", age,
+                " s old (command_timeout_s ", impl_->config.command_timeout_s, "): not sent");
+  }
   impl_->arm->Publish(ToRos(trajectory));
 }
 
+int Ros2RobotPort::stale_base_commands() const {
+  const std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->stale_base_commands;
+}
+
+int Ros2RobotPort::watchdog_stops() const {
+  const std::lock_guard<std::mutex> lock(impl_->mutex);
+  return impl_->watchdog_stops;
+}
+
 void Ros2RobotPort::DoSendGripperCommand(const GripperCommand& command) {
-  impl_->gripper->Publish(GripperToRos(command));
+  Impl& m = *impl_;
+  const GripperGoal goal = GripperToRos(command, m.config.gripper_open_torque);
+  tmc_control_msgs::action::GripperApplyEffort_SendGoal_Request request;
+  const std::uint64_t id[2] = {m.goal_prefix, ++m.goals_sent};
+  std::memcpy(request.goal_id().uuid().data(), id, sizeof(id));
+  request.goal(goal.goal);
+  (goal.action == GripperGoal::Action::kGrasp ? m.grasp_goals : m.apply_force_goals)->Call(request);
+}
+
+bool Ros2RobotPort::GripperConnected() const {
+  return impl_->grasp_goals->ServerMatched() && impl_->apply_force_goals->ServerMatched();
+}
+
+std::pair<int, int> Ros2RobotPort::gripper_goals() const {
+  const std::lock_guard<std::mutex> lock(impl_->mutex);
+  return {impl_->gripper_goals_accepted, impl_->gripper_goals_refused};
 }
 
 }  // namespace egress::ros2

@@ -162,5 +162,39 @@ TEST(Ros2ConversionsTest, TwistTransformAndTrajectory) {
   EXPECT_NO_THROW(t_back.Validate());
 }
 
+// The HSR's gripper controller: a grasp is its apply_force action with the force [N], open its
+// grasp action with a positive torque; what the twin cannot do is refused by name.
+TEST(Ros2ConversionsTest, GripperCommandsAsTheHsrsActionGoals) {
+  const GripperGoal grasp = GripperToRos({GripperCommand::Mode::kGrasp, 0.0, 12.5});
+  EXPECT_EQ(grasp.action, GripperGoal::Action::kApplyForce);
+  EXPECT_DOUBLE_EQ(grasp.goal.effort(), 12.5);
+  EXPECT_FALSE(grasp.goal.do_control_stop());
+  const GripperCommand grasp_back = GripperFromRos(grasp);
+  EXPECT_EQ(grasp_back.mode, GripperCommand::Mode::kGrasp);
+  EXPECT_DOUBLE_EQ(grasp_back.effort, 12.5);
+  const GripperGoal open = GripperToRos({GripperCommand::Mode::kOpen, 0.0, 0.0}, 0.6);
+  EXPECT_EQ(open.action, GripperGoal::Action::kGrasp);
+  EXPECT_DOUBLE_EQ(open.goal.effort(), 0.6);
+  EXPECT_EQ(GripperFromRos(open).mode, GripperCommand::Mode::kOpen);
+  EXPECT_THAT(
+      [] {
+        GripperToRos({GripperCommand::Mode::kPosition, 0.3, 0.0});
+      },
+      ThrowsMessage<InvalidArgument>(HasSubstr("position command")));
+  EXPECT_THAT(
+      [] {
+        GripperToRos({GripperCommand::Mode::kOpen, 0.0, 0.0}, -1.0);
+      },
+      ThrowsMessage<InvalidArgument>(HasSubstr("opening torque")));
+  GripperGoal closing{GripperGoal::Action::kGrasp, {}};
+  closing.goal.effort(-0.5);
+  EXPECT_THAT([&] { GripperFromRos(closing); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("closing torque")));
+  GripperGoal negative{GripperGoal::Action::kApplyForce, {}};
+  negative.goal.effort(-2.0);
+  EXPECT_THAT([&] { GripperFromRos(negative); },
+              ThrowsMessage<InvalidArgument>(HasSubstr(">= 0 N")));
+}
+
 }  // namespace
 }  // namespace egress::ros2

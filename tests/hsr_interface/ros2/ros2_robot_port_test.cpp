@@ -136,15 +136,30 @@ TEST(Ros2RobotPortTest, SensorsAndCommandsCrossTheBridge) {
   arm.joint_names = {"arm_lift_joint"};
   arm.points = {{{0.3}, {}, {}, Duration{1'000'000'000}}};
   b.brain.SendArmTrajectory(arm);
+  // The gripper's goals go to the controller's actions (services: a goal sent before the
+  // server is matched is lost, as with ROS 2's own clients).
+  ASSERT_TRUE(Eventually([&] { return b.brain.GripperConnected(); }));
   b.brain.SendGripperCommand({GripperCommand::Mode::kGrasp, 0.0, 8.0});
+  b.brain.SendGripperCommand({GripperCommand::Mode::kOpen, 0.0, 0.0});
+  EXPECT_THAT(
+      [&] {
+        b.brain.SendGripperCommand({GripperCommand::Mode::kPosition, 0.5, 0.0});
+      },
+      ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("FollowJointTrajectory")));
   ASSERT_TRUE(Eventually([&] {
     b.server.ApplyCommands();
-    return !b.robot.velocities.empty() && !b.robot.trajectories.empty() && !b.robot.gripper.empty();
+    return !b.robot.velocities.empty() && !b.robot.trajectories.empty() &&
+           b.robot.gripper.size() >= 2 && b.brain.gripper_goals().first == 2;
   }));
+  EXPECT_EQ(b.brain.gripper_goals().second, 0);
   EXPECT_DOUBLE_EQ(b.robot.velocities[0].vy, -0.1);
   EXPECT_EQ(b.robot.trajectories[0].joint_names, arm.joint_names);
-  EXPECT_EQ(b.robot.gripper[0].mode, GripperCommand::Mode::kGrasp);
-  EXPECT_DOUBLE_EQ(b.robot.gripper[0].effort, 8.0);
+  // Two actions, two services: their arrival order is not defined.
+  const bool grasp_first = b.robot.gripper[0].mode == GripperCommand::Mode::kGrasp;
+  const GripperCommand& grasp = b.robot.gripper[grasp_first ? 0 : 1];
+  EXPECT_EQ(grasp.mode, GripperCommand::Mode::kGrasp);
+  EXPECT_DOUBLE_EQ(grasp.effort, 8.0);
+  EXPECT_EQ(b.robot.gripper[grasp_first ? 1 : 0].mode, GripperCommand::Mode::kOpen);
 }
 
 // A laser that goes quiet while the clock runs on: within its 0.3 s the port says so, and from
@@ -177,6 +192,62 @@ TEST(Ros2RobotPortTest, AStaleSensorOrAnEstopStopsTheBase) {
   b.brain.PublishEstop(true);
   ASSERT_TRUE(Eventually([&] { return b.brain.Fault().has_value(); }));
   EXPECT_THAT(*b.brain.Fault(), HasSubstr("e-stop"));
+}
+
+// Commands go out only while fresh: a base velocity decided from a Sense() older than the
+// command timeout goes out as zero; a moving base the brain stops commanding is stopped by the
+// port; an arm trajectory with an old start stamp is refused.
+// The forward speed of the next base command the robot receives (those before it dropped).
+double NextForwardSpeed(Bridge& b) {
+  b.robot.velocities.clear();
+  EXPECT_TRUE(Eventually([&] {
+    b.server.ApplyCommands();
+    return !b.robot.velocities.empty();
+  }));
+  return b.robot.velocities.empty() ? std::nan("") : b.robot.velocities.back().vx;
+}
+
+TEST(Ros2RobotPortTest, StaleCommandsAreNeverSent) {
+  const egress::testing::DdsDomain claim;
+  Bridge b(claim.id());
+  b.Deliver(Sensors(Time{1'000'000'000}));
+  b.brain.Sense();
+  b.brain.SendBaseVelocity({0.4, 0.0, 0.0});
+  EXPECT_EQ(NextForwardSpeed(b), 0.4);
+  EXPECT_EQ(b.brain.stale_base_commands(), 0);
+
+  // 0.3 s on (the sensors healthy) with no command since: the watchdog sends zero.
+  b.Deliver(Sensors(Time{1'300'000'000}));
+  EXPECT_EQ(NextForwardSpeed(b), 0.0);
+  EXPECT_EQ(b.brain.watchdog_stops(), 1);
+
+  // A command with no Sense() since 1.0 s (now 1.3 s): zero goes out.
+  b.brain.SendBaseVelocity({0.4, 0.0, 0.0});
+  EXPECT_EQ(NextForwardSpeed(b), 0.0);
+  EXPECT_EQ(b.brain.stale_base_commands(), 1);
+  // Sensed again: the command goes out as asked.
+  b.brain.Sense();
+  b.brain.SendBaseVelocity({0.4, 0.0, 0.0});
+  EXPECT_EQ(NextForwardSpeed(b), 0.4);
+
+  JointTrajectory arm;
+  arm.joint_names = {"arm_lift_joint"};
+  arm.points = {{{0.3}, {}, {}, Duration{1'000'000'000}}};
+  arm.start = b.brain.clock().Now() - Duration{500'000'000};
+  try {
+    b.brain.SendArmTrajectory(arm);
+    ADD_FAILURE() << "an arm trajectory 0.5 s old was sent";
+  } catch (const InvalidArgument& e) {
+    EXPECT_THAT(e.what(), HasSubstr("start stamp"));
+    EXPECT_THAT(e.what(), HasSubstr("command_timeout_s"));
+  }
+  arm.start = b.brain.clock().Now();
+  b.brain.SendArmTrajectory(arm);
+  ASSERT_TRUE(Eventually([&] {
+    b.server.ApplyCommands();
+    return !b.robot.trajectories.empty();
+  }));
+  EXPECT_EQ(b.robot.trajectories.back().start, arm.start);
 }
 
 TEST(Ros2RobotPortTest, TopicMapFromYamlNamesBadEntries) {

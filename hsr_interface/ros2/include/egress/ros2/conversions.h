@@ -25,6 +25,7 @@
 #include <sensor_msgs/msg/Image.h>
 #include <sensor_msgs/msg/JointState.h>
 #include <sensor_msgs/msg/LaserScan.h>
+#include <tmc_control_msgs/action/GripperApplyEffort.h>
 #include <trajectory_msgs/msg/JointTrajectory.h>
 #include <vision_msgs/msg/Detection2DArray.h>
 
@@ -85,11 +86,23 @@ JointTrajectory FromRos(const trajectory_msgs::msg::JointTrajectory& msg);
 /// The HSR's hand_motor_joint fully open [rad] (its URDF's upper limit).
 inline constexpr double kHandOpenRad = 1.24;
 
-/// The gripper command as a trajectory of hand_motor_joint with one point: open is the open
-/// position, a position is that position, a grasp is no position and the grip force in
-/// `effort` [N]. @throws InvalidArgument (FromRos) for any other trajectory.
-trajectory_msgs::msg::JointTrajectory GripperToRos(const GripperCommand& command);
-GripperCommand GripperFromRos(const trajectory_msgs::msg::JointTrajectory& msg);
+/// A gripper command as the HSR's ROS 2 gripper controller takes it: a goal of one of its
+/// tmc_control_msgs/action/GripperApplyEffort actions. A grasp is `apply_force` with the grip
+/// force [N] (the controller closes until the fingers press with it); open is `grasp` with a
+/// positive motor torque [Nm] (`open_torque`: the hand opens until its stop).
+struct GripperGoal {
+  enum class Action { kGrasp, kApplyForce };
+  Action action{Action::kGrasp};
+  tmc_control_msgs::action::GripperApplyEffort_Goal goal;
+};
+/// The HSR's default opening torque for GripperToRos [Nm].
+inline constexpr double kHandOpenTorqueNm = 0.8;
+/// @throws InvalidArgument for a position command: the HSR takes positions only as a
+/// control_msgs FollowJointTrajectory action, which is not built (no egress task sends one).
+GripperGoal GripperToRos(const GripperCommand& command, double open_torque = kHandOpenTorqueNm);
+/// @throws InvalidArgument for a goal the twin cannot carry out (a closing `grasp` torque: the
+/// twin grips with a force, take `apply_force`), or a non-finite or negative force.
+GripperCommand GripperFromRos(const GripperGoal& goal);
 
 /// Detections of one image (all with its capture stamp): one Detection2D per box, its label the
 /// hypothesis' class_id and its confidence the score.

@@ -4,19 +4,31 @@
 /// `/a/b` is DDS topic `rt/a/b`, types carry ROS 2's DDS names (fastddsgen -typeros2), and the
 /// QoS profiles are ROS 2's. Typed publishers and subscriptions over the generated types.
 ///
+/// Services (and so actions' goals) as rmw_fastrtps lays them out: service `/a` is the topics
+/// `rq/aRequest` and `rr/aReply`; a request carries its client's reply reader as its related
+/// sample identity, and a reply carries the request's sample identity, by which a client tells
+/// the replies to it from those to other clients.
+///
 /// Subscriptions call back on Fast DDS's own listener thread: keep callbacks short and
 /// thread-safe (Ros2RobotPort copies the message under a mutex).
 
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 
+#include <fastdds/rtps/common/WriteParams.h>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
 #include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/DataWriterListener.hpp>
 #include <fastdds/dds/publisher/Publisher.hpp>
 #include <fastdds/dds/subscriber/DataReader.hpp>
 #include <fastdds/dds/subscriber/DataReaderListener.hpp>
@@ -45,6 +57,12 @@ struct QosProfile {
 /// "/omni_base_controller/cmd_vel" -> "rt/omni_base_controller/cmd_vel" (ROS 2's topic prefix).
 /// @throws InvalidArgument for a name that is not an absolute ROS 2 topic name.
 std::string DdsTopicName(std::string_view ros_topic);
+/// "/gripper_controller/grasp/_action/send_goal" -> the request and reply topics
+/// {"rq/gripper_controller/grasp/_action/send_goalRequest", "rr/..._action/send_goalReply"}.
+/// @throws InvalidArgument as DdsTopicName.
+std::pair<std::string, std::string> DdsServiceTopicNames(std::string_view ros_service);
+/// An action's goal service: "/a" -> "/a/_action/send_goal".
+std::string ActionSendGoalService(std::string_view ros_action);
 
 class DdsNode;
 
@@ -107,6 +125,105 @@ class Subscription final : public eprosima::fastdds::dds::DataReaderListener {
   Message message_;  // reused: only the listener thread touches it
 };
 
+/// Calls a ROS 2 service (see the file comment for the wire protocol); replies call back on
+/// Fast DDS's listener thread with the sequence number Call() returned.
+template <class RequestType, class ReplyType>
+class ServiceClient final : public eprosima::fastdds::dds::DataReaderListener {
+ public:
+  using Request = typename RequestType::type;
+  using Reply = typename ReplyType::type;
+  using Callback = std::function<void(std::int64_t sequence, const Reply&)>;
+  /// Sends `request`; returns its sequence number. @throws std::runtime_error if DDS refuses.
+  std::int64_t Call(const Request& request) {
+    eprosima::fastrtps::rtps::WriteParams params;
+    params.related_sample_identity().writer_guid(reader_->guid());
+    if (!writer_->write(const_cast<Request*>(&request), params))
+      throw std::runtime_error("DDS write failed on the request of " + service_);
+    return params.sample_identity().sequence_number().to64long();
+  }
+  void on_data_available(eprosima::fastdds::dds::DataReader* reader) override {
+    eprosima::fastdds::dds::SampleInfo info;
+    while (reader->take_next_sample(&reply_, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data || info.related_sample_identity.writer_guid() != writer_->guid())
+        continue;  // a reply to another client
+      callback_(info.related_sample_identity.sequence_number().to64long(), reply_);
+    }
+  }
+  /// Whether a server reads the requests and writes replies this client reads.
+  bool ServerMatched() const {
+    eprosima::fastdds::dds::PublicationMatchedStatus out;
+    eprosima::fastdds::dds::SubscriptionMatchedStatus in;
+    writer_->get_publication_matched_status(out);
+    reader_->get_subscription_matched_status(in);
+    return out.current_count > 0 && in.current_count > 0;
+  }
+  const std::string& service() const { return service_; }
+  ~ServiceClient() override;
+
+ private:
+  friend class DdsNode;
+  ServiceClient(DdsNode* node, std::string service, Callback callback)
+      : node_(node), service_(std::move(service)), callback_(std::move(callback)) {}
+  DdsNode* node_;
+  std::string service_;
+  Callback callback_;
+  eprosima::fastdds::dds::DataWriter* writer_{nullptr};
+  eprosima::fastdds::dds::DataReader* reader_{nullptr};
+  Reply reply_;  // reused: only the listener thread touches it
+};
+
+/// The readers a writer is matched with, as they come and go (a service server waits, as
+/// rmw_fastrtps does, for the requesting client's reply reader before it replies: a reply
+/// written before that match would be lost).
+class MatchedReaders final : public eprosima::fastdds::dds::DataWriterListener {
+ public:
+  void on_publication_matched(
+      eprosima::fastdds::dds::DataWriter* writer,
+      const eprosima::fastdds::dds::PublicationMatchedStatus& info) override;
+  /// Waits (wall time, bounded) until `reader` is matched; returns whether it is.
+  bool WaitFor(const eprosima::fastrtps::rtps::GUID_t& reader, std::chrono::milliseconds timeout);
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  std::set<eprosima::fastrtps::rtps::GUID_t> readers_;
+};
+
+/// Serves a ROS 2 service: `handler` answers each request, on Fast DDS's listener thread.
+template <class RequestType, class ReplyType>
+class ServiceServer final : public eprosima::fastdds::dds::DataReaderListener {
+ public:
+  using Request = typename RequestType::type;
+  using Reply = typename ReplyType::type;
+  using Handler = std::function<Reply(const Request&)>;
+  /// How long a reply waits for its client's reply reader to be matched (rmw_fastrtps: 100 ms).
+  static constexpr std::chrono::milliseconds kClientMatchTimeout{100};
+  void on_data_available(eprosima::fastdds::dds::DataReader* reader) override {
+    eprosima::fastdds::dds::SampleInfo info;
+    while (reader->take_next_sample(&request_, &info) == ReturnCode_t::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      Reply reply = handler_(request_);
+      const auto& client_reader = info.related_sample_identity.writer_guid();
+      if (client_reader != eprosima::fastrtps::rtps::GUID_t::unknown())
+        matched_.WaitFor(client_reader, kClientMatchTimeout);
+      eprosima::fastrtps::rtps::WriteParams params;
+      params.related_sample_identity(info.sample_identity);
+      writer_->write(&reply, params);
+    }
+  }
+  ~ServiceServer() override;
+
+ private:
+  friend class DdsNode;
+  ServiceServer(DdsNode* node, Handler handler) : node_(node), handler_(std::move(handler)) {}
+  DdsNode* node_;
+  Handler handler_;
+  MatchedReaders matched_;
+  eprosima::fastdds::dds::DataWriter* writer_{nullptr};
+  eprosima::fastdds::dds::DataReader* reader_{nullptr};
+  Request request_;
+};
+
 /// One DDS participant (a "node"). Not copyable; create endpoints from one thread.
 class DdsNode {
  public:
@@ -140,6 +257,34 @@ class DdsNode {
     return subscription;
   }
 
+  /// Services use ROS 2's services QoS (reliable, volatile, keep last 10).
+  template <class RequestType, class ReplyType>
+  std::unique_ptr<ServiceClient<RequestType, ReplyType>> CreateServiceClient(
+      std::string_view ros_service,
+      typename ServiceClient<RequestType, ReplyType>::Callback callback) {
+    const auto [request, reply] = DdsServiceTopicNames(ros_service);
+    std::unique_ptr<ServiceClient<RequestType, ReplyType>> client(
+        new ServiceClient<RequestType, ReplyType>(this, std::string(ros_service),
+                                                  std::move(callback)));
+    client->writer_ = CreateWriter(request, std::make_unique<RequestType>(), QosProfile::Default());
+    client->reader_ =
+        CreateReader(reply, std::make_unique<ReplyType>(), QosProfile::Default(), client.get());
+    return client;
+  }
+  template <class RequestType, class ReplyType>
+  std::unique_ptr<ServiceServer<RequestType, ReplyType>> CreateServiceServer(
+      std::string_view ros_service,
+      typename ServiceServer<RequestType, ReplyType>::Handler handler) {
+    const auto [request, reply] = DdsServiceTopicNames(ros_service);
+    std::unique_ptr<ServiceServer<RequestType, ReplyType>> server(
+        new ServiceServer<RequestType, ReplyType>(this, std::move(handler)));
+    server->writer_ = CreateWriter(reply, std::make_unique<ReplyType>(), QosProfile::Default(),
+                                   &server->matched_);
+    server->reader_ =
+        CreateReader(request, std::make_unique<RequestType>(), QosProfile::Default(), server.get());
+    return server;
+  }
+
   const std::string& name() const { return name_; }
 
   // For Publisher/Subscription destructors.
@@ -149,7 +294,7 @@ class DdsNode {
  private:
   eprosima::fastdds::dds::DataWriter* CreateWriter(
       const std::string& topic, std::unique_ptr<eprosima::fastdds::dds::TopicDataType> type,
-      const QosProfile& qos);
+      const QosProfile& qos, eprosima::fastdds::dds::DataWriterListener* listener = nullptr);
   eprosima::fastdds::dds::DataReader* CreateReader(
       const std::string& topic, std::unique_ptr<eprosima::fastdds::dds::TopicDataType> type,
       const QosProfile& qos, eprosima::fastdds::dds::DataReaderListener* listener);
@@ -173,6 +318,18 @@ Publisher<PubSubType>::~Publisher() {
 template <class PubSubType>
 Subscription<PubSubType>::~Subscription() {
   if (reader_ != nullptr) node_->DeleteReader(reader_);
+}
+
+template <class RequestType, class ReplyType>
+ServiceClient<RequestType, ReplyType>::~ServiceClient() {
+  if (reader_ != nullptr) node_->DeleteReader(reader_);
+  if (writer_ != nullptr) node_->DeleteWriter(writer_);
+}
+
+template <class RequestType, class ReplyType>
+ServiceServer<RequestType, ReplyType>::~ServiceServer() {
+  if (reader_ != nullptr) node_->DeleteReader(reader_);
+  if (writer_ != nullptr) node_->DeleteWriter(writer_);
 }
 
 }  // namespace egress::ros2

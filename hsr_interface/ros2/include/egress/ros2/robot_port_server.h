@@ -2,9 +2,11 @@
 /// @file
 /// RobotPortServer: serves any RobotPort (the twin's, in `egress twin serve --ros2`) as a ROS 2
 /// robot: what its Sense() returns is published on the robot's topics (Ros2Topics), with
-/// /clock and the camera's transform on /tf; commands received on cmd_vel and the trajectory
-/// topics are applied to it. The port is not thread-safe: commands are queued as they arrive
-/// and applied on the caller's thread by ApplyCommands().
+/// /clock and the camera's transform on /tf; commands received on cmd_vel and the arm's
+/// trajectory topic, and goals of the gripper controller's actions (their send_goal service:
+/// accepted, or refused with why in TakeRejected()), are applied to it. The port is not
+/// thread-safe: commands are queued as they arrive and applied on the caller's thread by
+/// ApplyCommands().
 
 #include <chrono>
 #include <memory>

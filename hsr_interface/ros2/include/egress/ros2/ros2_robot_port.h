@@ -8,6 +8,11 @@
 /// odometry_timeout_s, no joint states for joints_timeout_s, by the port's clock since the last
 /// one arrived) or an e-stop; while it does, the port sends only zero base velocities, whatever
 /// the brain asks. The caller halts the tree (egress robot does, within one control step).
+///
+/// Commands are sent only while fresh (command_timeout_s, by the port's clock): a base velocity
+/// only if the Sense() it was decided from is that recent (else zero goes out), an arm
+/// trajectory only if its start stamp is (else it is refused); and if the brain sends no base
+/// command for that long after a moving one — a stalled brain — the port itself sends zero.
 
 #include <chrono>
 #include <condition_variable>
@@ -16,6 +21,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include "egress/hsr_interface/clock.h"
 #include "egress/hsr_interface/robot_port.h"
@@ -30,6 +36,11 @@ struct Ros2RobotPortConfig {
   double scan_timeout_s{0.3};
   double odometry_timeout_s{0.2};
   double joints_timeout_s{0.5};
+  /// The oldest a command may be when it goes out [s] (see the class comment): a few control
+  /// periods (the executive's is 0.01 s), under the sensors' timeouts.
+  double command_timeout_s{0.1};
+  /// The motor torque the gripper opens with (the HSR's `grasp` action, > 0 opens) [Nm].
+  double gripper_open_torque{0.8};
   /// Subscribe to the sensors reliably, not with ROS 2's sensor-data QoS (best effort): for a
   /// lock-step simulation, where a dropped reading would make a sensor look stale. A real
   /// robot's best-effort sensor publishers do not match reliable subscribers: leave it off.
@@ -72,11 +83,22 @@ class Ros2RobotPort final : public RobotPort {
   void PublishStepDone(Time t);
   /// Publishes an e-stop (true) or its release, as any node may.
   void PublishEstop(bool stop);
+  /// How many base commands went out as zero because the Sense() behind them was stale, and
+  /// how many times the watchdog stopped a base the brain had stopped commanding.
+  int stale_base_commands() const;
+  int watchdog_stops() const;
+  /// Whether the gripper controller's action servers are there (goals sent before are lost).
+  bool GripperConnected() const;
+  /// Gripper goals the controller accepted and refused so far.
+  std::pair<int, int> gripper_goals() const;
 
  protected:
   SensorSnapshot DoSense() override;
   void DoSendBaseVelocity(const Twist2& V_B) override;
+  /// @throws InvalidArgument if `trajectory.start` is set and older than command_timeout_s.
   void DoSendArmTrajectory(const JointTrajectory& trajectory) override;
+  /// A goal of the gripper controller's `apply_force` (grasp) or `grasp` (open) action
+  /// (GripperToRos). @throws InvalidArgument for a position command (no HSR action built).
   void DoSendGripperCommand(const GripperCommand& command) override;
 
  private:

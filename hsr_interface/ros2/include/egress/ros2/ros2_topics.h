@@ -24,9 +24,11 @@ struct Ros2Topics {
   // The brain publishes:
   std::string cmd_vel{"/omni_base_controller/cmd_vel"};  ///< geometry_msgs/Twist
   std::string arm_trajectory{"/arm_trajectory_controller/joint_trajectory"};
-  /// trajectory_msgs/JointTrajectory of hand_motor_joint (an effort in the point's `effort`
-  /// closes on an object; see the README for the HSR's grasp action).
-  std::string gripper_trajectory{"/gripper_controller/joint_trajectory"};
+  /// The gripper controller's actions (tmc_control_msgs/action/GripperApplyEffort; their goals
+  /// go to `<name>/_action/send_goal`): `grasp` takes a motor torque [Nm] (egress opens with
+  /// it), `apply_force` a grip force [N] (egress grasps with it).
+  std::string gripper_grasp_action{"/gripper_controller/grasp"};
+  std::string gripper_apply_force_action{"/gripper_controller/apply_force"};
   /// std_msgs/String: the mission tree's status (IDLE, RUNNING, SUCCESS, FAILURE, HALTED: why).
   std::string status{"/egress/status"};
   /// rosgraph_msgs/Clock: the time of the control step the brain has just finished (lock-step
