@@ -15,6 +15,7 @@
 #include <urdf_parser/urdf_parser.h>
 
 #include "egress/hsr_interface/error.h"
+#include "egress/hsr_interface/text_file.h"
 
 #ifndef EGRESS_HSR_URDF_PATH
 #error "EGRESS_HSR_URDF_PATH must be defined by the build"
@@ -150,6 +151,29 @@ struct RobotModel::Impl {
         q[index] = value;
       }
       named_configurations.emplace(name, q);
+    }
+  }
+
+  // Every link's chain of parents reaches the root: a kinematic cycle (which urdfdom lets
+  // through when it is cut off from the root) would make PathFromRoot walk forever.
+  void RequireTree() const {
+    for (const auto& [start, first_joint] : parent_joint_of_link) {
+      std::vector<std::string> chain;  // joints walked from `start` towards the root
+      std::string current = start;
+      while (current != kRootLink) {
+        auto it = parent_joint_of_link.find(current);
+        if (it == parent_joint_of_link.end()) break;  // a dangling parent: reported elsewhere
+        const auto seen = std::find(chain.begin(), chain.end(), it->second);
+        if (seen != chain.end()) {
+          std::string cycle;
+          for (auto j = seen; j != chain.end(); ++j)
+            cycle += "'" + *j + "' -> ";
+          Fail(StrCat("joints form a kinematic cycle: ", cycle, "'", *seen,
+                      "' (a robot model must be a tree rooted at '", kRootLink, "')."));
+        }
+        chain.push_back(it->second);
+        current = joints.at(it->second).parent_link;
+      }
     }
   }
 
@@ -399,19 +423,13 @@ RobotModel RobotModel::LoadDefault() {
 }
 
 RobotModel RobotModel::LoadFromFile(const std::filesystem::path& urdf_path) {
-  std::error_code error;
-  if (!std::filesystem::is_regular_file(urdf_path, error)) {
-    throw LoadError(StrCat("Cannot load robot model: URDF file '", urdf_path.string(),
-                           "' does not exist or is not a regular file."));
+  std::string text;
+  try {
+    text = ReadTextFile(urdf_path, "URDF file");
+  } catch (const LoadError& e) {
+    throw LoadError(StrCat("Cannot load robot model: ", e.what()));
   }
-  std::ifstream file(urdf_path);
-  std::stringstream text;
-  text << file.rdbuf();
-  if (!file) {
-    throw LoadError(
-        StrCat("Cannot load robot model: URDF file '", urdf_path.string(), "' could not be read."));
-  }
-  return LoadFromString(text.str(), urdf_path.string());
+  return LoadFromString(text, urdf_path.string());
 }
 
 RobotModel RobotModel::LoadFromString(const std::string& urdf_xml, std::string_view source_name) {
@@ -450,6 +468,7 @@ RobotModel RobotModel::LoadFromString(const std::string& urdf_xml, std::string_v
     impl->RequireLink(*model, link);
   }
   impl->ReadJoints(*model);
+  impl->RequireTree();
   impl->BuildArmChain();
 
   // Fingertip point: midpoint of the two fingertip frames at hand_motor_joint = 0, in the palm.

@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "egress/hsr_interface/error.h"
+#include "egress/hsr_interface/text_file.h"
 
 namespace egress::perception {
 
@@ -92,9 +93,13 @@ std::string Trim(const std::string& s) {
 
 OccupancyGrid OccupancyGrid::LoadMapServerYaml(const std::filesystem::path& yaml_path) {
   const std::string file = yaml_path.string();
-  std::ifstream in(yaml_path);
-  if (!in)
-    throw LoadError(StrCat("Cannot load map: '", file, "' does not exist or cannot be read."));
+  std::string text;
+  try {
+    text = ReadTextFile(yaml_path, "map YAML");
+  } catch (const LoadError& e) {
+    throw LoadError(StrCat("Cannot load map: ", e.what()));
+  }
+  std::istringstream in(text);
   std::map<std::string, YamlField> fields;
   std::string line;
   for (int number = 1; std::getline(in, line); ++number) {

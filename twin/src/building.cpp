@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "egress/hsr_interface/error.h"
+#include "egress/hsr_interface/text_file.h"
 #include "yaml_field_reader.h"
 
 namespace egress::twin {
@@ -358,11 +359,8 @@ BuildingDescription DescribeBuildingFromString(const WorldDescription& world,
 BuildingDescription DescribeBuilding(const WorldDescription& world,
                                      const std::filesystem::path& building_yaml) {
   if (building_yaml.empty()) return Describe(world, BuildingYaml{});
-  std::ifstream in(building_yaml);
-  if (!in) throw LoadError(StrCat(building_yaml.string(), ": cannot open the building file"));
-  std::stringstream text;
-  text << in.rdbuf();
-  return DescribeBuildingFromString(world, text.str(), building_yaml.string());
+  return DescribeBuildingFromString(world, ReadTextFile(building_yaml, "building file"),
+                                    building_yaml.string());
 }
 
 void AssignActuator(const WorldDescription& world, const std::string& model,

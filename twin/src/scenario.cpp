@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "egress/hsr_interface/error.h"
+#include "egress/hsr_interface/text_file.h"
 #include "egress/twin/mobility.h"
 #include "people/approach_and_wait.h"
 #include "people/evacuate.h"
@@ -610,12 +611,8 @@ void Scenario::ValidateAgainst(const WorldDescription& world) const {
 }
 
 Scenario LoadScenario(const std::filesystem::path& path) {
-  if (!std::filesystem::exists(path))
-    throw LoadError(StrCat(path.string(), ": no such scenario file"));
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  Scenario s = LoadScenarioFromString(text.str(), path.string(), path.parent_path());
+  Scenario s = LoadScenarioFromString(ReadTextFile(path, "scenario file"), path.string(),
+                                      path.parent_path());
   s.source = path;
   return s;
 }

@@ -29,6 +29,7 @@
 #include <sdf/World.hh>
 
 #include "egress/hsr_interface/error.h"
+#include "egress/hsr_interface/text_file.h"
 
 namespace egress::twin {
 namespace {
@@ -316,12 +317,8 @@ WorldDescription LoadRoot(const sdf::Root& root, const sdf::Errors& errors,
 }  // namespace
 
 WorldDescription LoadSdfWorld(const std::filesystem::path& path) {
-  if (!fs::exists(path)) throw LoadError(StrCat(path.string(), ": no such world file"));
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  if (!in) throw LoadError(StrCat(path.string(), ": cannot read the world file"));
-  WorldDescription out = LoadSdfWorldFromString(text.str(), path.string(), path.parent_path());
+  WorldDescription out =
+      LoadSdfWorldFromString(ReadTextFile(path, "world file"), path.string(), path.parent_path());
   out.source = path;
   return out;
 }

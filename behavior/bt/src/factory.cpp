@@ -57,11 +57,8 @@ void BehaviorTreeFactory::RegisterStandIn(const std::string& id, NodeKind kind, 
 
 std::vector<std::string> BehaviorTreeFactory::RegisterStandInsFromModelFile(
     const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in) throw LogicError(Cat("model file '", path.string(), "' cannot be read"));
-  std::stringstream text;
-  text << in.rdbuf();
-  return RegisterStandInsFromModelText(text.str(), path.string());
+  return RegisterStandInsFromModelText(factory_detail::ReadTreeFile(path, "model file"),
+                                       path.string());
 }
 
 std::vector<std::string> BehaviorTreeFactory::RegisterStandInsFromModelText(
@@ -114,15 +111,10 @@ std::vector<const NodeManifest*> BehaviorTreeFactory::Manifests() const {
 }
 
 void BehaviorTreeFactory::RegisterTreesFromFile(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  if (!in)
-    throw LogicError(
-        Cat("behavior tree file '", path.string(), "' does not exist or cannot be read"));
-  std::stringstream text;
-  text << in.rdbuf();
+  const std::string text = factory_detail::ReadTreeFile(path, "behavior tree file");
   std::error_code error;
   std::vector<std::filesystem::path> stack = {std::filesystem::weakly_canonical(path, error)};
-  impl_->ReadDocument(text.str(), path.string(), path.parent_path(), stack);
+  impl_->ReadDocument(text, path.string(), path.parent_path(), stack);
 }
 
 void BehaviorTreeFactory::RegisterTreesFromText(const std::string& xml,

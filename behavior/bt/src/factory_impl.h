@@ -22,6 +22,15 @@ using tinyxml2::XMLDocument;
 using tinyxml2::XMLElement;
 
 constexpr int kMaxSubTreeDepth = 256;
+// The largest tree file read [bytes] (a FIFO, a device or a huge file is an error, not an
+// unbounded read). egress::bt stands alone, so this is its own reader.
+constexpr std::size_t kMaxTreeFileBytes = std::size_t{16} << 20;
+
+// The whole of `path`, a regular file of at most kMaxTreeFileBytes. `what` names it in errors
+// ("behavior tree file", "included file"), `where` prefixes them (the including element).
+// @throws LogicError.
+std::string ReadTreeFile(const std::filesystem::path& path, std::string_view what,
+                         const std::string& where = "");
 constexpr std::string_view kExplicitTags[] = {"Action", "Condition", "Control", "Decorator"};
 
 inline std::optional<NodeKind> ExplicitKind(std::string_view tag) {

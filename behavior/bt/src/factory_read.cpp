@@ -2,6 +2,29 @@
 
 namespace egress::bt {
 
+std::string factory_detail::ReadTreeFile(const std::filesystem::path& path, std::string_view what,
+                                         const std::string& where) {
+  std::error_code error;
+  const auto status = std::filesystem::status(path, error);
+  if (!std::filesystem::exists(status))
+    throw LogicError(Cat(where, what, " '", path.string(), "' does not exist"));
+  if (!std::filesystem::is_regular_file(status))
+    throw LogicError(Cat(where, what, " '", path.string(), "' is not a regular file"));
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw LogicError(Cat(where, what, " '", path.string(), "' cannot be read"));
+  std::string text;
+  char buffer[1 << 16];
+  while (in && text.size() <= kMaxTreeFileBytes) {
+    in.read(buffer, sizeof(buffer));
+    text.append(buffer, std::size_t(in.gcount()));
+  }
+  if (text.size() > kMaxTreeFileBytes)
+    throw LogicError(Cat(where, what, " '", path.string(), "' is larger than ", kMaxTreeFileBytes,
+                         " bytes, the most egress reads"));
+  if (in.bad()) throw LogicError(Cat(where, what, " '", path.string(), "' cannot be read"));
+  return text;
+}
+
 std::string BehaviorTreeFactory::Impl::Where(const std::string& file, const XMLElement* e) {
   return Cat(file, ":", e->GetLineNum(), ": ");
 }
@@ -81,13 +104,9 @@ void BehaviorTreeFactory::Impl::ReadInclude(const XMLElement* e, const std::stri
     throw LogicError(
         Cat(Where(file, e), "<include path=\"", path_attr, "\"> includes itself (a cycle)"));
   }
-  std::ifstream in(path);
-  if (!in)
-    throw LogicError(Cat(Where(file, e), "included file '", path.string(), "' cannot be read"));
-  std::stringstream text;
-  text << in.rdbuf();
+  const std::string text = ReadTreeFile(path, "included file", Where(file, e));
   include_stack.push_back(canonical);
-  ReadDocument(text.str(), path.string(), path.parent_path(), include_stack);
+  ReadDocument(text, path.string(), path.parent_path(), include_stack);
   include_stack.pop_back();
 }
 

@@ -30,8 +30,20 @@ struct Token {
   std::size_t column{0};  // 1-based
 };
 
+// A long script is quoted around the column only (a message is read, not a dump).
+constexpr std::size_t kQuotedScriptChars = 80;
+
 [[noreturn]] void SyntaxError(std::string_view code, std::string_view what, std::size_t column) {
-  throw LogicError(Cat("invalid script '", code, "': ", what, " at column ", column));
+  std::string quoted(code);
+  if (code.size() > kQuotedScriptChars) {
+    const std::size_t from =
+        std::min(column > kQuotedScriptChars / 2 ? column - kQuotedScriptChars / 2 : 0,
+                 code.size() - kQuotedScriptChars);
+    quoted = (from > 0 ? "..." : "") + std::string(code.substr(from, kQuotedScriptChars)) +
+             (from + kQuotedScriptChars < code.size() ? "..." : "");
+  }
+  throw LogicError(Cat("invalid script '", quoted, "' (", code.size(), " characters): ", what,
+                       " at column ", column));
 }
 
 std::vector<Token> Tokenize(std::string_view code) {
@@ -73,7 +85,11 @@ std::vector<Token> Tokenize(std::string_view code) {
               ++j;
           }
         }
-        value = std::stod(std::string(code.substr(i, j - i)));
+        try {
+          value = std::stod(std::string(code.substr(i, j - i)));
+        } catch (const std::out_of_range&) {
+          SyntaxError(code, "number out of range", column);
+        }
       }
       if (std::isalpha(static_cast<unsigned char>(at(j))) || at(j) == '_') {
         SyntaxError(code, "a number runs into a name", j + 1);
@@ -165,6 +181,7 @@ struct Script::Node {
   double number{0.0};
   std::vector<std::unique_ptr<Node>> children;
   std::vector<std::string> compare_ops;  // for kCompare: one per adjacent pair
+  std::size_t depth{1};                  // levels of this node's subtree (a leaf: 1)
 };
 
 namespace {
@@ -179,6 +196,14 @@ NodePtr MakeNode(Kind kind, std::string text = {}) {
   return node;
 }
 
+// Expressions nest at most this deep (parentheses, unary operators, chained assignments and
+// ternaries, long operator chains): parsing, evaluating and freeing a script recurse once per
+// level, and a script is a line of a tree file, not a program.
+constexpr std::size_t kMaxScriptDepth = 128;
+// Integers the script converts to (bitwise operators, integer blackboard entries) are exact
+// int64 values strictly inside +-2^63.
+constexpr double kInt64Limit = 9223372036854775808.0;  // 2^63
+
 class Parser {
  public:
   Parser(std::string_view code, std::vector<Token> tokens)
@@ -191,7 +216,7 @@ class Parser {
         Next();
         continue;
       }
-      sequence->children.push_back(ParseAssignment());
+      Add(*sequence, ParseAssignment());
       if (Peek().kind != Tok::kSemicolon && Peek().kind != Tok::kEnd) {
         Fail(Cat("unexpected '", Peek().text, "'"));
       }
@@ -206,14 +231,34 @@ class Parser {
   bool IsOp(std::string_view op) const { return Peek().kind == Tok::kOp && Peek().text == op; }
   [[noreturn]] void Fail(std::string_view what) const { SyntaxError(code_, what, Peek().column); }
 
+  // Appends `child` to `parent`, keeping the depth within kMaxScriptDepth.
+  void Add(Script::Node& parent, NodePtr child) {
+    parent.depth = std::max(parent.depth, child->depth + 1);
+    if (parent.depth > kMaxScriptDepth)
+      Fail(Cat("expression nested deeper than ", kMaxScriptDepth, " levels"));
+    parent.children.push_back(std::move(child));
+  }
+  // Counts the parser's own recursion (it recurses before the tree it builds is deep).
+  struct Nesting {
+    explicit Nesting(Parser& p) : parser(p) {
+      if (++parser.nesting_ > kMaxScriptDepth)
+        parser.Fail(Cat("expression nested deeper than ", kMaxScriptDepth, " levels"));
+    }
+    ~Nesting() { --parser.nesting_; }
+    Nesting(const Nesting&) = delete;
+    Nesting& operator=(const Nesting&) = delete;
+    Parser& parser;
+  };
+
   NodePtr ParseAssignment() {
+    const Nesting nesting(*this);
     if (Peek().kind == Tok::kIdent && tokens_[pos_ + 1].kind == Tok::kOp) {
       const std::string& op = tokens_[pos_ + 1].text;
       if (op == ":=" || op == "=" || op == "+=" || op == "-=" || op == "*=" || op == "/=") {
         auto node = MakeNode(Kind::kAssign, op);
-        node->children.push_back(MakeNode(Kind::kVariable, Next().text));
+        Add(*node, MakeNode(Kind::kVariable, Next().text));
         Next();
-        node->children.push_back(ParseAssignment());
+        Add(*node, ParseAssignment());
         return node;
       }
     }
@@ -221,15 +266,16 @@ class Parser {
   }
 
   NodePtr ParseTernary() {
+    const Nesting nesting(*this);
     NodePtr condition = ParseBinary(0);
     if (Peek().kind != Tok::kQuestion) return condition;
     Next();
     auto node = MakeNode(Kind::kTernary);
-    node->children.push_back(std::move(condition));
-    node->children.push_back(ParseTernary());
+    Add(*node, std::move(condition));
+    Add(*node, ParseTernary());
     if (Peek().kind != Tok::kColon) Fail("expected ':' in a ternary expression");
     Next();
-    node->children.push_back(ParseTernary());
+    Add(*node, ParseTernary());
     return node;
   }
 
@@ -254,26 +300,27 @@ class Parser {
     if (level == 2) {
       if (!matches()) return left;
       auto chain = MakeNode(Kind::kCompare);
-      chain->children.push_back(std::move(left));
+      Add(*chain, std::move(left));
       while (matches()) {
         chain->compare_ops.push_back(Next().text);
-        chain->children.push_back(ParseBinary(level + 1));
+        Add(*chain, ParseBinary(level + 1));
       }
       return chain;
     }
     while (matches()) {
       auto node = MakeNode(Kind::kBinary, Next().text);
-      node->children.push_back(std::move(left));
-      node->children.push_back(ParseBinary(level + 1));
+      Add(*node, std::move(left));
+      Add(*node, ParseBinary(level + 1));
       left = std::move(node);
     }
     return left;
   }
 
   NodePtr ParseUnary() {
+    const Nesting nesting(*this);
     if (IsOp("-") || IsOp("!") || IsOp("~")) {
       auto node = MakeNode(Kind::kUnary, Next().text);
-      node->children.push_back(ParseUnary());
+      Add(*node, ParseUnary());
       return node;
     }
     return ParsePrimary();
@@ -315,6 +362,7 @@ class Parser {
   std::string_view code_;
   std::vector<Token> tokens_;
   std::size_t pos_{0};
+  std::size_t nesting_{0};
 };
 
 // ---- evaluation
@@ -414,6 +462,8 @@ class Evaluator {
   std::int64_t Integer(const Value& v, std::string_view op) {
     const double d = Number(v, op);
     if (std::trunc(d) != d) Fail(Cat("operator '", op, "' needs an integer, got ", d));
+    if (!(std::abs(d) < kInt64Limit))
+      Fail(Cat("operator '", op, "': ", d, " is outside the 64-bit integer range"));
     return static_cast<std::int64_t>(d);
   }
 
@@ -499,7 +549,8 @@ class Evaluator {
     if (const double* d = std::get_if<double>(&value)) {
       // Keep integer and bool entries integer and bool when the value fits.
       const std::optional<Any> previous = exists ? env_.blackboard->GetAny(name) : std::nullopt;
-      if (previous && previous->IsType<std::int64_t>() && std::trunc(*d) == *d) {
+      if (previous && previous->IsType<std::int64_t>() && std::trunc(*d) == *d &&
+          std::abs(*d) < kInt64Limit) {
         stored = static_cast<std::int64_t>(*d);
       } else if (previous && previous->IsType<bool>() && (*d == 0.0 || *d == 1.0)) {
         stored = *d == 1.0;

@@ -299,6 +299,30 @@ TEST_F(FactoryTest, IncludesResolveRelativeToTheIncludingFile) {
   std::filesystem::remove_all(dir);
 }
 
+// Found by probing (kept as a regression test): an <include> of a device read without end.
+// Only regular files are read, and only up to the size cap.
+TEST_F(FactoryTest, IncludesOfDevicesOrHugeFilesAreRefused) {
+  const auto dir = egress::testing::TestTempPath("include_special");
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "zero.xml")
+      << "<root BTCPP_format='4'><include path='/dev/zero'/>"
+         "<BehaviorTree ID='Main'><AlwaysSuccess/></BehaviorTree></root>";
+  EXPECT_THAT([&] { factory.RegisterTreesFromFile(dir / "zero.xml"); },
+              ::testing::ThrowsMessage<LogicError>(::testing::AllOf(
+                  HasSubstr("zero.xml:1"), HasSubstr("'/dev/zero' is not a regular file"))));
+  EXPECT_THAT([&] { factory.RegisterTreesFromFile("/dev/zero"); },
+              ::testing::ThrowsMessage<LogicError>(HasSubstr("not a regular file")));
+  {
+    std::ofstream huge(dir / "huge.xml");
+    const std::string block(1 << 20, ' ');
+    for (int i = 0; i < 17; ++i)
+      huge << block;
+  }
+  EXPECT_THAT([&] { factory.RegisterTreesFromFile(dir / "huge.xml"); },
+              ::testing::ThrowsMessage<LogicError>(HasSubstr("is larger than")));
+  std::filesystem::remove_all(dir);
+}
+
 struct Pose2 {
   double x, y, yaw;
 };

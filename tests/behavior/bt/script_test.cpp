@@ -115,6 +115,44 @@ TEST_F(ScriptTest, SyntaxErrorsNameTheColumn) {
   EXPECT_THAT(ParseErrorOf("3 ? 1"), HasSubstr("expected ':'"));
 }
 
+// Hostile scripts (found by probing; kept as regression tests): nesting that would recurse
+// past the stack is refused by depth, a long script is quoted around the error only, and
+// numbers outside int64 are errors, not undefined conversions.
+TEST_F(ScriptTest, DeepLongOrHugeScriptsAreClearErrors) {
+  const std::string bangs = "x := " + std::string(200000, '!') + "1";
+  const std::string bang_error = ParseErrorOf(bangs);
+  EXPECT_THAT(bang_error, HasSubstr("nested deeper than 128 levels"));
+  EXPECT_THAT(bang_error, HasSubstr("(200006 characters)"));
+  EXPECT_LT(bang_error.size(), 300u);
+  std::string sum = "x := 1";
+  for (int i = 0; i < 100000; ++i)
+    sum += "+1";
+  EXPECT_THAT(ParseErrorOf(sum), HasSubstr("nested deeper than"));
+  EXPECT_THAT(ParseErrorOf(std::string(5000, '(') + "1" + std::string(5000, ')')),
+              HasSubstr("nested deeper than"));
+  EXPECT_THAT(ParseErrorOf("a := " + std::string(3000, '-') + "1"), HasSubstr("nested deeper"));
+  std::string assignments;
+  for (int i = 0; i < 3000; ++i)
+    assignments += "a := ";
+  EXPECT_THAT(ParseErrorOf(assignments + "1"), HasSubstr("nested deeper"));
+  std::string ternary;
+  for (int i = 0; i < 3000; ++i)
+    ternary += "1 ? ";
+  EXPECT_THAT(ParseErrorOf(ternary + "1"), HasSubstr("nested deeper"));
+  // A chain of 100 stays well inside the limit and evaluates.
+  std::string hundred = "1";
+  for (int i = 0; i < 99; ++i)
+    hundred += " + 1";
+  EXPECT_DOUBLE_EQ(Script::Parse(hundred)->Evaluate({board.get(), &enums}).Cast<double>(), 100.0);
+  EXPECT_THAT(ParseErrorOf("x := 1e999"), HasSubstr("number out of range"));
+  EXPECT_THAT(RuntimeErrorOf("1e300 | 1"), HasSubstr("outside the 64-bit integer range"));
+  EXPECT_THAT(RuntimeErrorOf("~9223372036854775808"), HasSubstr("outside the 64-bit integer"));
+  // An integer entry assigned a huge whole number becomes a double, not a wrapped integer.
+  board->Set("count", std::int64_t{3});
+  Script::Parse("count := 1e300")->Evaluate({board.get(), &enums});
+  EXPECT_EQ(board->Get<double>("count"), std::optional<double>(1e300));
+}
+
 TEST_F(ScriptTest, ConditionsRejectNonBooleanStrings) {
   board->Set("s", std::string("maybe"));
   EXPECT_THROW(Condition("s"), RuntimeError);

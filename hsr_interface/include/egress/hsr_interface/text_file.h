@@ -1,0 +1,24 @@
+#pragma once
+/// @file
+/// ReadTextFile: the one way egress reads a document the user names (a world, a scenario, a
+/// building, a robot model): only a regular file, and only up to a size cap, so that a path to
+/// a FIFO, a device (`/dev/zero`) or a huge file is a clear error instead of an unbounded read.
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+#include <string_view>
+
+namespace egress {
+
+/// The largest document egress reads [bytes]: far above any world, scenario or URDF (the
+/// largest shipped is well under 1 MiB), far below what would exhaust memory.
+inline constexpr std::size_t kMaxTextFileBytes = std::size_t{64} << 20;
+
+/// The whole content of `path`. `what` names the document in errors ("world file").
+/// @throws LoadError naming the path and `what` if it does not exist, is not a regular file,
+/// is larger than `max_bytes` or cannot be read.
+std::string ReadTextFile(const std::filesystem::path& path, std::string_view what,
+                         std::size_t max_bytes = kMaxTextFileBytes);
+
+}  // namespace egress
