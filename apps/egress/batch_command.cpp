@@ -389,8 +389,13 @@ void AddSimBatchCommand(CLI::App& sim_group) {
       ->add_option("scenarios", o->scenarios,
                    "scenario YAML files with a mission; FILE:N runs N trials of that one")
       ->required();
-  batch->add_option("--trials", o->trials, "trials per scenario")->capture_default_str();
-  batch->add_option("--jobs,-j", o->jobs, "worker processes")->capture_default_str();
+  // Bounded: the batch holds a result per trial (2e9 trials allocated gigabytes before any ran).
+  batch->add_option("--trials", o->trials, "trials per scenario")
+      ->capture_default_str()
+      ->check(CLI::Range(1, kMaxTrials));
+  batch->add_option("--jobs,-j", o->jobs, "worker processes")
+      ->capture_default_str()
+      ->check(CLI::Range(1, kMaxJobs));
   batch->add_option("--seed-base", o->seed_base, "trial i runs with seed seed-base + i")
       ->capture_default_str();
   batch->add_option("--out", o->out, "directory for trials.csv and batch.json")

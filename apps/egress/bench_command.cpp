@@ -127,12 +127,17 @@ void AddBenchCommand(CLI::App& app) {
       "plan", "Run the base planners over the planning suite (OMPL benchmark logs + CSV)");
   plan->add_option("--out", options->out, "output folder")->capture_default_str();
   plan->add_option("--planner", options->planners, "planners to run (default: all)");
-  plan->add_option("--runs", options->runs, "runs per planner and problem")->capture_default_str();
-  plan->add_option("--time", options->time, "time limit per run [s]")->capture_default_str();
+  plan->add_option("--runs", options->runs, "runs per planner and problem")
+      ->capture_default_str()
+      ->check(CLI::Range(1, kMaxTrials));
+  plan->add_option("--time", options->time, "time limit per run [s]")
+      ->capture_default_str()
+      ->check(FiniteIn(1e-3, 3600.0));
   plan->add_option("--reference", options->reference,
                    "folder holding movingai/ (default: EGRESS_REFERENCE_DIR)");
   plan->add_option("--movingai-problems", options->movingai_problems, "scenarios per MovingAI map")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::Range(0, kMaxTrials));
   plan->callback([options] {
     if (options->runs < 1 || options->time <= 0)
       throw CommandFailed("--runs must be >= 1 and --time > 0");

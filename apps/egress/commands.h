@@ -5,7 +5,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cmath>
+#include <cstdlib>
 #include <stdexcept>
+#include <string>
 
 namespace egress::apps {
 
@@ -15,6 +18,28 @@ class CommandFailed : public std::runtime_error {
  public:
   using std::runtime_error::runtime_error;
 };
+
+/// A CLI11 check for a real number in [lo, hi] that also refuses NaN and infinity (CLI11's own
+/// PositiveNumber and Range let NaN through: every comparison with it is false).
+inline CLI::Validator FiniteIn(double lo, double hi) {
+  const std::string range =
+      "[" + CLI::detail::to_string(lo) + ", " + CLI::detail::to_string(hi) + "]";
+  return CLI::Validator(
+      [lo, hi, range](std::string& text) -> std::string {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (text.empty() || end == nullptr || *end != '\0') return "'" + text + "' is not a number";
+        if (!std::isfinite(v) || v < lo || v > hi)
+          return "must be a finite number in " + range + ", not " + text;
+        return {};
+      },
+      "FINITE in " + range);
+}
+
+/// Bounds of batch sizes on the command line: trials (or runs) per scenario and worker
+/// processes.
+inline constexpr int kMaxTrials = 1'000'000;
+inline constexpr int kMaxJobs = 256;
 
 /// `egress --version`: the text printed (egress version, git revision, library versions).
 std::string VersionText();

@@ -65,9 +65,11 @@ void AddCostmapCommand(CLI::App& app) {
       ->check(CLI::ExistingFile);
   command->add_option("--out", options->out, "PNG to write")->capture_default_str();
   command->add_option("--robot-radius", options->robot_radius, "inscribed radius [m]")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(FiniteIn(0.0, 10.0));
   command->add_option("--inflation-radius", options->inflation_radius, "[m]")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(FiniteIn(0.0, 10.0));
   command->add_option("--doorway", options->doorways, "hinge x y latch x y [m] (repeatable)")
       ->expected(4)
       ->take_all();

@@ -400,8 +400,12 @@ void AddEvacCommand(CLI::App& app) {
   auto o = std::make_shared<StudyOptions>();
   study->add_option("scenario", o->scenario, "Scenario with evacuees and the robot's mission")
       ->required();
-  study->add_option("--trials", o->trials, "Seeds per condition")->capture_default_str();
-  study->add_option("--jobs", o->jobs, "Worker processes")->capture_default_str();
+  study->add_option("--trials", o->trials, "Seeds per condition")
+      ->capture_default_str()
+      ->check(CLI::Range(1, kMaxTrials));
+  study->add_option("--jobs", o->jobs, "Worker processes")
+      ->capture_default_str()
+      ->check(CLI::Range(1, kMaxJobs));
   study->add_option("--seed-base", o->seed_base, "Seed of the first trial")->capture_default_str();
   study->add_option("--out", o->out, "Output folder")->capture_default_str();
   study

@@ -250,7 +250,8 @@ void AddPlanCommand(CLI::App& app) {
       ->required()
       ->check(CLI::ExistingFile);
   plan->add_option("--resolution", options->resolution, "cell size for an SDF world [m]")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(FiniteIn(0.005, 10.0));
   plan->add_option("--start", options->start, "x y yaw [m, m, rad] in the map frame")
       ->required()
       ->expected(3);
@@ -260,7 +261,9 @@ void AddPlanCommand(CLI::App& app) {
   plan->add_option("--planner", options->planner,
                    "RRTConnect, RRTstar, PRMstar, BITstar, InformedRRTstar")
       ->capture_default_str();
-  plan->add_option("--budget", options->budget, "time budget [s]")->capture_default_str();
+  plan->add_option("--budget", options->budget, "time budget [s]")
+      ->capture_default_str()
+      ->check(FiniteIn(1e-3, 3600.0));
   plan->add_option("--server", options->server, "egress-navd address")->capture_default_str();
   plan->add_option("--token-file", options->token_file, "token for a remote server")
       ->check(CLI::ExistingFile);

@@ -309,11 +309,11 @@ void AddRos2Commands(CLI::App& app) {
   serve->add_flag("--lockstep", o->lockstep,
                   "Step the twin only once the brain has finished each control step (tests)");
   serve->add_option("--speed", o->speed, "Real-time factor without --lockstep")
-      ->check(CLI::Range(0.01, 100.0));
+      ->check(FiniteIn(0.01, 100.0));
   serve->add_option("--duration", o->duration, "Simulated seconds (default: the time limit)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(FiniteIn(1e-3, 1e7));
   serve->add_option("--wait", o->wait_s, "Seconds to wait for the brain (and each lock-step)")
-      ->check(CLI::Range(0.1, 3600.0));
+      ->check(FiniteIn(0.1, 3600.0));
   serve->add_option("--json", o->json, "Write the verdict as JSON");
   serve->add_flag("-q,--quiet", o->quiet, "Only the verdict");
   serve->callback([o] { ServeTwin(*o); });
@@ -343,9 +343,9 @@ void AddRos2Commands(CLI::App& app) {
       ->add_option("--command-timeout", o->command_timeout_s,
                    "Oldest a command may be when sent [s]: older goes out as zero (base) or "
                    "not at all (arm); the base is stopped if the brain goes quiet this long")
-      ->check(CLI::PositiveNumber);
+      ->check(FiniteIn(1e-3, 10.0));
   robot->add_option("--wait", o->wait_s, "Seconds to wait for the robot's sensors and clock")
-      ->check(CLI::Range(0.1, 3600.0));
+      ->check(FiniteIn(0.1, 3600.0));
   robot->add_flag("-q,--quiet", o->quiet, "Only errors");
   robot->callback([o] { RunRobot(*o); });
 }

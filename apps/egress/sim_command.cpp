@@ -273,13 +273,14 @@ void AddSimCommand(CLI::App& app) {
                   "place)");
   sim->add_option("--time-limit", o->time_limit, "with a world file: time limit [s]")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(FiniteIn(1e-3, 1e7));
   sim->add_option("--tree", o->tree, "with a world file: the mission tree (goal on {goal})")
       ->capture_default_str()
       ->check(CLI::ExistingFile);
   sim->add_option("--seed", o->seed, "seed (default: the scenario's)");
   sim->add_option("--duration", o->duration,
-                  "simulated seconds (default: the scenario's time limit)");
+                  "simulated seconds (default: the scenario's time limit)")
+      ->check(FiniteIn(1e-3, 1e7));
   sim->add_option("--driver", o->driver,
                   "who drives the robot: auto (brain if the scenario has a mission, else idle) | "
                   "brain | idle | dead-reckoning")

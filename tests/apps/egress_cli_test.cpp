@@ -86,6 +86,29 @@ TEST(EgressCliTest, ClearErrors) {
   EXPECT_NE(result.exit_code, 0);
 }
 
+// Found by probing (kept as regression tests): values that were accepted silently (a run of
+// NaN seconds, a batch of 2e9 trials that allocated gigabytes before any ran) are refused by
+// name before anything runs; CLI11's own range checks let NaN through.
+TEST(EgressCliTest, BadNumbersAreRefusedByName) {
+  const std::string s1 = (std::filesystem::path(EGRESS_OFFICE_MAP).parent_path().parent_path() /
+                          "scenarios/s1_nominal.yaml")
+                             .string();
+  for (const char* duration : {"0", "-1", "nan", "inf", "1e300", "abc"}) {
+    const Result result = RunEgress("sim run " + s1 + " --duration " + duration);
+    EXPECT_NE(result.exit_code, 0) << duration;
+    EXPECT_THAT(result.output, HasSubstr("--duration")) << duration;
+  }
+  Result result = RunEgress("sim batch " + s1 + " --trials 2000000000");
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_THAT(result.output, HasSubstr("--trials"));
+  result = RunEgress("sim batch " + s1 + " --jobs 0");
+  EXPECT_THAT(result.output, HasSubstr("--jobs"));
+  result = RunEgress("costmap --robot-radius nan");
+  EXPECT_THAT(result.output, HasSubstr("--robot-radius"));
+  result = RunEgress("twin serve --ros2 " + s1 + " --speed nan");
+  EXPECT_THAT(result.output, HasSubstr("--speed"));
+}
+
 // ---- egress bt
 
 std::string WriteTemp(const std::string& name, const std::string& text) {
