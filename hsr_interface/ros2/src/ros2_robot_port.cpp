@@ -26,6 +26,10 @@
 #include "egress/ros2/dds_node.h"
 
 namespace egress::ros2 {
+namespace {
+// How long a gripper goal waits for the controller's action server to be matched.
+constexpr std::chrono::milliseconds kGripperServerWait{2000};
+}  // namespace
 
 void Ros2RobotPortConfig::Validate() const {
   topics.Validate();
@@ -422,7 +426,13 @@ void Ros2RobotPort::DoSendGripperCommand(const GripperCommand& command) {
   const std::uint64_t id[2] = {m.goal_prefix, ++m.goals_sent};
   std::memcpy(request.goal_id().uuid().data(), id, sizeof(id));
   request.goal(goal.goal);
-  (goal.action == GripperGoal::Action::kGrasp ? m.grasp_goals : m.apply_force_goals)->Call(request);
+  auto& client = goal.action == GripperGoal::Action::kGrasp ? m.grasp_goals : m.apply_force_goals;
+  // A goal sent before the controller's action server is matched would be lost without a word.
+  if (!client->WaitForServer(kGripperServerWait))
+    throw std::runtime_error("gripper: no action server on " + client->service() + " after " +
+                             std::to_string(kGripperServerWait.count()) +
+                             " ms: the goal was not sent");
+  client->Call(request);
 }
 
 bool Ros2RobotPort::GripperConnected() const {

@@ -23,6 +23,7 @@
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <thread>
 #include <utility>
 
 #include <fastdds/rtps/common/WriteParams.h>
@@ -149,13 +150,23 @@ class ServiceClient final : public eprosima::fastdds::dds::DataReaderListener {
       callback_(info.related_sample_identity.sequence_number().to64long(), reply_);
     }
   }
-  /// Whether a server reads the requests and writes replies this client reads.
+  /// Whether a server reads the requests and writes replies this client reads (a request sent
+  /// before is lost: service topics are volatile, as in ROS 2).
   bool ServerMatched() const {
     eprosima::fastdds::dds::PublicationMatchedStatus out;
     eprosima::fastdds::dds::SubscriptionMatchedStatus in;
     writer_->get_publication_matched_status(out);
     reader_->get_subscription_matched_status(in);
     return out.current_count > 0 && in.current_count > 0;
+  }
+  /// Waits (wall time, bounded) until ServerMatched(); returns whether it is.
+  bool WaitForServer(std::chrono::milliseconds timeout) const {
+    const auto until = std::chrono::steady_clock::now() + timeout;
+    while (!ServerMatched()) {
+      if (std::chrono::steady_clock::now() >= until) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    return true;
   }
   const std::string& service() const { return service_; }
   ~ServiceClient() override;
@@ -198,6 +209,12 @@ class ServiceServer final : public eprosima::fastdds::dds::DataReaderListener {
   using Handler = std::function<Reply(const Request&)>;
   /// How long a reply waits for its client's reply reader to be matched (rmw_fastrtps: 100 ms).
   static constexpr std::chrono::milliseconds kClientMatchTimeout{100};
+  /// Whether a client writes requests here.
+  bool ClientMatched() const {
+    eprosima::fastdds::dds::SubscriptionMatchedStatus in;
+    reader_->get_subscription_matched_status(in);
+    return in.current_count > 0;
+  }
   void on_data_available(eprosima::fastdds::dds::DataReader* reader) override {
     eprosima::fastdds::dds::SampleInfo info;
     while (reader->take_next_sample(&request_, &info) == ReturnCode_t::RETCODE_OK) {

@@ -87,7 +87,8 @@ class Ros2RobotPort final : public RobotPort {
   /// how many times the watchdog stopped a base the brain had stopped commanding.
   int stale_base_commands() const;
   int watchdog_stops() const;
-  /// Whether the gripper controller's action servers are there (goals sent before are lost).
+  /// Whether the gripper controller's action servers are matched (a goal waits up to 2 s for
+  /// them, then fails with an error naming the action).
   bool GripperConnected() const;
   /// Gripper goals the controller accepted and refused so far.
   std::pair<int, int> gripper_goals() const;
@@ -98,7 +99,8 @@ class Ros2RobotPort final : public RobotPort {
   /// @throws InvalidArgument if `trajectory.start` is set and older than command_timeout_s.
   void DoSendArmTrajectory(const JointTrajectory& trajectory) override;
   /// A goal of the gripper controller's `apply_force` (grasp) or `grasp` (open) action
-  /// (GripperToRos). @throws InvalidArgument for a position command (no HSR action built).
+  /// (GripperToRos). @throws InvalidArgument for a position command (no HSR action built),
+  /// std::runtime_error if the action server is not matched within 2 s.
   void DoSendGripperCommand(const GripperCommand& command) override;
 
  private:
