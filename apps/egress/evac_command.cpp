@@ -39,8 +39,6 @@ constexpr const char* kConditions[] = {"no_robot", "robot", "propped_open"};
 constexpr double kDoorwayBlockRadiusM = 2.0;
 // The robot is in a doorway within this of the door line (and within its jambs) [m].
 constexpr double kInDoorwayM = 0.5;
-// Where the robot is parked for the conditions without it: this far beyond the world [m].
-constexpr double kParkedOffSceneM = 50.0;
 
 struct StudyOptions {
   std::string scenario;
@@ -64,10 +62,8 @@ twin::Scenario ConditionScenario(const twin::Scenario& base, const twin::WorldDe
   if (condition == "robot") return s;
   s.mission.reset();
   s.start_place.clear();
-  double max_x = 0.0;
-  for (const auto& f : twin::CalcFloorFootprints(world))
-    max_x = std::max(max_x, f.X_WF.x + f.size.norm());
-  s.robot_start = {max_x + kParkedOffSceneM, 0.0, 0.0};
+  s.robot_off_scene = true;
+  s.robot_start = twin::OffScenePose(world);
   s.success.clear();
   if (condition == "propped_open") {
     for (auto& door : s.doors) {

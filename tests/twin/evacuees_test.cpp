@@ -159,7 +159,7 @@ TEST(EvacueesTest, AMixedGroupOpensTheClinicsShutDoorsItself) {
   // deferred to someone nearer the actuator who was not in reach of it.
   const std::string text =
       "world: clinic.sdf\n"
-      "robot: {start: {x: 80.0, y: 0.0}}\n"
+      "robot: {off_scene: true}\n"
       "people:\n"
       "  - {name: r, behavior: evacuate, route: [door_d, door_e, exit_door], start: [2.8, -3.0],"
       " goal: [21.0, 11.5], count: 20, trigger: {at: 5.0},"

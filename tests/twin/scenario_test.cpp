@@ -69,6 +69,37 @@ TEST(ScenarioTest, ErrorsNameFileLineAndField) {
   ExpectError("world: [lab.sdf\n", "bad.yaml:", "not valid YAML");
   ExpectError(Minimal("randomize: {hold_angle_deg: [30, 120]}\n"), "randomize.hold_angle_deg",
               "(0, 90]");
+  // Found by probing (issue 19): a seed past 2^64 was converted undefined; a time limit of
+  // 1e300 s bounded nothing.
+  ExpectError(Minimal("seed: 1e30\n"), "seed", "at most 2^53");
+  ExpectError(Minimal("time_limit: 1e300\n"), "time_limit", "at most 86400 s");
+}
+
+// A start or goal inside a wall, or far outside the building, is refused by field at load (it
+// was found only at the run's time limit, 42 s and more of simulation later).
+TEST(ScenarioTest, StartAndGoalMustBeOnTheFloorOfTheBuilding) {
+  const auto error_of = [](const std::string& robot) {
+    const Scenario s = LoadScenarioFromString("world: lab.sdf\nrobot: " + robot + "\n", "v.yaml",
+                                              WorldsDir() / "lab");
+    try {
+      s.ValidateAgainst(LoadSdfWorld(s.world_file));
+    } catch (const LoadError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(error_of("{start: {x: 0, y: 1}, goal: {x: 0, y: 5}}"), "");
+  // The lab's south wall is a 6.2 x 0.1 m box centred at (0, -1.05).
+  EXPECT_THAT(error_of("{start: {x: 1, y: -1.05}}"),
+              ::testing::AllOf(HasSubstr("'robot.start'"), HasSubstr("inside model")));
+  EXPECT_THAT(error_of("{start: {x: 0, y: 1}, goal: {x: 50, y: 50}}"),
+              ::testing::AllOf(HasSubstr("'robot.goal'"), HasSubstr("outside the building")));
+  // Just outside the walls (an exit's far side) is a place a robot may go.
+  EXPECT_EQ(error_of("{start: {x: 0, y: 1}, goal: {x: 0, y: 9}}"), "");
+  // A robot that takes no part is said so, not parked by hand far away; it has no start.
+  EXPECT_EQ(error_of("{off_scene: true}"), "");
+  ExpectError("world: lab.sdf\nrobot: {off_scene: true, start: {x: 0, y: 0}}\n", "robot",
+              "no start or goal");
 }
 
 TEST(ScenarioTest, ValidationAgainstTheWorldNamesTheField) {

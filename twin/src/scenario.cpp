@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 
@@ -18,6 +19,12 @@
 #include "yaml_field_reader.h"
 
 namespace egress::twin {
+namespace {
+constexpr double kMaxExactSeed = 9007199254740992.0;  // 2^53
+// A simulated run is bounded: a day of simulated time is far past any scenario's need.
+constexpr double kMaxTimeLimitSec = 86400.0;
+}  // namespace
+
 namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
@@ -186,13 +193,24 @@ Scenario Parse(const YAML::Node& root, const FieldReader& r,
   if (root["seed"]) {
     const double seed = r.NonNegative(root["seed"], "seed");
     if (seed != std::floor(seed)) r.Fail(root["seed"], "seed", "must be a whole number");
+    // Seeds are read as doubles: above 2^53 they are no longer exact (and past 2^64 the
+    // conversion was undefined).
+    if (seed > kMaxExactSeed) r.Fail(root["seed"], "seed", "must be at most 2^53");
     s.seed = std::uint64_t(seed);
   }
-  if (root["time_limit"]) s.time_limit = r.Positive(root["time_limit"], "time_limit");
+  if (root["time_limit"]) {
+    s.time_limit = r.Positive(root["time_limit"], "time_limit");
+    if (s.time_limit > kMaxTimeLimitSec)
+      r.Fail(root["time_limit"], "time_limit", StrCat("must be at most ", kMaxTimeLimitSec, " s"));
+  }
 
   const YAML::Node robot = r.Required(root, "", "robot");
-  r.CheckKeys(robot, "robot", {"start", "goal"});
-  if (const YAML::Node start = r.Required(robot, "robot", "start"); start["place"]) {
+  r.CheckKeys(robot, "robot", {"start", "goal", "off_scene"});
+  if (robot["off_scene"]) s.robot_off_scene = r.Bool(robot["off_scene"], "robot.off_scene");
+  if (s.robot_off_scene) {
+    if (robot["start"] || robot["goal"])
+      r.Fail(robot, "robot", "a robot off the scene has no start or goal");
+  } else if (const YAML::Node start = r.Required(robot, "robot", "start"); start["place"]) {
     r.CheckKeys(start, "robot.start", {"place"});
     s.start_place = r.String(start["place"], "robot.start.place");
   } else {
@@ -545,8 +563,70 @@ std::string ToString(const PredicateSpec& p) {
   return "unknown";
 }
 
+namespace {
+
+// A robot pose may lie outside the walls' bounds by at most this [m] (a goal outside the exit
+// door is fine; one 50 m off is a typo, and the run would only find out at its time limit).
+constexpr double kPoseOutsideWallsMaxM = 5.0;
+
+// The static box or upright cylinder whose floor outline holds p, or null. Meshes are skipped:
+// their outline is only their bounds, which may cover free floor.
+const ShapeDescription* ShapeHolding(const WorldDescription& world, const Eigen::Vector2d& p) {
+  for (const auto& shape : world.shapes) {
+    if (shape.kind != ShapeKind::kBox && shape.kind != ShapeKind::kCylinder) continue;
+    const auto f = CalcFloorFootprint(shape);
+    if (!f) continue;
+    if (shape.kind == ShapeKind::kCylinder) {
+      if ((p - Eigen::Vector2d(f->X_WF.x, f->X_WF.y)).norm() < shape.radius) return &shape;
+      continue;
+    }
+    const Eigen::Vector2d q = f->X_WF.Inverse() * p;
+    if (std::abs(q.x()) < 0.5 * f->size.x() && std::abs(q.y()) < 0.5 * f->size.y()) return &shape;
+  }
+  return nullptr;
+}
+
+// The robot's start or goal: on the floor, not inside a wall, not far outside the building.
+void CheckRobotPose(const WorldDescription& world, const std::string& where,
+                    const std::string& field, const std::string& place, const Pose2& X_WB) {
+  const std::string what =
+      StrCat(where, ": field '", field, "'", place.empty() ? "" : " (place '" + place + "')", ": (",
+             X_WB.x, ", ", X_WB.y, ")");
+  if (const ShapeDescription* shape = ShapeHolding(world, {X_WB.x, X_WB.y}))
+    throw LoadError(StrCat(what, " is inside model '", shape->model, "'"));
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector2d hi = -lo;
+  for (const FloorFootprint& f : CalcFloorFootprints(world)) {
+    for (const double sx : {-0.5, 0.5}) {
+      for (const double sy : {-0.5, 0.5}) {
+        const Eigen::Vector2d corner = f.X_WF * Eigen::Vector2d(sx * f.size.x(), sy * f.size.y());
+        lo = lo.cwiseMin(corner);
+        hi = hi.cwiseMax(corner);
+      }
+    }
+  }
+  if (!(lo.x() <= hi.x())) return;  // no walls: nothing to be outside of
+  const Eigen::Vector2d p(X_WB.x, X_WB.y);
+  const double outside = (p - p.cwiseMax(lo).cwiseMin(hi)).norm();
+  if (outside > kPoseOutsideWallsMaxM)
+    throw LoadError(StrCat(what, " is ", outside, " m outside the building's walls (x ", lo.x(),
+                           "..", hi.x(), ", y ", lo.y(), "..", hi.y(), " m; at most ",
+                           kPoseOutsideWallsMaxM, " m allowed)"));
+}
+
+}  // namespace
+
+Pose2 OffScenePose(const WorldDescription& world) {
+  double max_x = 0.0;
+  for (const auto& f : CalcFloorFootprints(world))
+    max_x = std::max(max_x, f.X_WF.x + f.size.norm());
+  return {max_x + kOffSceneDistanceM, 0.0, 0.0};
+}
+
 void Scenario::ValidateAgainst(const WorldDescription& world) const {
   const std::string where = source.string();
+  if (!robot_off_scene) CheckRobotPose(world, where, "robot.start", start_place, robot_start);
+  if (goal) CheckRobotPose(world, where, "robot.goal", goal_place, *goal);
   for (std::size_t i = 0; i < doors.size(); ++i) {
     const auto& op = doors[i];
     const std::string f = StrCat(where, ": field 'doors[", i, "]");

@@ -130,6 +130,7 @@ TwinModel::TwinModel(Scenario scenario, WorldDescription world,
   config_.Validate();
   building_ = DescribeScenarioBuilding(scenario_, world_);
   ApplyBuildingDefaults(building_, &scenario_);
+  if (scenario_.robot_off_scene) scenario_.robot_start = OffScenePose(world_);
   scenario_.ValidateAgainst(world_);
   CompileStatics(scenario_, world_, compiled_.get());
   CompileDoors(scenario_, world_, compiled_.get());

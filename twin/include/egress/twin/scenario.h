@@ -204,6 +204,9 @@ struct Scenario {
   std::uint64_t seed{1};
   double time_limit{120.0};  ///< [s]
   Pose2 robot_start;
+  /// The robot takes no part (`robot: {off_scene: true}`): it stands kOffSceneDistanceM beyond
+  /// the world (OffScenePose), with no goal; e.g. a crowd study's runs without a robot.
+  bool robot_off_scene{false};
   std::optional<Pose2> goal;
   double goal_tolerance{0.3};  ///< [m]
   std::vector<DoorOperatorSpec> doors;
@@ -240,6 +243,11 @@ void ApplyBuildingDefaults(const BuildingDescription& building, Scenario* scenar
 /// are the building's. @throws LoadError naming the field for a place the building lacks.
 Scenario DrawScenarioVariant(const Scenario& scenario, const BuildingDescription& building,
                              std::uint64_t seed);
+
+/// How far beyond the world a robot off the scene stands [m].
+inline constexpr double kOffSceneDistanceM = 50.0;
+/// Where a robot off the scene stands: kOffSceneDistanceM beyond the world's walls in +x.
+Pose2 OffScenePose(const WorldDescription& world);
 
 /// Reads a scenario YAML file. @throws LoadError naming file, line and field.
 Scenario LoadScenario(const std::filesystem::path& path);
