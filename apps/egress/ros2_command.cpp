@@ -327,7 +327,7 @@ void AddRos2Commands(CLI::App& app) {
       ->check(CLI::ExistingFile);
   robot->add_option("--start", o->start, "With --map: the initial pose (place or x;y;yaw)");
   robot->add_option("--goal", o->goal, "With --map: the goal (place or x;y;yaw)");
-  robot->add_option("--tree", o->tree, "With --map: the mission tree (default go_to.xml)")
+  robot->add_option("--tree,--mission", o->tree, "With --map: the mission tree (default go_to.xml)")
       ->check(CLI::ExistingFile);
   robot->add_option("--seed", o->seed, "The scenario's seed (its start pose and variant)");
   robot->add_option("--domain", o->domain, "ROS_DOMAIN_ID")->check(CLI::Range(0, 232));

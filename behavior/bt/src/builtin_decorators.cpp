@@ -315,9 +315,12 @@ void RegisterBuiltinDecorators(BehaviorTreeFactory& factory) {
                             std::move(builder));
   };
   using Mode = MapResultNode::Mode;
-  for (auto [id, mode] :
+  for (const auto& [id, mapping] :
        {std::pair{"Inverter", Mode::kInvert}, std::pair{"ForceSuccess", Mode::kForceSuccess},
         std::pair{"ForceFailure", Mode::kForceFailure}}) {
+    // A copy: a lambda may capture a structured binding only from C++20 compilers that
+    // implement it (clang 14 does not).
+    const Mode mode = mapping;
     reg(id, {}, [mode](const std::string& n, NodeConfig c) {
       return std::make_unique<MapResultNode>(n, std::move(c), mode);
     });

@@ -480,8 +480,11 @@ class Evaluator {
         std::holds_alternative<std::string>(b)) {
       return std::get<std::string>(a) + std::get<std::string>(b);
     }
-    if (op == "&&") return (Truthy(a) & Truthy(b)) ? 1.0 : 0.0;  // both sides evaluated
-    if (op == "||") return (Truthy(a) | Truthy(b)) ? 1.0 : 0.0;
+    if (op == "&&" || op == "||") {
+      // Both sides are evaluated and must be booleans (BT.CPP does not short-circuit).
+      const bool x = Truthy(a), y = Truthy(b);
+      return (op == "&&" ? x && y : x || y) ? 1.0 : 0.0;
+    }
     if (op == "|") return double(Integer(a, op) | Integer(b, op));
     if (op == "^") return double(Integer(a, op) ^ Integer(b, op));
     if (op == "&") return double(Integer(a, op) & Integer(b, op));
