@@ -7,8 +7,10 @@
 #   ./egress.sh build      configure and build only
 #   ./egress.sh sanitize   build with AddressSanitizer + UBSan in build-asan/ and run the tests
 #   ./egress.sh bench      build and run the Google Benchmark programs in bench/
+#   ./egress.sh fuzz [S]   build the libFuzzer targets (clang, ASan + UBSan) in build-fuzz/ and
+#                          run each for S seconds (default 60) from seeds of the project's files
 # Environment: EGRESS_BUILD_DIR (default build), EGRESS_ASAN_BUILD_DIR (default build-asan),
-# EGRESS_JOBS (default: all cores),
+# EGRESS_FUZZ_BUILD_DIR (default build-fuzz), EGRESS_JOBS (default: all cores),
 # EGRESS_REFERENCE_DIR (shared reference data; default ../shared/reference).
 set -euo pipefail
 
@@ -22,8 +24,8 @@ die() { printf '[egress] error: %s\n' "$*" >&2; exit 1; }
 # Installs the packages of deps/apt-packages.txt that are not installed yet. Silent when
 # everything is present; apt-get update runs only when something must be installed.
 install_deps() {
-  local wanted missing=()
-  wanted=$(sed -e 's/#.*//' -e '/^[[:space:]]*$/d' deps/apt-packages.txt)
+  local wanted missing=() list=${1:-deps/apt-packages.txt}
+  wanted=$(sed -e 's/#.*//' -e '/^[[:space:]]*$/d' "$list")
   for pkg in $wanted; do
     if ! dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q 'install ok installed'; then
       missing+=("$pkg")
@@ -114,10 +116,29 @@ case "$command" in
       "$program"
     done
     ;;
+  fuzz)
+    seconds=${2:-60}
+    [[ "$seconds" =~ ^[0-9]+$ ]] && [ "$seconds" -gt 0 ] || die "fuzz: SECONDS must be a positive integer"
+    install_deps
+    install_deps deps/apt-packages-fuzz.txt
+    fuzz_dir=${EGRESS_FUZZ_BUILD_DIR:-build-fuzz}
+    if [ ! -f "$fuzz_dir/CMakeCache.txt" ]; then
+      say "configuring $fuzz_dir (clang, libFuzzer, ASan + UBSan)"
+      mkdir -p "$fuzz_dir"
+      generator=()
+      command -v ninja >/dev/null && generator=(-G Ninja)
+      CC=clang CXX=clang++ cmake -S . -B "$fuzz_dir" "${generator[@]}" -DEGRESS_FUZZ=ON \
+        -DEGRESS_BUILD_TESTS=OFF -DEGRESS_BUILD_BENCHMARKS=OFF -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+        >"$fuzz_dir/configure.log" 2>&1 || { cat "$fuzz_dir/configure.log"; die "configure failed"; }
+    fi
+    say "building the fuzz targets in $fuzz_dir ($jobs jobs)"
+    cmake --build "$fuzz_dir" -j "$jobs" --target egress_fuzz
+    fuzz/run_fuzzers.sh "$fuzz_dir" "$seconds"
+    ;;
   help|-h|--help)
-    sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'
+    sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'
     ;;
   *)
-    die "unknown sub-command '$command' (try: demo, test, deps, build, sanitize, bench)"
+    die "unknown sub-command '$command' (try: demo, test, deps, build, sanitize, bench, fuzz)"
     ;;
 esac

@@ -335,10 +335,16 @@ WorldDescription LoadSdfWorldFromString(const std::string& sdf_xml, std::string_
 }
 
 TriangleMesh LoadTriangleMesh(const std::filesystem::path& path, const Eigen::Vector3d& scale) {
+  // Read by egress (a regular file, bounded), parsed by assimp from memory: a mesh URI naming a
+  // device or a FIFO must not be read without end. Collision needs no materials or textures.
+  const std::string bytes = ReadTextFile(path, "mesh file");
+  std::string hint = path.extension().string();
+  if (!hint.empty()) hint.erase(0, 1);
   Assimp::Importer importer;
-  const aiScene* scene =
-      importer.ReadFile(path.string(), aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                                           aiProcess_PreTransformVertices);
+  const aiScene* scene = importer.ReadFileFromMemory(
+      bytes.data(), bytes.size(),
+      aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices,
+      hint.c_str());
   if (scene == nullptr || scene->mNumMeshes == 0) {
     throw LoadError(StrCat(path.string(), ": cannot read mesh: ", importer.GetErrorString()));
   }
