@@ -154,16 +154,32 @@ struct RobotModel::Impl {
     }
   }
 
-  // Every link's chain of parents reaches the root: a kinematic cycle (which urdfdom lets
-  // through when it is cut off from the root) would make PathFromRoot walk forever.
-  void RequireTree() const {
-    for (const auto& [start, first_joint] : parent_joint_of_link) {
+  // The joints form a tree: checked on the XML, before urdfdom reads it. urdfdom lets a loop
+  // of joints cut off from the root through, builds it of shared pointers that never free each
+  // other (a leak), and walking up from one of its links never ends.
+  void RequireJointTree(const std::string& urdf_xml) const {
+    tinyxml2::XMLDocument doc;
+    if (doc.Parse(urdf_xml.c_str(), urdf_xml.size()) != tinyxml2::XML_SUCCESS)
+      Fail(StrCat("XML error: ", doc.ErrorStr()));
+    const tinyxml2::XMLElement* robot = doc.RootElement();
+    if (robot == nullptr) Fail("the document has no root element.");
+    std::map<std::string, std::pair<std::string, std::string>> parent_of;  // child -> joint, parent
+    for (const auto* joint = robot->FirstChildElement("joint"); joint != nullptr;
+         joint = joint->NextSiblingElement("joint")) {
+      const auto* parent = joint->FirstChildElement("parent");
+      const auto* child = joint->FirstChildElement("child");
+      const char* name = joint->Attribute("name");
+      if (parent == nullptr || child == nullptr || name == nullptr) continue;  // urdfdom says
+      const char* parent_link = parent->Attribute("link");
+      const char* child_link = child->Attribute("link");
+      if (parent_link == nullptr || child_link == nullptr) continue;
+      parent_of[child_link] = {name, parent_link};
+    }
+    for (const auto& [start, unused] : parent_of) {
       std::vector<std::string> chain;  // joints walked from `start` towards the root
-      std::string current = start;
-      while (current != kRootLink) {
-        auto it = parent_joint_of_link.find(current);
-        if (it == parent_joint_of_link.end()) break;  // a dangling parent: reported elsewhere
-        const auto seen = std::find(chain.begin(), chain.end(), it->second);
+      for (auto it = parent_of.find(start); it != parent_of.end();
+           it = parent_of.find(it->second.second)) {
+        const auto seen = std::find(chain.begin(), chain.end(), it->second.first);
         if (seen != chain.end()) {
           std::string cycle;
           for (auto j = seen; j != chain.end(); ++j)
@@ -171,8 +187,7 @@ struct RobotModel::Impl {
           Fail(StrCat("joints form a kinematic cycle: ", cycle, "'", *seen,
                       "' (a robot model must be a tree rooted at '", kRootLink, "')."));
         }
-        chain.push_back(it->second);
-        current = joints.at(it->second).parent_link;
+        chain.push_back(it->second.first);
       }
     }
   }
@@ -438,6 +453,7 @@ RobotModel RobotModel::LoadFromString(const std::string& urdf_xml, std::string_v
   if (urdf_xml.find_first_not_of(" \t\r\n") == std::string::npos)
     impl->Fail("the document is empty.");
 
+  impl->RequireJointTree(urdf_xml);
   urdf::ModelInterfaceSharedPtr model;
   std::string parser_messages;
   {
@@ -468,7 +484,6 @@ RobotModel RobotModel::LoadFromString(const std::string& urdf_xml, std::string_v
     impl->RequireLink(*model, link);
   }
   impl->ReadJoints(*model);
-  impl->RequireTree();
   impl->BuildArmChain();
 
   // Fingertip point: midpoint of the two fingertip frames at hand_motor_joint = 0, in the palm.

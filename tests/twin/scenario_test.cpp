@@ -73,6 +73,10 @@ TEST(ScenarioTest, ErrorsNameFileLineAndField) {
   // 1e300 s bounded nothing.
   ExpectError(Minimal("seed: 1e30\n"), "seed", "at most 2^53");
   ExpectError(Minimal("time_limit: 1e300\n"), "time_limit", "at most 86400 s");
+  // Found by the fuzzer: a complex key escaped as yaml-cpp's raw "bad conversion".
+  ExpectError(Minimal("? [robot_dyaw]\n: 1\n"), "bad.yaml:4", "a key must be a plain name");
+  ExpectError(Minimal("mission: {tree: ../../behavior/trees/go_to.xml, blackboard: {? [a]: 1}}\n"),
+              "mission.blackboard", "plain name");
 }
 
 // A start or goal inside a wall, or far outside the building, is refused by field at load (it

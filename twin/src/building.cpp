@@ -104,7 +104,7 @@ BuildingYaml ParseYaml(const WorldDescription& world, const std::string& text,
   if (const YAML::Node places = root["places"]) {
     if (!places.IsMap()) reader.Fail(places, "places", "expected a mapping of place names");
     for (const auto& kv : places) {
-      const std::string name = kv.first.as<std::string>();
+      const std::string name = reader.Key(kv.first, "places");
       const std::string field = "places." + name;
       reader.CheckKeys(kv.second, field, {"x", "y", "yaw", "yaw_deg", "kind"});
       BuildingPlace place;
@@ -134,7 +134,7 @@ BuildingYaml ParseYaml(const WorldDescription& world, const std::string& text,
   if (const YAML::Node doors = root["doors"]) {
     if (!doors.IsMap()) reader.Fail(doors, "doors", "expected a mapping of door models");
     for (const auto& kv : doors) {
-      const std::string name = kv.first.as<std::string>();
+      const std::string name = reader.Key(kv.first, "doors");
       const std::string field = "doors." + name;
       if (world.FindDoor(name) == nullptr)
         reader.Fail(
@@ -148,7 +148,7 @@ BuildingYaml ParseYaml(const WorldDescription& world, const std::string& text,
     if (!actuators.IsMap())
       reader.Fail(actuators, "actuators", "expected a mapping of actuator models");
     for (const auto& kv : actuators) {
-      const std::string name = kv.first.as<std::string>();
+      const std::string name = reader.Key(kv.first, "actuators");
       const std::string field = "actuators." + name;
       if (world.ShapesOfModel(name).empty())
         reader.Fail(

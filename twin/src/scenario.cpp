@@ -134,7 +134,7 @@ PredicateSpec ParsePredicate(const FieldReader& r, const YAML::Node& node,
     return p;
   }
   if (!node.IsMap() || node.size() != 1) r.Fail(node, field, "expected one predicate");
-  const std::string key = node.begin()->first.as<std::string>();
+  const std::string key = r.Key(node.begin()->first, field);
   const YAML::Node value = node.begin()->second;
   const std::string sub = field + "." + key;
   if (key == "cross_door" || key == "door_open_when_crossed" || key == "button_pressed" ||
@@ -476,7 +476,7 @@ Scenario Parse(const YAML::Node& root, const FieldReader& r,
     if (const YAML::Node bb = mission["blackboard"]) {
       if (!bb.IsMap()) r.Fail(bb, "mission.blackboard", "expected a mapping of key: value");
       for (const auto& kv : bb) {
-        const std::string key = kv.first.as<std::string>();
+        const std::string key = r.Key(kv.first, "mission.blackboard");
         if (!kv.second.IsScalar())
           r.Fail(kv.second, "mission.blackboard." + key, "expected a scalar value");
         m.blackboard[key] = kv.second.Scalar();

@@ -22,10 +22,11 @@ class FieldReader {
   [[noreturn]] void Fail(const YAML::Node& node, const std::string& field,
                          const std::string& message) const {
     // StrCat, not "literal" + std::string: GCC 12 warns falsely (-Wrestrict) on that.
+    const std::string what =
+        field.empty() ? StrCat("top level: ", message) : StrCat("field '", field, "': ", message);
     if (node.IsDefined() && node.Mark().line >= 0)
-      throw LoadError(
-          StrCat(source_, ":", node.Mark().line + 1, ": field '", field, "': ", message));
-    throw LoadError(StrCat(source_, ": field '", field, "': ", message));
+      throw LoadError(StrCat(source_, ":", node.Mark().line + 1, ": ", what));
+    throw LoadError(StrCat(source_, ": ", what));
   }
 
   // Refuses keys outside `allowed`, so a typo never becomes a silent default.
@@ -33,7 +34,7 @@ class FieldReader {
                  const std::set<std::string>& allowed) const {
     if (!map.IsMap()) Fail(map, field, "expected a mapping");
     for (const auto& kv : map) {
-      const std::string key = kv.first.as<std::string>();
+      const std::string key = Key(kv.first, field);
       if (allowed.count(key) == 0) {
         std::string list;
         for (const auto& a : allowed)
@@ -41,6 +42,13 @@ class FieldReader {
         Fail(kv.first, Join(field, key), "unknown field (expected one of: " + list + ")");
       }
     }
+  }
+
+  // A mapping's key as a name. A complex key (`? [a, b]`) is no name: said by line, not
+  // yaml-cpp's raw "bad conversion".
+  std::string Key(const YAML::Node& key, const std::string& field) const {
+    if (!key.IsScalar()) Fail(key, field, "a key must be a plain name");
+    return key.Scalar();
   }
 
   static std::string Join(const std::string& parent, const std::string& key) {
