@@ -35,9 +35,14 @@ SdfMap RasterizeSdfWorld(const twin::WorldDescription& world, double resolution,
   // Snap the bounds to the cell grid so walls on whole metres land on cell edges.
   lo = (lo / resolution).array().floor() * resolution;
   hi = (hi / resolution).array().ceil() * resolution;
+  ThrowUnless(lo.allFinite() && hi.allFinite(), world.source.string(),
+              ": the walls' and furniture's bounds are not finite (a shape of infinite or NaN "
+              "size or pose)");
+  // A double, not an integer: a world of absurd extent must give its count, not overflow it.
   const double cells = ((hi - lo) / resolution).prod();
-  ThrowUnless(cells <= double(max_cells), world.source.string(), ": the world needs ",
-              std::int64_t(cells), " cells at ", resolution, " m, more than the limit ", max_cells);
+  ThrowUnless(cells <= double(max_cells), world.source.string(), ": the world (x ", lo.x(), "..",
+              hi.x(), ", y ", lo.y(), "..", hi.y(), " m) needs ", cells, " cells at ", resolution,
+              " m, more than the limit ", max_cells);
   SdfMap out{perception::OccupancyGrid::FromBoxes(boxes, lo, hi, resolution), {}};
   for (const auto& d : world.doors) {
     const twin::BuildingDoor door = twin::DescribeDoor(d);

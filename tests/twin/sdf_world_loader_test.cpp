@@ -167,6 +167,41 @@ TEST(SdfWorldLoaderTest, MalformedSdfNamesFileAndLine) {
   }
 }
 
+// Found by probing (issue 19): degenerate or absurd shapes were accepted and failed later
+// without a file or field (a zero plane normal, a negative radius, a box 1e300 m long, door
+// limits of 1e300 rad). Each is refused by model and collision.
+TEST(SdfWorldLoaderTest, DegenerateShapesAreRefusedByName) {
+  const auto error_of = [](const std::string& geometry) {
+    const std::string sdf =
+        "<?xml version='1.0'?><sdf version='1.9'><world name='w'><model name='m'>"
+        "<static>true</static><link name='l'><collision name='c'><geometry>" +
+        geometry + "</geometry></collision></link></model></world></sdf>";
+    try {
+      LoadSdfWorldFromString(sdf, "shapes.sdf");
+    } catch (const LoadError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(error_of("<box><size>1 1 1</size></box>"), "");
+  for (const char* bad :
+       {"<box><size>1e300 0.1 2</size></box>", "<box><size>1 0 1</size></box>",
+        "<cylinder><radius>-1</radius><length>2</length></cylinder>",
+        "<cylinder><radius>0.2</radius><length>nan</length></cylinder>",
+        "<sphere><radius>0</radius></sphere>", "<plane><normal>0 0 0</normal></plane>"}) {
+    const std::string error = error_of(bad);
+    EXPECT_THAT(error, HasSubstr("shapes.sdf: model 'm' collision 'c'")) << bad;
+  }
+  std::string door = DoorSdf("<box><size>1 0.05 2</size></box>");
+  door.replace(door.find("<upper>1.5</upper>"), 18, "<upper>1e300</upper>");
+  try {
+    LoadSdfWorldFromString(door, "door.sdf");
+    ADD_FAILURE() << "a door limit of 1e300 rad was accepted";
+  } catch (const LoadError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("within +-2 pi rad"));
+  }
+}
+
 TEST(SdfWorldLoaderTest, MeshCollisionFromObjRelativeToTheWorldFile) {
   const auto dir = egress::testing::TestTempPath("mesh_world");
   std::filesystem::create_directories(dir);

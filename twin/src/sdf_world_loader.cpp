@@ -33,6 +33,12 @@
 
 namespace egress::twin {
 namespace {
+// No shape of a building is larger, nor further from its origin, than this [m]: anything past
+// it is a typo (or an attack) that would make every map of the world absurd.
+constexpr double kMaxShapeExtentM = 1000.0;
+}  // namespace
+
+namespace {
 
 namespace fs = std::filesystem;
 
@@ -195,7 +201,15 @@ class WorldReader {
     }
     door.X_WL = X_WLeaf * ResolvePose(*box, source_, where + " leaf collision");
     door.leaf_size = ToEigen(box->Geom()->BoxShape()->Size());
+    if (!(door.leaf_size.allFinite() && door.leaf_size.minCoeff() > 0.0 &&
+          door.leaf_size.maxCoeff() <= kMaxShapeExtentM))
+      throw LoadError(StrCat(source_, ": ", where, ": the leaf's box size must be in (0, ",
+                             kMaxShapeExtentM, "] m"));
     const double lower = axis->Lower(), upper = axis->Upper();
+    if (!(std::abs(lower) <= 2 * M_PI && std::abs(upper) <= 2 * M_PI)) {
+      throw LoadError(StrCat(source_, ": ", where, ": limits [", lower, ", ", upper,
+                             "] must be finite angles within +-2 pi rad"));
+    }
     if (!(lower <= 0.0 && upper >= 0.0) || lower == upper) {
       throw LoadError(StrCat(source_, ": ", where, ": limits [", lower, ", ", upper,
                              "] must contain the closed position 0"));
@@ -240,7 +254,10 @@ class WorldReader {
         break;
       case sdf::GeometryType::PLANE: {
         shape.kind = ShapeKind::kPlane;
-        const Eigen::Vector3d n = ToEigen(geom.PlaneShape()->Normal()).normalized();
+        const Eigen::Vector3d normal = ToEigen(geom.PlaneShape()->Normal());
+        if (!(normal.allFinite() && normal.norm() > 1e-9))
+          throw LoadError(StrCat(source_, ": ", where, ": plane normal must be a non-zero vector"));
+        const Eigen::Vector3d n = normal.normalized();
         // Frame S with its z axis along the normal.
         const Eigen::Quaterniond q =
             Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), n);
@@ -252,7 +269,11 @@ class WorldReader {
         shape.kind = ShapeKind::kMesh;
         const sdf::Mesh& mesh = *geom.MeshShape();
         const fs::path file = ResolveMeshUri(mesh.Uri(), mesh.FilePath(), where);
-        shape.mesh = std::make_shared<TriangleMesh>(LoadTriangleMesh(file, ToEigen(mesh.Scale())));
+        const Eigen::Vector3d scale = ToEigen(mesh.Scale());
+        if (!(scale.allFinite() && scale.cwiseAbs().minCoeff() > 0.0 &&
+              scale.cwiseAbs().maxCoeff() <= kMaxShapeExtentM))
+          throw LoadError(StrCat(source_, ": ", where, ": mesh scale must be finite and non-zero"));
+        shape.mesh = std::make_shared<TriangleMesh>(LoadTriangleMesh(file, scale));
         break;
       }
       default:
@@ -261,9 +282,35 @@ class WorldReader {
                                     "cylinder, sphere, plane, mesh)"));
         return;
     }
-    if (shape.kind == ShapeKind::kBox && !(shape.box_size.minCoeff() > 0.0)) {
-      throw LoadError(StrCat(source_, ": ", where, ": box size must be positive"));
+    const auto require_size = [&](double value, const char* what) {
+      if (!(value > 0.0 && value <= kMaxShapeExtentM))
+        throw LoadError(StrCat(source_, ": ", where, ": ", what, " ", value, " must be in (0, ",
+                               kMaxShapeExtentM, "] m"));
+    };
+    switch (shape.kind) {
+      case ShapeKind::kBox:
+        require_size(shape.box_size.x(), "box size x");
+        require_size(shape.box_size.y(), "box size y");
+        require_size(shape.box_size.z(), "box size z");
+        break;
+      case ShapeKind::kCylinder:
+        require_size(shape.radius, "cylinder radius");
+        require_size(shape.length, "cylinder length");
+        break;
+      case ShapeKind::kSphere:
+        require_size(shape.radius, "sphere radius");
+        break;
+      case ShapeKind::kPlane:
+        if (!(shape.plane_size.allFinite() && shape.plane_size.minCoeff() >= 0.0))
+          throw LoadError(StrCat(source_, ": ", where, ": plane size must be finite and >= 0"));
+        break;
+      case ShapeKind::kMesh:
+        break;
     }
+    if (!shape.X_WS.translation().allFinite() || !shape.X_WS.rotation().allFinite() ||
+        shape.X_WS.translation().cwiseAbs().maxCoeff() > kMaxShapeExtentM)
+      throw LoadError(StrCat(source_, ": ", where, ": its pose must be finite and within ",
+                             kMaxShapeExtentM, " m of the origin"));
     out_.shapes.push_back(std::move(shape));
   }
 
