@@ -66,6 +66,8 @@ std::vector<Token> Tokenize(std::string_view code) {
         while (std::isxdigit(static_cast<unsigned char>(at(j))))
           ++j;
         if (j == i + 2) SyntaxError(code, "hexadecimal literal without digits", column);
+        // At most 16 hex digits (64 bits); longer ones overflowed std::stoull (found by fuzzing).
+        if (j - i - 2 > 16) SyntaxError(code, "hexadecimal literal longer than 64 bits", column);
         value = double(std::stoull(std::string(code.substr(i + 2, j - i - 2)), nullptr, 16));
       } else {
         while (std::isdigit(static_cast<unsigned char>(at(j))))

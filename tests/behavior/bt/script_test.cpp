@@ -145,6 +145,10 @@ TEST_F(ScriptTest, DeepLongOrHugeScriptsAreClearErrors) {
     hundred += " + 1";
   EXPECT_DOUBLE_EQ(Script::Parse(hundred)->Evaluate({board.get(), &enums}).Cast<double>(), 100.0);
   EXPECT_THAT(ParseErrorOf("x := 1e999"), HasSubstr("number out of range"));
+  // Found by the fuzzer: a long hexadecimal literal threw std::out_of_range out of the parser.
+  EXPECT_THAT(ParseErrorOf("0X" + std::string(40, '4')), HasSubstr("longer than 64 bits"));
+  EXPECT_DOUBLE_EQ(Script::Parse("0xFFFF")->Evaluate({board.get(), &enums}).Cast<double>(),
+                   65535.0);
   EXPECT_THAT(RuntimeErrorOf("1e300 | 1"), HasSubstr("outside the 64-bit integer range"));
   EXPECT_THAT(RuntimeErrorOf("~9223372036854775808"), HasSubstr("outside the 64-bit integer"));
   // An integer entry assigned a huge whole number becomes a double, not a wrapped integer.
