@@ -173,7 +173,13 @@ struct RobotModel::Impl {
       const char* parent_link = parent->Attribute("link");
       const char* child_link = child->Attribute("link");
       if (parent_link == nullptr || child_link == nullptr) continue;
-      parent_of[child_link] = {name, parent_link};
+      if (std::string_view(parent_link) == child_link)
+        Fail(StrCat("joint '", name, "' (line ", joint->GetLineNum(), ") has link '", child_link,
+                    "' as both its parent and its child."));
+      const auto [it, added] = parent_of.try_emplace(child_link, name, parent_link);
+      if (!added)
+        Fail(StrCat("link '", child_link, "' is the child of two joints, '", it->second.first,
+                    "' and '", name, "' (line ", joint->GetLineNum(), "): a link has one parent."));
     }
     for (const auto& [start, unused] : parent_of) {
       std::vector<std::string> chain;  // joints walked from `start` towards the root

@@ -308,6 +308,18 @@ TEST(RobotModelLoadTest, AKinematicCycleIsNamedNotWalkedForever) {
   EXPECT_THAT(message, HasSubstr("kinematic cycle"));
   EXPECT_THAT(message, HasSubstr("'loop_ab'"));
   EXPECT_THAT(message, HasSubstr("'loop_ba'"));
+  // Found by the fuzzer: a joint from a link to itself, or a second parent, leaked urdfdom's
+  // model (shared pointers owning each other) and is refused on the XML first.
+  std::string self = DefaultUrdfText();
+  self = ReplaceAll(self, "</robot>", R"(<link name="loop_a"/>
+    <joint name="loop_aa" type="fixed"><parent link="loop_a"/><child link="loop_a"/></joint>
+    </robot>)");
+  EXPECT_THAT(LoadErrorOf(self), HasSubstr("'loop_a' as both its parent and its child"));
+  std::string two = DefaultUrdfText();
+  two = ReplaceAll(two, "</robot>", R"(<link name="extra"/>
+    <joint name="second_parent" type="fixed"><parent link="extra"/><child link="base_link"/></joint>
+    </robot>)");
+  EXPECT_THAT(LoadErrorOf(two), HasSubstr("link 'base_link' is the child of two joints"));
 }
 
 TEST(RobotModelLoadTest, FootprintRadiusFollowsTheBaseCylinder) {

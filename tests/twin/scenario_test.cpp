@@ -75,6 +75,9 @@ TEST(ScenarioTest, ErrorsNameFileLineAndField) {
   ExpectError(Minimal("time_limit: 1e300\n"), "time_limit", "at most 86400 s");
   // Found by the fuzzer: a complex key escaped as yaml-cpp's raw "bad conversion".
   ExpectError(Minimal("? [robot_dyaw]\n: 1\n"), "bad.yaml:4", "a key must be a plain name");
+  // ... and a scalar where a mapping belongs escaped as yaml-cpp's raw BadSubscript.
+  ExpectError("world: lab.sdf\nrobot:\n  start: here\n", "bad.yaml:3",
+              "operator[] call on a scalar");
   ExpectError(Minimal("mission: {tree: ../../behavior/trees/go_to.xml, blackboard: {? [a]: 1}}\n"),
               "mission.blackboard", "plain name");
 }

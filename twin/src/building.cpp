@@ -351,7 +351,9 @@ BuildingDoor DescribeDoor(const DoorDescription& d) {
 BuildingDescription DescribeBuildingFromString(const WorldDescription& world,
                                                const std::string& building_yaml,
                                                const std::string& source_name) {
-  BuildingDescription b = Describe(world, ParseYaml(world, building_yaml, source_name));
+  BuildingDescription b = Describe(world, FieldReader{source_name}.Guard([&] {
+    return ParseYaml(world, building_yaml, source_name);
+  }));
   b.yaml_source = source_name;
   return b;
 }

@@ -707,7 +707,7 @@ Scenario LoadScenarioFromString(const std::string& yaml, std::string_view source
     throw LoadError(StrCat(source_name, ":", e.mark.line + 1, ": not valid YAML: ", e.msg));
   }
   if (!root.IsMap()) throw LoadError(StrCat(source_name, ": a scenario is a YAML mapping"));
-  Scenario s = Parse(root, reader, base_dir);
+  Scenario s = reader.Guard([&] { return Parse(root, reader, base_dir); });
   s.source = std::string(source_name);
   return s;
 }

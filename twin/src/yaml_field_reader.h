@@ -29,6 +29,18 @@ class FieldReader {
     throw LoadError(StrCat(source_, ": ", what));
   }
 
+  // Runs `read`, naming by line any error yaml-cpp lets out of it (a subscript on a scalar, a
+  // bad conversion): none may escape as yaml-cpp's own exception and abort a program.
+  template <class F>
+  auto Guard(F read) const -> decltype(read()) {
+    try {
+      return read();
+    } catch (const YAML::Exception& e) {
+      if (e.mark.is_null()) throw LoadError(StrCat(source_, ": ", e.msg));
+      throw LoadError(StrCat(source_, ":", e.mark.line + 1, ": ", e.msg));
+    }
+  }
+
   // Refuses keys outside `allowed`, so a typo never becomes a silent default.
   void CheckKeys(const YAML::Node& map, const std::string& field,
                  const std::set<std::string>& allowed) const {
