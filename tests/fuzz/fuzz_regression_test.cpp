@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,13 @@ std::string Read(const fs::path& path) {
 }
 
 class FuzzRegressionTest : public ::testing::TestWithParam<NamedTarget> {};
+
+}  // namespace
+
+// The target's name in test listings, not gtest's byte dump.
+void PrintTo(const NamedTarget& target, std::ostream* out) { *out << target.name; }
+
+namespace {
 
 TEST_P(FuzzRegressionTest, KeptInputsAndSeedsRunCleanly) {
   const NamedTarget target = GetParam();
