@@ -8,6 +8,7 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <sstream>
 
 #include <console_bridge/console.h>
@@ -163,6 +164,11 @@ struct RobotModel::Impl {
       Fail(StrCat("XML error: ", doc.ErrorStr()));
     const tinyxml2::XMLElement* robot = doc.RootElement();
     if (robot == nullptr) Fail("the document has no root element.");
+    std::set<std::string, std::less<>> links;
+    for (const auto* link = robot->FirstChildElement("link"); link != nullptr;
+         link = link->NextSiblingElement("link")) {
+      if (const char* name = link->Attribute("name")) links.insert(name);
+    }
     std::map<std::string, std::pair<std::string, std::string>> parent_of;  // child -> joint, parent
     for (const auto* joint = robot->FirstChildElement("joint"); joint != nullptr;
          joint = joint->NextSiblingElement("joint")) {
@@ -173,6 +179,12 @@ struct RobotModel::Impl {
       const char* parent_link = parent->Attribute("link");
       const char* child_link = child->Attribute("link");
       if (parent_link == nullptr || child_link == nullptr) continue;
+      // urdfdom fails on an undeclared link only after linking part of its tree, and leaks it.
+      for (const char* link : {parent_link, child_link}) {
+        if (!links.contains(link))
+          Fail(StrCat("joint '", name, "' (line ", joint->GetLineNum(), ") names link '", link,
+                      "', which the model does not declare."));
+      }
       if (std::string_view(parent_link) == child_link)
         Fail(StrCat("joint '", name, "' (line ", joint->GetLineNum(), ") has link '", child_link,
                     "' as both its parent and its child."));

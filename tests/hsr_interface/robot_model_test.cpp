@@ -320,6 +320,13 @@ TEST(RobotModelLoadTest, AKinematicCycleIsNamedNotWalkedForever) {
     <joint name="second_parent" type="fixed"><parent link="extra"/><child link="base_link"/></joint>
     </robot>)");
   EXPECT_THAT(LoadErrorOf(two), HasSubstr("link 'base_link' is the child of two joints"));
+  std::string ghost = DefaultUrdfText();
+  ghost = ReplaceAll(ghost, "</robot>", R"(
+    <joint name="to_ghost" type="fixed"><parent link="base_link"/><child link="ghost"/></joint>
+    </robot>)");
+  EXPECT_THAT(LoadErrorOf(ghost), HasSubstr("joint 'to_ghost'"));
+  EXPECT_THAT(LoadErrorOf(ghost),
+              HasSubstr("names link 'ghost', which the model does not declare"));
 }
 
 TEST(RobotModelLoadTest, FootprintRadiusFollowsTheBaseCylinder) {
