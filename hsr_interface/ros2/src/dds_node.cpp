@@ -35,23 +35,41 @@ std::string ActionSendGoalService(std::string_view ros_action) {
   return std::string(ros_action) + "/_action/send_goal";
 }
 
-void MatchedReaders::on_publication_matched(dds::DataWriter*,
-                                            const dds::PublicationMatchedStatus& info) {
+void ReplyGate::on_publication_matched(dds::DataWriter*,
+                                       const dds::PublicationMatchedStatus& info) {
   const auto reader = eprosima::fastrtps::rtps::iHandle2GUID(info.last_subscription_handle);
+  std::vector<std::function<void()>> ready;
   {
     const std::lock_guard<std::mutex> lock(mutex_);
-    if (info.current_count_change > 0)
+    if (info.current_count_change > 0) {
       readers_.insert(reader);
-    else if (info.current_count_change < 0)
+      for (auto it = held_.begin(); it != held_.end();) {
+        if (it->first == reader) {
+          ready.push_back(std::move(it->second));
+          it = held_.erase(it);
+        } else {
+          ++it;
+        }
+      }
+    } else if (info.current_count_change < 0) {
       readers_.erase(reader);
+    }
   }
-  changed_.notify_all();
+  for (auto& send : ready)
+    send();
 }
 
-bool MatchedReaders::WaitFor(const eprosima::fastrtps::rtps::GUID_t& reader,
-                             std::chrono::milliseconds timeout) {
-  std::unique_lock<std::mutex> lock(mutex_);
-  return changed_.wait_for(lock, timeout, [&] { return readers_.count(reader) > 0; });
+void ReplyGate::SendWhenMatched(const eprosima::fastrtps::rtps::GUID_t& reader,
+                                std::function<void()> send) {
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (reader != eprosima::fastrtps::rtps::GUID_t::unknown() && readers_.count(reader) == 0) {
+      if (held_.size() >= kMaxHeldReplies) held_.erase(held_.begin());
+      held_.emplace_back(reader, std::move(send));
+      return;
+    }
+  }
+  send();
 }
 
 namespace {

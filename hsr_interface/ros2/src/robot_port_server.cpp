@@ -264,17 +264,16 @@ std::optional<std::string> RobotPortServer::brain_status() const {
 }
 
 bool RobotPortServer::BrainConnected() const {
-  // Every sensor topic read, the base command and the gripper's goals written: a brain matched
-  // on some topics only would miss the first readings of the others, or lose its first goals
-  // (volatile topics keep nothing for late readers).
+  // Every sensor topic read and the base command written: a brain matched on some topics only
+  // would miss the first readings of the others (volatile topics keep nothing for late
+  // readers). Its gripper goals wait for their server themselves (Ros2RobotPort).
   const Impl& m = *impl_;
   const bool sensors =
       m.scan->MatchedSubscriptions() > 0 && m.odometry->MatchedSubscriptions() > 0 &&
       m.joints->MatchedSubscriptions() > 0 && m.depth->MatchedSubscriptions() > 0 &&
       m.camera_info->MatchedSubscriptions() > 0 && m.tf->MatchedSubscriptions() > 0 &&
       m.clock->MatchedSubscriptions() > 0;
-  return sensors && m.cmd_vel->MatchedPublications() > 0 && m.grasp_goals->ClientMatched() &&
-         m.apply_force_goals->ClientMatched();
+  return sensors && m.cmd_vel->MatchedPublications() > 0;
 }
 
 std::vector<std::string> RobotPortServer::TakeRejected() {

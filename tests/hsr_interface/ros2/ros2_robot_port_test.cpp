@@ -69,6 +69,9 @@ struct Bridge {
   // go before discovery completes). Each retry a nanosecond later, as a new reading: the server
   // publishes odometry and joint states only when they are new.
   void Deliver(const SensorSnapshot& s) {
+    // The brain's command writers matched too: a command sent before its reader is matched is
+    // lost (volatile topics), and the tests send commands right after delivering.
+    ASSERT_TRUE(Eventually([&] { return server.BrainConnected(); }));
     Duration later{0};
     ASSERT_TRUE(Eventually([&] {
       SensorSnapshot copy = s;

@@ -25,6 +25,7 @@
 #include <string_view>
 #include <thread>
 #include <utility>
+#include <vector>
 
 #include <fastdds/rtps/common/WriteParams.h>
 #include <fastdds/dds/domain/DomainParticipant.hpp>
@@ -183,21 +184,24 @@ class ServiceClient final : public eprosima::fastdds::dds::DataReaderListener {
   Reply reply_;  // reused: only the listener thread touches it
 };
 
-/// The readers a writer is matched with, as they come and go (a service server waits, as
-/// rmw_fastrtps does, for the requesting client's reply reader before it replies: a reply
-/// written before that match would be lost).
-class MatchedReaders final : public eprosima::fastdds::dds::DataWriterListener {
+/// The readers a service's reply writer is matched with, and the replies held for a client
+/// whose reply reader it has not matched yet (a reply written before that match would be lost;
+/// rmw_fastrtps waits for it in the replying thread, but a reply written from a listener must
+/// not block the thread that may deliver the match: it is held and sent on the match).
+class ReplyGate final : public eprosima::fastdds::dds::DataWriterListener {
  public:
   void on_publication_matched(
       eprosima::fastdds::dds::DataWriter* writer,
       const eprosima::fastdds::dds::PublicationMatchedStatus& info) override;
-  /// Waits (wall time, bounded) until `reader` is matched; returns whether it is.
-  bool WaitFor(const eprosima::fastrtps::rtps::GUID_t& reader, std::chrono::milliseconds timeout);
+  /// Runs `send` now if `reader` is matched (or unknown), else once it is. At most
+  /// kMaxHeldReplies are held; the oldest is dropped past that.
+  void SendWhenMatched(const eprosima::fastrtps::rtps::GUID_t& reader, std::function<void()> send);
+  static constexpr std::size_t kMaxHeldReplies = 64;
 
  private:
   std::mutex mutex_;
-  std::condition_variable changed_;
   std::set<eprosima::fastrtps::rtps::GUID_t> readers_;
+  std::vector<std::pair<eprosima::fastrtps::rtps::GUID_t, std::function<void()>>> held_;
 };
 
 /// Serves a ROS 2 service: `handler` answers each request, on Fast DDS's listener thread.
@@ -207,8 +211,6 @@ class ServiceServer final : public eprosima::fastdds::dds::DataReaderListener {
   using Request = typename RequestType::type;
   using Reply = typename ReplyType::type;
   using Handler = std::function<Reply(const Request&)>;
-  /// How long a reply waits for its client's reply reader to be matched (rmw_fastrtps: 100 ms).
-  static constexpr std::chrono::milliseconds kClientMatchTimeout{100};
   /// Whether a client writes requests here.
   bool ClientMatched() const {
     eprosima::fastdds::dds::SubscriptionMatchedStatus in;
@@ -219,13 +221,13 @@ class ServiceServer final : public eprosima::fastdds::dds::DataReaderListener {
     eprosima::fastdds::dds::SampleInfo info;
     while (reader->take_next_sample(&request_, &info) == ReturnCode_t::RETCODE_OK) {
       if (!info.valid_data) continue;
-      Reply reply = handler_(request_);
-      const auto& client_reader = info.related_sample_identity.writer_guid();
-      if (client_reader != eprosima::fastrtps::rtps::GUID_t::unknown())
-        matched_.WaitFor(client_reader, kClientMatchTimeout);
-      eprosima::fastrtps::rtps::WriteParams params;
-      params.related_sample_identity(info.sample_identity);
-      writer_->write(&reply, params);
+      auto reply = std::make_shared<Reply>(handler_(request_));
+      const auto identity = info.sample_identity;
+      gate_.SendWhenMatched(info.related_sample_identity.writer_guid(), [this, reply, identity] {
+        eprosima::fastrtps::rtps::WriteParams params;
+        params.related_sample_identity(identity);
+        writer_->write(reply.get(), params);
+      });
     }
   }
   ~ServiceServer() override;
@@ -235,7 +237,7 @@ class ServiceServer final : public eprosima::fastdds::dds::DataReaderListener {
   ServiceServer(DdsNode* node, Handler handler) : node_(node), handler_(std::move(handler)) {}
   DdsNode* node_;
   Handler handler_;
-  MatchedReaders matched_;
+  ReplyGate gate_;
   eprosima::fastdds::dds::DataWriter* writer_{nullptr};
   eprosima::fastdds::dds::DataReader* reader_{nullptr};
   Request request_;
@@ -295,8 +297,8 @@ class DdsNode {
     const auto [request, reply] = DdsServiceTopicNames(ros_service);
     std::unique_ptr<ServiceServer<RequestType, ReplyType>> server(
         new ServiceServer<RequestType, ReplyType>(this, std::move(handler)));
-    server->writer_ = CreateWriter(reply, std::make_unique<ReplyType>(), QosProfile::Default(),
-                                   &server->matched_);
+    server->writer_ =
+        CreateWriter(reply, std::make_unique<ReplyType>(), QosProfile::Default(), &server->gate_);
     server->reader_ =
         CreateReader(request, std::make_unique<RequestType>(), QosProfile::Default(), server.get());
     return server;
@@ -345,6 +347,7 @@ ServiceClient<RequestType, ReplyType>::~ServiceClient() {
 
 template <class RequestType, class ReplyType>
 ServiceServer<RequestType, ReplyType>::~ServiceServer() {
+  if (writer_ != nullptr) writer_->set_listener(nullptr);  // no held reply sent from here on
   if (reader_ != nullptr) node_->DeleteReader(reader_);
   if (writer_ != nullptr) node_->DeleteWriter(writer_);
 }
