@@ -51,7 +51,9 @@ class FuzzRegressionTest : public ::testing::TestWithParam<NamedTarget> {};
 }  // namespace
 
 // The target's name in test listings, not gtest's byte dump.
-void PrintTo(const NamedTarget& target, std::ostream* out) { *out << target.name; }
+void PrintTo(const NamedTarget& target, std::ostream* out) {
+  *out << target.name;
+}
 
 namespace {
 
