@@ -13,7 +13,6 @@
 /// thread-safe (Ros2RobotPort copies the message under a mutex).
 
 #include <chrono>
-#include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <map>
