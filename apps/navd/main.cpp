@@ -1,5 +1,8 @@
 // egress-navd: the navigation service (gRPC). Loopback only unless --allow-remote with a token.
 
+#include <sys/resource.h>
+
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <fstream>
@@ -33,6 +36,26 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--max-map-cells", config.max_map_cells, "largest map accepted [cells]")
       ->capture_default_str();
+  app.add_option("--data-root", config.data_root,
+                 "directory request file paths are confined to (default: none, paths refused)")
+      ->check(CLI::ExistingDirectory);
+  app.add_option("--max-cached-cells", config.max_cached_cells,
+                 "world cache cap [cells]; least recently used worlds are evicted past it")
+      ->capture_default_str();
+  app.add_option("--max-worlds", config.max_worlds, "world cache cap [worlds]")
+      ->capture_default_str();
+  app.add_option("--max-connections", config.max_connections,
+                 "open connections; more are closed on arrival")
+      ->capture_default_str();
+  app.add_option("--max-streams", config.max_streams_per_connection,
+                 "concurrent calls on one connection")
+      ->capture_default_str();
+  app.add_option("--idle-timeout", config.idle_timeout_s,
+                 "close a connection without calls after this long [s]")
+      ->capture_default_str();
+  app.add_option("--handshake-timeout", config.handshake_timeout_s,
+                 "close a connection that does not speak HTTP/2 within this [s]")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   if (!token_file.empty()) {
     std::ifstream in(token_file);
@@ -43,6 +66,14 @@ int main(int argc, char** argv) {
     }
   }
   config.log = [](const std::string& line) { spdlog::info("{}", line); };
+  // Each connection is a descriptor: make room for the cap (up to the hard limit).
+  if (rlimit limit{}; getrlimit(RLIMIT_NOFILE, &limit) == 0) {
+    const rlim_t wanted = rlim_t(config.max_connections) + 256;
+    if (limit.rlim_cur < wanted) {
+      limit.rlim_cur = std::min(wanted, limit.rlim_max);
+      setrlimit(RLIMIT_NOFILE, &limit);
+    }
+  }
   try {
     egress::navd::NavigationServer server(config);
     spdlog::info("egress-navd listening on {} (port {}, {} workers)", config.listen, server.port(),

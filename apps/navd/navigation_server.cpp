@@ -6,12 +6,16 @@
 #include <cmath>
 #include <map>
 #include <mutex>
+#include <regex>
 #include <sstream>
 #include <stdexcept>
 
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "connection_gate.h"
+#include "egress/hsr_interface/error.h"
+#include "egress/hsr_interface/text_file.h"
 #include "egress/hsr_interface/version.h"
 #include "egress/nav/v1/navigation.grpc.pb.h"
 #include "egress/perception/costmap.h"
@@ -32,10 +36,8 @@ bool IsLoopback(const std::string& host) {
   return host == "localhost" || host.rfind("127.", 0) == 0 || host == "[::1]" || host == "::1";
 }
 
-std::string HostOf(const std::string& address) {
-  const auto colon = address.rfind(':');
-  return colon == std::string::npos ? address : address.substr(0, colon);
-}
+// A loaded world in the cache, with what eviction needs.
+struct CachedWorld;
 
 // One loaded world: the static map, its costmap and planner. Requests on a world are
 // serialized by its mutex (OMPL setups are not shared across threads).
@@ -46,6 +48,32 @@ struct World {
   std::map<std::string, perception::Doorway> doors;
   std::unique_ptr<planning::RoutePlanner> routes;  // over the static map, doors passable
 };
+
+struct CachedWorld {
+  std::shared_ptr<World> world;  // requests running on an evicted world keep it alive
+  std::int64_t cells{0};
+  std::uint64_t last_used{0};
+};
+
+// The error for a file named by a client. It names the field, the path as given and the line,
+// never the file's content (the client may not read the file; the log has the details).
+Status FileError(const std::string& field, const std::string& given, const std::exception& e,
+                 const std::function<void(const std::string&)>& log) {
+  if (dynamic_cast<const PathOutsideRoot*>(&e) != nullptr) {
+    return {StatusCode::PERMISSION_DENIED,
+            field + ": '" + given + "' or a file it references lies outside the data root"};
+  }
+  if (log) log(nlohmann::json{{"file_error", field}, {"path", given}, {"detail", e.what()}}.dump());
+  std::string message = field + ": '" + given + "' cannot be loaded";
+  const std::string what = e.what();
+  std::smatch line;
+  if (what.find(": no such ") != std::string::npos) {
+    message = field + ": '" + given + "' does not exist";
+  } else if (std::regex_search(what, line, std::regex(R"(:(\d+):)"))) {
+    message += " (error at line " + line[1].str() + ")";
+  }
+  return {StatusCode::INVALID_ARGUMENT, message + "; the server's log has the details"};
+}
 
 void SetPose(const Pose2& X, v1::Pose2* out) {
   out->set_x(X.x);
@@ -63,7 +91,8 @@ bool Finite(const v1::Pose2& p) {
 
 class Service final : public v1::Navigation::Service {
  public:
-  explicit Service(const NavigationServerConfig& config) : config_(config) {}
+  Service(const NavigationServerConfig& config, std::function<ConnectionGate::Counts()> counts)
+      : config_(config), connection_counts_(std::move(counts)) {}
 
   Status LoadWorld(ServerContext* context, const v1::LoadWorldRequest* request,
                    v1::LoadWorldResponse* response) override {
@@ -72,6 +101,18 @@ class Service final : public v1::Navigation::Service {
   Status UpdateCostmap(ServerContext* context, const v1::UpdateCostmapRequest* request,
                        v1::UpdateCostmapResponse*) override {
     return Handle("UpdateCostmap", false, context, [&] { return DoUpdateCostmap(*request); });
+  }
+  Status UnloadWorld(ServerContext* context, const v1::UnloadWorldRequest* request,
+                     v1::UnloadWorldResponse*) override {
+    return Handle("UnloadWorld", false, context, [&]() -> Status {
+      std::lock_guard lock(worlds_mutex_);
+      const auto it = worlds_.find(request->world_id());
+      if (it == worlds_.end())
+        return {StatusCode::NOT_FOUND, "world_id '" + request->world_id() + "' is not loaded"};
+      cached_cells_ -= it->second.cells;
+      worlds_.erase(it);
+      return Status::OK;
+    });
   }
   Status SetDoorState(ServerContext* context, const v1::SetDoorStateRequest* request,
                       v1::SetDoorStateResponse*) override {
@@ -97,9 +138,17 @@ class Service final : public v1::Navigation::Service {
       {
         std::lock_guard lock(worlds_mutex_);
         response->set_worlds(int(worlds_.size()));
+        response->set_cached_cells(cached_cells_);
+        response->set_worlds_evicted(evicted_);
       }
+      response->set_max_cached_cells(config_.max_cached_cells);
       response->set_busy_workers(busy_.load());
       response->set_max_workers(config_.max_workers);
+      if (connection_counts_) {
+        const ConnectionGate::Counts counts = connection_counts_();
+        response->set_connections(counts.live);
+        response->set_connections_refused(counts.refused);
+      }
       return Status::OK;
     });
   }
@@ -152,32 +201,69 @@ class Service final : public v1::Navigation::Service {
   std::shared_ptr<World> Find(const std::string& id) {
     std::lock_guard lock(worlds_mutex_);
     auto it = worlds_.find(id);
-    return it == worlds_.end() ? nullptr : it->second;
+    if (it == worlds_.end()) return nullptr;
+    it->second.last_used = ++use_clock_;
+    return it->second.world;
+  }
+
+  // Adds a world and evicts the least recently used others past the caps.
+  std::string Insert(std::shared_ptr<World> world, std::int64_t cells) {
+    std::lock_guard lock(worlds_mutex_);
+    const std::string id = "world-" + std::to_string(++next_world_);
+    worlds_[id] = {std::move(world), cells, ++use_clock_};
+    cached_cells_ += cells;
+    while (worlds_.size() > 1 &&
+           (cached_cells_ > config_.max_cached_cells || int(worlds_.size()) > config_.max_worlds)) {
+      auto oldest = worlds_.end();
+      for (auto it = worlds_.begin(); it != worlds_.end(); ++it) {
+        if (it->first != id &&
+            (oldest == worlds_.end() || it->second.last_used < oldest->second.last_used)) {
+          oldest = it;
+        }
+      }
+      cached_cells_ -= oldest->second.cells;
+      worlds_.erase(oldest);
+      ++evicted_;
+    }
+    return id;
+  }
+
+  // Refuses a file path unless the server has a data root; `load` runs confined to it.
+  template <typename Load>
+  Status LoadFile(const std::string& field, const std::string& path, Load load) {
+    if (config_.data_root.empty()) {
+      return {StatusCode::PERMISSION_DENIED,
+              field +
+                  ": this server reads no files (start egress-navd with --data-root DIR); "
+                  "send the world by value"};
+    }
+    try {
+      const ScopedReadRoot root(config_.data_root);
+      load(CheckUnderReadRoot(path, field));
+    } catch (const std::exception& e) {
+      return FileError(field, path, e, config_.log);
+    }
+    return Status::OK;
   }
 
   Status DoLoadWorld(const v1::LoadWorldRequest& request, v1::LoadWorldResponse* response) {
     perception::OccupancyGrid grid;
     std::vector<perception::Doorway> sdf_doors;
     switch (request.source_case()) {
-      case v1::LoadWorldRequest::kMapYamlPath:
-        try {
-          grid = perception::OccupancyGrid::LoadMapServerYaml(request.map_yaml_path());
-        } catch (const std::exception& e) {
-          return Invalid(std::string("map_yaml_path: ") + e.what());
-        }
+      case v1::LoadWorldRequest::kMapYamlPath: {
+        const Status status =
+            LoadFile("map_yaml_path", request.map_yaml_path(), [&](const auto& path) {
+              grid = perception::OccupancyGrid::LoadMapServerYaml(path, config_.max_map_cells);
+            });
+        if (!status.ok()) return status;
         break;
+      }
       case v1::LoadWorldRequest::kMap: {
         const auto& map = request.map();
-        const std::vector<std::uint8_t> bytes(map.image().begin(), map.image().end());
-        if (bytes.empty()) return Invalid("map.image is empty");
-        const cv::Mat image = cv::imdecode(bytes, cv::IMREAD_GRAYSCALE);
-        if (image.empty()) return Invalid("map.image is not a PGM or PNG image");
-        if (std::int64_t(image.cols) * image.rows > config_.max_map_cells) {
-          return Invalid("map.image has " + std::to_string(image.cols) + " x " +
-                         std::to_string(image.rows) + " cells, more than the server's limit of " +
-                         std::to_string(config_.max_map_cells));
-        }
+        if (map.image().empty()) return Invalid("map.image is empty");
         try {
+          const cv::Mat image = perception::OccupancyGrid::DecodeMapImage(
+              map.image(), config_.max_map_cells, "map.image");
           grid = perception::OccupancyGrid::FromImage(
               image, map.resolution(), {map.origin().x(), map.origin().y()}, map.negate(),
               map.occupied_thresh() > 0 ? map.occupied_thresh() : 0.65,
@@ -189,17 +275,30 @@ class Service final : public v1::Navigation::Service {
       }
       case v1::LoadWorldRequest::kSdfPath:
       case v1::LoadWorldRequest::kSdfText: {
-        const bool by_path = request.source_case() == v1::LoadWorldRequest::kSdfPath;
-        try {
-          const apps::SdfMap map = apps::RasterizeSdfWorld(
-              by_path ? twin::LoadSdfWorld(request.sdf_path())
-                      : twin::LoadSdfWorldFromString(request.sdf_text(), "sdf_text"),
-              request.sdf_resolution() != 0 ? request.sdf_resolution() : 0.05,
-              config_.max_map_cells);
+        const double resolution = request.sdf_resolution() != 0 ? request.sdf_resolution() : 0.05;
+        const auto rasterize = [&](const twin::WorldDescription& world) {
+          const apps::SdfMap map =
+              apps::RasterizeSdfWorld(world, resolution, config_.max_map_cells);
           grid = map.grid;
           sdf_doors = map.doors;
+        };
+        if (request.source_case() == v1::LoadWorldRequest::kSdfPath) {
+          const Status status = LoadFile("sdf_path", request.sdf_path(), [&](const auto& path) {
+            const twin::WorldDescription world = twin::LoadSdfWorld(path);
+            // Rasterizing is not reading: a bad resolution is the request's, not the file's.
+            try {
+              rasterize(world);
+            } catch (const std::exception& e) {
+              throw InvalidArgument(e.what());
+            }
+          });
+          if (status.ok()) break;
+          return status;
+        }
+        try {
+          rasterize(twin::LoadSdfWorldFromString(request.sdf_text(), "sdf_text"));
         } catch (const std::exception& e) {
-          return Invalid(std::string(by_path ? "sdf_path: " : "sdf_text: ") + e.what());
+          return Invalid(std::string("sdf_text: ") + e.what());
         }
         break;
       }
@@ -249,13 +348,13 @@ class Service final : public v1::Navigation::Service {
         return Invalid(std::string("route planner: ") + e.what());
       }
     }
-    std::string id;
-    {
-      std::lock_guard lock(worlds_mutex_);
-      id = "world-" + std::to_string(++next_world_);
-      worlds_[id] = world;
+    const std::int64_t cells = std::int64_t(grid.geometry().size());
+    if (cells > config_.max_cached_cells) {
+      return Invalid("the map has " + std::to_string(cells) +
+                     " cells, more than the world cache holds (" +
+                     std::to_string(config_.max_cached_cells) + ")");
     }
-    response->set_world_id(id);
+    response->set_world_id(Insert(std::move(world), cells));
     response->set_width(grid.geometry().width);
     response->set_height(grid.geometry().height);
     response->set_resolution(grid.geometry().resolution);
@@ -398,16 +497,20 @@ class Service final : public v1::Navigation::Service {
   }
 
   const NavigationServerConfig& config_;
+  std::function<ConnectionGate::Counts()> connection_counts_;
   std::atomic<int> busy_{0};
   std::mutex worlds_mutex_;
-  std::map<std::string, std::shared_ptr<World>> worlds_;
-  int next_world_{0};
+  std::map<std::string, CachedWorld> worlds_;
+  std::int64_t cached_cells_{0};
+  std::uint64_t use_clock_{0};
+  std::int64_t evicted_{0};
+  std::int64_t next_world_{0};
 };
 
 }  // namespace
 
 void ValidateListenAddress(const NavigationServerConfig& config) {
-  const std::string host = HostOf(config.listen);
+  const std::string host = ParseListenAddress(config.listen).host;
   if (!IsLoopback(host) && !config.allow_remote) {
     throw std::invalid_argument(
         "refusing to listen on '" + config.listen +
@@ -418,13 +521,35 @@ void ValidateListenAddress(const NavigationServerConfig& config) {
         "--allow-remote needs a token (--token-file): remote requests must authenticate");
   }
   if (config.max_workers < 1) throw std::invalid_argument("max_workers must be >= 1");
+  const auto at_least_one = [](const char* name, std::int64_t value) {
+    if (value < 1) throw std::invalid_argument(std::string(name) + " must be >= 1");
+  };
+  at_least_one("max_map_cells", config.max_map_cells);
+  at_least_one("max_cached_cells", config.max_cached_cells);
+  at_least_one("max_worlds", config.max_worlds);
+  at_least_one("max_connections", config.max_connections);
+  at_least_one("max_streams_per_connection", config.max_streams_per_connection);
+  at_least_one("max_message_bytes", config.max_message_bytes);
+  at_least_one("max_threads", config.max_threads);
+  for (const auto& [name, seconds] :
+       {std::pair{"idle_timeout_s", config.idle_timeout_s},
+        std::pair{"handshake_timeout_s", config.handshake_timeout_s},
+        std::pair{"keepalive_time_s", config.keepalive_time_s},
+        std::pair{"keepalive_timeout_s", config.keepalive_timeout_s}}) {
+    if (!std::isfinite(seconds) || seconds <= 0 || seconds > 86400)
+      throw std::invalid_argument(std::string(name) + " must be in (0, 86400] s");
+  }
+  if (!config.data_root.empty() && !std::filesystem::is_directory(config.data_root)) {
+    throw std::invalid_argument("data root '" + config.data_root + "' is not a directory");
+  }
 }
 
 struct NavigationServer::Impl {
   NavigationServerConfig config;
+  std::unique_ptr<ConnectionGate> gate;
   std::unique_ptr<Service> service;
+  std::unique_ptr<grpc::experimental::ExternalConnectionAcceptor> acceptor;
   std::unique_ptr<grpc::Server> server;
-  int port{0};
   std::once_flag shutdown;
 };
 
@@ -432,15 +557,30 @@ NavigationServer::NavigationServer(NavigationServerConfig config)
     : impl_(std::make_unique<Impl>()) {
   ValidateListenAddress(config);
   impl_->config = std::move(config);
-  impl_->service = std::make_unique<Service>(impl_->config);
+  const NavigationServerConfig& c = impl_->config;
+  impl_->gate = std::make_unique<ConnectionGate>(c.listen, c.max_connections);
+  impl_->service =
+      std::make_unique<Service>(c, [gate = impl_->gate.get()] { return gate->counts(); });
   grpc::ServerBuilder builder;
-  builder.AddListeningPort(impl_->config.listen, grpc::InsecureServerCredentials(), &impl_->port);
+  // Connections come from the gate (see connection_gate.h), not from a gRPC listening port.
+  impl_->acceptor = builder.experimental().AddExternalConnectionAcceptor(
+      grpc::ServerBuilder::experimental_type::ExternalConnectionType::FROM_FD,
+      grpc::InsecureServerCredentials());
   builder.RegisterService(impl_->service.get());
+  builder.SetMaxReceiveMessageSize(c.max_message_bytes);
+  const auto ms = [](double seconds) { return int(std::min(seconds * 1000.0, 2.0e9)); };
+  builder.AddChannelArgument(GRPC_ARG_MAX_CONCURRENT_STREAMS, c.max_streams_per_connection);
+  builder.AddChannelArgument(GRPC_ARG_MAX_CONNECTION_IDLE_MS, ms(c.idle_timeout_s));
+  builder.AddChannelArgument(GRPC_ARG_SERVER_HANDSHAKE_TIMEOUT_MS, ms(c.handshake_timeout_s));
+  builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIME_MS, ms(c.keepalive_time_s));
+  builder.AddChannelArgument(GRPC_ARG_KEEPALIVE_TIMEOUT_MS, ms(c.keepalive_timeout_s));
+  grpc::ResourceQuota quota("egress-navd");
+  quota.SetMaxThreads(c.max_threads);
+  builder.SetResourceQuota(quota);
   impl_->server = builder.BuildAndStart();
-  if (!impl_->server || impl_->port == 0) {
-    throw std::runtime_error("cannot listen on '" + impl_->config.listen +
-                             "' (address in use or invalid)");
-  }
+  if (!impl_->server)
+    throw std::runtime_error("cannot start the gRPC server on '" + c.listen + "'");
+  impl_->gate->Start(impl_->acceptor.get());
 }
 
 NavigationServer::~NavigationServer() {
@@ -448,7 +588,7 @@ NavigationServer::~NavigationServer() {
 }
 
 int NavigationServer::port() const {
-  return impl_->port;
+  return impl_->gate->port();
 }
 
 void NavigationServer::Wait() {
@@ -456,8 +596,10 @@ void NavigationServer::Wait() {
 }
 
 void NavigationServer::Shutdown(std::chrono::milliseconds grace) {
-  std::call_once(impl_->shutdown,
-                 [&] { impl_->server->Shutdown(std::chrono::system_clock::now() + grace); });
+  std::call_once(impl_->shutdown, [&] {
+    impl_->gate->Stop();  // no new connections; calls already running finish
+    impl_->server->Shutdown(std::chrono::system_clock::now() + grace);
+  });
 }
 
 }  // namespace egress::navd

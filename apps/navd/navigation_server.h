@@ -17,13 +17,31 @@ struct NavigationServerConfig {
   std::string token;                      ///< Required with allow_remote; clients send it as
                                           ///< "authorization: Bearer <token>" metadata.
   int max_workers{4};  ///< Concurrent planning requests; more get RESOURCE_EXHAUSTED.
-  std::int64_t max_map_cells{16'000'000};  ///< Larger maps are refused (INVALID_ARGUMENT).
+  std::int64_t max_map_cells{16'000'000};  ///< Larger maps are refused (INVALID_ARGUMENT),
+                                           ///< checked on an image's header before decoding.
+  /// Directory file paths in requests are confined to (with every file they reference);
+  /// empty: paths are refused (PERMISSION_DENIED) and worlds come by value only.
+  std::string data_root;
+  /// The world cache: loaded worlds past either cap are evicted, least recently used first.
+  std::int64_t max_cached_cells{64'000'000};
+  int max_worlds{32};
+  /// Connections: more than max_connections open at once are closed on arrival; at most
+  /// max_streams_per_connection calls run on one connection.
+  int max_connections{256};
+  int max_streams_per_connection{16};
+  double idle_timeout_s{60.0};       ///< A connection with no call for this long is closed.
+  double handshake_timeout_s{10.0};  ///< A connection that sends no HTTP/2 preface is closed.
+  double keepalive_time_s{30.0};     ///< The server pings an idle connection this often...
+  double keepalive_timeout_s{10.0};  ///< ...and closes it when the ping goes unanswered.
+  int max_message_bytes{64 << 20};   ///< Largest request accepted [bytes].
+  int max_threads{64};               ///< gRPC threads serving calls.
   /// One structured line per request (JSON); null for silence.
   std::function<void(const std::string&)> log;
 };
 
-/// @throws std::invalid_argument naming the problem: a non-loopback address without
-/// allow_remote, or allow_remote without a token.
+/// @throws std::invalid_argument naming the problem: a port outside 0..65535, a non-loopback
+/// address without allow_remote, allow_remote without a token, a data root that is not a
+/// directory, or a limit out of range.
 void ValidateListenAddress(const NavigationServerConfig& config);
 
 class NavigationServer {

@@ -1,5 +1,6 @@
 #include "egress/perception/occupancy_grid.h"
 
+#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -91,7 +92,74 @@ std::string Trim(const std::string& s) {
 
 }  // namespace
 
-OccupancyGrid OccupancyGrid::LoadMapServerYaml(const std::filesystem::path& yaml_path) {
+namespace {
+
+// Width and height from a PGM (P2/P5) or PNG header, or nullopt for another format.
+std::optional<std::pair<std::int64_t, std::int64_t>> MapImageDimensions(std::string_view bytes,
+                                                                        std::string_view what) {
+  static constexpr std::string_view kPngSignature{"\x89PNG\r\n\x1a\n", 8};
+  if (bytes.substr(0, 8) == kPngSignature) {
+    // The first chunk is IHDR: length (4), type (4), width (4, big-endian), height (4).
+    if (bytes.size() < 24 || bytes.substr(12, 4) != "IHDR")
+      throw LoadError(StrCat(what, ": a PNG without its IHDR header"));
+    const auto be32 = [&](std::size_t at) {
+      std::int64_t v = 0;
+      for (std::size_t i = 0; i < 4; ++i)
+        v = (v << 8) | static_cast<unsigned char>(bytes[at + i]);
+      return v;
+    };
+    return std::pair{be32(16), be32(20)};
+  }
+  if (bytes.size() >= 2 && bytes[0] == 'P' && (bytes[1] == '5' || bytes[1] == '2')) {
+    // P5/P2, then width, height and maxval as decimal tokens separated by whitespace, with
+    // '#' comments to the end of a line.
+    std::size_t at = 2;
+    std::int64_t values[2] = {0, 0};
+    for (std::int64_t& value : values) {
+      while (at < bytes.size()) {
+        if (std::isspace(static_cast<unsigned char>(bytes[at]))) {
+          ++at;
+        } else if (bytes[at] == '#') {
+          while (at < bytes.size() && bytes[at] != '\n')
+            ++at;
+        } else {
+          break;
+        }
+      }
+      const std::size_t begin = at;
+      while (at < bytes.size() && at - begin < 10 &&
+             std::isdigit(static_cast<unsigned char>(bytes[at]))) {
+        value = value * 10 + (bytes[at] - '0');
+        ++at;
+      }
+      if (at == begin) throw LoadError(StrCat(what, ": a PGM header without its width and height"));
+    }
+    return std::pair{values[0], values[1]};
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+cv::Mat OccupancyGrid::DecodeMapImage(std::string_view bytes, std::int64_t max_cells,
+                                      std::string_view what) {
+  const auto size = MapImageDimensions(bytes, what);
+  if (!size) throw LoadError(StrCat(what, ": not a PGM or PNG image (the formats egress reads)"));
+  const auto [width, height] = *size;
+  if (width <= 0 || height <= 0 || width > max_cells || height > max_cells ||
+      width * height > max_cells) {
+    throw LoadError(
+        StrCat(what, ": ", width, " x ", height, " cells; the limit is ", max_cells, " cells"));
+  }
+  const cv::Mat encoded(1, int(bytes.size()), CV_8UC1,
+                        const_cast<char*>(bytes.data()));  // imdecode only reads it
+  cv::Mat image = cv::imdecode(encoded, cv::IMREAD_GRAYSCALE);
+  if (image.empty()) throw LoadError(StrCat(what, ": the image cannot be decoded"));
+  return image;
+}
+
+OccupancyGrid OccupancyGrid::LoadMapServerYaml(const std::filesystem::path& yaml_path,
+                                               std::int64_t max_cells) {
   const std::string file = yaml_path.string();
   std::string text;
   try {
@@ -180,11 +248,17 @@ OccupancyGrid OccupancyGrid::LoadMapServerYaml(const std::filesystem::path& yaml
   }
   std::filesystem::path image_path = image_field.value;
   if (image_path.is_relative()) image_path = yaml_path.parent_path() / image_path;
-  const cv::Mat image = cv::imread(image_path.string(), cv::IMREAD_GRAYSCALE);
-  if (image.empty()) {
-    throw LoadError(
-        StrCat(file, ":", image_field.line, ": image '", image_path.string(), "' cannot be read."));
+  const std::string where =
+      StrCat(file, ":", image_field.line, ": image '", image_path.string(), "'");
+  std::string bytes;
+  try {
+    bytes = ReadTextFile(image_path, "map image");
+  } catch (const PathOutsideRoot&) {
+    throw;
+  } catch (const LoadError& e) {
+    throw LoadError(StrCat(where, " cannot be read (", e.what(), ")."));
   }
+  const cv::Mat image = DecodeMapImage(bytes, max_cells, where);
   return FromImage(image, resolution, {origin[0], origin[1]}, negate, occupied_thresh, free_thresh);
 }
 

@@ -12,6 +12,10 @@
 #include <limits>
 #include <thread>
 
+#include <unistd.h>
+
+#include <opencv2/imgcodecs.hpp>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -174,7 +178,7 @@ TEST_F(NavigationServerTest, RefusesMapsBeyondTheCellLimit) {
   v1::LoadWorldResponse response;
   const grpc::Status status = stub_->LoadWorld(&context, request, &response);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
-  EXPECT_THAT(status.error_message(), HasSubstr("limit of 10000"));
+  EXPECT_THAT(status.error_message(), HasSubstr("280 x 120 cells; the limit is 10000"));
 }
 
 TEST_F(NavigationServerTest, AnswersThirtyTwoConcurrentRequests) {
@@ -267,6 +271,12 @@ TEST_F(NavigationServerTest, TokensAndListenAddresses) {
   EXPECT_THROW(ValidateListenAddress(remote), std::invalid_argument);  // no token
   remote.token = "t";
   EXPECT_NO_THROW(ValidateListenAddress(remote));
+  // Ports outside 0..65535 or missing are refused, not replaced by a random one.
+  for (const char* listen : {"127.0.0.1:99999", "127.0.0.1:-1", "127.0.0.1", "127.0.0.1:80x"}) {
+    NavigationServerConfig bad;
+    bad.listen = listen;
+    EXPECT_THROW(ValidateListenAddress(bad), std::invalid_argument) << listen;
+  }
 }
 
 TEST_F(NavigationServerTest, ListsPlanners) {
@@ -278,9 +288,13 @@ TEST_F(NavigationServerTest, ListsPlanners) {
 }
 
 TEST_F(NavigationServerTest, LoadsTheOfficeSdfWorldWithItsDoors) {
+  server_.reset();
+  NavigationServerConfig config;
+  const auto worlds = std::filesystem::path(EGRESS_OFFICE_MAP).parent_path().parent_path();
+  config.data_root = worlds.string();
+  Start(config);
   v1::LoadWorldRequest sdf;
-  sdf.set_sdf_path(
-      (std::filesystem::path(EGRESS_OFFICE_MAP).parent_path() / "office.sdf").string());
+  sdf.set_sdf_path("office/office.sdf");  // relative to the data root
   grpc::ClientContext context;
   v1::LoadWorldResponse loaded;
   const grpc::Status status = stub_->LoadWorld(&context, sdf, &loaded);
@@ -312,14 +326,16 @@ TEST_F(NavigationServerTest, LoadsTheOfficeSdfWorldWithItsDoors) {
   v1::PlanPathResponse blocked;
   ASSERT_TRUE(Plan(loaded.world_id(), Pose(1.5, 4.5), Pose(12.5, 1.5), &blocked).ok());
   EXPECT_EQ(blocked.status(), v1::PLAN_STATUS_GOAL_UNREACHABLE);
-  // A missing or malformed SDF file is INVALID_ARGUMENT naming the file.
-  sdf.set_sdf_path("/nonexistent/office.sdf");
+  // A missing file under the root is INVALID_ARGUMENT naming it; one outside is refused.
+  sdf.set_sdf_path("office/missing.sdf");
   grpc::ClientContext c3;
   const grpc::Status missing = stub_->LoadWorld(&c3, sdf, &loaded);
   EXPECT_EQ(missing.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
-  EXPECT_THAT(missing.error_message(), HasSubstr("/nonexistent/office.sdf"));
-  sdf.set_sdf_path(
-      (std::filesystem::path(EGRESS_OFFICE_MAP).parent_path() / "office.sdf").string());
+  EXPECT_THAT(missing.error_message(), HasSubstr("'office/missing.sdf' does not exist"));
+  sdf.set_sdf_path("/nonexistent/office.sdf");
+  grpc::ClientContext c3b;
+  EXPECT_EQ(stub_->LoadWorld(&c3b, sdf, &loaded).error_code(), grpc::StatusCode::PERMISSION_DENIED);
+  sdf.set_sdf_path((worlds / "office" / "office.sdf").string());  // absolute, under the root
   sdf.set_sdf_resolution(0.001);
   grpc::ClientContext c4;
   EXPECT_EQ(stub_->LoadWorld(&c4, sdf, &loaded).error_code(), grpc::StatusCode::INVALID_ARGUMENT);
@@ -339,6 +355,149 @@ TEST_F(NavigationServerTest, LoadsTheOfficeSdfWorldWithItsDoors) {
   const grpc::Status bad = stub_->LoadWorld(&c6, by_value, &from_text);
   EXPECT_EQ(bad.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
   EXPECT_THAT(bad.error_message(), HasSubstr("sdf_text"));
+}
+
+// A scratch directory tree: `root` (the data root) and `outside` next to it.
+class DataRootTest : public NavigationServerTest {
+ protected:
+  void SetUp() override {
+    base_ = std::filesystem::temp_directory_path() /
+            ("egress_navd_root_" + std::to_string(::getpid()) + "_" +
+             ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    std::filesystem::remove_all(base_);
+    std::filesystem::create_directories(base_ / "root");
+    std::filesystem::create_directories(base_ / "outside");
+    NavigationServerConfig config;
+    config.data_root = (base_ / "root").string();
+    Start(config);
+  }
+  void TearDown() override { std::filesystem::remove_all(base_); }
+  void Write(const std::filesystem::path& relative, const std::string& text) {
+    std::ofstream(base_ / relative, std::ios::binary) << text;
+  }
+  grpc::Status LoadPath(const std::string& yaml_or_sdf, bool sdf = false) {
+    v1::LoadWorldRequest request;
+    if (sdf) {
+      request.set_sdf_path(yaml_or_sdf);
+    } else {
+      request.set_map_yaml_path(yaml_or_sdf);
+    }
+    grpc::ClientContext context;
+    v1::LoadWorldResponse response;
+    return stub_->LoadWorld(&context, request, &response);
+  }
+  std::filesystem::path base_;
+};
+
+TEST_F(DataRootTest, PathsStayUnderTheRootWithEveryFileTheyReference) {
+  Write("root/map.pgm", OfficePng());
+  Write("outside/map.pgm", OfficePng());
+  Write("root/ok.yaml", "image: map.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n");
+  EXPECT_TRUE(LoadPath("ok.yaml").ok()) << LoadPath("ok.yaml").error_message();
+  Write("outside/ok.yaml", "image: map.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n");
+  // Outside by '..', by an absolute path, by a symbolic link, and by the image a YAML names.
+  std::filesystem::create_symlink(base_ / "outside" / "ok.yaml", base_ / "root" / "link.yaml");
+  Write("root/escape.yaml", "image: ../outside/map.pgm\nresolution: 0.05\norigin: [0, 0, 0]\n");
+  for (const std::string& path :
+       {std::string("../outside/ok.yaml"), (base_ / "outside" / "ok.yaml").string(),
+        std::string("link.yaml"), std::string("escape.yaml")}) {
+    const grpc::Status status = LoadPath(path);
+    EXPECT_EQ(status.error_code(), grpc::StatusCode::PERMISSION_DENIED) << path;
+    EXPECT_THAT(status.error_message(), HasSubstr("outside the data root")) << path;
+  }
+  // An SDF world that <include>s (libsdformat would read the file itself) or names a mesh
+  // outside the root.
+  Write("root/include.sdf", "<sdf version='1.9'><world name='w'><include><uri>" +
+                                (base_ / "outside").string() + "</uri></include></world></sdf>");
+  EXPECT_EQ(LoadPath("include.sdf", true).error_code(), grpc::StatusCode::PERMISSION_DENIED);
+  Write("outside/box.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  Write("root/mesh.sdf",
+        "<sdf version='1.9'><world name='w'><model name='m'><static>true</static><link "
+        "name='l'><collision name='c'><geometry><mesh><uri>../outside/box.obj</uri></mesh>"
+        "</geometry></collision></link></model></world></sdf>");
+  EXPECT_EQ(LoadPath("mesh.sdf", true).error_code(), grpc::StatusCode::PERMISSION_DENIED)
+      << LoadPath("mesh.sdf", true).error_message();
+}
+
+TEST_F(DataRootTest, AnErrorNamesTheFileAndLineButNeverItsContent) {
+  Write("root/secret.yaml", "image: map.pgm\nresolution: 0.05\nSECRET-d41d8cd9 no colon here\n");
+  const grpc::Status status = LoadPath("secret.yaml");
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("'secret.yaml' cannot be loaded"));
+  EXPECT_THAT(status.error_message(), HasSubstr("line 3"));
+  EXPECT_THAT(status.error_message(), ::testing::Not(HasSubstr("SECRET")));
+  Write("root/secret.sdf", "<sdf version='1.9'><world name='SECRET-d41d8cd9'><bogus/>");
+  const grpc::Status sdf = LoadPath("secret.sdf", true);
+  EXPECT_EQ(sdf.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(sdf.error_message(), ::testing::Not(HasSubstr("SECRET")));
+}
+
+TEST_F(NavigationServerTest, WithoutADataRootPathsAreRefused) {
+  v1::LoadWorldRequest request;
+  request.set_map_yaml_path(std::string(EGRESS_OFFICE_MAP));
+  grpc::ClientContext context;
+  v1::LoadWorldResponse response;
+  const grpc::Status status = stub_->LoadWorld(&context, request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::PERMISSION_DENIED);
+  EXPECT_THAT(status.error_message(), HasSubstr("--data-root"));
+}
+
+TEST_F(NavigationServerTest, AnImageIsMeasuredBeforeItIsDecoded) {
+  server_.reset();
+  NavigationServerConfig config;
+  config.max_map_cells = 1'000'000;
+  Start(config);
+  // 4000 x 4000 white: a few kB of PNG, 16 M cells decoded.
+  std::vector<std::uint8_t> png;
+  cv::imencode(".png", cv::Mat(4000, 4000, CV_8UC1, cv::Scalar(255)), png);
+  ASSERT_LT(png.size(), 100'000u);
+  v1::LoadWorldRequest request;
+  request.mutable_map()->set_image(std::string(png.begin(), png.end()));
+  request.mutable_map()->set_resolution(0.05);
+  grpc::ClientContext context;
+  v1::LoadWorldResponse response;
+  const grpc::Status status = stub_->LoadWorld(&context, request, &response);
+  EXPECT_EQ(status.error_code(), grpc::StatusCode::INVALID_ARGUMENT);
+  EXPECT_THAT(status.error_message(), HasSubstr("4000 x 4000 cells; the limit is 1000000"));
+  request.mutable_map()->set_image("GIF89a....");
+  grpc::ClientContext c2;
+  EXPECT_THAT(stub_->LoadWorld(&c2, request, &response).error_message(),
+              HasSubstr("not a PGM or PNG"));
+}
+
+TEST_F(NavigationServerTest, TheWorldCacheEvictsTheLeastRecentlyUsedAndUnloads) {
+  server_.reset();
+  NavigationServerConfig config;
+  config.max_worlds = 2;
+  Start(config);
+  const auto health = [&] {
+    grpc::ClientContext context;
+    v1::HealthResponse response;
+    EXPECT_TRUE(stub_->Health(&context, v1::HealthRequest{}, &response).ok());
+    return response;
+  };
+  const std::string a = LoadOffice();
+  const std::string b = LoadOffice();
+  v1::PlanPathResponse plan;
+  ASSERT_TRUE(Plan(a, Pose(1.5, 4.5), Pose(3.5, 4.5), &plan).ok());  // a is now the newer
+  const std::string c = LoadOffice();                                // evicts b
+  EXPECT_EQ(Plan(b, Pose(1.5, 4.5), Pose(3.5, 4.5), &plan).error_code(),
+            grpc::StatusCode::NOT_FOUND);
+  EXPECT_TRUE(Plan(a, Pose(1.5, 4.5), Pose(3.5, 4.5), &plan).ok());
+  EXPECT_EQ(health().worlds(), 2);
+  EXPECT_EQ(health().worlds_evicted(), 1);
+  EXPECT_EQ(health().cached_cells(), 2 * 280 * 120);
+  v1::UnloadWorldRequest unload;
+  unload.set_world_id(a);
+  v1::UnloadWorldResponse unloaded;
+  grpc::ClientContext c1;
+  EXPECT_TRUE(stub_->UnloadWorld(&c1, unload, &unloaded).ok());
+  grpc::ClientContext c2;
+  EXPECT_EQ(stub_->UnloadWorld(&c2, unload, &unloaded).error_code(), grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(Plan(a, Pose(1.5, 4.5), Pose(3.5, 4.5), &plan).error_code(),
+            grpc::StatusCode::NOT_FOUND);
+  EXPECT_EQ(health().worlds(), 1);
+  EXPECT_EQ(health().cached_cells(), 280 * 120);
 }
 
 }  // namespace

@@ -48,5 +48,36 @@ TEST(ReadTextFileTest, RefusesWhatIsNotABoundedRegularFile) {
   std::filesystem::remove(big);
 }
 
+// Under a ScopedReadRoot only what resolves under the root is read, however the path gets out;
+// nesting restores the outer root and leaving the scope lifts it.
+TEST(ReadTextFileTest, AReadRootConfinesEveryRead) {
+  const auto base = egress::testing::TestTempPath("root");
+  std::filesystem::create_directories(base / "root" / "sub");
+  std::filesystem::create_directories(base / "outside");
+  std::ofstream(base / "root" / "sub" / "in.txt") << "in";
+  std::ofstream(base / "outside" / "out.txt") << "out";
+  std::filesystem::create_symlink(base / "outside" / "out.txt", base / "root" / "link.txt");
+  {
+    const ScopedReadRoot root(base / "root");
+    EXPECT_EQ(ReadTextFile("sub/in.txt", "file"), "in");  // relative to the root
+    EXPECT_EQ(ReadTextFile(base / "root" / "sub" / "in.txt", "file"), "in");
+    for (const std::filesystem::path& escape :
+         {std::filesystem::path("../outside/out.txt"), base / "outside" / "out.txt",
+          std::filesystem::path("link.txt"), std::filesystem::path("sub/../../outside/out.txt")}) {
+      EXPECT_THROW(ReadTextFile(escape, "file"), PathOutsideRoot) << escape;
+    }
+    {
+      const ScopedReadRoot inner(base / "root" / "sub");
+      EXPECT_THROW(ReadTextFile(base / "root" / "link.txt", "file"), PathOutsideRoot);
+      EXPECT_EQ(ReadTextFile("in.txt", "file"), "in");
+    }
+    EXPECT_EQ(ScopedReadRoot::Current(), std::filesystem::canonical(base / "root"));
+  }
+  EXPECT_TRUE(ScopedReadRoot::Current().empty());
+  EXPECT_EQ(ReadTextFile(base / "outside" / "out.txt", "file"), "out");
+  EXPECT_THROW(ScopedReadRoot(base / "missing"), LoadError);
+  std::filesystem::remove_all(base);
+}
+
 }  // namespace
 }  // namespace egress

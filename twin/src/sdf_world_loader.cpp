@@ -374,6 +374,13 @@ WorldDescription LoadSdfWorldFromString(const std::string& sdf_xml, std::string_
                                         const std::filesystem::path& base_dir) {
   // Errors come back as LoadError; libsdformat's own console lines would only repeat them.
   sdf::Console::Instance()->SetQuiet(true);
+  // libsdformat reads <include>d files itself, past ReadTextFile: where reads are confined to
+  // a root (egress-navd), a world must be self-contained.
+  if (!ScopedReadRoot::Current().empty() && sdf_xml.find("<include") != std::string::npos) {
+    throw PathOutsideRoot(StrCat(source_name,
+                                 ": <include> is not read here (files are confined to the data "
+                                 "root); inline the included model"));
+  }
   sdf::Root root;
   const sdf::Errors errors = root.LoadSdfString(sdf_xml);
   WorldDescription out = LoadRoot(root, errors, std::string(source_name), base_dir);

@@ -37,6 +37,12 @@ class LoadError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// A file lies outside the directory the reader is confined to (ScopedReadRoot).
+class PathOutsideRoot : public LoadError {
+ public:
+  using LoadError::LoadError;
+};
+
 /// Throws InvalidArgument with the concatenated message unless `condition` holds.
 template <typename... Args>
 void ThrowUnless(bool condition, const Args&... message) {

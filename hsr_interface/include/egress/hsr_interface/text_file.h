@@ -21,4 +21,28 @@ inline constexpr std::size_t kMaxTextFileBytes = std::size_t{64} << 20;
 std::string ReadTextFile(const std::filesystem::path& path, std::string_view what,
                          std::size_t max_bytes = kMaxTextFileBytes);
 
+/// While one is alive on a thread, ReadTextFile on that thread reads only files that resolve
+/// (symbolic links and `..` followed) to a place under `root`, and throws PathOutsideRoot for
+/// any other. egress-navd holds one around a client's request so that the file the client
+/// names and every file that file references (a map's image, a world's meshes) stay under the
+/// server's data root. Nests: the innermost root applies.
+class ScopedReadRoot {
+ public:
+  /// @throws LoadError if `root` is not an existing directory.
+  explicit ScopedReadRoot(const std::filesystem::path& root);
+  ~ScopedReadRoot();
+  ScopedReadRoot(const ScopedReadRoot&) = delete;
+  ScopedReadRoot& operator=(const ScopedReadRoot&) = delete;
+
+  /// The root in force on this thread, or empty.
+  static std::filesystem::path Current();
+
+ private:
+  std::filesystem::path previous_;
+};
+
+/// `path` resolved (symbolic links, `..`) if it lies under the current ScopedReadRoot, or
+/// unchanged when none is in force. @throws PathOutsideRoot otherwise.
+std::filesystem::path CheckUnderReadRoot(const std::filesystem::path& path, std::string_view what);
+
 }  // namespace egress

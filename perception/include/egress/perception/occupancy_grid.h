@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Core>
@@ -59,7 +60,18 @@ class OccupancyGrid {
   /// Loads a map_server YAML (image, resolution, origin [x, y, yaw], negate, occupied_thresh,
   /// free_thresh; mode trinary). The image path is relative to the YAML file. Origin yaw must be
   /// 0. @throws LoadError naming the file, line and field.
-  static OccupancyGrid LoadMapServerYaml(const std::filesystem::path& yaml_path);
+  /// `max_cells` bounds the image, checked on its header before it is decoded (a small PNG
+  /// can decode to gigabytes).
+  static OccupancyGrid LoadMapServerYaml(const std::filesystem::path& yaml_path,
+                                         std::int64_t max_cells = kMaxMapImageCells);
+  /// The most cells a map image may have unless a caller says otherwise (64 M: 400 m x 400 m
+  /// at 5 cm).
+  static constexpr std::int64_t kMaxMapImageCells = 64'000'000;
+  /// Decodes a map image (PGM P2/P5 or PNG) to 8-bit gray after reading its width and height
+  /// from the header alone. `what` names it in errors. @throws LoadError for another format, a
+  /// malformed header, more than `max_cells` cells or undecodable bytes.
+  static cv::Mat DecodeMapImage(std::string_view bytes, std::int64_t max_cells,
+                                std::string_view what);
   /// A map_server image (8-bit gray, row 0 at the top) with its YAML parameters: dark cells
   /// (occupancy > occupied_thresh) are occupied, light ones (< free_thresh) free, the rest
   /// unknown. @throws InvalidArgument for an empty image or bad parameters.
