@@ -39,6 +39,7 @@ struct TrialResult {
   std::vector<double> preemption_total_latencies;  ///< [s] person in the zone (truth) -> stop.
   double wall_time{0.0};                           ///< [s]
   std::string error;                               ///< The run threw this.
+  bool crashed{false};  ///< The worker process died running it (`error` says how).
 };
 
 /// One trial in this process. @throws like `egress sim run` for a bad scenario.
@@ -65,7 +66,7 @@ struct ScenarioSummary {
 std::vector<ScenarioSummary> Summarize(const std::vector<TrialResult>& trials);
 std::string FormatSummaryTable(const std::vector<ScenarioSummary>& summaries);
 
-/// Adds `batch` under the `sim` command group.
+/// Adds `batch` and `merge` under the `sim` command group.
 void AddSimBatchCommand(CLI::App& sim_group);
 
 }  // namespace egress::apps

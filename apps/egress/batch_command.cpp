@@ -5,7 +5,10 @@
 //
 // Trial i of a scenario runs with seed `seed_base + i`; a trial is a pure function of its
 // scenario file and seed, so the results do not depend on --jobs, and a batch can be split into
-// shards (--first) whose merged files equal one machine's.
+// shards (--shard I/N: work items I-1, I-1+N, ...) whose merged files (`sim merge`) equal one
+// machine's. Every finished trial goes to DIR/journal.jsonl as it ends (batch_journal.h), so an
+// interrupted batch continues with --resume; a worker that dies has its trial recorded as
+// crashed (seed, signal, replay command) and the batch goes on.
 
 #include <unistd.h>
 
@@ -22,9 +25,11 @@
 #include <nlohmann/json.hpp>
 
 #include "batch.h"
+#include "batch_journal.h"
 #include "brain_trial.h"
 #include "commands.h"
 #include "egress/hsr_interface/error.h"
+#include "egress/hsr_interface/text_file.h"
 #include "egress/twin/sdf_world_loader.h"
 #include "egress/twin/twin_run.h"
 #include "workers.h"
@@ -132,7 +137,8 @@ nlohmann::json ToJson(const TrialResult& r) {
           {"preemption_latencies", r.preemption_latencies},
           {"preemption_total_latencies", r.preemption_total_latencies},
           {"wall_time", r.wall_time},
-          {"error", r.error}};
+          {"error", r.error},
+          {"crashed", r.crashed}};
 }
 
 TrialResult TrialFromJson(const nlohmann::json& j) {
@@ -154,6 +160,7 @@ TrialResult TrialFromJson(const nlohmann::json& j) {
   r.preemption_total_latencies = j.at("preemption_total_latencies").get<std::vector<double>>();
   r.wall_time = j.at("wall_time").get<double>();
   r.error = j.at("error").get<std::string>();
+  r.crashed = j.value("crashed", false);
   return r;
 }
 
@@ -228,84 +235,66 @@ struct BatchOptions {
   int jobs{2};
   std::uint64_t seed_base{1};
   std::string out{"batch"};
+  std::string shard{"1/1"};
+  bool resume{false};
   bool overwrite{false};
   bool quiet{false};
 };
 
-// The trials in worker processes (workers.h), in the order of the work list.
-std::vector<TrialResult> RunTrialsInWorkers(
-    const std::vector<std::pair<std::string, std::uint64_t>>& work, int jobs, bool progress) {
-  CompiledScenario compiled;  // each worker's own copy after the fork
-  const std::vector<nlohmann::json> lines =
-      RunInWorkers(work.size(), jobs, progress, [&](std::size_t k) {
-        TrialResult r;
-        try {
-          r = RunBrainTrial(work[k].first, work[k].second, &compiled);
-        } catch (const std::exception& e) {
-          r.scenario = work[k].first;
-          r.name = std::filesystem::path(work[k].first).stem().string();
-          r.seed = work[k].second;
-          r.error = e.what();
-        }
-        return ToJson(r);
-      });
-  std::vector<TrialResult> results;
-  for (const auto& line : lines)
-    results.push_back(TrialFromJson(line));
-  return results;
+// "I/N" with 1 <= I <= N.
+std::pair<int, int> ParseShard(const std::string& text) {
+  const auto slash = text.find('/');
+  int index = 0, count = 0;
+  try {
+    std::size_t used_i = 0, used_n = 0;
+    if (slash == std::string::npos) throw std::invalid_argument("");
+    index = std::stoi(text.substr(0, slash), &used_i);
+    count = std::stoi(text.substr(slash + 1), &used_n);
+    if (used_i != slash || used_n != text.size() - slash - 1) throw std::invalid_argument("");
+  } catch (const std::exception&) {
+    index = 0;
+  }
+  if (index < 1 || count < index || count > 100000) {
+    throw CommandFailed(fmt::format("--shard '{}': expected I/N with 1 <= I <= N", text));
+  }
+  return {index, count};
 }
 
-void RunBatch(const BatchOptions& o) {
-  if (o.trials < 1) throw CommandFailed("--trials must be at least 1");
-  if (o.jobs < 1) throw CommandFailed("--jobs must be at least 1");
-  const std::filesystem::path dir(o.out);
-  const auto csv_path = dir / "trials.csv";
-  const auto json_path = dir / "batch.json";
-  for (const auto& p : {csv_path, json_path}) {
-    if (std::filesystem::exists(p) && !o.overwrite) {
-      throw CommandFailed(fmt::format("'{}' exists; pass --overwrite to replace it", p.string()));
-    }
-  }
-  // Check every scenario (and its mission) before starting any worker.
-  // SCENARIO or SCENARIO:N (N trials of that one, e.g. the paper's protocol).
-  std::vector<std::pair<std::string, int>> plan;
-  for (const auto& arg : o.scenarios) {
-    std::string file = arg;
-    int trials = o.trials;
-    if (const auto colon = arg.rfind(':');
-        colon != std::string::npos && !std::filesystem::exists(arg)) {
-      const std::string count = arg.substr(colon + 1);
-      if (count.empty() || count.find_first_not_of("0123456789") != std::string::npos ||
-          std::stoll(count) < 1 || std::stoll(count) > 1000000) {
-        throw CommandFailed(fmt::format("'{}': expected SCENARIO or SCENARIO:TRIALS", arg));
-      }
-      file = arg.substr(0, colon);
-      trials = int(std::stoll(count));
-    }
-    if (!std::filesystem::exists(file))
-      throw CommandFailed(fmt::format("'{}': no such scenario file", file));
-    // Check every scenario (and its mission) before starting any worker.
-    const twin::Scenario scenario = twin::LoadScenario(file);
-    if (!scenario.mission) {
-      throw CommandFailed(
-          fmt::format("{}: no 'mission' section: sim batch runs the robot brain", file));
-    }
-    plan.emplace_back(file, trials);
-  }
+// The batch's plan as written in its journal and batch.json: what makes two runs the same batch.
+nlohmann::json PlanJson(const std::vector<std::pair<std::string, int>>& scenarios,
+                        std::uint64_t seed_base, std::pair<int, int> shard) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& [file, trials] : scenarios)
+    list.push_back({{"scenario", file}, {"trials", trials}});
+  return {{"scenarios", list}, {"seed_base", seed_base}, {"shard", {shard.first, shard.second}}};
+}
+
+// Every (scenario, seed) of the plan in order: scenario by scenario, seeds ascending.
+std::vector<std::pair<std::string, std::uint64_t>> WorkList(const nlohmann::json& plan) {
   std::vector<std::pair<std::string, std::uint64_t>> work;
-  for (const auto& [file, trials] : plan) {
-    for (int i = 0; i < trials; ++i)
-      work.emplace_back(file, o.seed_base + std::uint64_t(i));
+  const auto seed_base = plan.at("seed_base").get<std::uint64_t>();
+  for (const auto& s : plan.at("scenarios")) {
+    for (int i = 0; i < s.at("trials").get<int>(); ++i)
+      work.emplace_back(s.at("scenario").get<std::string>(), seed_base + std::uint64_t(i));
   }
-  if (!o.quiet) {
-    fmt::print("{} scenario(s), {} runs on {} worker process(es)\n", plan.size(), work.size(),
-               std::min<std::size_t>(std::size_t(o.jobs), work.size()));
-  }
-  const auto started = std::chrono::steady_clock::now();
-  const std::vector<TrialResult> results =
-      RunTrialsInWorkers(work, o.jobs, !o.quiet && ::isatty(::fileno(stderr)));
-  const double wall =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  return work;
+}
+
+// A worker's answer for one trial as a TrialResult (a crash or a throw keep scenario and seed).
+TrialResult FromWorker(const nlohmann::json& r, const std::pair<std::string, std::uint64_t>& w) {
+  if (r.contains("scenario")) return TrialFromJson(r);
+  TrialResult t;
+  t.scenario = w.first;
+  t.name = std::filesystem::path(w.first).stem().string();
+  t.seed = w.second;
+  t.error = r.value("error", std::string("no result"));
+  t.crashed = r.contains("crashed");
+  return t;
+}
+
+// The table, the figures and the failed seeds on stdout; trials.csv and batch.json in `dir`.
+void ReportBatch(const std::filesystem::path& dir, const nlohmann::json& plan,
+                 const std::vector<TrialResult>& results, double wall, int jobs) {
   const std::vector<ScenarioSummary> summaries = Summarize(results);
   std::cout << FormatSummaryTable(summaries);
   const auto report = [&](const char* what, auto member) {
@@ -322,17 +311,19 @@ void RunBatch(const BatchOptions& o) {
          &TrialResult::preemption_latencies);
   report("total (person really in the zone -> stop command, sensor latency included)",
          &TrialResult::preemption_total_latencies);
-  fmt::print("wall time {:.1f} s for {} trials ({} jobs)\n", wall, results.size(), o.jobs);
+  fmt::print("wall time {:.1f} s for {} trials ({} jobs)\n", wall, results.size(), jobs);
   for (const auto& r : results) {
     if (r.success) continue;
     std::string why;
     for (const auto& f : r.failed)
       why += (why.empty() ? "" : ", ") + f;
     if (!r.error.empty()) why = r.error;
-    fmt::print("  failed: {} seed {} ({})  replay: egress sim run {} --seed {}\n", r.name, r.seed,
-               why, r.scenario, r.seed);
+    fmt::print("  {}: {} seed {} ({})  replay: egress sim run {} --seed {}\n",
+               r.crashed ? "CRASHED" : "failed", r.name, r.seed, why, r.scenario, r.seed);
   }
   std::filesystem::create_directories(dir);
+  const auto csv_path = dir / "trials.csv";
+  const auto json_path = dir / "batch.json";
   {
     std::ofstream csv(csv_path);
     csv << "scenario,name,seed,success,time_s,min_person_distance_m,person_contacts,"
@@ -370,13 +361,177 @@ void RunBatch(const BatchOptions& o) {
   nlohmann::json trials = nlohmann::json::array();
   for (const auto& r : results)
     trials.push_back(ToJson(r));
-  std::ofstream(json_path) << nlohmann::json{{"wall_s", wall},
-                                             {"jobs", o.jobs},
+  std::ofstream(json_path) << nlohmann::json{{"batch", plan},
+                                             {"wall_s", wall},
+                                             {"jobs", jobs},
                                              {"summary", summary},
                                              {"trials", trials}}
                                   .dump(2)
                            << "\n";
   fmt::print("wrote {} and {}\n", csv_path.string(), json_path.string());
+}
+
+void RunBatch(const BatchOptions& o) {
+  if (o.trials < 1) throw CommandFailed("--trials must be at least 1");
+  if (o.jobs < 1) throw CommandFailed("--jobs must be at least 1");
+  if (o.resume && o.overwrite) throw CommandFailed("--resume and --overwrite exclude each other");
+  const std::pair<int, int> shard = ParseShard(o.shard);
+  const std::filesystem::path dir(o.out);
+  if (!o.resume && !o.overwrite) {
+    for (const auto& p : {dir / "trials.csv", dir / "batch.json"}) {
+      if (std::filesystem::exists(p)) {
+        throw CommandFailed(fmt::format(
+            "'{}' exists; pass --overwrite to replace it (or --resume to continue)", p.string()));
+      }
+    }
+  }
+  // SCENARIO or SCENARIO:N (N trials of that one, e.g. the paper's protocol).
+  std::vector<std::pair<std::string, int>> scenarios;
+  for (const auto& arg : o.scenarios) {
+    std::string file = arg;
+    int trials = o.trials;
+    if (const auto colon = arg.rfind(':');
+        colon != std::string::npos && !std::filesystem::exists(arg)) {
+      const std::string count = arg.substr(colon + 1);
+      if (count.empty() || count.size() > 7 ||
+          count.find_first_not_of("0123456789") != std::string::npos || std::stoll(count) < 1 ||
+          std::stoll(count) > kMaxTrials) {
+        throw CommandFailed(fmt::format("'{}': expected SCENARIO or SCENARIO:TRIALS", arg));
+      }
+      file = arg.substr(0, colon);
+      trials = int(std::stoll(count));
+    }
+    if (!std::filesystem::exists(file))
+      throw CommandFailed(fmt::format("'{}': no such scenario file", file));
+    // Check every scenario (and its mission) before starting any worker.
+    const twin::Scenario scenario = twin::LoadScenario(file);
+    if (!scenario.mission) {
+      throw CommandFailed(
+          fmt::format("{}: no 'mission' section: sim batch runs the robot brain", file));
+    }
+    scenarios.emplace_back(file, trials);
+  }
+  const nlohmann::json plan = PlanJson(scenarios, o.seed_base, shard);
+  const auto all = WorkList(plan);
+  // This shard's work items, as indices into the whole batch's list.
+  std::vector<std::size_t> mine;
+  for (std::size_t k = std::size_t(shard.first - 1); k < all.size(); k += std::size_t(shard.second))
+    mine.push_back(k);
+  if (mine.empty()) throw CommandFailed(fmt::format("--shard {}: no trials fall in it", o.shard));
+  std::map<std::size_t, nlohmann::json> finished;
+  BatchJournal journal = o.resume ? BatchJournal::Resume(dir / "journal.jsonl", plan, &finished)
+                                  : BatchJournal::Create(dir / "journal.jsonl", plan, o.overwrite);
+  WorkerPoolOptions pool;
+  pool.jobs = o.jobs;
+  pool.progress = !o.quiet && ::isatty(::fileno(stderr));
+  pool.skip.resize(mine.size());
+  std::vector<TrialResult> results(mine.size());
+  for (std::size_t k = 0; k < mine.size(); ++k) {
+    if (const auto it = finished.find(mine[k]); it != finished.end()) {
+      results[k] = TrialFromJson(it->second);
+      pool.skip[k] = true;
+    }
+  }
+  pool.on_result = [&](std::size_t k, const nlohmann::json& r) {
+    results[k] = FromWorker(r, all[mine[k]]);
+    journal.Append(mine[k], ToJson(results[k]));
+  };
+  const std::size_t to_run =
+      mine.size() - std::size_t(std::count(pool.skip.begin(), pool.skip.end(), true));
+  if (!o.quiet) {
+    fmt::print("{} scenario(s), {} runs{}{} on {} worker process(es)\n", scenarios.size(),
+               mine.size(),
+               shard.second > 1 ? fmt::format(" (shard {} of {})", shard.first, shard.second) : "",
+               o.resume ? fmt::format(", {} already in the journal", mine.size() - to_run) : "",
+               std::min<std::size_t>(std::size_t(o.jobs), std::max<std::size_t>(1, to_run)));
+  }
+  const auto started = std::chrono::steady_clock::now();
+  CompiledScenario compiled;  // each worker's own copy after the fork
+  RunInWorkers(
+      mine.size(),
+      [&](std::size_t k) {
+        const auto& [file, seed] = all[mine[k]];
+        try {
+          return ToJson(RunBrainTrial(file, seed, &compiled));
+        } catch (const std::exception& e) {
+          TrialResult r = FromWorker({{"error", e.what()}}, all[mine[k]]);
+          return ToJson(r);
+        }
+      },
+      pool);
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  ReportBatch(dir, plan, results, wall, o.jobs);
+}
+
+// `sim merge DIR... --out OUT`: the shards of one batch into the files one machine would write.
+struct MergeOptions {
+  std::vector<std::string> shards;
+  std::string out{"batch"};
+  bool overwrite{false};
+};
+
+void RunMerge(const MergeOptions& o) {
+  const std::filesystem::path out(o.out);
+  for (const auto& p : {out / "trials.csv", out / "batch.json"}) {
+    if (std::filesystem::exists(p) && !o.overwrite)
+      throw CommandFailed(fmt::format("'{}' exists; pass --overwrite to replace it", p.string()));
+  }
+  nlohmann::json plan;
+  std::map<int, nlohmann::json> by_shard;  // shard index -> its trials
+  double wall = 0.0;
+  int jobs = 0;
+  for (const auto& dir : o.shards) {
+    const auto path = std::filesystem::path(dir) / "batch.json";
+    if (!std::filesystem::exists(path)) {
+      throw CommandFailed(fmt::format(
+          "'{}': no batch.json (the shard did not finish: continue it with --resume)", dir));
+    }
+    nlohmann::json j;
+    try {
+      j = nlohmann::json::parse(ReadTextFile(path, "batch file"));
+    } catch (const std::exception& e) {
+      throw CommandFailed(fmt::format("{}: {}", path.string(), e.what()));
+    }
+    if (!j.contains("batch") || !j.contains("trials"))
+      throw CommandFailed(fmt::format("{}: not a sim batch result", path.string()));
+    nlohmann::json shard_plan = j.at("batch");
+    const int index = shard_plan.at("shard").at(0).get<int>();
+    shard_plan["shard"] = {1, shard_plan.at("shard").at(1).get<int>()};
+    if (plan.is_null()) plan = shard_plan;
+    if (shard_plan != plan) {
+      throw CommandFailed(fmt::format(
+          "{}: a shard of another batch (scenarios, trial counts, seed base or shard count "
+          "differ from {})",
+          path.string(), o.shards.front()));
+    }
+    if (!by_shard.emplace(index, j.at("trials")).second)
+      throw CommandFailed(fmt::format("{}: shard {} is given twice", path.string(), index));
+    wall = std::max(wall, j.value("wall_s", 0.0));
+    jobs += j.value("jobs", 0);
+  }
+  const int count = plan.at("shard").at(1).get<int>();
+  for (int i = 1; i <= count; ++i) {
+    if (!by_shard.count(i)) throw CommandFailed(fmt::format("shard {} of {} is missing", i, count));
+  }
+  const auto all = WorkList(plan);
+  std::vector<TrialResult> results;
+  std::map<int, std::size_t> next;  // per shard: its next trial
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    const int shard = int(k % std::size_t(count)) + 1;
+    const nlohmann::json& trials = by_shard.at(shard);
+    const std::size_t at = next[shard]++;
+    if (at >= trials.size())
+      throw CommandFailed(fmt::format("shard {} has fewer trials than its plan", shard));
+    TrialResult r = TrialFromJson(trials.at(at));
+    if (r.scenario != all[k].first || r.seed != all[k].second) {
+      throw CommandFailed(fmt::format("shard {}: trial {} is {} seed {}, the plan says {} seed {}",
+                                      shard, at, r.scenario, r.seed, all[k].first, all[k].second));
+    }
+    results.push_back(std::move(r));
+  }
+  plan["shard"] = {1, 1};
+  ReportBatch(out, plan, results, wall, jobs);
 }
 
 }  // namespace
@@ -398,11 +553,26 @@ void AddSimBatchCommand(CLI::App& sim_group) {
       ->check(CLI::Range(1, kMaxJobs));
   batch->add_option("--seed-base", o->seed_base, "trial i runs with seed seed-base + i")
       ->capture_default_str();
-  batch->add_option("--out", o->out, "directory for trials.csv and batch.json")
+  batch->add_option("--out", o->out, "directory for trials.csv, batch.json and journal.jsonl")
       ->capture_default_str();
+  batch
+      ->add_option("--shard", o->shard,
+                   "I/N: run only work items I-1, I-1+N, ... (merge the shards with sim merge)")
+      ->capture_default_str();
+  batch->add_flag("--resume", o->resume,
+                  "continue the interrupted batch in --out: run only trials not in its journal");
   batch->add_flag("--overwrite", o->overwrite, "replace existing result files");
   batch->add_flag("-q,--quiet", o->quiet, "no progress bar");
   batch->callback([o] { RunBatch(*o); });
+
+  auto m = std::make_shared<MergeOptions>();
+  auto* merge = sim_group.add_subcommand(
+      "merge", "Merge the shards of a batch (sim batch --shard I/N) into one machine's files");
+  merge->add_option("shards", m->shards, "the shards' --out directories")->required();
+  merge->add_option("--out", m->out, "directory for the merged trials.csv and batch.json")
+      ->capture_default_str();
+  merge->add_flag("--overwrite", m->overwrite, "replace existing result files");
+  merge->callback([m] { RunMerge(*m); });
 }
 
 }  // namespace egress::apps

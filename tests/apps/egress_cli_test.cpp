@@ -1,14 +1,19 @@
 // Runs the real `egress` program as a user would and checks what it prints and returns.
 
+#include <signal.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <array>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <string>
+#include <thread>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -481,6 +486,96 @@ TEST(EgressCliTest, SimBatchPrintsTheTableAndWritesTheSameResultsForAnyJobCount)
                 (dir / "x").string());
   EXPECT_EQ(no_mission.exit_code, 1);
   EXPECT_THAT(no_mission.output, HasSubstr("no 'mission' section"));
+  std::filesystem::remove_all(dir);
+}
+
+// A batch killed (SIGKILL, no chance to clean up) after some trials continues with --resume:
+// no trial lost or run twice, and the files equal an uninterrupted run's. Shards merged with
+// `sim merge` equal one machine's run too.
+TEST(EgressCliTest, SimBatchResumesAfterAKillAndShardsMergeToOneMachinesRun) {
+  const auto dir = egress::testing::TestTempPath("resume");
+  const std::string scenarios =
+      kWorldsDir + "/scenarios/s3_held_door.yaml " + kWorldsDir + "/scenarios/s1_nominal.yaml:2";
+  const std::string batch = "sim batch " + scenarios + " --trials 5 --jobs 2 -q --out ";
+  ASSERT_EQ(RunEgress(batch + (dir / "whole").string()).exit_code, 0);
+  const auto trials = [&](const std::string& run) {
+    nlohmann::json j = nlohmann::json::parse(std::ifstream(dir / run / "batch.json"));
+    for (auto& t : j.at("trials"))
+      t.erase("wall_time");
+    return nlohmann::json{
+        {"batch", j.at("batch")}, {"summary", j.at("summary")}, {"trials", j.at("trials")}};
+  };
+  const auto journal_trials = [&](const std::string& run) {
+    std::ifstream in(dir / run / "journal.jsonl");
+    std::vector<std::size_t> items;
+    std::string line;
+    std::getline(in, line);  // the plan
+    while (std::getline(in, line))
+      items.push_back(nlohmann::json::parse(line).at("i").get<std::size_t>());
+    return items;
+  };
+  // Killed once three trials are in the journal.
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const std::string command =
+        std::string(EGRESS_CLI_PATH) + " " + batch + (dir / "killed").string() + " >/dev/null";
+    execl("/bin/sh", "sh", "-c", ("exec " + command).c_str(), nullptr);
+    _exit(127);
+  }
+  for (int k = 0; k < 600 && std::filesystem::exists(dir / "killed" / "journal.jsonl") == false;
+       ++k)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  for (int k = 0; k < 600 && journal_trials("killed").size() < 3; ++k)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  kill(pid, SIGKILL);
+  waitpid(pid, nullptr, 0);
+  const std::size_t before = journal_trials("killed").size();
+  ASSERT_GE(before, 3u);
+  ASSERT_LT(before, 7u) << "the batch finished before it was killed";
+  EXPECT_FALSE(std::filesystem::exists(dir / "killed" / "batch.json"));
+  // Without --resume the journal is never overwritten.
+  const Result refused = RunEgress(batch + (dir / "killed").string());
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_THAT(refused.output, HasSubstr("--resume"));
+  const Result resumed = RunEgress(batch + (dir / "killed").string() + " --resume");
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  std::vector<std::size_t> items = journal_trials("killed");
+  std::sort(items.begin(), items.end());
+  EXPECT_EQ(items, (std::vector<std::size_t>{0, 1, 2, 3, 4, 5, 6}));  // each trial exactly once
+  EXPECT_EQ(trials("killed"), trials("whole"));
+  // A resume of another batch is refused.
+  const Result other = RunEgress("sim batch " + scenarios + " --trials 4 -q --resume --out " +
+                                 (dir / "killed").string());
+  EXPECT_EQ(other.exit_code, 1);
+  EXPECT_THAT(other.output, HasSubstr("another batch"));
+
+  // Shards 1/3..3/3, merged in any order, equal the whole batch.
+  for (int i = 1; i <= 3; ++i) {
+    const Result shard = RunEgress(batch + (dir / ("shard" + std::to_string(i))).string() +
+                                   " --shard " + std::to_string(i) + "/3");
+    ASSERT_EQ(shard.exit_code, 0) << shard.output;
+  }
+  const Result merged =
+      RunEgress("sim merge " + (dir / "shard3").string() + " " + (dir / "shard1").string() + " " +
+                (dir / "shard2").string() + " --out " + (dir / "merged").string());
+  ASSERT_EQ(merged.exit_code, 0) << merged.output;
+  EXPECT_THAT(merged.output, HasSubstr("S3 held door"));
+  EXPECT_EQ(trials("merged"), trials("whole"));
+  const auto csv = [&](const std::string& run) {  // without the wall-time column
+    std::ifstream in(dir / run / "trials.csv");
+    std::string out, line;
+    while (std::getline(in, line))
+      out += line.substr(0, line.rfind(',')) + "\n";
+    return out;
+  };
+  EXPECT_EQ(csv("merged"), csv("whole"));
+  const Result missing =
+      RunEgress("sim merge " + (dir / "shard1").string() + " --out " + (dir / "partial").string());
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_THAT(missing.output, HasSubstr("shard 2 of 3 is missing"));
+  const Result bad_shard = RunEgress(batch + (dir / "x").string() + " --shard 4/3");
+  EXPECT_EQ(bad_shard.exit_code, 1);
+  EXPECT_THAT(bad_shard.output, HasSubstr("1 <= I <= N"));
   std::filesystem::remove_all(dir);
 }
 
