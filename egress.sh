@@ -7,6 +7,8 @@
 #   ./egress.sh build      configure and build only
 #   ./egress.sh sanitize   build with AddressSanitizer + UBSan in build-asan/ and run the tests
 #   ./egress.sh bench      build and run the Google Benchmark programs in bench/
+#   ./egress.sh deps-slurm install Slurm and munge (deps/apt-packages-slurm.txt) for deploy/slurm
+#                          and its test, which is skipped without them
 #   ./egress.sh fuzz [S]   build the libFuzzer targets (clang, ASan + UBSan) in build-fuzz/ and
 #                          run each for S seconds (default 60) from seeds of the project's files
 # Environment: EGRESS_BUILD_DIR (default build), EGRESS_ASAN_BUILD_DIR (default build-asan),
@@ -116,6 +118,9 @@ case "$command" in
       "$program"
     done
     ;;
+  deps-slurm)
+    install_deps deps/apt-packages-slurm.txt
+    ;;
   fuzz)
     seconds=${2:-60}
     [[ "$seconds" =~ ^[0-9]+$ ]] && [ "$seconds" -gt 0 ] || die "fuzz: SECONDS must be a positive integer"
@@ -136,9 +141,9 @@ case "$command" in
     fuzz/run_fuzzers.sh "$fuzz_dir" "$seconds"
     ;;
   help|-h|--help)
-    sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'
+    sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'
     ;;
   *)
-    die "unknown sub-command '$command' (try: demo, test, deps, build, sanitize, bench, fuzz)"
+    die "unknown sub-command '$command' (try: demo, test, deps, deps-slurm, build, sanitize, bench, fuzz)"
     ;;
 esac
