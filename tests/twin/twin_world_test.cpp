@@ -257,7 +257,7 @@ people:
 class GraspTest : public ::testing::Test {
  protected:
   // A bottle on the office table; the robot reaches it from the table's north side.
-  std::unique_ptr<TwinWorld> MakeWorld(double reach_offset) {
+  std::unique_ptr<TwinWorld> MakeWorld(double reach_offset, const std::string& extra = "") {
     const Eigen::Vector3d p_bottle(2.3, 1.35, 0.856);
     planning::IkConfig ik;
     ik.use_base = true;
@@ -280,7 +280,7 @@ class GraspTest : public ::testing::Test {
         "world: office.sdf\nrobot: {start: {x: " + std::to_string(solution.q[kBaseX]) +
         ", y: " + std::to_string(solution.q[kBaseY]) +
         ", yaw: " + std::to_string(solution.q[kBaseYaw]) +
-        "}}\npayloads: [{name: bottle, kind: water_bottle, x: 2.3, y: 1.35, z: 0.856}]\n";
+        "}}\npayloads: [{name: bottle, kind: water_bottle, x: 2.3, y: 1.35, z: 0.856}]\n" + extra;
     auto loaded = LoadText(yaml, WorldsDir() / "office");
     return std::make_unique<TwinWorld>(loaded.scenario, loaded.world, 1, Hsr());
   }
@@ -336,6 +336,16 @@ TEST_F(GraspTest, AHeldBottleTuckedOverTheBaseDoesNotPushTheRobot) {
   const Pose2 after = world->robot_pose();
   EXPECT_LT((after.translation() - before.translation()).norm(), 0.01);
   EXPECT_LT(std::abs(after.yaw - before.yaw), 0.01);
+}
+
+// An injected grasp slip (faults: grasp_slip) drops a held bottle at its time.
+TEST_F(GraspTest, AGraspSlipDropsTheHeldBottle) {
+  auto world = MakeWorld(0.0, "faults: [{kind: grasp_slip, start: 7.0}]\n");
+  ReachAndClose(world.get());  // t = 6
+  ASSERT_EQ(world->held_payload(), std::optional<std::string>("bottle"));
+  world->StepFor(1.5);
+  EXPECT_FALSE(world->held_payload().has_value());
+  EXPECT_EQ(CountEvents(*world, "fault", "grasp_slip"), 1);
 }
 
 TEST_F(GraspTest, OutsideToleranceTheGraspFails) {

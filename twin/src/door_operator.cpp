@@ -38,6 +38,11 @@ void AdaDoorOperator::Trigger(double now) {
   trigger_time_ = now;
 }
 
+void AdaDoorOperator::CloseNow() {
+  pending_trigger_ = false;
+  if (phase_ == DoorPhase::kOpening || phase_ == DoorPhase::kHeldOpen) phase_ = DoorPhase::kClosing;
+}
+
 double AdaDoorOperator::Update(double now, double angle) {
   if (pending_trigger_) {
     pending_trigger_ = false;

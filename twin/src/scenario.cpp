@@ -15,6 +15,7 @@
 #include "people/evacuate.h"
 #include "people/hold_door.h"
 #include "people/walk_past.h"
+#include "scenario_faults.h"
 #include "scenario_poses.h"
 #include "scenario_sensors.h"
 #include "yaml_field_reader.h"
@@ -174,7 +175,7 @@ Scenario Parse(const YAML::Node& root, const FieldReader& r,
                const std::filesystem::path& base_dir) {
   r.CheckKeys(root, "",
               {"name", "world", "building", "seed", "time_limit", "robot", "doors", "people",
-               "payloads", "obstacles", "randomize", "success", "sensors", "mission"});
+               "payloads", "obstacles", "randomize", "success", "sensors", "faults", "mission"});
   Scenario s;
   s.name = root["name"] ? r.String(root["name"], "name") : std::string();
   const std::string world = r.String(r.Required(root, "", "world"), "world");
@@ -464,6 +465,7 @@ Scenario Parse(const YAML::Node& root, const FieldReader& r,
     }
   }
   if (const YAML::Node sensors = root["sensors"]) ParseSensors(r, sensors, &s.sensors);
+  if (const YAML::Node faults = root["faults"]) s.faults = ParseFaults(r, faults);
   if (const YAML::Node mission = root["mission"]) {
     r.CheckKeys(mission, "mission", {"tree", "main", "blackboard"});
     MissionSpec m;
@@ -594,6 +596,12 @@ void Scenario::ValidateAgainst(const WorldDescription& world) const {
     }
     return false;
   };
+  for (const FaultSpec& fault : faults) {
+    if (!fault.door.empty() && !known_door(fault.door)) {
+      throw LoadError(StrCat(where, ":", fault.line, ": field 'faults': world ",
+                             world_file.string(), " has no hinged door '", fault.door, "'"));
+    }
+  }
   for (std::size_t i = 0; i < people.size(); ++i) {
     if (!people[i].door.empty() && !known_door(people[i].door)) {
       throw LoadError(StrCat(where, ": field 'people[", i, "].door': world has no door '",

@@ -74,8 +74,16 @@ void TwinWorld::Impl::UpdateActuators() {
     if (d.spec && d.next_open_at < d.spec->open_at.size() &&
         time >= d.spec->open_at[d.next_open_at]) {
       ++d.next_open_at;
-      AddEvent("door_triggered", d.fixed->desc->name, "scheduled");
-      d.op->Trigger(time);
+      if (DoorRefusesAt(d, time)) {
+        AddEvent("fault_refused_press", d.fixed->desc->name, "scheduled");
+      } else {
+        AddEvent("door_triggered", d.fixed->desc->name, "scheduled");
+        d.op->Trigger(time);
+      }
+    }
+    if (triggered != nullptr && DoorRefusesAt(d, time)) {
+      AddEvent("fault_refused_press", d.fixed->desc->name, *triggered);
+      triggered = nullptr;
     }
     if (triggered != nullptr) {
       ++d.presses;

@@ -52,19 +52,31 @@ void TwinRobot::StepOnce() {
   world_->Step();
   const double t = world_->time();
   clock_.AdvanceTo(world_->now());
-  timed(&cost_.odometry,
-        [&] { odometry_.Integrate(world_->robot_velocity(), world_->step_size()); });
+  using Fault = FaultSpec::Kind;
+  timed(&cost_.odometry, [&] {
+    Twist2 V_B = world_->robot_velocity();
+    if (const FaultSpec* slip = world_->ActiveFault(Fault::kOdometrySlip, t)) {
+      V_B = {V_B.vx * slip->odometry_scale, V_B.vy * slip->odometry_scale,
+             V_B.wz * slip->odometry_scale};
+    }
+    odometry_.Integrate(V_B, world_->step_size());
+  });
   if (t + 1e-9 >= next_odometry_) {
     last_odometry_ = odometry_.Read(world_->now());
     next_odometry_ += 1.0 / config_.odometry_rate_hz;
   }
-  if (t + 1e-9 >= next_laser_) {
+  if (t + 1e-9 >= next_laser_ && world_->ActiveFault(Fault::kLaserDropout, t) != nullptr) {
+    next_laser_ += 1.0 / config_.laser_rate_hz;  // a scan that never comes
+  } else if (t + 1e-9 >= next_laser_) {
     timed(&cost_.laser, [&] {
       laser_queue_.push_back({t + config_.laser_latency_s, laser_.Capture(*world_, laser_rng_)});
     });
     next_laser_ += 1.0 / config_.laser_rate_hz;
   }
-  if (t + 1e-9 >= next_depth_) {
+  const bool blackout = world_->ActiveFault(Fault::kCameraBlackout, t) != nullptr;
+  if (t + 1e-9 >= next_depth_ && blackout) {
+    next_depth_ += 1.0 / config_.depth_rate_hz;
+  } else if (t + 1e-9 >= next_depth_) {
     timed(&cost_.depth, [&] {
       depth_queue_.push_back(
           {t + config_.depth_latency_s,
@@ -73,9 +85,13 @@ void TwinRobot::StepOnce() {
     });
     next_depth_ += 1.0 / config_.depth_rate_hz;
   }
-  if (t + 1e-9 >= next_detector_) {
+  if (t + 1e-9 >= next_detector_ && blackout) {
+    next_detector_ += 1.0 / config_.detector_rate_hz;
+  } else if (t + 1e-9 >= next_detector_) {
     timed(&cost_.detector, [&] {
-      const double latency = config_.detector_latency_s.Sample(detector_rng_);
+      double latency = config_.detector_latency_s.Sample(detector_rng_);
+      if (const FaultSpec* spike = world_->ActiveFault(Fault::kDetectorLatency, t))
+        latency += spike->latency_s;
       for (auto& d : detector_.Detect(*world_, detector_rng_))
         detection_queue_.push_back({t + latency, std::move(d)});
     });

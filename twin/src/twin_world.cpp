@@ -47,6 +47,7 @@ TwinWorld::Impl::Impl(std::shared_ptr<const TwinModel> twin_model_in, std::uint6
   BuildPeople();
   BuildRayProxies();
   SyncRayProxies();
+  DrawFaults();
 }
 
 TwinWorld::Impl::~Impl() {
@@ -179,6 +180,7 @@ void TwinWorld::Impl::RecordContacts() {
 }
 
 void TwinWorld::Impl::StepOnce() {
+  ApplyFaults();
   UpdatePeople();
   UpdateRobot();
   UpdateArmBodies();

@@ -199,6 +199,12 @@ struct TwinWorld::Impl {
   void FollowHeldPayload();
 
   void StepOnce();
+  // Fires the instantaneous faults whose time has come (kidnap, door closing early, grasp
+  // slip): twin_faults.cpp.
+  void DrawFaults();
+  void ApplyFaults();
+  bool DoorRefusesAt(const Door& d, double t) const;
+  std::vector<TwinWorld::DrawnFault> faults;
 
   Pose2 RobotPose() const;
 

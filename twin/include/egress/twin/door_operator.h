@@ -26,6 +26,9 @@ class AdaDoorOperator {
 
   /// A press or a wave at time `now` [s].
   void Trigger(double now);
+  /// Starts closing now if opening or held open (a fault: the operator cuts its hold short).
+  /// A later trigger re-opens it as usual.
+  void CloseNow();
   /// Advances the state machine to `now` [s] given the measured opening angle [rad]; returns
   /// the commanded opening rate [rad/s] (positive opens).
   double Update(double now, double angle);

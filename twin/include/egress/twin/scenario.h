@@ -136,6 +136,35 @@ struct SensorConfig {
   int detector_visibility_samples{12};        ///< Ray-cast samples per object.
 };
 
+/// A fault injected into a run (`faults:` in the scenario): what goes wrong and when. Start and
+/// duration are drawn per seed from their ranges (a pure function of scenario and seed). The
+/// twin applies them; the brain is not told (it must notice).
+struct FaultSpec {
+  enum class Kind {
+    kLaserDropout,     ///< No scans during the window.
+    kCameraBlackout,   ///< No depth images and no detections during the window.
+    kDetectorLatency,  ///< Detections made in the window arrive `latency_s` later.
+    kOdometrySlip,     ///< Odometry reports `odometry_scale` times the true motion in the window.
+    kKidnap,           ///< At `start` the robot is moved by `offset` (in W) if the spot is free.
+    kDoorClosesEarly,  ///< At `start`, `door`'s operator starts closing, whatever its hold.
+    kDoorRefuses,      ///< `door` ignores presses and waves during the window.
+    kGraspSlip,        ///< At `start`, a payload in the gripper slips out (if one is held).
+  };
+  Kind kind{Kind::kLaserDropout};
+  Range start;     ///< [s] simulated time.
+  Range duration;  ///< [s] for window faults; 0 for the instantaneous ones.
+  double latency_s{1.0};
+  double odometry_scale{1.5};
+  Pose2 offset;      ///< kKidnap: [m, m, rad] added to the true pose in W.
+  std::string door;  ///< kDoorClosesEarly, kDoorRefuses.
+  int line{0};       ///< In the scenario file, for messages.
+  /// True for a fault that happens at an instant (kidnap, door closing early, grasp slip).
+  bool Instantaneous() const;
+};
+/// laser_dropout, camera_blackout, detector_latency, odometry_slip, kidnap, door_closes_early,
+/// door_refuses, grasp_slip (the file's names).
+std::string_view ToString(FaultSpec::Kind kind);
+
 /// A success predicate the judge evaluates at the end of a run.
 struct PredicateSpec {
   enum class Kind {
@@ -216,6 +245,7 @@ struct Scenario {
   RandomizeSpec randomize;
   std::vector<PredicateSpec> success;
   SensorConfig sensors;
+  std::vector<FaultSpec> faults;
   std::optional<MissionSpec> mission;
 
   /// Checks the scenario against its world: doors and actuators exist, poses are free of

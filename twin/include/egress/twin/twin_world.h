@@ -114,6 +114,18 @@ class TwinWorld {
   TwinWorld(const TwinWorld&) = delete;
   TwinWorld& operator=(const TwinWorld&) = delete;
 
+  /// A fault of the scenario as drawn for this run (FaultSpec: start and duration drawn).
+  struct DrawnFault {
+    const FaultSpec* spec{nullptr};
+    double start{0.0};  ///< [s]
+    double end{0.0};    ///< [s]; == start for an instantaneous fault
+    bool fired{false};  ///< An instantaneous fault has happened (or was skipped, see events).
+  };
+  /// The run's faults, drawn from the scenario's `faults:` by the seed.
+  const std::vector<DrawnFault>& faults() const;
+  /// A window fault of `kind` in force at time `t` [s] (start <= t < end), or null.
+  const FaultSpec* ActiveFault(FaultSpec::Kind kind, double t) const;
+
   /// One fixed physics step.
   void Step();
   /// Steps until the simulated time has advanced by at least `seconds`.
