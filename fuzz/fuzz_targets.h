@@ -31,6 +31,12 @@ int ScenarioYaml(const std::uint8_t* data, std::size_t size);
 int SdfWorld(const std::uint8_t* data, std::size_t size);
 /// A URDF robot model.
 int Urdf(const std::uint8_t* data, std::size_t size);
+/// A map_server map: the bytes up to the first NUL are the YAML, the rest the image file it
+/// names (`map.pgm`), read confined to a scratch directory (ScopedReadRoot) with a 1 M cell cap.
+int MapServer(const std::uint8_t* data, std::size_t size);
+/// egress-navd's request handlers (NavigationHandlers) on a fresh service: a sequence of
+/// calls, each [RPC index byte][length: 2 bytes, little-endian][serialized request].
+int NavdRequests(const std::uint8_t* data, std::size_t size);
 
 /// Every target, by the name its corpus and regression folders use.
 const std::vector<NamedTarget>& AllTargets();

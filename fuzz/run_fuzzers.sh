@@ -4,7 +4,7 @@
 # inputs of fuzz/regressions/, and prints a table (executions/s, coverage, findings); writes
 # BUILD/fuzz_report.json. Exit status 1 if any target found a crash, a hang or a leak; its input
 # is in BUILD/artifacts/<target>/ (copy it into fuzz/regressions/<target>/ once fixed).
-#   fuzz/run_fuzzers.sh BUILD SECONDS
+#   fuzz/run_fuzzers.sh BUILD SECONDS   (EGRESS_FUZZ_TARGETS="a b": only those)
 set -euo pipefail
 build=$1
 seconds=$2
@@ -17,11 +17,12 @@ seed_files() {
     scenario_yaml) find "$root/worlds/scenarios" -name '*.yaml' ;;
     sdf_world) find "$root/worlds" -name '*.sdf' ;;
     urdf) find "$root/hsr_interface/models" -name '*.urdf' ;;
+    map_server | navd_requests) find "$root/fuzz/seeds/$1" -type f ;;
   esac
   find "$root/fuzz/regressions/$1" -type f
 }
 
-targets=(bt_script bt_xml scenario_yaml sdf_world urdf)
+targets=(${EGRESS_FUZZ_TARGETS:-bt_script bt_xml scenario_yaml sdf_world urdf map_server navd_requests})
 failed=0
 rows=()
 json="["

@@ -40,6 +40,10 @@ struct TrialResult {
   double wall_time{0.0};                           ///< [s]
   std::string error;                               ///< The run threw this.
   bool crashed{false};  ///< The worker process died running it (`error` says how).
+  /// Not a success, but the brain gave up by itself (its mission failed or it halted) with
+  /// the robot standing still and no person touched: a safe abort, for the reason given.
+  bool safe_abort{false};
+  std::string abort_reason;  ///< The brain's last note before it gave up.
 };
 
 /// One trial in this process. @throws like `egress sim run` for a bad scenario.
@@ -57,6 +61,7 @@ struct ScenarioSummary {
   int static_contacts{0};
   int trials_with_static_contacts{0};
   int trials_with_relocalizations{0};
+  int safe_aborts{0};  ///< Trials that were not successes but safe aborts.
   std::map<std::string, int> failure_reasons;
   std::vector<std::uint64_t> failed_seeds;
   std::vector<double> times;

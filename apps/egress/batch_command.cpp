@@ -35,6 +35,11 @@
 #include "workers.h"
 
 namespace egress::apps {
+namespace {
+// Below this base speed at the end of a run the robot stands still (a safe abort) [m/s].
+constexpr double kStillSpeed = 0.05;
+constexpr double kStopWithinS = 1.0;  // [s] for the base to stop after the brain gives up
+}  // namespace
 
 WilsonInterval CalcWilsonInterval(int successes, int trials, double z) {
   ThrowUnless(trials >= 0 && successes >= 0 && successes <= trials,
@@ -116,6 +121,24 @@ TrialResult RunBrainTrial(const std::string& scenario_path, std::uint64_t seed,
     }
     r.preemption_total_latencies.push_back(entered >= 0 ? std::max(0.0, commanded - entered) : 0.0);
   }
+  // A safe abort: the brain gave up by itself, standing still, having touched no one.
+  // The base was commanded to zero when the mission failed; it must come to rest within
+  // kStopWithinS (its deceleration limit), touching no one.
+  if (!r.success && brain->finished() && brain->status() != bt::NodeStatus::kSuccess) {
+    trial.world->SetBaseVelocity(Twist2{});
+    trial.world->StepFor(kStopWithinS);
+    const Twist2 V = trial.world->robot_velocity();
+    const bool still = std::hypot(V.vx, V.vy) < kStillSpeed;
+    for (auto it = brain->decisions().rbegin(); it != brain->decisions().rend(); ++it) {
+      const std::string& text = it->text;
+      const bool halted = text.size() > 7 && text.compare(text.size() - 7, 7, " halted") == 0;
+      if (text != "mission failed" && !halted) {
+        r.abort_reason = text;
+        break;
+      }
+    }
+    r.safe_abort = still && r.person_contacts == 0;
+  }
   r.wall_time = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   return r;
 }
@@ -138,7 +161,9 @@ nlohmann::json ToJson(const TrialResult& r) {
           {"preemption_total_latencies", r.preemption_total_latencies},
           {"wall_time", r.wall_time},
           {"error", r.error},
-          {"crashed", r.crashed}};
+          {"crashed", r.crashed},
+          {"safe_abort", r.safe_abort},
+          {"abort_reason", r.abort_reason}};
 }
 
 TrialResult TrialFromJson(const nlohmann::json& j) {
@@ -161,6 +186,8 @@ TrialResult TrialFromJson(const nlohmann::json& j) {
   r.wall_time = j.at("wall_time").get<double>();
   r.error = j.at("error").get<std::string>();
   r.crashed = j.value("crashed", false);
+  r.safe_abort = j.value("safe_abort", false);
+  r.abort_reason = j.value("abort_reason", std::string());
   return r;
 }
 
@@ -182,11 +209,16 @@ std::vector<ScenarioSummary> Summarize(const std::vector<TrialResult>& trials) {
     s.static_contacts += t.static_contacts;
     s.trials_with_static_contacts += t.static_contacts > 0 ? 1 : 0;
     s.trials_with_relocalizations += t.relocalizations > 0 ? 1 : 0;
+    s.safe_aborts += t.safe_abort ? 1 : 0;
     s.min_person_distance = std::min(s.min_person_distance, t.min_person_distance);
     if (t.success) s.times.push_back(t.time);
     if (!t.success) s.failed_seeds.push_back(t.seed);
-    for (const auto& f : t.failed)
-      ++s.failure_reasons[f];
+    if (t.safe_abort) {
+      ++s.failure_reasons["safe abort: " + t.abort_reason];
+    } else {
+      for (const auto& f : t.failed)
+        ++s.failure_reasons[f];
+    }
     if (!t.error.empty()) ++s.failure_reasons["error: " + t.error];
   }
   for (ScenarioSummary& s : out) {
@@ -202,18 +234,18 @@ std::vector<ScenarioSummary> Summarize(const std::vector<TrialResult>& trials) {
 
 std::string FormatSummaryTable(const std::vector<ScenarioSummary>& summaries) {
   std::ostringstream out;
-  out << fmt::format("{:<28} {:>6} {:>5} {:>7}  {:<15} {:>8} {:>9} {:>8} {:>6}  {}\n", "scenario",
-                     "trials", "ok", "rate", "95% Wilson", "median", "closest", "contacts", "bumps",
-                     "failure reasons");
+  out << fmt::format("{:<28} {:>6} {:>5} {:>7}  {:<15} {:>5} {:>8} {:>9} {:>8} {:>6}  {}\n",
+                     "scenario", "trials", "ok", "rate", "95% Wilson", "safe", "median", "closest",
+                     "contacts", "bumps", "failure reasons");
   int trials = 0, successes = 0;
   for (const ScenarioSummary& s : summaries) {
     std::string reasons;
     for (const auto& [reason, n] : s.failure_reasons)
       reasons += fmt::format("{}{} x{}", reasons.empty() ? "" : ", ", reason, n);
     out << fmt::format(
-        "{:<28} {:>6} {:>5} {:>6.1f}%  [{:>5.1f}, {:>5.1f}] {:>7} {:>9} {:>8} {:>6}  {}\n",
+        "{:<28} {:>6} {:>5} {:>6.1f}%  [{:>5.1f}, {:>5.1f}] {:>5} {:>7} {:>9} {:>8} {:>6}  {}\n",
         s.name.substr(0, 28), s.trials, s.successes, 100.0 * s.successes / std::max(1, s.trials),
-        100 * s.rate.low, 100 * s.rate.high,
+        100 * s.rate.low, 100 * s.rate.high, s.successes + s.safe_aborts,
         s.median_time ? fmt::format("{:.1f} s", *s.median_time) : "-",
         std::isfinite(s.min_person_distance) ? fmt::format("{:.2f} m", s.min_person_distance) : "-",
         s.person_contacts, s.trials_with_static_contacts, reasons.empty() ? "-" : reasons);
@@ -355,6 +387,8 @@ void ReportBatch(const std::filesystem::path& dir, const nlohmann::json& plan,
          {"static_contacts", s.static_contacts},
          {"trials_with_static_contacts", s.trials_with_static_contacts},
          {"trials_with_relocalizations", s.trials_with_relocalizations},
+         {"safe_aborts", s.safe_aborts},
+         {"success_or_safe_abort", double(s.successes + s.safe_aborts) / std::max(1, s.trials)},
          {"failure_reasons", s.failure_reasons},
          {"failed_seeds", s.failed_seeds}});
   }

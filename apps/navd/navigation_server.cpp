@@ -28,6 +28,8 @@ namespace egress::navd {
 namespace {
 
 namespace v1 = egress::nav::v1;
+constexpr double kMaxRobotRadiusM = 1.0;
+constexpr double kMaxInflationRadiusM = 5.0;
 using grpc::ServerContext;
 using grpc::Status;
 using grpc::StatusCode;
@@ -161,7 +163,8 @@ class Service final : public v1::Navigation::Service {
     const auto start = std::chrono::steady_clock::now();
     Status status;
     bool counted = false;
-    if (!config_.token.empty() && !Authorized(*context)) {
+    // A null context: called in-process by NavigationHandlers (no transport, no token).
+    if (context != nullptr && !config_.token.empty() && !Authorized(*context)) {
       status = {StatusCode::UNAUTHENTICATED,
                 "missing or wrong 'authorization: Bearer <token>' metadata"};
     } else if (bounded && busy_.fetch_add(1) >= config_.max_workers) {
@@ -177,7 +180,7 @@ class Service final : public v1::Navigation::Service {
       }
     }
     if (counted) busy_.fetch_sub(1);
-    if (config_.log) {
+    if (config_.log && context != nullptr) {
       const double ms =
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
               .count();
@@ -276,6 +279,8 @@ class Service final : public v1::Navigation::Service {
       case v1::LoadWorldRequest::kSdfPath:
       case v1::LoadWorldRequest::kSdfText: {
         const double resolution = request.sdf_resolution() != 0 ? request.sdf_resolution() : 0.05;
+        if (!std::isfinite(resolution) || resolution < 0.005 || resolution > 1.0)
+          return Invalid("sdf_resolution must be 0 (default 0.05) or in [0.005, 1] m");
         const auto rasterize = [&](const twin::WorldDescription& world) {
           const apps::SdfMap map =
               apps::RasterizeSdfWorld(world, resolution, config_.max_map_cells);
@@ -309,10 +314,21 @@ class Service final : public v1::Navigation::Service {
       return Invalid("the map has " + std::to_string(grid.geometry().size()) +
                      " cells, more than the limit " + std::to_string(config_.max_map_cells));
     }
+    // Bounded: an inflation radius of 1e6 m would inflate every cell over the whole map.
+    const auto in = [](double v, double lo, double hi) {
+      return std::isfinite(v) && v >= lo && v <= hi;
+    };
+    if (request.robot_radius() != 0 && !in(request.robot_radius(), 0.01, kMaxRobotRadiusM))
+      return Invalid("robot_radius must be 0 (default) or in [0.01, 1] m");
+    if (request.inflation_radius() != 0 &&
+        !in(request.inflation_radius(), 0.0, kMaxInflationRadiusM))
+      return Invalid("inflation_radius must be 0 (default) or in [0, 5] m");
     perception::CostmapConfig costmap_config;
     if (request.robot_radius() != 0) costmap_config.robot_radius = request.robot_radius();
     if (request.inflation_radius() != 0)
       costmap_config.inflation_radius = request.inflation_radius();
+    if (costmap_config.inflation_radius < costmap_config.robot_radius)
+      return Invalid("inflation_radius must not be below robot_radius");
     auto world = std::make_shared<World>();
     world->costmap = std::make_unique<perception::Costmap2D>(grid, costmap_config);
     planning::BasePlannerConfig planner_config;
@@ -326,6 +342,11 @@ class Service final : public v1::Navigation::Service {
     }
     for (const auto& door : request.doors()) {
       if (door.id().empty()) return Invalid("doors[].id must not be empty");
+      for (const double v :
+           {door.hinge().x(), door.hinge().y(), door.latch().x(), door.latch().y()}) {
+        if (!std::isfinite(v))
+          return Invalid("doors[].hinge and latch of '" + door.id() + "' must be finite");
+      }
       if (world->doors.count(door.id()) > 0) {
         return Invalid("doors[].id '" + door.id() +
                        "' is given twice (or is a door of the SDF world)");
@@ -420,14 +441,20 @@ class Service final : public v1::Navigation::Service {
       return {StatusCode::NOT_FOUND, "world_id '" + request.world_id() + "' is not loaded"};
     if (!Finite(request.start())) return Invalid("start must be finite (x, y, yaw)");
     if (!Finite(request.goal())) return Invalid("goal must be finite (x, y, yaw)");
-    if (!std::isfinite(request.time_budget()) || request.time_budget() < 0) {
-      return Invalid("time_budget must be a finite number >= 0");
+    if (!std::isfinite(request.time_budget()) || request.time_budget() < 0 ||
+        request.time_budget() > config_.max_time_budget_s) {
+      return Invalid("time_budget must be in [0, " + std::to_string(config_.max_time_budget_s) +
+                     "] s (0: 1 s)");
     }
+    if (!std::isfinite(request.costmap_cost_weight()) || request.costmap_cost_weight() < 0)
+      return Invalid("costmap_cost_weight must be a finite number >= 0");
     planning::BasePlannerConfig config;
     if (!request.planner().empty()) config.planner = request.planner();
-    double budget = request.time_budget() > 0 ? request.time_budget() : 1.0;
+    double budget = request.time_budget() > 0 ? request.time_budget()
+                                              : std::min(1.0, config_.max_time_budget_s);
     // Honour the request deadline: never plan past it.
-    const auto deadline = context->deadline();
+    const auto deadline =
+        context != nullptr ? context->deadline() : std::chrono::system_clock::time_point::max();
     if (deadline != std::chrono::system_clock::time_point::max()) {
       const double remaining =
           std::chrono::duration<double>(deadline - std::chrono::system_clock::now()).count();
@@ -438,7 +465,8 @@ class Service final : public v1::Navigation::Service {
     config.time_budget = budget;
     config.costmap_cost_weight = request.costmap_cost_weight();
     std::lock_guard lock(world->mutex);
-    if (context->IsCancelled()) return {StatusCode::CANCELLED, "the client cancelled the request"};
+    if (context != nullptr && context->IsCancelled())
+      return {StatusCode::CANCELLED, "the client cancelled the request"};
     std::unique_ptr<planning::BasePlanner> planner;
     try {
       planner = std::make_unique<planning::BasePlanner>(*world->costmap, nullptr, config);
@@ -531,6 +559,8 @@ void ValidateListenAddress(const NavigationServerConfig& config) {
   at_least_one("max_streams_per_connection", config.max_streams_per_connection);
   at_least_one("max_message_bytes", config.max_message_bytes);
   at_least_one("max_threads", config.max_threads);
+  if (!std::isfinite(config.max_time_budget_s) || config.max_time_budget_s <= 0)
+    throw std::invalid_argument("max_time_budget_s must be > 0");
   for (const auto& [name, seconds] :
        {std::pair{"idle_timeout_s", config.idle_timeout_s},
         std::pair{"handshake_timeout_s", config.handshake_timeout_s},
@@ -542,6 +572,50 @@ void ValidateListenAddress(const NavigationServerConfig& config) {
   if (!config.data_root.empty() && !std::filesystem::is_directory(config.data_root)) {
     throw std::invalid_argument("data root '" + config.data_root + "' is not a directory");
   }
+}
+
+struct NavigationHandlers::Impl {
+  NavigationServerConfig config;
+  std::unique_ptr<Service> service;
+};
+
+NavigationHandlers::NavigationHandlers(NavigationServerConfig config)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->config = std::move(config);
+  impl_->config.log = nullptr;
+  impl_->service = std::make_unique<Service>(impl_->config, nullptr);
+}
+
+NavigationHandlers::~NavigationHandlers() = default;
+
+int NavigationHandlers::Call(std::string_view rpc, std::string_view bytes) {
+  Service& s = *impl_->service;
+  // Parses `bytes` as the RPC's request (gRPC answers an unparsable message with INTERNAL).
+  const auto call = [&](auto request, auto response, auto method) {
+    if (!request.ParseFromArray(bytes.data(), int(bytes.size()))) return int(StatusCode::INTERNAL);
+    return int((s.*method)(nullptr, &request, &response).error_code());
+  };
+  if (rpc == "LoadWorld")
+    return call(v1::LoadWorldRequest{}, v1::LoadWorldResponse{}, &Service::LoadWorld);
+  if (rpc == "UpdateCostmap")
+    return call(v1::UpdateCostmapRequest{}, v1::UpdateCostmapResponse{}, &Service::UpdateCostmap);
+  if (rpc == "UnloadWorld")
+    return call(v1::UnloadWorldRequest{}, v1::UnloadWorldResponse{}, &Service::UnloadWorld);
+  if (rpc == "SetDoorState")
+    return call(v1::SetDoorStateRequest{}, v1::SetDoorStateResponse{}, &Service::SetDoorState);
+  if (rpc == "PlanPath")
+    return call(v1::PlanPathRequest{}, v1::PlanPathResponse{}, &Service::PlanPath);
+  if (rpc == "ListPlanners")
+    return call(v1::ListPlannersRequest{}, v1::ListPlannersResponse{}, &Service::ListPlanners);
+  if (rpc == "Health") return call(v1::HealthRequest{}, v1::HealthResponse{}, &Service::Health);
+  throw std::invalid_argument("no RPC '" + std::string(rpc) + "' in egress.nav.v1.Navigation");
+}
+
+const std::vector<std::string>& NavigationHandlers::Rpcs() {
+  static const std::vector<std::string> rpcs = {"LoadWorld",    "UpdateCostmap", "UnloadWorld",
+                                                "SetDoorState", "PlanPath",      "ListPlanners",
+                                                "Health"};
+  return rpcs;
 }
 
 struct NavigationServer::Impl {

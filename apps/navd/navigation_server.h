@@ -8,6 +8,8 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
+#include <vector>
 
 namespace egress::navd {
 
@@ -35,6 +37,7 @@ struct NavigationServerConfig {
   double keepalive_timeout_s{10.0};  ///< ...and closes it when the ping goes unanswered.
   int max_message_bytes{64 << 20};   ///< Largest request accepted [bytes].
   int max_threads{64};               ///< gRPC threads serving calls.
+  double max_time_budget_s{30.0};    ///< Longest planning time a request may ask for [s].
   /// One structured line per request (JSON); null for silence.
   std::function<void(const std::string&)> log;
 };
@@ -43,6 +46,27 @@ struct NavigationServerConfig {
 /// address without allow_remote, allow_remote without a token, a data root that is not a
 /// directory, or a limit out of range.
 void ValidateListenAddress(const NavigationServerConfig& config);
+
+/// The service's request handlers called in-process, without the gRPC transport (the fuzz
+/// target, tests): the same code a server runs for each call, minus authentication and the
+/// log line. Not thread-safe across calls on one instance only where the server is not either.
+class NavigationHandlers {
+ public:
+  explicit NavigationHandlers(NavigationServerConfig config);
+  ~NavigationHandlers();
+  NavigationHandlers(const NavigationHandlers&) = delete;
+  NavigationHandlers& operator=(const NavigationHandlers&) = delete;
+  /// Calls `rpc` (one of Rpcs()) with a serialized request; returns the gRPC status code (an
+  /// unparsable request: INTERNAL, as gRPC answers). @throws std::invalid_argument for an
+  /// unknown RPC name.
+  int Call(std::string_view rpc, std::string_view request_bytes);
+  /// The RPC names of egress.nav.v1.Navigation.
+  static const std::vector<std::string>& Rpcs();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 class NavigationServer {
  public:

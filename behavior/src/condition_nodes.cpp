@@ -86,7 +86,9 @@ class IsHoldingPayload final : public TaskNode<bt::ConditionNode> {
         InputPort<std::string>("payload", "", "payload class (bottle, flashlight); empty: any")};
   }
   NodeStatus Tick() override {
-    return belief_.holding_object ? NodeStatus::kSuccess : NodeStatus::kFailure;
+    if (belief_.holding_object) return NodeStatus::kSuccess;
+    Note("the payload is not in the gripper (the fingers closed on nothing)");
+    return NodeStatus::kFailure;
   }
 };
 

@@ -38,6 +38,8 @@ std::vector<fs::path> Seeds(std::string_view target) {
   if (target == "scenario_yaml") return FilesIn(kSource / "worlds/scenarios", ".yaml");
   if (target == "sdf_world") return FilesIn(kSource / "worlds", ".sdf");
   if (target == "urdf") return FilesIn(kSource / "hsr_interface/models", ".urdf");
+  if (target == "map_server") return FilesIn(kSource / "fuzz/seeds/map_server");
+  if (target == "navd_requests") return FilesIn(kSource / "fuzz/seeds/navd_requests");
   return {};
 }
 

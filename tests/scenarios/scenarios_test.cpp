@@ -250,5 +250,49 @@ TEST(ScenarioTest, OverhangTableIsPassedCarryingTheBottle) {
   EXPECT_TRUE(has_payload);
 }
 
+// The fault variants (issue 19): each injected fault happens in the run, and the brain either
+// completes or gives up by itself, with a reason, standing still; nobody is touched.
+class FaultScenarioTest : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(FaultScenarioTest, CompletesOrAbortsSafelyWithAReason) {
+  const BrainRun run = RunWithBrain(kScenarios / "hard" / GetParam(), 1);
+  const twin::RunMetrics& m = run.result.verdict.metrics;
+  EXPECT_EQ(m.contacts.count("person") ? m.contacts.at("person") : 0, 0);
+  // Every fault drawn for the run began before it ended.
+  ASSERT_FALSE(run.world->faults().empty());
+  for (const auto& f : run.world->faults())
+    EXPECT_LT(f.start, run.world->time()) << twin::ToString(f.spec->kind);
+  if (run.result.verdict.success) return;
+  EXPECT_EQ(run.brain->status(), bt::NodeStatus::kFailure)
+      << twin::FormatVerdict(run.result.verdict);
+  ASSERT_GE(run.brain->decisions().size(), 2u);
+  EXPECT_EQ(run.brain->decisions().back().text, "mission failed");
+}
+
+INSTANTIATE_TEST_SUITE_P(Hard, FaultScenarioTest,
+                         ::testing::Values("h6_laser_dropout.yaml", "h7_camera_blackout.yaml",
+                                           "h8_odometry_slip_kidnap.yaml",
+                                           "h9_door_closes_early.yaml", "h10_door_refuses.yaml",
+                                           "h11_grasp_slip.yaml"));
+
+TEST(ScenarioTest, ASlippedPayloadStopsTheCarryNamingIt) {
+  const BrainRun run = RunWithBrain(kScenarios / "hard" / "h11_grasp_slip.yaml", 1);
+  EXPECT_FALSE(run.result.verdict.success);
+  bool named = false;
+  for (const auto& d : run.brain->decisions())
+    named |= d.text.find("the payload is not in the gripper") != std::string::npos;
+  EXPECT_TRUE(named);
+  int slips = 0;
+  for (const auto& e : run.world->events())
+    slips += e.kind == "fault" && e.subject == "grasp_slip" ? 1 : 0;
+  EXPECT_EQ(slips, 1);
+}
+
+TEST(ScenarioTest, HardPersonFromBehindTheLeafIsYieldedTo) {
+  const BrainRun run = RunWithBrain(kScenarios / "hard" / "h12_person_behind_leaf.yaml", 1);
+  EXPECT_TRUE(run.result.verdict.success) << twin::FormatVerdict(run.result.verdict);
+  EXPECT_FALSE(run.brain->preemptions().empty());
+}
+
 }  // namespace
 }  // namespace egress
