@@ -4,7 +4,8 @@
 # inputs of fuzz/regressions/, and prints a table (executions/s, coverage, findings); writes
 # BUILD/fuzz_report.json. Exit status 1 if any target found a crash, a hang or a leak; its input
 # is in BUILD/artifacts/<target>/ (copy it into fuzz/regressions/<target>/ once fixed).
-#   fuzz/run_fuzzers.sh BUILD SECONDS   (EGRESS_FUZZ_TARGETS="a b": only those)
+#   fuzz/run_fuzzers.sh BUILD SECONDS   (EGRESS_FUZZ_TARGETS="a b": only those;
+#                                        EGRESS_FUZZ_REPORT: the report's path)
 set -euo pipefail
 build=$1
 seconds=$2
@@ -50,9 +51,10 @@ for name in "${targets[@]}"; do
   json+="$( [ "$json" = "[" ] || echo ,){\"target\":\"$name\",\"seconds\":$seconds,\"runs\":${runs:-0},\"exec_per_s\":${speed:-0},\"coverage\":${cov:-0},\"findings\":$findings,\"exit\":$status}"
 done
 json+="]"
-echo "$json" >"$build/fuzz_report.json"
+report=${EGRESS_FUZZ_REPORT:-$build/fuzz_report.json}
+echo "$json" >"$report"
 echo
 printf '%-14s %10s %9s %8s  %s\n' target runs exec/s cov result
 for row in "${rows[@]}"; do echo "$row"; done
-echo "report: $build/fuzz_report.json; logs: $build/fuzz_<target>.log"
+echo "report: $report; logs: $build/fuzz_<target>.log"
 exit $failed

@@ -20,6 +20,8 @@ void ExecutiveConfig::Validate() const {
   ThrowUnless(
       tick_rate_hz > 0 && control_rate_hz >= tick_rate_hz,
       "ExecutiveConfig: rates must be positive and the control rate at least the tick rate");
+  ThrowUnless(scan_hold_after_s > 0 && scan_abort_after_s >= scan_hold_after_s,
+              "ExecutiveConfig: need 0 < scan_hold_after_s <= scan_abort_after_s");
   tasks.Validate();
   arm.Validate();
   grasp.Validate();
@@ -119,6 +121,8 @@ LaserScan WithoutDoorSweeps(const LaserScan& scan, const MissionMap& map, const 
 }  // namespace
 
 struct Executive::Impl {
+  std::optional<Time> last_scan_at;  // the last step with a scan
+  bool holding_for_laser{false};     // the base is held still for a silent laser
   std::shared_ptr<const RobotModel> model;
   MissionMap map;
   ExecutiveConfig config;
@@ -362,6 +366,9 @@ bool Executive::Step(RobotPort& port) {
   const Time now = port.clock().Now();
   belief_.now = now;
   m.clock->Set(now);
+  // How long the base laser has been silent (from the first step if it never spoke).
+  if (snapshot.scan || !m.last_scan_at) m.last_scan_at = now;
+  const double scan_silence = ToSeconds(now) - ToSeconds(*m.last_scan_at);
 
   // Localize: odometry predicts, laser scans correct on the building map (or odometry alone
   // from the initial pose).
@@ -527,7 +534,31 @@ bool Executive::Step(RobotPort& port) {
         perception::ScanPoints(*snapshot.scan, (Pose3::FromPose2(belief_.X_MB) * X_BL).ToPose2()),
         std::move(people));
   }
-  const Twist2 V_B = m.motion.Update(now, belief_.X_MB, snapshot.odometry.V_B);
+  Twist2 V_B = m.motion.Update(now, belief_.X_MB, snapshot.odometry.V_B);
+  if (scan_silence > m.config.scan_hold_after_s) {
+    V_B = Twist2{};  // blind: stand still until scans come again
+    if (!m.holding_for_laser) {
+      decisions_.push_back(
+          {ToSeconds(now),
+           StrCat("the base laser is silent (", scan_silence, " s): holding the base still"),
+           DecisionEvent::kNote});
+    }
+    m.holding_for_laser = true;
+    if (scan_silence > m.config.scan_abort_after_s && !m.finished) {
+      m.motion.StopBase();
+      m.tree->HaltTree();
+      m.finished = true;
+      status_ = bt::NodeStatus::kFailure;
+      decisions_.push_back(
+          {ToSeconds(now),
+           StrCat("the base laser has been silent for ", scan_silence, " s: giving up"),
+           DecisionEvent::kNote});
+      decisions_.push_back({ToSeconds(now), "mission failed", DecisionEvent::kNote});
+    }
+  } else if (m.holding_for_laser) {
+    m.holding_for_laser = false;
+    decisions_.push_back({ToSeconds(now), "the base laser is back", DecisionEvent::kNote});
+  }
   port.SendBaseVelocity(V_B);
   if (auto arm = m.motion.TakeArmCommand()) port.SendArmTrajectory(*arm);
   if (auto gripper = m.motion.TakeGripperCommand()) {

@@ -16,8 +16,10 @@ std::optional<std::string> FindJointTreeProblem(const std::string& urdf_xml,
   tinyxml2::XMLDocument doc;
   if (doc.Parse(urdf_xml.c_str(), urdf_xml.size()) != tinyxml2::XML_SUCCESS)
     return std::string(StrCat("XML error: ", doc.ErrorStr()));
-  const tinyxml2::XMLElement* robot = doc.RootElement();
-  if (robot == nullptr) return std::string("the document has no root element.");
+  // The element urdfdom reads: the first top-level <robot>, not merely the first element (a
+  // fuzzed file with a stray element before <robot> passed this check and leaked in urdfdom).
+  const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
+  if (robot == nullptr) return std::string("the document has no <robot> element.");
   std::set<std::string, std::less<>> links;
   for (const auto* link = robot->FirstChildElement("link"); link != nullptr;
        link = link->NextSiblingElement("link")) {

@@ -23,7 +23,6 @@
 #include <fstream>
 #include <map>
 #include <mutex>
-#include <regex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -74,9 +73,15 @@ class NavdProcess {
     out_ = out[0];
     std::string text;
     const auto give_up = Clock::now() + std::chrono::seconds(20);
-    const std::regex port(R"(\(port (\d+),)");
-    std::smatch match;
-    while (Clock::now() < give_up && !std::regex_search(text, match, port)) {
+    // "(port N," in the first log line (no std::regex: GCC 12 warns inside it under ASan).
+    const auto find_port = [&]() -> int {
+      const auto at = text.find("(port ");
+      if (at == std::string::npos) return 0;
+      const auto comma = text.find(',', at);
+      if (comma == std::string::npos) return 0;
+      return std::atoi(text.substr(at + 6, comma - at - 6).c_str());
+    };
+    while (Clock::now() < give_up && find_port() == 0) {
       pollfd p{out_, POLLIN, 0};
       if (poll(&p, 1, 100) <= 0) continue;
       char buffer[4096];
@@ -84,7 +89,7 @@ class NavdProcess {
       if (n <= 0) break;
       text.append(buffer, std::size_t(n));
     }
-    if (std::regex_search(text, match, port)) port_ = std::stoi(match[1]);
+    port_ = find_port();
     drain_ = std::thread([this] {
       char buffer[4096];
       while (read(out_, buffer, sizeof(buffer)) > 0) {

@@ -37,6 +37,19 @@ class DoorZoneRulesTest : public ::testing::Test {
   }();
 };
 
+// A pose on a blackboard (x;y;yaw) is numbers, finite ones: std::stod reads "nan" and "inf",
+// which would reach the planners as a goal.
+TEST(ParsePose2Test, RefusesNonNumbersAndNonFiniteValues) {
+  const Pose2 X = ParsePose2("1.5;-2;0.25");
+  EXPECT_DOUBLE_EQ(X.x, 1.5);
+  EXPECT_DOUBLE_EQ(X.yaw, 0.25);
+  EXPECT_DOUBLE_EQ(ParsePose2("3;4").yaw, 0.0);
+  for (const char* bad :
+       {"nan;0;0", "0;inf;0", "0;0;-inf", "1e400;0;0", "1;x;0", "1;2;3;4", "1", ""}) {
+    EXPECT_THROW(ParsePose2(bad), InvalidArgument) << bad;
+  }
+}
+
 TEST_F(DoorZoneRulesTest, AHolderBesideTheHingeJambIsNoReasonToWait) {
   // A person holding the door, standing by the hinge jamb, 0.4 m off the line: their disc
   // reaches into the zone, but not into the robot's lane through the opening.

@@ -1,7 +1,10 @@
 // The paper's scenarios (worlds/scenarios/) at a fixed seed, driven by the robot brain and
 // judged by the twin's ground truth.
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -286,6 +289,32 @@ TEST(ScenarioTest, ASlippedPayloadStopsTheCarryNamingIt) {
   for (const auto& e : run.world->events())
     slips += e.kind == "fault" && e.subject == "grasp_slip" ? 1 : 0;
   EXPECT_EQ(slips, 1);
+}
+
+// A laser that stays silent: the base is held still at once, and after 10 s the mission is
+// given up, naming the laser, with the robot standing.
+TEST(ScenarioTest, ALaserThatStaysSilentStopsTheRobotThenTheMission) {
+  const auto file = std::filesystem::temp_directory_path() /
+                    ("egress_laser_silent_" + std::to_string(::getpid()) + ".yaml");
+  std::ofstream(file)
+      << "name: laser dies\nworld: " << (kScenarios.parent_path() / "lab/lab.sdf").string()
+      << "\ntime_limit: 60\nrobot:\n  start: {x: 0.0, y: 1.0, yaw_deg: 90}\n"
+         "  goal: {place: room_north}\ndoors: [{door: lab_door, operator: push}]\n"
+         "faults: [{kind: laser_dropout, start: 2.0, duration: 100.0}]\n"
+         "mission:\n  tree: "
+      << (kScenarios.parent_path().parent_path() / "behavior/trees/go_to.xml").string()
+      << "\n  blackboard: {max_yields: \"5\"}\nsuccess: [reach_goal, no_person_contact]\n";
+  const BrainRun run = RunWithBrain(file, 1);
+  std::filesystem::remove(file);
+  EXPECT_FALSE(run.result.verdict.success);
+  EXPECT_EQ(run.brain->status(), bt::NodeStatus::kFailure);
+  EXPECT_NEAR(run.world->time(), 2.0 + 10.0, 0.3);
+  bool named = false;
+  for (const auto& d : run.brain->decisions())
+    named |= d.text.find("laser has been silent") != std::string::npos;
+  EXPECT_TRUE(named);
+  const Twist2 V = run.world->robot_velocity();
+  EXPECT_LT(std::hypot(V.vx, V.vy), 0.02);
 }
 
 TEST(ScenarioTest, HardPersonFromBehindTheLeafIsYieldedTo) {

@@ -82,6 +82,11 @@ struct ExecutiveConfig {
   /// A held payload's outline for collision checks: a vertical cylinder at the palm [m].
   double held_payload_radius{0.05};
   double held_payload_length{0.26};
+  /// The base laser silent this long (no scan): the base is held still, whatever the tree
+  /// commands, until scans come again (the costmap and the localizer would be going blind) [s].
+  double scan_hold_after_s{0.5};
+  /// ... and this long: the mission fails, naming it (a safe abort) [s].
+  double scan_abort_after_s{10.0};
   planning::BasePlannerConfig planner = [] {
     planning::BasePlannerConfig c;
     c.deterministic = true;  // a twin run must be a pure function of its seed
