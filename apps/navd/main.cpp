@@ -53,6 +53,9 @@ int main(int argc, char** argv) {
   app.add_option("--idle-timeout", config.idle_timeout_s,
                  "close a connection without calls after this long [s]")
       ->capture_default_str();
+  app.add_option("--max-time-budget", config.max_time_budget_s,
+                 "longest planning time a request may ask for [s]")
+      ->capture_default_str();
   app.add_option("--handshake-timeout", config.handshake_timeout_s,
                  "close a connection that does not speak HTTP/2 within this [s]")
       ->capture_default_str();
