@@ -24,12 +24,19 @@ void CostmapConfig::Validate() const {
 
 namespace {
 constexpr int kLookupSubdivisions = 8;
-}
+constexpr double kMaxInflationCells = 1000.0;
+constexpr double kMaxDoorwayWidthM = 10.0;
+}  // namespace
 
 Costmap2D::Costmap2D(const OccupancyGrid& static_map, CostmapConfig config)
     : config_(config), geometry_(static_map.geometry()), static_(static_map.cells()) {
   config_.Validate();
   geometry_.Validate();
+  // The inflation kernel spans inflation_radius / resolution cells each way: bounded, so that
+  // a tiny resolution (1e-20 m, found by fuzzing navd) is an error, not a kernel of 1e20 cells.
+  ThrowUnless(config_.inflation_radius / geometry_.resolution <= kMaxInflationCells,
+              "Costmap: the inflation radius (", config_.inflation_radius, " m) spans more than ",
+              kMaxInflationCells, " cells of ", geometry_.resolution, " m");
   obstacle_.assign(geometry_.size(), kFreeCost);
   projection_.assign(geometry_.size(), kFreeCost);
   leaves_.assign(geometry_.size(), kFreeCost);
@@ -179,8 +186,14 @@ void Costmap2D::AddDoorway(const Doorway& doorway) {
   ThrowUnless(
       doorway.p_MHinge.allFinite() && doorway.p_MLatch.allFinite() && doorway.width() > 1e-3,
       "Invalid doorway '", doorway.id, "': jambs must be finite and distinct.");
-  ThrowUnless(doorway.threshold_depth >= 0.0, "Invalid doorway '", doorway.id,
-              "': threshold_depth must be >= 0.");
+  // A doorway wider than any door (a 1e9 m one, found by fuzzing navd) would be walked cell by
+  // cell for ever when its leaf is marked.
+  ThrowUnless(doorway.width() <= kMaxDoorwayWidthM, "Invalid doorway '", doorway.id,
+              "': its jambs are ", doorway.width(), " m apart (at most ", kMaxDoorwayWidthM,
+              " m).");
+  ThrowUnless(doorway.threshold_depth >= 0.0 && doorway.threshold_depth <= kMaxDoorwayWidthM,
+              "Invalid doorway '", doorway.id, "': threshold_depth must be in [0, ",
+              kMaxDoorwayWidthM, "] m.");
   doorways_[doorway.id] = doorway;
   // The threshold zone: the rectangle between the jambs, threshold_depth to each side.
   const Eigen::Vector2d along = (doorway.p_MLatch - doorway.p_MHinge) / doorway.width();

@@ -16,10 +16,11 @@ namespace egress::perception {
 std::optional<Eigen::Vector2i> GridGeometry::CellOf(const Eigen::Vector2d& p_MQ) const {
   if (!p_MQ.allFinite()) return std::nullopt;
   const Eigen::Vector2d local = (p_MQ - origin) / resolution;
-  const int ix = static_cast<int>(std::floor(local.x()));
-  const int iy = static_cast<int>(std::floor(local.y()));
-  if (!Contains(ix, iy)) return std::nullopt;
-  return Eigen::Vector2i(ix, iy);
+  const double fx = std::floor(local.x());
+  const double fy = std::floor(local.y());
+  // Range first: a far point (1e174 m, found by fuzzing navd) does not fit an int.
+  if (!(fx >= 0.0 && fx < double(width) && fy >= 0.0 && fy < double(height))) return std::nullopt;
+  return Eigen::Vector2i(static_cast<int>(fx), static_cast<int>(fy));
 }
 
 void GridGeometry::Validate() const {
