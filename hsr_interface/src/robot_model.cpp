@@ -423,6 +423,9 @@ RobotModel RobotModel::LoadFromString(const std::string& urdf_xml, std::string_v
     impl->Fail("the document is empty.");
 
   impl->RequireJointTree(urdf_xml);
+  // urdfdom reads the document as the checks read it (urdf_joint_tree.h).
+  const std::string canonical = CanonicalRobotXml(urdf_xml);
+  if (canonical.empty()) impl->Fail("the document has no <robot> element.");
   urdf::ModelInterfaceSharedPtr model;
   std::string parser_messages;
   {
@@ -430,7 +433,7 @@ RobotModel RobotModel::LoadFromString(const std::string& urdf_xml, std::string_v
     CapturingOutputHandler capture;
     console_bridge::useOutputHandler(&capture);
     try {
-      model = urdf::parseURDF(urdf_xml);
+      model = urdf::parseURDF(canonical);
     } catch (const std::exception& e) {
       console_bridge::restorePreviousOutputHandler();
       impl->Fail(e.what());

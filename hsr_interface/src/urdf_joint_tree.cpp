@@ -11,6 +11,17 @@
 
 namespace egress {
 
+std::string CanonicalRobotXml(const std::string& urdf_xml) {
+  tinyxml2::XMLDocument doc;
+  if (doc.Parse(urdf_xml.c_str(), urdf_xml.size()) != tinyxml2::XML_SUCCESS) return {};
+  const tinyxml2::XMLElement* robot = doc.FirstChildElement("robot");
+  if (robot == nullptr) return {};
+  tinyxml2::XMLPrinter printer;
+  robot->Accept(&printer);
+  return std::string(printer.CStr(),
+                     std::size_t(printer.CStrSize() > 0 ? printer.CStrSize() - 1 : 0));
+}
+
 std::optional<std::string> FindJointTreeProblem(const std::string& urdf_xml,
                                                 std::string_view root_link) {
   tinyxml2::XMLDocument doc;

@@ -16,4 +16,11 @@ namespace egress {
 std::optional<std::string> FindJointTreeProblem(const std::string& urdf_xml,
                                                 std::string_view root_link);
 
+/// The first top-level <robot> element of `urdf_xml` as tinyxml2 reads it, printed again (empty
+/// if there is none or the XML is malformed). This is what urdfdom is given, so that it reads
+/// the very document the checks above read: urdfdom parses with TinyXML 1, which reads malformed
+/// XML differently (a fuzzed file passed the checks as one tree and reached urdfdom as another,
+/// with a self-joint, which it leaked).
+std::string CanonicalRobotXml(const std::string& urdf_xml);
+
 }  // namespace egress
