@@ -22,6 +22,11 @@ ScopedReadRoot::~ScopedReadRoot() {
   t_read_root = previous_;
 }
 
+bool PathExists(const std::filesystem::path& path) {
+  std::error_code error;
+  return std::filesystem::exists(path, error) && !error;
+}
+
 std::filesystem::path ScopedReadRoot::Current() {
   return t_read_root;
 }

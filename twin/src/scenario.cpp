@@ -181,7 +181,7 @@ Scenario Parse(const YAML::Node& root, const FieldReader& r,
   const std::string world = r.String(r.Required(root, "", "world"), "world");
   s.world_file =
       std::filesystem::path(world).is_absolute() ? std::filesystem::path(world) : base_dir / world;
-  if (!std::filesystem::exists(s.world_file)) {
+  if (!PathExists(s.world_file)) {
     r.Fail(root["world"], "world", "no such file: " + s.world_file.string());
   }
   if (root["building"]) {
@@ -189,7 +189,7 @@ Scenario Parse(const YAML::Node& root, const FieldReader& r,
     s.building_file = std::filesystem::path(building).is_absolute()
                           ? std::filesystem::path(building)
                           : base_dir / building;
-    if (!std::filesystem::exists(s.building_file))
+    if (!PathExists(s.building_file))
       r.Fail(root["building"], "building", "no such file: " + s.building_file.string());
   }
   if (root["seed"]) {
@@ -473,7 +473,7 @@ Scenario Parse(const YAML::Node& root, const FieldReader& r,
     const std::filesystem::path file = r.String(tree, "mission.tree");
     m.tree_file = file.is_absolute() ? file : base_dir / file;
     m.tree_line = tree.Mark().line + 1;
-    if (!std::filesystem::exists(m.tree_file))
+    if (!PathExists(m.tree_file))
       r.Fail(tree, "mission.tree", "no such file: " + m.tree_file.string());
     if (mission["main"]) m.tree_id = r.String(mission["main"], "mission.main");
     if (const YAML::Node bb = mission["blackboard"]) {

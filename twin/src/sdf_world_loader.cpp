@@ -341,7 +341,7 @@ class WorldReader {
       candidates.push_back(fs::path(rest).is_absolute() ? fs::path(rest) : dir / rest);
     }
     for (const auto& c : candidates) {
-      if (fs::exists(c)) return c;
+      if (PathExists(c)) return c;
     }
     throw LoadError(StrCat(source_, ": ", where, ": mesh '", uri, "' not found (looked at ",
                            candidates.front().string(), ")"));

@@ -21,6 +21,10 @@ inline constexpr std::size_t kMaxTextFileBytes = std::size_t{64} << 20;
 std::string ReadTextFile(const std::filesystem::path& path, std::string_view what,
                          std::size_t max_bytes = kMaxTextFileBytes);
 
+/// Whether something exists at `path`; false (not an exception) when the path cannot even be
+/// looked at (a name too long, a loop of links): for paths written in a user's document.
+bool PathExists(const std::filesystem::path& path);
+
 /// While one is alive on a thread, ReadTextFile on that thread reads only files that resolve
 /// (symbolic links and `..` followed) to a place under `root`, and throws PathOutsideRoot for
 /// any other. egress-navd holds one around a client's request so that the file the client
