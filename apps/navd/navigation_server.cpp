@@ -38,9 +38,6 @@ bool IsLoopback(const std::string& host) {
   return host == "localhost" || host.rfind("127.", 0) == 0 || host == "[::1]" || host == "::1";
 }
 
-// A loaded world in the cache, with what eviction needs.
-struct CachedWorld;
-
 // One loaded world: the static map, its costmap and planner. Requests on a world are
 // serialized by its mutex (OMPL setups are not shared across threads).
 struct World {

@@ -49,7 +49,7 @@ void ValidateListenAddress(const NavigationServerConfig& config);
 
 /// The service's request handlers called in-process, without the gRPC transport (the fuzz
 /// target, tests): the same code a server runs for each call, minus authentication and the
-/// log line. Not thread-safe across calls on one instance only where the server is not either.
+/// log line. Calls may come from several threads, as on a server.
 class NavigationHandlers {
  public:
   explicit NavigationHandlers(NavigationServerConfig config);
