@@ -30,6 +30,8 @@ struct BtOptions {
   std::string script_file;
   std::string btlog;
   bool json{false};
+  std::string format{"text"};
+  std::uint64_t ticks{0};  ///< 0: until the root completes or the script's max_ticks
 };
 
 void RegisterModels(bt::BehaviorTreeFactory& factory, const BtOptions& options) {
@@ -49,7 +51,7 @@ int RunValidate(const BtOptions& options) {
         fmt::print("warning: {}\n", warning);
       std::set<std::string> subtrees;
       for (const auto& node : tree.nodes()) {
-        if (node->kind() == bt::NodeKind::kSubTree) subtrees.insert(node->registration_id());
+        if (node->kind() == bt::NodeKind::kSubTree) subtrees.insert(node->config().subtree_id);
       }
       fmt::print("OK: {} loads: tree '{}', {} nodes, {} subtree types\n", options.tree_file,
                  tree.main_tree_id(), tree.nodes().size(), subtrees.size());
@@ -196,8 +198,33 @@ bt::Any ToAny(const YAML::Node& value) {
   return bt::Any(text);
 }
 
+/// Every blackboard of the tree (the main tree's, then each SubTree instance's by its path),
+/// key -> {type, value}, as Groot2's blackboard view shows them.
+nlohmann::json BlackboardJson(const bt::Tree& tree) {
+  nlohmann::json out = nlohmann::json::object();
+  const auto dump = [](const bt::Blackboard& blackboard) {
+    nlohmann::json entries = nlohmann::json::object();
+    for (const std::string& key : blackboard.LocalKeys()) {
+      const std::optional<bt::Any> value = blackboard.GetAny(key);
+      if (!value || value->empty()) {
+        entries[key] = {{"type", blackboard.DeclaredTypeName(key)}, {"value", nullptr}};
+        continue;
+      }
+      entries[key] = {{"type", bt::TypeName(value->type())}, {"value", value->ToString()}};
+    }
+    return entries;
+  };
+  out[""] = dump(*tree.root_blackboard());
+  for (const auto& node : tree.nodes()) {
+    if (node->kind() == bt::NodeKind::kSubTree && !node->children().empty())
+      out[node->path()] = dump(*node->children().front()->config().blackboard);
+  }
+  return out;
+}
+
 int RunTrace(const BtOptions& options) {
   const TraceScript script = ReadTraceScript(options.script_file);
+  const std::string format = options.json ? "json" : options.format;
   bt::BehaviorTreeFactory factory;
   RegisterModels(factory, options);
   const std::string tree_id = !options.tree_id.empty() ? options.tree_id : script.tree;
@@ -224,6 +251,8 @@ int RunTrace(const BtOptions& options) {
     }
   }
 
+  // Outcomes are per tick number: every instance of a leaf returns that tick's value, and
+  // after the script's last tick its outcomes go on.
   const TickScript* current = nullptr;
   tree.SetStandInDriver([&](const bt::TreeNode& node) {
     if (current != nullptr) {
@@ -235,13 +264,24 @@ int RunTrace(const BtOptions& options) {
     return script.default_outcome;
   });
 
+  const std::set<std::string> stand_ins(tree.stand_in_node_ids().begin(),
+                                        tree.stand_in_node_ids().end());
   nlohmann::json json_ticks = nlohmann::json::array();
   nlohmann::json* json_tick = nullptr;
-  tree.AddStatusObserver([&](bt::Duration, const bt::TreeNode& node, bt::NodeStatus previous,
-                             bt::NodeStatus status) {
-    if (options.json) {
+  const int observer = tree.AddStatusObserver([&](bt::Duration, const bt::TreeNode& node,
+                                                  bt::NodeStatus previous, bt::NodeStatus status) {
+    if (format == "json") {
       (*json_tick)["transitions"].push_back(
           {{"node", node.path()}, {"from", bt::ToString(previous)}, {"to", bt::ToString(status)}});
+    } else if (format == "btcpp") {
+      // A stand-in action going from RUNNING to IDLE was halted (BT.CPP's onHalted() prints
+      // first, then the status change).
+      if (previous == bt::NodeStatus::kRunning && status == bt::NodeStatus::kIdle &&
+          node.children().empty() && stand_ins.contains(node.registration_id())) {
+        fmt::print("halt {} {}\n", node.path(), node.registration_id());
+      }
+      fmt::print("status {} {} {} -> {}\n", node.path(), node.registration_id(),
+                 bt::ToString(previous), bt::ToString(status));
     } else {
       fmt::print("  {:<48} {:>7} -> {}\n", node.path(), bt::ToString(previous),
                  bt::ToString(status));
@@ -251,7 +291,7 @@ int RunTrace(const BtOptions& options) {
   if (!options.btlog.empty())
     btlog = std::make_unique<bt::FileLogger2>(tree, factory, options.btlog);
 
-  if (!options.json) {
+  if (format == "text") {
     if (!tree.stand_in_node_ids().empty()) {
       fmt::print("stand-ins: {}\n", fmt::join(tree.stand_in_node_ids(), ", "));
     }
@@ -259,38 +299,50 @@ int RunTrace(const BtOptions& options) {
       fmt::print("stub subtrees: {}\n", fmt::join(tree.stubbed_subtree_ids(), ", "));
     }
   }
+  // --ticks N runs exactly N ticks (a completed root starts over); else until the root
+  // completes or max_ticks.
+  const std::uint64_t limit = options.ticks != 0 ? options.ticks : script.max_ticks;
   bt::NodeStatus result = bt::NodeStatus::kRunning;
   std::uint64_t tick = 0;
-  while (tick < script.max_ticks) {
-    current = tick < script.ticks.size() ? &script.ticks[tick] : nullptr;
-    if (current != nullptr) {
-      for (const auto& [key, value] : current->blackboard)
-        tree.root_blackboard()->Set(key, ToAny(value));
+  while (tick < limit) {
+    if (!script.ticks.empty()) {
+      current = &script.ticks[std::min<std::size_t>(tick, script.ticks.size() - 1)];
+      if (tick < script.ticks.size()) {
+        for (const auto& [key, value] : current->blackboard)
+          tree.root_blackboard()->Set(key, ToAny(value));
+      }
     }
     ++tick;
-    if (options.json) {
-      json_ticks.push_back({{"tick", tick},
-                            {"time_ms", script.tick_period_ms * std::int64_t(tick - 1)},
-                            {"transitions", nlohmann::json::array()}});
+    const std::int64_t time_ms = script.tick_period_ms * std::int64_t(tick - 1);
+    if (format == "json") {
+      json_ticks.push_back(
+          {{"tick", tick}, {"time_ms", time_ms}, {"transitions", nlohmann::json::array()}});
       json_tick = &json_ticks.back();
-    } else {
-      fmt::print("tick {} (t = {} ms)\n", tick, script.tick_period_ms * std::int64_t(tick - 1));
+    } else if (format == "text") {
+      fmt::print("tick {} (t = {} ms)\n", tick, time_ms);
     }
     result = tree.TickOnce();
-    if (options.json) (*json_tick)["result"] = bt::ToString(result);
-    if (result != bt::NodeStatus::kRunning) break;
+    if (format == "json") {
+      (*json_tick)["result"] = bt::ToString(result);
+      (*json_tick)["blackboard"] = BlackboardJson(tree);
+    } else if (format == "btcpp") {
+      fmt::print("tick {} -> {}\n", tick, bt::ToString(result));
+    }
+    if (result != bt::NodeStatus::kRunning && options.ticks == 0) break;
     clock->Advance(std::chrono::milliseconds(script.tick_period_ms));
   }
-  if (options.json) {
+  tree.RemoveStatusObserver(observer);  // the tree's halt on destruction is not traced
+  if (format == "json") {
     std::cout << nlohmann::json{{"tree", tree.main_tree_id()},
                                 {"result", bt::ToString(result)},
                                 {"ticks", json_ticks}}
                      .dump(2)
               << "\n";
-  } else {
+  } else if (format == "text") {
     fmt::print("result: {} after {} tick{}{}\n", bt::ToString(result), tick, tick == 1 ? "" : "s",
                result == bt::NodeStatus::kRunning ? " (max_ticks reached)" : "");
   }
+  std::fflush(stdout);
   return 0;
 }
 
@@ -321,7 +373,18 @@ void AddBtCommand(CLI::App& app) {
                    "YAML script of outcomes per tick (see README)")
       ->required();
   trace->add_option("--btlog", options->btlog, "also write a Groot2 .btlog of the run");
-  trace->add_flag("--json", options->json, "print the trace as JSON");
+  trace->add_flag("--json", options->json,
+                  "print the trace as JSON, with every blackboard after each tick");
+  trace
+      ->add_option("--format", options->format,
+                   "text (default), json, or btcpp: BehaviorTree.CPP's status-change stream "
+                   "('status PATH ID PREV -> NEW', 'halt PATH ID', 'tick N -> STATUS')")
+      ->check(CLI::IsMember({"text", "json", "btcpp"}));
+  trace
+      ->add_option("--ticks", options->ticks,
+                   "run exactly N ticks, whatever the root returns (default: until it "
+                   "completes, at most the script's max_ticks)")
+      ->check(CLI::PositiveNumber);
   auto* model = bt_app->add_subcommand(
       "model",
       "Print the TreeNodesModel of egress's task nodes (Groot2's palette), from their "

@@ -1,5 +1,5 @@
 // Leaves: AlwaysSuccess, AlwaysFailure, Script, ScriptCondition, SetBlackboard,
-// UnsetBlackboard, Sleep; and the stand-in leaf for unknown node types.
+// UnsetBlackboard, Sleep, WasEntryUpdated; and the stand-in leaf for unknown node types.
 
 #include "builtin_nodes.h"
 #include "egress/bt/factory.h"
@@ -17,6 +17,26 @@ class ConstantNode final : public SyncActionNode {
 
  private:
   NodeStatus result_;
+};
+
+/// WasEntryUpdated (BT.CPP 4.10's EntryUpdatedAction): SUCCESS if the watched blackboard entry
+/// was written since the node last looked, else FAILURE.
+class WasEntryUpdatedNode final : public SyncActionNode {
+ public:
+  WasEntryUpdatedNode(std::string name, NodeConfig config)
+      : SyncActionNode(std::move(name), std::move(config)), key_(WatchedEntryKey(*this)) {}
+  static PortsList ProvidedPorts() { return {InputPort<Any>("entry", "the entry to watch")}; }
+
+ protected:
+  NodeStatus Tick() override {
+    const std::uint64_t previous = sequence_;
+    sequence_ = config().blackboard->SequenceId(key_);
+    return sequence_ != 0 && sequence_ != previous ? NodeStatus::kSuccess : NodeStatus::kFailure;
+  }
+
+ private:
+  std::string key_;
+  std::uint64_t sequence_{0};
 };
 
 /// Script (always SUCCESS once the code ran) and ScriptCondition (SUCCESS if the result is
@@ -172,6 +192,10 @@ void RegisterBuiltinNodes(BehaviorTreeFactory& factory) {
   const auto reg = [&](const std::string& id, NodeKind kind, PortsList ports, NodeBuilder builder) {
     factory.RegisterBuilder({id, kind, std::move(ports), "", true}, std::move(builder));
   };
+  reg("WasEntryUpdated", NodeKind::kAction, WasEntryUpdatedNode::ProvidedPorts(),
+      [](const std::string& n, NodeConfig c) {
+        return std::make_unique<WasEntryUpdatedNode>(n, std::move(c));
+      });
   reg("AlwaysSuccess", NodeKind::kAction, {}, [](const std::string& n, NodeConfig c) {
     return std::make_unique<ConstantNode>(n, std::move(c), NodeStatus::kSuccess);
   });

@@ -1,5 +1,6 @@
-// Control nodes: Sequence, SequenceWithMemory, ReactiveSequence, Fallback, ReactiveFallback,
-// Parallel, ParallelAll, IfThenElse, WhileDoElse, Switch2..Switch6.
+// Control nodes: Sequence, AsyncSequence, SequenceWithMemory (SequenceStar), ReactiveSequence,
+// Fallback, AsyncFallback, ReactiveFallback, Parallel, ParallelAll, IfThenElse, WhileDoElse,
+// Switch2..Switch6, TryCatch.
 
 #include <algorithm>
 #include <cmath>
@@ -11,27 +12,38 @@
 namespace egress::bt::internal {
 namespace {
 
-/// Sequence, SequenceWithMemory and Fallback: tick children in order and resume at a RUNNING
-/// child without re-ticking completed ones. A Sequence stops at the first FAILURE (and starts
-/// over next time; with memory it retries the failed child), a Fallback at the first SUCCESS.
+/// Sequence, SequenceWithMemory, Fallback, AsyncSequence and AsyncFallback (BT.CPP 4.10's
+/// SequenceNode, SequenceWithMemory and FallbackNode): tick children in order and resume at a
+/// RUNNING child without re-ticking completed ones. A Sequence stops at the first FAILURE (and
+/// starts over next time; with memory it retries the failed child), a Fallback at the first
+/// SUCCESS. SequenceWithMemory and the Async variants yield (RUNNING with a wake-up pass) after
+/// a child that completed within its first tick, so reactive guards above them are re-checked
+/// between children.
 class OrderedNode : public ControlNode {
  public:
-  OrderedNode(std::string name, NodeConfig config, bool is_sequence, bool with_memory)
+  enum class Flavor { kPlain, kAsync, kMemory };
+  OrderedNode(std::string name, NodeConfig config, bool is_sequence, Flavor flavor)
       : ControlNode(std::move(name), std::move(config)),
         is_sequence_(is_sequence),
-        with_memory_(with_memory) {}
+        flavor_(flavor) {}
 
  protected:
   NodeStatus Tick() override {
-    if (status() == NodeStatus::kIdle) all_skipped_ = true;
+    const std::size_t n = children_.size();
+    if (!IsActive(status())) skipped_ = 0;
     SetStatus(NodeStatus::kRunning);
     const NodeStatus stop_on = is_sequence_ ? NodeStatus::kFailure : NodeStatus::kSuccess;
-    while (index_ < children_.size()) {
+    while (index_ < n) {
+      const NodeStatus previous = children_[index_]->status();
       const NodeStatus child_status = children_[index_]->ExecuteTick();
-      all_skipped_ = all_skipped_ && child_status == NodeStatus::kSkipped;
       if (child_status == NodeStatus::kRunning) return NodeStatus::kRunning;
+      if (child_status == NodeStatus::kSkipped) {
+        ++index_;
+        ++skipped_;
+        continue;
+      }
       if (child_status == stop_on) {
-        if (with_memory_) {
+        if (flavor_ == Flavor::kMemory) {
           HaltChildren(index_);  // keep the index: the next tick retries this child
         } else {
           HaltChildren();
@@ -39,25 +51,37 @@ class OrderedNode : public ControlNode {
         }
         return stop_on;
       }
-      ++index_;  // the other result, or SKIPPED: move on
+      ++index_;
+      if (flavor_ != Flavor::kPlain && previous == NodeStatus::kIdle && index_ < n) {
+        EmitWakeUpSignal();
+        return NodeStatus::kRunning;
+      }
     }
-    HaltChildren();
-    index_ = 0;
-    if (all_skipped_) return NodeStatus::kSkipped;
+    const bool all_skipped = skipped_ == n;
+    if (index_ == n) {
+      HaltChildren();
+      index_ = 0;
+      skipped_ = 0;
+    }
+    if (all_skipped) return NodeStatus::kSkipped;
     return is_sequence_ ? NodeStatus::kSuccess : NodeStatus::kFailure;
   }
 
   void Halt() override {
     // As in BT.CPP, a halted SequenceWithMemory keeps its index and resumes there.
-    if (!with_memory_) index_ = 0;
+    if (flavor_ != Flavor::kMemory) {
+      index_ = 0;
+      skipped_ = 0;
+    }
     HaltChildren();
   }
 
  private:
+  static bool IsActive(NodeStatus s) { return s != NodeStatus::kIdle && s != NodeStatus::kSkipped; }
   bool is_sequence_;
-  bool with_memory_;
+  Flavor flavor_;
   std::size_t index_{0};
-  bool all_skipped_{true};
+  std::size_t skipped_{0};
 };
 
 /// ReactiveSequence and ReactiveFallback: every tick re-ticks from child 0.
@@ -325,8 +349,9 @@ class SwitchNode : public ControlNode {
         }
       }
     }
-    if (running_ >= 0 && running_ != match) HaltChildren();
-    SetStatus(NodeStatus::kRunning);
+    if (running_ >= 0 && running_ != match) children_[std::size_t(running_)]->HaltNode();
+    // No RUNNING of its own before the child runs: BT.CPP's Switch goes from IDLE straight to
+    // the child's result.
     const NodeStatus result = children_[match]->ExecuteTick();
     if (result == NodeStatus::kSkipped) {
       running_ = -1;
@@ -370,11 +395,78 @@ class SwitchNode : public ControlNode {
   int running_{-1};
 };
 
+/// TryCatch (BT.CPP 4.10): children 0..N-2 run as a Sequence (the try block); when one fails,
+/// the try block is reset and the last child (the catch block) runs to completion, after which
+/// the node fails. With `catch_on_halt`, halting it during the try block runs the catch block
+/// once, synchronously (a catch block still RUNNING then is halted too).
+class TryCatchNode : public ControlNode {
+ public:
+  using ControlNode::ControlNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<bool>("catch_on_halt", false,
+                            "run the catch child when halted during the try block")};
+  }
+
+ protected:
+  NodeStatus Tick() override {
+    const std::size_t n = children_.size();
+    if (n < 2) throw LogicError(Cat("[", path(), "] TryCatch requires at least 2 children"));
+    if (status() == NodeStatus::kIdle || status() == NodeStatus::kSkipped) {
+      skipped_ = 0;
+      in_catch_ = false;
+    }
+    SetStatus(NodeStatus::kRunning);
+    const std::size_t try_count = n - 1;
+    while (!in_catch_ && index_ < try_count) {
+      const NodeStatus child_status = children_[index_]->ExecuteTick();
+      if (child_status == NodeStatus::kRunning) return NodeStatus::kRunning;
+      if (child_status == NodeStatus::kFailure) {
+        HaltChildren();
+        index_ = 0;
+        in_catch_ = true;
+        break;
+      }
+      if (child_status == NodeStatus::kSkipped) ++skipped_;
+      ++index_;
+    }
+    if (in_catch_) {
+      if (children_.back()->ExecuteTick() == NodeStatus::kRunning) return NodeStatus::kRunning;
+      HaltChildren();
+      index_ = 0;
+      in_catch_ = false;
+      return NodeStatus::kFailure;
+    }
+    const bool all_skipped = skipped_ == try_count;
+    HaltChildren();
+    index_ = 0;
+    skipped_ = 0;
+    return all_skipped ? NodeStatus::kSkipped : NodeStatus::kSuccess;
+  }
+
+  void Halt() override {
+    const bool catch_on_halt = GetInput<bool>("catch_on_halt").value();
+    if (catch_on_halt && !in_catch_ && status() == NodeStatus::kRunning) {
+      for (std::size_t i = 0; i + 1 < children_.size(); ++i)
+        children_[i]->HaltNode();
+      if (children_.back()->ExecuteTick() == NodeStatus::kRunning) children_.back()->HaltNode();
+    }
+    index_ = 0;
+    skipped_ = 0;
+    in_catch_ = false;
+    HaltChildren();
+  }
+
+ private:
+  std::size_t index_{0};
+  std::size_t skipped_{0};
+  bool in_catch_{false};
+};
+
 /// Stand-in for an unknown control node: a Sequence.
 class StandInControl final : public OrderedNode {
  public:
   StandInControl(std::string name, NodeConfig config)
-      : OrderedNode(std::move(name), std::move(config), true, false) {}
+      : OrderedNode(std::move(name), std::move(config), true, Flavor::kPlain) {}
 };
 
 }  // namespace
@@ -390,17 +482,22 @@ void RegisterBuiltinControls(BehaviorTreeFactory& factory) {
                               return make(name, std::move(config));
                             });
   };
-  reg("Sequence", {}, [](const std::string& n, NodeConfig c) {
-    return std::make_unique<OrderedNode>(n, std::move(c), true, false);
-  });
-  reg("SequenceWithMemory", {}, [](const std::string& n, NodeConfig c) {
-    return std::make_unique<OrderedNode>(n, std::move(c), true, true);
-  });
+  using Flavor = OrderedNode::Flavor;
+  const auto ordered = [&](const std::string& id, bool is_sequence, Flavor flavor,
+                           std::string registration_id) {
+    reg(id, {}, [=](const std::string& n, NodeConfig c) {
+      c.registration_id = registration_id;  // SequenceStar reports SequenceWithMemory
+      return std::make_unique<OrderedNode>(n, std::move(c), is_sequence, flavor);
+    });
+  };
+  ordered("Sequence", true, Flavor::kPlain, "Sequence");
+  ordered("AsyncSequence", true, Flavor::kAsync, "AsyncSequence");
+  ordered("SequenceWithMemory", true, Flavor::kMemory, "SequenceWithMemory");
+  ordered("SequenceStar", true, Flavor::kMemory, "SequenceWithMemory");  // v3 name
+  ordered("Fallback", false, Flavor::kPlain, "Fallback");
+  ordered("AsyncFallback", false, Flavor::kAsync, "AsyncFallback");
   reg("ReactiveSequence", {}, [](const std::string& n, NodeConfig c) {
     return std::make_unique<ReactiveNode>(n, std::move(c), true);
-  });
-  reg("Fallback", {}, [](const std::string& n, NodeConfig c) {
-    return std::make_unique<OrderedNode>(n, std::move(c), false, false);
   });
   reg("ReactiveFallback", {}, [](const std::string& n, NodeConfig c) {
     return std::make_unique<ReactiveNode>(n, std::move(c), false);
@@ -416,6 +513,9 @@ void RegisterBuiltinControls(BehaviorTreeFactory& factory) {
   });
   reg("WhileDoElse", {}, [](const std::string& n, NodeConfig c) {
     return std::make_unique<WhileDoElseNode>(n, std::move(c));
+  });
+  reg("TryCatch", TryCatchNode::ProvidedPorts(), [](const std::string& n, NodeConfig c) {
+    return std::make_unique<TryCatchNode>(n, std::move(c));
   });
   for (int cases = 2; cases <= 6; ++cases) {
     reg(Cat("Switch", cases), SwitchNode::Ports(cases),

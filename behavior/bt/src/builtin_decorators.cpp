@@ -1,6 +1,6 @@
 // Decorators: Inverter, ForceSuccess, ForceFailure, Repeat, RetryUntilSuccessful,
 // KeepRunningUntilFailure, Delay, Timeout, RunOnce, Precondition, LoopInt, LoopBool,
-// LoopDouble, LoopString; and the SubTree node.
+// LoopDouble, LoopString, SkipUnlessUpdated, WaitValueUpdate; and the SubTree node.
 
 #include "builtin_nodes.h"
 #include "egress/bt/factory.h"
@@ -39,9 +39,12 @@ class MapResultNode : public DecoratorNode {
   Mode mode_;
 };
 
-/// Repeat (while the child succeeds) and RetryUntilSuccessful (while it fails). A synchronous
-/// child loops within the tick; an asynchronous one yields (RUNNING) after each cycle, and so
-/// does every cycle of an endless (-1) loop, so that a tick always ends.
+/// Repeat (while the child succeeds) and RetryUntilSuccessful (while it fails), as BT.CPP 4.10's
+/// RepeatNode and RetryNode: a child that completes after RUNNING is started again within the
+/// same tick; after a cycle that completed within its first tick the node yields RUNNING with a
+/// wake-up pass (the tree is ticked again at once, guards above re-checked). Deliberate
+/// difference: an endless loop (-1) yields without the wake-up pass, so a tick always ends
+/// (BT.CPP's tickOnce() never returns from an endless synchronous loop).
 class LoopNode : public DecoratorNode {
  public:
   LoopNode(std::string name, NodeConfig config, bool repeat_on_success)
@@ -53,7 +56,8 @@ class LoopNode : public DecoratorNode {
     int limit = GetInput<int>(port).value();
     SetStatus(NodeStatus::kRunning);
     const NodeStatus continue_on = repeat_on_success_ ? NodeStatus::kSuccess : NodeStatus::kFailure;
-    while (limit == -1 || count_ < limit) {
+    bool loop = limit == -1 || count_ < limit;
+    while (loop) {
       const NodeStatus previous = child_->status();
       const NodeStatus child_status = child_->ExecuteTick();
       if (child_status == NodeStatus::kRunning) return child_status;
@@ -61,14 +65,18 @@ class LoopNode : public DecoratorNode {
         child_->ResetStatus();
         return NodeStatus::kSkipped;  // keeps the counter
       }
-      child_->ResetStatus();
       if (child_status != continue_on) {
         count_ = 0;
+        HaltChild();
         return child_status;
       }
       ++count_;
-      if (!repeat_on_success_) limit = GetInput<int>(port).value();  // re-read after a failure
-      if ((previous == NodeStatus::kRunning || limit == -1) && (limit == -1 || count_ < limit)) {
+      // RetryUntilSuccessful re-reads its limit after a failure (a child may have changed it).
+      if (!repeat_on_success_) limit = GetInput<int>(port).value();
+      loop = limit == -1 || count_ < limit;
+      HaltChild();
+      if (previous == NodeStatus::kIdle && loop) {
+        if (limit != -1) EmitWakeUpSignal();
         return NodeStatus::kRunning;
       }
     }
@@ -207,8 +215,11 @@ class RunOnceNode : public DecoratorNode {
   NodeStatus result_{NodeStatus::kIdle};
 };
 
-/// Precondition: ticks the child if the `if` script is true, else returns `else`. The script is
-/// not re-checked while the child is RUNNING (BT.CPP 4.7+).
+/// Precondition: ticks the child if the `if` script is true, else returns `else`. Once the
+/// script was true it is not checked again until the child completes (BT.CPP 4.7+), and the
+/// node has no RUNNING of its own. Deliberate difference: a halt clears that, so a halted
+/// Precondition checks its script again (BT.CPP 4.10 keeps the flag through a halt and runs the
+/// child unchecked next time).
 class PreconditionNode : public DecoratorNode {
  public:
   PreconditionNode(std::string name, NodeConfig config)
@@ -226,25 +237,32 @@ class PreconditionNode : public DecoratorNode {
 
  protected:
   NodeStatus Tick() override {
-    if (child_->status() != NodeStatus::kRunning) {
+    const NodeStatus otherwise = GetInput<NodeStatus>("else").value();
+    if (!child_running_) {
       std::shared_ptr<const Script> script = script_;
       if (!script) script = Script::Parse(GetInput<std::string>("if").value());
-      bool condition;
       try {
-        condition = script->EvaluateCondition(script_environment());
+        child_running_ = script->EvaluateCondition(script_environment());
       } catch (const RuntimeError& e) {
         throw RuntimeError(Cat("[", path(), "] if: ", e.what()));
       }
-      if (!condition) return GetInput<NodeStatus>("else").value();
+      if (!child_running_) return otherwise;
     }
-    SetStatus(NodeStatus::kRunning);
     const NodeStatus child_status = child_->ExecuteTick();
-    if (IsCompleted(child_status)) child_->ResetStatus();
+    if (IsCompleted(child_status)) {
+      HaltChild();
+      child_running_ = false;
+    }
     return child_status;
+  }
+  void Halt() override {
+    child_running_ = false;
+    HaltChild();
   }
 
  private:
   std::shared_ptr<const Script> script_;
+  bool child_running_{false};
 };
 
 /// LoopInt, LoopBool, LoopDouble, LoopString (BT.CPP 4's LoopNode<T>): pops the front of
@@ -295,7 +313,49 @@ class QueueLoopNode : public DecoratorNode {
   SharedQueue<T> queue_;
 };
 
+/// SkipUnlessUpdated and WaitValueUpdate (BT.CPP 4.10's EntryUpdatedDecorator): ticks the child
+/// only if the watched blackboard entry was written since the node last looked, else returns
+/// SKIPPED (SkipUnlessUpdated) or RUNNING (WaitValueUpdate); a RUNNING child is ticked on
+/// without looking. The child is not reset after it completes (as in BT.CPP).
+class EntryUpdatedNode : public DecoratorNode {
+ public:
+  EntryUpdatedNode(std::string name, NodeConfig config, NodeStatus if_not_updated)
+      : DecoratorNode(std::move(name), std::move(config)),
+        key_(WatchedEntryKey(*this)),
+        if_not_updated_(if_not_updated) {}
+  static PortsList ProvidedPorts() { return {InputPort<Any>("entry", "the entry to watch")}; }
+
+ protected:
+  NodeStatus Tick() override {
+    if (!child_running_) {
+      const std::uint64_t previous = sequence_;
+      sequence_ = config().blackboard->SequenceId(key_);
+      if (sequence_ == 0 || sequence_ == previous) return if_not_updated_;
+    }
+    const NodeStatus child_status = child_->ExecuteTick();
+    child_running_ = child_status == NodeStatus::kRunning;
+    return child_status;
+  }
+  void Halt() override {
+    child_running_ = false;
+    HaltChild();
+  }
+
+ private:
+  std::string key_;
+  NodeStatus if_not_updated_;
+  std::uint64_t sequence_{0};
+  bool child_running_{false};
+};
+
 }  // namespace
+
+std::string WatchedEntryKey(const TreeNode& node) {
+  const std::optional<std::string> text = node.PortText("entry");
+  if (!text || text->empty()) throw LogicError(Cat("[", node.path(), "] missing port 'entry'"));
+  if (auto key = BlackboardKeyOf(*text, "entry")) return *key;
+  return *text;
+}
 
 NodeStatus SubTreeNode::Tick() {
   if (status() == NodeStatus::kIdle) SetStatus(NodeStatus::kRunning);
@@ -348,6 +408,13 @@ void RegisterBuiltinDecorators(BehaviorTreeFactory& factory) {
   reg("Precondition", PreconditionNode::ProvidedPorts(), [](const std::string& n, NodeConfig c) {
     return std::make_unique<PreconditionNode>(n, std::move(c));
   });
+  for (const auto& [id, if_not_updated] : {std::pair{"SkipUnlessUpdated", NodeStatus::kSkipped},
+                                           std::pair{"WaitValueUpdate", NodeStatus::kRunning}}) {
+    const NodeStatus result = if_not_updated;  // a copy: see above
+    reg(id, EntryUpdatedNode::ProvidedPorts(), [result](const std::string& n, NodeConfig c) {
+      return std::make_unique<EntryUpdatedNode>(n, std::move(c), result);
+    });
+  }
   reg("LoopInt", QueueLoopNode<int>::ProvidedPorts(), [](const std::string& n, NodeConfig c) {
     return std::make_unique<QueueLoopNode<int>>(n, std::move(c));
   });

@@ -18,6 +18,11 @@ void RegisterBuiltinNodes(BehaviorTreeFactory& factory);
 /// Sequence, a decorator passes its child's status through.
 std::unique_ptr<TreeNode> MakeStandIn(NodeKind kind, std::string name, NodeConfig config);
 
+/// The blackboard key a WasEntryUpdated / SkipUnlessUpdated / WaitValueUpdate node watches: its
+/// `entry` port, "{key}" or a bare key name.
+/// @throws LogicError naming the node when the port is missing or empty.
+std::string WatchedEntryKey(const TreeNode& node);
+
 /// The node a SubTree element becomes: ticks the subtree's root.
 class SubTreeNode final : public DecoratorNode {
  public:

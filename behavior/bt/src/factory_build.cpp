@@ -100,6 +100,23 @@ TreeNode* BehaviorTreeFactory::Impl::Build(const XMLElement* e, const Blackboard
     };
     auto& ids = state.tree->stand_in_ids_;
     if (std::find(ids.begin(), ids.end(), id) == ids.end()) ids.push_back(id);
+    // For the tree's model (Groot2, .btlog): the kind, and every port any instance sets
+    // (taken as input ports: a stand-in has no declaration to say otherwise).
+    auto& models = state.tree->stand_in_manifests_;
+    auto model =
+        std::find_if(models.begin(), models.end(), [&](const auto& m) { return m->id == id; });
+    if (model == models.end()) model = models.insert(models.end(), stand_in);
+    auto widened = std::make_shared<NodeManifest>(**model);
+    for (const tinyxml2::XMLAttribute* a = e->FirstAttribute(); a != nullptr; a = a->Next()) {
+      const std::string_view attribute = a->Name();
+      if (attribute == "ID" || attribute == "name" || attribute.starts_with("_")) continue;
+      if (!widened->ports.contains(attribute)) {
+        PortInfo port;
+        port.type_name = "Any";
+        widened->ports.emplace(std::string(attribute), std::move(port));
+      }
+    }
+    *model = std::move(widened);
   } else {
     std::string hint;
     for (const auto& [known, r] : registrations) {
@@ -280,9 +297,14 @@ TreeNode* BehaviorTreeFactory::Impl::BuildSubTree(const XMLElement* e,
     throw LogicError(Cat(where, "SubTrees nest deeper than ", kMaxSubTreeDepth));
   }
 
-  NodeConfig config = BaseConfig(state, parent, id);
+  // As in BT.CPP: the node's registration ID is "SubTree"; its path gets "::uid" when its name
+  // is the subtree's ID, and the subtree's nodes live under its name, or "ID::uid" unnamed.
+  NodeConfig config = BaseConfig(state, parent, "SubTree");
+  config.subtree_id = id;
   config.path = prefix + name;
-  if (name_attr == nullptr) config.path += Cat("::", config.uid);
+  if (name == id) config.path += Cat("::", config.uid);
+  const std::string subtree_prefix =
+      prefix + (name_attr != nullptr ? name : Cat(id, "::", config.uid)) + "/";
   if (!state.paths.insert(config.path).second) {
     throw LogicError(Cat(where, "Duplicate SubTree path '", config.path,
                          "': give sibling SubTrees distinct name attributes"));
@@ -324,7 +346,7 @@ TreeNode* BehaviorTreeFactory::Impl::BuildSubTree(const XMLElement* e,
   TreeNode* raw = AddNode(state, std::move(node));
   state.subtree_stack.push_back(id);
   const XMLElement* body = found->second.element->FirstChildElement();
-  TreeNode* root = Build(body, child_blackboard, raw->path() + "/", found->second, state);
+  TreeNode* root = Build(body, child_blackboard, subtree_prefix, found->second, state);
   state.subtree_stack.pop_back();
   static_cast<internal::SubTreeNode*>(raw)->SetChild(root);
   return raw;

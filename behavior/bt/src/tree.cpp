@@ -1,5 +1,7 @@
 #include "egress/bt/tree.h"
 
+#include "egress/bt/factory.h"
+
 #include <algorithm>
 
 namespace egress::bt {
@@ -22,7 +24,14 @@ Tree::~Tree() {
 NodeStatus Tree::TickOnce() {
   ++tick_count_;
   context_->start_guards.clear();
-  NodeStatus status = root().ExecuteTick();
+  NodeStatus status;
+  // The wake-up pass: a node that yielded between synchronous cycles asked for the tree to be
+  // ticked again, so that reactive guards above it are re-checked before the next cycle.
+  do {
+    context_->wake_up = false;
+    status = root().ExecuteTick();
+  } while (status == NodeStatus::kRunning && context_->wake_up);
+  context_->wake_up = false;
   // A tree whose root completed is ready to start over: reset it, as BT.CPP's tick loop does.
   if (IsCompleted(status)) root().ResetStatus();
   return status;
@@ -57,6 +66,13 @@ std::vector<TreeNode*> Tree::FindNodesByName(std::string_view name) const {
     if (node->name() == name) found.push_back(node.get());
   }
   return found;
+}
+
+const NodeManifest* Tree::FindStandInManifest(std::string_view id) const {
+  for (const auto& manifest : stand_in_manifests_) {
+    if (manifest->id == id) return manifest.get();
+  }
+  return nullptr;
 }
 
 void Tree::SetClock(std::shared_ptr<const Clock> clock) {

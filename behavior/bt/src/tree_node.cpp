@@ -133,14 +133,18 @@ NodeStatus TreeNode::ExecuteTick() {
                            " returned RUNNING"));
     }
   }
-  // A skipped node keeps IDLE as its own status (a control node that set itself RUNNING
-  // before all its children skipped goes back to IDLE); the parent sees SKIPPED.
-  if (result != NodeStatus::kSkipped) {
-    SetStatus(result);
-  } else if (status_ != NodeStatus::kIdle) {
-    ResetStatus();
-  }
+  // Post-conditions run before the status is published, and a skipped node keeps the status
+  // it had (the parent sees SKIPPED), both as in BehaviorTree.CPP 4.10.
   RunPostConditions(result);
+  if (result != NodeStatus::kSkipped) SetStatus(result);
+  // A decorator's completed child goes back to IDLE once the decorator's own status is set
+  // (BT.CPP's DecoratorNode::executeTick; most decorators reset it themselves, earlier).
+  if (const NodeKind k = kind(); k == NodeKind::kDecorator || k == NodeKind::kSubTree) {
+    if (const auto children = this->children();
+        !children.empty() && IsCompleted(children.front()->status())) {
+      children.front()->ResetStatus();
+    }
+  }
   return result;
 }
 

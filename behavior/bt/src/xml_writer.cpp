@@ -34,6 +34,10 @@ void AddModel(XMLDocument& doc, XMLElement* model, const NodeManifest& manifest)
   model->InsertEndChild(element);
 }
 
+const std::string& SubTreeId(const TreeNode& node) {
+  return node.config().subtree_id;
+}
+
 class TreeWriter {
  public:
   explicit TreeWriter(XMLDocument& doc) : doc_(doc) {}
@@ -41,9 +45,10 @@ class TreeWriter {
   // Writes `node` (and, for a SubTree, queues its body as a separate BehaviorTree).
   XMLElement* Write(const TreeNode& node) {
     const bool subtree = node.kind() == NodeKind::kSubTree;
-    XMLElement* e = doc_.NewElement(subtree ? "SubTree" : node.registration_id().c_str());
-    if (subtree) e->SetAttribute("ID", node.registration_id().c_str());
-    if (node.name() != node.registration_id()) e->SetAttribute("name", node.name().c_str());
+    const std::string& id = subtree ? SubTreeId(node) : node.registration_id();
+    XMLElement* e = doc_.NewElement(subtree ? "SubTree" : id.c_str());
+    if (subtree) e->SetAttribute("ID", id.c_str());
+    if (node.name() != id) e->SetAttribute("name", node.name().c_str());
     for (const auto& [port, text] : node.config().ports)
       e->SetAttribute(port.c_str(), text.c_str());
     for (int i = 0; i < kNumPreConditions; ++i) {
@@ -109,7 +114,7 @@ std::string WriteTreeToXml(const Tree& tree, const BehaviorTreeFactory& factory)
   for (auto pending = writer.TakePending(); !pending.empty(); pending = writer.TakePending()) {
     for (const TreeNode* subtree : pending) {
       XMLElement* body = doc.NewElement("BehaviorTree");
-      body->SetAttribute("ID", subtree->registration_id().c_str());
+      body->SetAttribute("ID", SubTreeId(*subtree).c_str());
       body->SetAttribute("_fullpath", subtree->path().c_str());
       body->InsertEndChild(writer.Write(*subtree->children().front()));
       root->InsertEndChild(body);
@@ -117,7 +122,11 @@ std::string WriteTreeToXml(const Tree& tree, const BehaviorTreeFactory& factory)
   }
   XMLElement* model = doc.NewElement("TreeNodesModel");
   for (const std::string& id : writer.ids()) {
-    if (const NodeManifest* manifest = factory.FindManifest(id)) AddModel(doc, model, *manifest);
+    if (const NodeManifest* manifest = factory.FindManifest(id)) {
+      AddModel(doc, model, *manifest);
+    } else if (const NodeManifest* stand_in = tree.FindStandInManifest(id)) {
+      AddModel(doc, model, *stand_in);  // what the loader inferred of a type it did not know
+    }
   }
   root->InsertEndChild(model);
   return ToText(doc);

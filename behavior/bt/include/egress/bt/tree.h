@@ -14,6 +14,8 @@
 
 namespace egress::bt {
 
+struct NodeManifest;
+
 class Tree {
  public:
   Tree(Tree&&) noexcept;
@@ -21,7 +23,8 @@ class Tree {
   /// Halts the tree if it is still running.
   ~Tree();
 
-  /// One pass from the root. Returns the root's status.
+  /// One tick: a pass from the root, repeated at once while a node asked for a wake-up pass
+  /// (BehaviorTree.CPP's tickOnce()). Returns the root's status.
   NodeStatus TickOnce();
   /// Ticks until the root is not RUNNING, calling `between_ticks` after each RUNNING pass (to
   /// advance a simulation or sleep); stops after `max_ticks` passes if non-zero.
@@ -52,6 +55,9 @@ class Tree {
 
   /// Node types the loader did not know and replaced by stand-ins.
   const std::vector<std::string>& stand_in_node_ids() const { return stand_in_ids_; }
+  /// What the loader inferred of the unknown node type `id` (its kind, the ports the XML set),
+  /// or nullptr.
+  const NodeManifest* FindStandInManifest(std::string_view id) const;
   /// SubTree IDs without a definition that were replaced by stand-ins.
   const std::vector<std::string>& stubbed_subtree_ids() const { return stubbed_subtrees_; }
 
@@ -65,6 +71,7 @@ class Tree {
   std::vector<std::shared_ptr<const void>> keep_alive_;  // manifests, type registry, enums
   std::string main_tree_id_;
   std::vector<std::string> stand_in_ids_;
+  std::vector<std::shared_ptr<const NodeManifest>> stand_in_manifests_;
   std::vector<std::string> stubbed_subtrees_;
   std::uint64_t tick_count_{0};
   int next_observer_id_{1};

@@ -48,6 +48,10 @@ struct TreeContext {
   /// Preemption guards pushed by reactive parents while they tick an earlier child and a later
   /// child is RUNNING; run (innermost first) just before any action starts. See NotifyStarting.
   std::vector<std::function<void()>> start_guards;
+  /// Set by a node that returned RUNNING only to let the tree re-check what is above it (a
+  /// loop between synchronous cycles): Tree::TickOnce ticks the root again at once, as
+  /// BehaviorTree.CPP's tickOnce() does after emitWakeUpSignal().
+  bool wake_up{false};
 
   Duration Now() const { return clock->Now(); }
   /// Called by a node about to start an asynchronous action: halts the branches that reactive
@@ -72,6 +76,8 @@ struct NodeConfig {
   /// The node type's port declarations (null for nodes without ports).
   const PortsList* manifest_ports{nullptr};
   std::string registration_id;
+  /// For a SubTree node (registration ID "SubTree"), the ID of the tree it includes.
+  std::string subtree_id;
   std::string path;      ///< Unique instance path, e.g. "Main/FirstSubtree/SleepSequence".
   std::uint16_t uid{0};  ///< 1, 2, 3… in depth-first creation order.
   std::array<std::shared_ptr<const Script>, kNumPreConditions> pre;
@@ -151,6 +157,8 @@ class TreeNode {
   virtual void Halt() {}
   void SetStatus(NodeStatus status);
   TreeContext& context() const { return *config_.context; }
+  /// Asks for another pass from the root within the current TickOnce (see TreeContext).
+  void EmitWakeUpSignal() { config_.context->wake_up = true; }
 
  private:
   std::optional<NodeStatus> CheckPreConditions();
