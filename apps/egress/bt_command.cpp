@@ -321,7 +321,13 @@ int RunTrace(const BtOptions& options) {
     } else if (format == "text") {
       fmt::print("tick {} (t = {} ms)\n", tick, time_ms);
     }
-    result = tree.TickOnce();
+    try {
+      result = tree.TickOnce();
+    } catch (...) {
+      tree.RemoveStatusObserver(observer);  // the halt on destruction is not traced
+      std::fflush(stdout);
+      throw;
+    }
     if (format == "json") {
       (*json_tick)["result"] = bt::ToString(result);
       (*json_tick)["blackboard"] = BlackboardJson(tree);

@@ -132,6 +132,7 @@ void BehaviorTreeFactory::ClearRegisteredTrees() {
   impl_->tree_order.clear();
   impl_->subtree_models.clear();
   impl_->documents.clear();
+  impl_->files_read.clear();
   impl_->main_tree_to_execute.reset();
   impl_->first_document = true;
 }

@@ -158,6 +158,7 @@ TreeNode* BehaviorTreeFactory::Impl::Build(const XMLElement* e, const Blackboard
   }
 
   NodeConfig config = BaseConfig(state, blackboard, id);
+  config.location = Cat(definition.file, ":", e->GetLineNum());
   config.manifest_ports = m.stand_in ? nullptr : &m.ports;
   if (m.stand_in && !m.ports.empty()) config.manifest_ports = &m.ports;
   config.path = prefix + name;
@@ -166,7 +167,7 @@ TreeNode* BehaviorTreeFactory::Impl::Build(const XMLElement* e, const Blackboard
   for (const tinyxml2::XMLAttribute* a = e->FirstAttribute(); a != nullptr; a = a->Next()) {
     const std::string_view attribute = a->Name();
     if (attribute == "ID" || attribute == "name") continue;
-    if (ReadConditionAttribute(config, attribute, a->Value(), where)) continue;
+    if (ReadConditionAttribute(config, attribute, a->Value(), Cat(what, ": "))) continue;
     if (attribute.starts_with("_")) continue;  // UI metadata (_description, _uid, …)
     if (!m.stand_in || !m.ports.empty()) {
       if (!m.ports.contains(attribute)) {
@@ -301,6 +302,7 @@ TreeNode* BehaviorTreeFactory::Impl::BuildSubTree(const XMLElement* e,
   // is the subtree's ID, and the subtree's nodes live under its name, or "ID::uid" unnamed.
   NodeConfig config = BaseConfig(state, parent, "SubTree");
   config.subtree_id = id;
+  config.location = Cat(definition.file, ":", e->GetLineNum());
   config.path = prefix + name;
   if (name == id) config.path += Cat("::", config.uid);
   const std::string subtree_prefix =
@@ -318,7 +320,8 @@ TreeNode* BehaviorTreeFactory::Impl::BuildSubTree(const XMLElement* e,
   for (const tinyxml2::XMLAttribute* a = e->FirstAttribute(); a != nullptr; a = a->Next()) {
     const std::string attribute = a->Name();
     if (attribute == "ID" || attribute == "name") continue;
-    if (ReadConditionAttribute(config, attribute, a->Value(), where)) continue;  // parent scope
+    if (ReadConditionAttribute(config, attribute, a->Value(), Cat(where, "SubTree '", id, "': ")))
+      continue;  // parent scope
     if (attribute == "_autoremap") {
       auto_remap = ParseBoolAttribute(a->Value());
       continue;
@@ -388,9 +391,20 @@ std::string BehaviorTreeFactory::Impl::ChooseMainTree(std::string_view requested
     return *main_tree_to_execute;
   }
   if (trees.size() == 1) return trees.begin()->first;
-  if (trees.empty()) throw LogicError("no BehaviorTree is registered");
+  if (trees.empty()) {
+    throw LogicError(files_read.empty()
+                         ? std::string("no BehaviorTree is registered (no tree file was read)")
+                         : Cat(Join(files_read), ": no <BehaviorTree> in ",
+                               files_read.size() == 1 ? "this file" : "these files",
+                               " (a TreeNodesModel alone declares node types; it is not a tree)"));
+  }
+  std::vector<std::string> where;
+  for (const std::string& id : tree_order) {
+    const TreeDefinition& tree = trees.at(id);
+    where.push_back(Cat(id, " at ", tree.file, ":", tree.element->GetLineNum()));
+  }
   throw LogicError(Cat("[main_tree_to_execute] was not specified and there are several trees (",
-                       Join(tree_order), "); name the tree to run"));
+                       Join(where), "); name the tree to run (--tree ID)"));
 }
 
 }  // namespace egress::bt

@@ -93,6 +93,7 @@ struct BehaviorTreeFactory::Impl {
   std::vector<std::shared_ptr<XMLDocument>> documents;
   std::map<std::string, TreeDefinition, std::less<>> trees;
   std::vector<std::string> tree_order;
+  std::vector<std::string> files_read;  ///< Every document read since the last clear (errors).
   std::map<std::string, PortsList, std::less<>> subtree_models;
   std::optional<std::string> main_tree_to_execute;
   bool first_document{true};

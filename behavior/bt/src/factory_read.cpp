@@ -56,6 +56,7 @@ void BehaviorTreeFactory::Impl::ReadDocument(const std::string& xml, const std::
     first_document = false;
   }
   documents.push_back(doc);
+  files_read.push_back(file);
 
   bool seen_model = false;
   int unnamed = 0;

@@ -68,7 +68,8 @@ void TreeNode::ResetStatus() {
 }
 
 void TreeNode::ThrowScriptError(std::string_view attribute, const std::exception& e) const {
-  throw RuntimeError(Cat("[", path(), "] ", attribute, ": ", e.what()));
+  throw RuntimeError(Cat(config_.location.empty() ? "" : Cat(config_.location, ": "), "[", path(),
+                         "] ", attribute, ": ", e.what()));
 }
 
 std::optional<NodeStatus> TreeNode::CheckPreConditions() {

@@ -80,6 +80,7 @@ struct NodeConfig {
   std::string subtree_id;
   std::string path;      ///< Unique instance path, e.g. "Main/FirstSubtree/SleepSequence".
   std::uint16_t uid{0};  ///< 1, 2, 3… in depth-first creation order.
+  std::string location;  ///< "file:line" of the node's element (named in runtime errors).
   std::array<std::shared_ptr<const Script>, kNumPreConditions> pre;
   std::array<std::shared_ptr<const Script>, kNumPostConditions> post;
   TreeContext* context{nullptr};
