@@ -116,6 +116,17 @@ egress_require(fcl APT libfcl-dev)
 
 # --- behavior (the BehaviorTree.CPP v4 XML engine)
 egress_require(tinyxml2 APT libtinyxml2-dev)
+# Groot2 live monitoring (egress_bt_groot2): ZeroMQ, through its C API and pkg-config file.
+find_package(PkgConfig QUIET)
+if(PkgConfig_FOUND)
+  pkg_check_modules(EGRESS_ZMQ QUIET IMPORTED_TARGET libzmq)
+endif()
+if(NOT EGRESS_ZMQ_FOUND)
+  message(FATAL_ERROR
+    "egress: dependency 'libzmq' not found. Install the Debian package 'libzmq3-dev':\n"
+    "    apt-get install libzmq3-dev\n"
+    "or run `./egress.sh deps` as root to install every missing package.")
+endif()
 
 # --- apps
 egress_require(CLI11 APT libcli11-dev)

@@ -111,6 +111,7 @@ BrainTrial RunBrainTrial(std::shared_ptr<const twin::TwinModel> twin_model, std:
   trial.world = std::make_unique<twin::TwinWorld>(twin_model, seed);
   trial.brain = MakeScenarioExecutive(twin_model->scenario(), twin_model->world(), *trial.world,
                                       twin_model->robot_model(), options.config);
+  if (options.on_brain) options.on_brain(*trial.brain);
   twin::TwinRobot robot(trial.world.get());
   twin::RunOptions run = options.run;
   run.control_period = 1.0 / options.config.control_rate_hz;

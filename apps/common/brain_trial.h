@@ -53,6 +53,9 @@ struct BrainTrialOptions {
   /// How the twin runs (duration, trace, progress); its control_period is replaced by the
   /// executive's 1 / config.control_rate_hz.
   twin::RunOptions run;
+  /// Called once the brain exists, before the run (attaching a .btlog writer or a Groot2
+  /// publisher to its tree). What it attaches must be detached before the trial is destroyed.
+  std::function<void(behavior::Executive&)> on_brain;
   /// Called after every control step (ground-truth probes, debugging output).
   std::function<void(const twin::TwinWorld&, const behavior::Executive&)> after_step;
   /// Called with what the brain reads of the robot at each step (recording a run as a bag).

@@ -20,6 +20,7 @@
 #include "bag_recorder.h"
 #include "brain_trial.h"
 #include "commands.h"
+#include "egress/bt/groot2_publisher.h"
 #include "egress/hsr_interface/error.h"
 #include "egress/ros2/robot_port_server.h"
 #include "egress/ros2/ros2_robot_port.h"
@@ -55,6 +56,8 @@ struct Ros2Options {
   bool overwrite{false};
   bool sim_time{false};
   bool quiet{false};
+  std::optional<std::uint16_t> groot2_port;
+  std::string groot2_bind{"127.0.0.1"};
 };
 
 ros2::Ros2Topics TopicsOf(const Ros2Options& o) {
@@ -204,6 +207,16 @@ void RunRobot(const Ros2Options& o) {
     on_sense = [&](const SensorSnapshot& s) { bag->OnSense(s); };
   }
   ObservedPort observed(port, on_sense);
+  // Declared after the brain: it stops serving (and leaves the tree) before the brain goes.
+  std::unique_ptr<bt::Groot2Publisher> groot2;
+  if (o.groot2_port) {
+    groot2 = std::make_unique<bt::Groot2Publisher>(
+        brain->tree(), brain->tree_factory(), bt::Groot2Options{*o.groot2_port, o.groot2_bind});
+    if (!o.quiet) {
+      fmt::print("groot2    serving the tree on {}:{} (publisher :{})\n", o.groot2_bind,
+                 groot2->port(), groot2->port() + 1);
+    }
+  }
   std::signal(SIGINT, OnSigint);
   std::string missing;
   if (!port.WaitForSensors(std::chrono::milliseconds(int(o.wait_s * 1000)), &missing))
@@ -346,6 +359,11 @@ void AddRos2Commands(CLI::App& app) {
       ->check(FiniteIn(1e-3, 10.0));
   robot->add_option("--wait", o->wait_s, "Seconds to wait for the robot's sensors and clock")
       ->check(FiniteIn(0.1, 3600.0));
+  robot->add_option("--groot2", o->groot2_port,
+                    "Serve the mission tree to Groot2 live on this port and the next (0: the "
+                    "first free pair from 1667)");
+  robot->add_option("--groot2-bind", o->groot2_bind,
+                    "Interface the Groot2 server binds (default 127.0.0.1; '*' for all)");
   robot->add_flag("-q,--quiet", o->quiet, "Only errors");
   robot->callback([o] { RunRobot(*o); });
 }

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <thread>
 #include <vector>
 
 #include <fmt/format.h>
@@ -22,6 +23,8 @@
 #include "brain_trial.h"
 #include "commands.h"
 #include "egress/behavior/task_nodes.h"
+#include "egress/bt/groot2_publisher.h"
+#include "egress/bt/loggers.h"
 #include "egress/hsr_interface/error.h"
 #include "egress/twin/sdf_world_loader.h"
 #include "egress/twin/twin_run.h"
@@ -70,6 +73,10 @@ struct SimOptions {
   bool quiet{false};
   bool no_octomap{false};
   std::string bag;
+  std::string btlog;
+  std::optional<std::uint16_t> groot2_port;
+  std::string groot2_bind{"127.0.0.1"};
+  double pace{0.0};  ///< Real-time factor to hold the run to (0: as fast as it goes).
 };
 
 void RefuseOverwrite(const std::string& path, bool overwrite) {
@@ -115,7 +122,7 @@ twin::Scenario GoalScenarioOf(const SimOptions& o) {
 }
 
 void RunSim(const SimOptions& o) {
-  for (const auto* path : {&o.trace, &o.json, &o.png, &o.mp4})
+  for (const auto* path : {&o.trace, &o.json, &o.png, &o.mp4, &o.btlog})
     RefuseOverwrite(*path, o.overwrite);
   if (!IsWorldFile(o.scenario) && (!o.goal.empty() || !o.start.empty()))
     throw CommandFailed("--start and --goal go with a world file (.sdf/.world), not a scenario");
@@ -173,13 +180,50 @@ void RunSim(const SimOptions& o) {
       throw CommandFailed("--bag records a brain run (the driver is " + driver + ")");
     bag = BagRecorder::Open(o.bag, o.overwrite);
   }
+  for (const auto& [given, flag] :
+       {std::pair{!o.btlog.empty(), "--btlog"}, std::pair{o.groot2_port.has_value(), "--groot2"}}) {
+    if (given && driver != "brain")
+      throw CommandFailed(
+          fmt::format("{} shows the brain's tree (the driver is {})", flag, driver));
+  }
+  // Observers of the brain's tree; they go before the brain does (see the end of the run).
+  std::unique_ptr<bt::FileLogger2> btlog;
+  std::unique_ptr<bt::Groot2Publisher> groot2;
   if (driver == "brain") {
     BrainTrialOptions trial_options;
+    trial_options.on_brain = [&](behavior::Executive& b) {
+      if (!o.btlog.empty()) {
+        // Groot2 shows the replay against the wall time the run started.
+        const auto start_us = std::chrono::duration_cast<std::chrono::microseconds>(
+            std::chrono::system_clock::now().time_since_epoch());
+        btlog = std::make_unique<bt::FileLogger2>(b.tree(), b.tree_factory(), o.btlog,
+                                                  start_us.count());
+      }
+      if (o.groot2_port) {
+        groot2 = std::make_unique<bt::Groot2Publisher>(
+            b.tree(), b.tree_factory(), bt::Groot2Options{*o.groot2_port, o.groot2_bind});
+        fmt::print("groot2    serving the tree on {}:{} (publisher :{}); attach Groot2 there\n",
+                   o.groot2_bind, groot2->port(), groot2->port() + 1);
+        std::fflush(stdout);
+      }
+    };
+    if (o.pace > 0.0) {
+      // Holds the simulation to `pace` times real time, so that Groot2 can follow it.
+      trial_options.after_step = [&, wall_start = std::chrono::steady_clock::now()](
+                                     const twin::TwinWorld& w, const behavior::Executive& b) {
+        if (bag) bag->AfterStep(w.now(), b);
+        std::this_thread::sleep_until(
+            wall_start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                             std::chrono::duration<double>(w.time() / o.pace)));
+      };
+    }
     if (bag) {
       trial_options.on_sense = [&](const SensorSnapshot& s) { bag->OnSense(s); };
-      trial_options.after_step = [&](const twin::TwinWorld& w, const behavior::Executive& b) {
-        bag->AfterStep(w.now(), b);
-      };
+      if (!trial_options.after_step) {
+        trial_options.after_step = [&](const twin::TwinWorld& w, const behavior::Executive& b) {
+          bag->AfterStep(w.now(), b);
+        };
+      }
     }
     trial_options.config.use_octomap = !o.no_octomap;
     trial_options.run = options;
@@ -201,6 +245,14 @@ void RunSim(const SimOptions& o) {
     world_owner = std::move(trial.world);
     brain = std::move(trial.brain);
     result = std::move(trial.result);
+    if (groot2) {
+      fmt::print("groot2    answered {} requests\n", groot2->requests_served());
+      groot2.reset();
+    }
+    if (btlog) {
+      btlog.reset();  // flushes
+      fmt::print("btlog     {} (replay it in Groot2)\n", o.btlog);
+    }
   } else {
     world_owner = std::make_unique<twin::TwinWorld>(scenario, world_description, seed, model);
     twin::TwinRobot robot(world_owner.get());
@@ -292,6 +344,16 @@ void AddSimCommand(CLI::App& app) {
   sim->add_option("--bag", o->bag,
                   "record the brain's run as a rosbag2 bag in this folder (sqlite3 .db3 + "
                   "metadata.yaml: /scan /odom /tf /map /plan /people /egress/status)");
+  sim->add_option("--btlog", o->btlog,
+                  "write the brain's tree transitions as a Groot2 .btlog (replay in Groot2)");
+  sim->add_option("--groot2", o->groot2_port,
+                  "serve the brain's tree to Groot2 live on this port and the next (0: the "
+                  "first free pair from 1667)");
+  sim->add_option("--groot2-bind", o->groot2_bind,
+                  "interface the Groot2 server binds (default 127.0.0.1; '*' for all)");
+  sim->add_option("--pace", o->pace,
+                  "hold the run to this many times real time (e.g. 1 to watch it in Groot2)")
+      ->check(CLI::NonNegativeNumber);
   sim->add_flag("--overwrite", o->overwrite, "replace existing output files");
   sim->add_flag("-q,--quiet", o->quiet, "print only the verdict");
   sim->add_flag("--no-octomap", o->no_octomap,

@@ -354,6 +354,14 @@ void Executive::UpdateDoorLeaves() {
   }
 }
 
+bt::Tree& Executive::tree() {
+  return *impl_->tree;
+}
+
+const bt::BehaviorTreeFactory& Executive::tree_factory() const {
+  return impl_->factory;
+}
+
 std::string Executive::active_action() const {
   const bt::TreeNode* node = impl_->log->running();
   if (node == nullptr) return {};

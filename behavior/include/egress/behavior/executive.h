@@ -22,6 +22,12 @@
 #include "egress/behavior/motion_executor.h"
 #include "egress/behavior/task_services.h"
 #include "egress/bt/status.h"
+
+namespace egress::bt {
+class Tree;
+class BehaviorTreeFactory;
+}  // namespace egress::bt
+
 #include "egress/hsr_interface/robot_port.h"
 #include "egress/perception/costmap.h"
 #include "egress/perception/detection.h"
@@ -136,6 +142,10 @@ class Executive {
   /// detections); its boxes join the port's own detections. Without one, colour images are
   /// ignored. The executive owns it from here.
   void SetDetector(std::unique_ptr<perception::Detector> detector);
+  /// The mission tree and the factory that built it (to attach observers: a .btlog writer,
+  /// a Groot2 publisher). Observers must be removed before the executive is destroyed.
+  bt::Tree& tree();
+  const bt::BehaviorTreeFactory& tree_factory() const;
   /// The running action's name (instance name, else its type), or empty.
   std::string active_action() const;
   const Pose2& X_MB() const { return belief_.X_MB; }
