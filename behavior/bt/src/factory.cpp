@@ -153,7 +153,7 @@ Tree BehaviorTreeFactory::CreateTree(std::string_view tree_id, Blackboard::Ptr b
   blackboard->SetTypeRegistry(impl_->types.get());
   tree.blackboards_.push_back(blackboard);
 
-  Impl::BuildState state{&tree, &options, {main}, {}, {}};
+  Impl::BuildState state{&tree, &options, {main}, {}, {}, {}};
   const auto& definition = impl_->trees.at(main);
   impl_->Build(definition.element->FirstChildElement(), blackboard, "", definition, state);
   return tree;

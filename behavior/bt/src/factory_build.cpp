@@ -24,12 +24,12 @@ NodeConfig BehaviorTreeFactory::Impl::BaseConfig(BuildState& state,
 bool BehaviorTreeFactory::Impl::ReadConditionAttribute(NodeConfig& config,
                                                        std::string_view attribute,
                                                        const char* value,
-                                                       const std::string& where) {
+                                                       std::string_view context) {
   const auto parse = [&](std::shared_ptr<const Script>& slot) {
     try {
       slot = Script::Parse(value);
     } catch (const LogicError& e) {
-      throw LogicError(Cat(where, attribute, ": ", e.what()));
+      throw LogicError(Cat(context, ": ", attribute, ": ", e.what()));
     }
   };
   for (int i = 0; i < kNumPreConditions; ++i) {
@@ -158,7 +158,8 @@ TreeNode* BehaviorTreeFactory::Impl::Build(const XMLElement* e, const Blackboard
   }
 
   NodeConfig config = BaseConfig(state, blackboard, id);
-  config.location = Cat(definition.file, ":", e->GetLineNum());
+  config.file = state.File(definition.file);
+  config.line = e->GetLineNum();
   config.manifest_ports = m.stand_in ? nullptr : &m.ports;
   if (m.stand_in && !m.ports.empty()) config.manifest_ports = &m.ports;
   config.path = prefix + name;
@@ -167,7 +168,7 @@ TreeNode* BehaviorTreeFactory::Impl::Build(const XMLElement* e, const Blackboard
   for (const tinyxml2::XMLAttribute* a = e->FirstAttribute(); a != nullptr; a = a->Next()) {
     const std::string_view attribute = a->Name();
     if (attribute == "ID" || attribute == "name") continue;
-    if (ReadConditionAttribute(config, attribute, a->Value(), Cat(what, ": "))) continue;
+    if (ReadConditionAttribute(config, attribute, a->Value(), what)) continue;
     if (attribute.starts_with("_")) continue;  // UI metadata (_description, _uid, …)
     if (!m.stand_in || !m.ports.empty()) {
       if (!m.ports.contains(attribute)) {
@@ -302,7 +303,8 @@ TreeNode* BehaviorTreeFactory::Impl::BuildSubTree(const XMLElement* e,
   // is the subtree's ID, and the subtree's nodes live under its name, or "ID::uid" unnamed.
   NodeConfig config = BaseConfig(state, parent, "SubTree");
   config.subtree_id = id;
-  config.location = Cat(definition.file, ":", e->GetLineNum());
+  config.file = state.File(definition.file);
+  config.line = e->GetLineNum();
   config.path = prefix + name;
   if (name == id) config.path += Cat("::", config.uid);
   const std::string subtree_prefix =
@@ -315,12 +317,13 @@ TreeNode* BehaviorTreeFactory::Impl::BuildSubTree(const XMLElement* e,
   child_blackboard->SetTypeRegistry(types.get());
   state.tree->blackboards_.push_back(child_blackboard);
 
+  const std::string subtree_what = Cat(where, "SubTree '", id, "'");
   bool auto_remap = false;
   std::set<std::string> given;
   for (const tinyxml2::XMLAttribute* a = e->FirstAttribute(); a != nullptr; a = a->Next()) {
     const std::string attribute = a->Name();
     if (attribute == "ID" || attribute == "name") continue;
-    if (ReadConditionAttribute(config, attribute, a->Value(), Cat(where, "SubTree '", id, "': ")))
+    if (ReadConditionAttribute(config, attribute, a->Value(), subtree_what))
       continue;  // parent scope
     if (attribute == "_autoremap") {
       auto_remap = ParseBoolAttribute(a->Value());

@@ -128,6 +128,13 @@ struct BehaviorTreeFactory::Impl {
     std::vector<std::string> subtree_stack;
     std::set<std::string> paths;
     std::set<const NodeManifest*> manifests_used;
+    // The name of each tree file, shared by its nodes' NodeConfig::file.
+    std::map<std::string, std::shared_ptr<const std::string>, std::less<>> files;
+    std::shared_ptr<const std::string> File(const std::string& name) {
+      auto& file = files[name];
+      if (!file) file = std::make_shared<const std::string>(name);
+      return file;
+    }
   };
 
   TreeNode* AddNode(BuildState& state, std::unique_ptr<TreeNode> node);
@@ -135,9 +142,10 @@ struct BehaviorTreeFactory::Impl {
   NodeConfig BaseConfig(BuildState& state, const Blackboard::Ptr& blackboard,
                         std::string registration_id);
 
-  // Reads _failureIf … _onHalted into the config; returns true if the attribute was one.
+  // Reads _failureIf … _onHalted into the config; returns true if the attribute was one. An
+  // error reads "<context>: <attribute>: ..." (context: file, line and node).
   static bool ReadConditionAttribute(NodeConfig& config, std::string_view attribute,
-                                     const char* value, const std::string& where);
+                                     const char* value, std::string_view context);
 
   std::string DescribeNode(const std::string& where, std::string_view id, std::string_view name);
 

@@ -68,8 +68,8 @@ void TreeNode::ResetStatus() {
 }
 
 void TreeNode::ThrowScriptError(std::string_view attribute, const std::exception& e) const {
-  throw RuntimeError(Cat(config_.location.empty() ? "" : Cat(config_.location, ": "), "[", path(),
-                         "] ", attribute, ": ", e.what()));
+  const std::string location = config_.file ? Cat(*config_.file, ":", config_.line, ": ") : "";
+  throw RuntimeError(Cat(location, "[", path(), "] ", attribute, ": ", e.what()));
 }
 
 std::optional<NodeStatus> TreeNode::CheckPreConditions() {
@@ -140,7 +140,7 @@ NodeStatus TreeNode::ExecuteTick() {
   if (result != NodeStatus::kSkipped) SetStatus(result);
   // A decorator's completed child goes back to IDLE once the decorator's own status is set
   // (BT.CPP's DecoratorNode::executeTick; most decorators reset it themselves, earlier).
-  if (const NodeKind k = kind(); k == NodeKind::kDecorator || k == NodeKind::kSubTree) {
+  if (resets_completed_child_) {
     if (const auto children = this->children();
         !children.empty() && IsCompleted(children.front()->status())) {
       children.front()->ResetStatus();

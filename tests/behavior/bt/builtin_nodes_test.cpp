@@ -333,7 +333,10 @@ TEST_F(NodesTest, SkippedChildrenAndPreConditions) {
       "<Sequence><Counter key='{n}' _skipIf='n == 0'/><AlwaysSuccess _skipIf='true'/></Sequence>");
   EXPECT_EQ(tree.TickOnce(), K);  // all children skipped
   EXPECT_EQ(board->Get<int>("n"), 0);
-  EXPECT_EQ(tree.root().status(), NodeStatus::kIdle);  // a skipped node stays IDLE
+  // A skipped result is not a status: the Sequence keeps the RUNNING it set before its children
+  // skipped, as in BT.CPP 4.10 (its parent, if any, resets it).
+  EXPECT_EQ(tree.root().status(), NodeStatus::kRunning);
+  EXPECT_EQ(tree.TickOnce(), K);  // and it skips again
 
   factory.ClearRegisteredTrees();
   Tree guarded = Load("<Sequence><AlwaysSuccess _failureIf='n == 0'/></Sequence>");

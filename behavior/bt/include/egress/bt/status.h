@@ -8,7 +8,8 @@
 namespace egress::bt {
 
 /// Result of ticking a node. SKIPPED is returned only by pre-conditions and by parents whose
-/// children were all skipped; a skipped node keeps IDLE as its own status.
+/// children were all skipped; it is never a node's own status: a skipped node keeps the status
+/// it had (as in BehaviorTree.CPP 4.10).
 enum class NodeStatus : unsigned char {
   kIdle = 0,
   kRunning = 1,

@@ -80,7 +80,9 @@ struct NodeConfig {
   std::string subtree_id;
   std::string path;      ///< Unique instance path, e.g. "Main/FirstSubtree/SleepSequence".
   std::uint16_t uid{0};  ///< 1, 2, 3… in depth-first creation order.
-  std::string location;  ///< "file:line" of the node's element (named in runtime errors).
+  /// The file and line of the node's element (named in runtime errors).
+  std::shared_ptr<const std::string> file;
+  int line{0};
   std::array<std::shared_ptr<const Script>, kNumPreConditions> pre;
   std::array<std::shared_ptr<const Script>, kNumPostConditions> post;
   TreeContext* context{nullptr};
@@ -169,6 +171,10 @@ class TreeNode {
   std::string name_;
   NodeConfig config_;
   NodeStatus status_{NodeStatus::kIdle};
+
+ protected:
+  /// Set by DecoratorNode: ExecuteTick resets a completed child after the node's own status.
+  bool resets_completed_child_{false};
 };
 
 /// A leaf that completes within one tick; returning RUNNING is an error.
@@ -220,7 +226,10 @@ class ControlNode : public TreeNode {
 /// A node with exactly one child.
 class DecoratorNode : public TreeNode {
  public:
-  using TreeNode::TreeNode;
+  DecoratorNode(std::string name, NodeConfig config)
+      : TreeNode(std::move(name), std::move(config)) {
+    resets_completed_child_ = true;
+  }
   NodeKind kind() const override { return NodeKind::kDecorator; }
   std::span<TreeNode* const> children() const override { return {&child_, child_ ? 1u : 0u}; }
   void SetChild(TreeNode* child) { child_ = child; }
