@@ -14,6 +14,7 @@
 #include <map>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -116,9 +117,21 @@ TEST(EgressCliTest, BadNumbersAreRefusedByName) {
 
 // ---- egress bt
 
+// Scratch files written by the tests, removed when the test program ends.
+struct TempFiles {
+  std::vector<std::filesystem::path> paths;
+  ~TempFiles() {
+    std::error_code ignored;
+    for (const auto& path : paths)
+      std::filesystem::remove(path, ignored);
+  }
+};
+
 std::string WriteTemp(const std::string& name, const std::string& text) {
+  static TempFiles written;
   const auto path = egress::testing::TestTempPath(name);
   std::ofstream(path) << text;
+  written.paths.push_back(path);
   return path.string();
 }
 
@@ -184,6 +197,17 @@ ticks:
   const auto parsed = nlohmann::json::parse(json.output);
   EXPECT_EQ(parsed.at("result"), "FAILURE");
   EXPECT_EQ(parsed.at("ticks").size(), 2u);
+  // Every blackboard after each tick, as Groot2 shows them (the main tree's under "").
+  EXPECT_TRUE(parsed.at("ticks").at(0).at("blackboard").contains(""));
+
+  // --ticks N runs exactly N ticks, the root starting over after it completes.
+  const Result exact =
+      RunEgress("bt trace " + tree + " --script " + script + " --ticks 5 --format btcpp");
+  ASSERT_EQ(exact.exit_code, 0) << exact.output;
+  EXPECT_THAT(exact.output, HasSubstr("tick 2 -> FAILURE"));
+  EXPECT_THAT(exact.output, HasSubstr("tick 5 -> "));
+  EXPECT_THAT(exact.output, HasSubstr("halt TraverseDoor::6 TraverseDoor\n"
+                                      "status TraverseDoor::6 TraverseDoor RUNNING -> IDLE"));
 }
 
 TEST(EgressCliTest, BtTraceScriptErrorsNameTheLine) {
