@@ -2,6 +2,7 @@
 
 #include "commands.h"
 #include "egress/behavior/library_versions.h"
+#include "egress/bt/groot2_publisher.h"
 #include "egress/hsr_interface/version.h"
 #include "egress/perception/library_versions.h"
 #include "egress/planning/library_versions.h"
@@ -21,6 +22,7 @@ std::string VersionText() {
   add("perception", perception::LibraryVersions());
   add("planning", planning::LibraryVersions());
   add("behavior", behavior::LibraryVersions());
+  add("behavior", {{"ZeroMQ", bt::ZeroMqVersion()}});  // Groot2 monitoring
   add("apps", {{"protobuf", EGRESS_PROTOBUF_VERSION}, {"gRPC", EGRESS_GRPC_VERSION}});
   text.pop_back();  // CLI11 adds the final newline.
   return text;

@@ -51,7 +51,7 @@ TEST(EgressCliTest, VersionListsEveryModulesLibraries) {
   EXPECT_EQ(result.exit_code, 0) << result.output;
   EXPECT_THAT(result.output, HasSubstr("egress 0.1.0"));
   for (const char* library : {"Eigen", "urdfdom", "Bullet", "sdformat", "assimp", "OpenCV",
-                              "OctoMap", "OMPL", "FCL", "tinyxml2", "gRPC"}) {
+                              "OctoMap", "OMPL", "FCL", "tinyxml2", "gRPC", "ZeroMQ"}) {
     EXPECT_THAT(result.output, HasSubstr(library));
   }
   EXPECT_THAT(result.output, HasSubstr("double precision"));

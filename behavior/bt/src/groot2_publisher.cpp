@@ -310,6 +310,12 @@ Groot2Publisher::~Groot2Publisher() {
   if (impl_->thread.joinable()) impl_->thread.join();
 }
 
+std::string ZeroMqVersion() {
+  int major = 0, minor = 0, patch = 0;
+  zmq_version(&major, &minor, &patch);
+  return Cat(major, ".", minor, ".", patch);
+}
+
 std::uint16_t Groot2Publisher::port() const {
   return impl_->port;
 }

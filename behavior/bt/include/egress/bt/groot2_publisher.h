@@ -34,6 +34,9 @@ struct Groot2Options {
   std::string bind_address{"127.0.0.1"};
 };
 
+/// The version of the ZeroMQ library the publisher runs on ("4.3.4").
+std::string ZeroMqVersion();
+
 class Groot2Publisher {
  public:
   /// Subscribes to `tree` and starts serving. The tree and factory must outlive it.
