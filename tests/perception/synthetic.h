@@ -5,6 +5,9 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <vector>
+
+#include <Eigen/Core>
 
 #include "egress/hsr_interface/sensor_types.h"
 #include "egress/perception/occupancy_grid.h"
@@ -28,6 +31,39 @@ inline void CastScan(const OccupancyGrid& grid, const Pose2& X_ML, LaserScan* sc
     const auto hit =
         RayCast(grid, X_ML.translation(), X_ML.yaw + scan->AngleAt(i), scan->range_max);
     scan->ranges[i] = hit ? float(*hit) : std::numeric_limits<float>::infinity();
+  }
+}
+
+/// A disc at laser height (a leg, a body section) for CastScanAtDiscs.
+struct Disc {
+  Eigen::Vector2d centre;
+  double radius;
+};
+
+/// Fills `scan` with the nearest hit of each beam on `discs` (and on `grid` if given) from the
+/// laser pose X_ML; beams that hit nothing keep +inf.
+inline void CastScanAtDiscs(const std::vector<Disc>& discs, const Pose2& X_ML, LaserScan* scan,
+                            const OccupancyGrid* grid = nullptr) {
+  const Eigen::Vector2d origin = X_ML.translation();
+  for (std::size_t i = 0; i < scan->ranges.size(); ++i) {
+    const double angle = X_ML.yaw + scan->AngleAt(i);
+    const Eigen::Vector2d d(std::cos(angle), std::sin(angle));
+    double best = std::numeric_limits<double>::infinity();
+    if (grid != nullptr) {
+      if (const auto hit = RayCast(*grid, origin, angle, scan->range_max)) best = *hit;
+    }
+    for (const Disc& disc : discs) {
+      // |origin + t d - c|^2 = r^2, nearest t > 0.
+      const Eigen::Vector2d f = origin - disc.centre;
+      const double b = f.dot(d);
+      const double c = f.squaredNorm() - disc.radius * disc.radius;
+      const double discriminant = b * b - c;
+      if (discriminant < 0.0) continue;
+      const double t = -b - std::sqrt(discriminant);
+      if (t > 0.0 && t < best) best = t;
+    }
+    scan->ranges[i] =
+        best <= scan->range_max ? float(best) : std::numeric_limits<float>::infinity();
   }
 }
 

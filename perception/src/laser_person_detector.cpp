@@ -1,0 +1,159 @@
+#include "egress/perception/laser_person_detector.h"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include <Eigen/Dense>
+
+#include "egress/hsr_interface/error.h"
+
+namespace egress::perception {
+namespace {
+
+// A circle seen from outside shows its near half; the centroid of that arc lies this fraction of
+// the radius short of the centre, towards the laser (2/pi for a half circle).
+constexpr double kArcCentroidOffset = 0.64;
+
+struct Circle {
+  Eigen::Vector2d centre;
+  double radius;
+};
+
+// Algebraic (Kasa) least-squares circle through the points, or nullopt when they are
+// (nearly) collinear.
+std::optional<Circle> FitCircle(const std::vector<Eigen::Vector2d>& points) {
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const auto& p : points)
+    mean += p;
+  mean /= double(points.size());
+  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+  for (const auto& p : points) {
+    const Eigen::Vector2d q = p - mean;
+    const Eigen::Vector3d row(q.x(), q.y(), 1.0);
+    normal += row * row.transpose();
+    rhs -= row * q.squaredNorm();
+  }
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(normal);
+  if (ldlt.info() != Eigen::Success || std::abs(normal.determinant()) < 1e-12) return std::nullopt;
+  const Eigen::Vector3d s = ldlt.solve(rhs);
+  const Eigen::Vector2d centre(-s.x() / 2, -s.y() / 2);
+  const double r2 = centre.squaredNorm() - s.z();
+  if (!std::isfinite(r2) || r2 <= 0.0) return std::nullopt;
+  return Circle{centre + mean, std::sqrt(r2)};
+}
+
+}  // namespace
+
+void LaserPersonDetectorConfig::Validate() const {
+  const auto positive = [](double v, const char* field) {
+    ThrowUnless(std::isfinite(v) && v > 0.0,
+                StrCat("LaserPersonDetectorConfig: ", field, " must be finite and > 0"));
+  };
+  positive(cluster_gap, "cluster_gap");
+  positive(leg_min_width, "leg_min_width");
+  positive(leg_pair_max_gap, "leg_pair_max_gap");
+  positive(body_min_radius, "body_min_radius");
+  positive(max_range, "max_range");
+  ThrowUnless(min_points >= 2, "LaserPersonDetectorConfig: min_points must be >= 2");
+  ThrowUnless(leg_min_width < leg_max_width && leg_max_width < body_max_width,
+              "LaserPersonDetectorConfig: need leg_min_width < leg_max_width < body_max_width");
+  ThrowUnless(std::isfinite(body_max_radius) && body_min_radius < body_max_radius,
+              "LaserPersonDetectorConfig: need body_min_radius < body_max_radius");
+}
+
+LaserPersonDetector::LaserPersonDetector(LaserPersonDetectorConfig config)
+    : config_(std::move(config)) {
+  config_.Validate();
+}
+
+std::vector<LaserPersonDetection> LaserPersonDetector::Detect(
+    const LaserScan& scan, const Pose2& X_ML,
+    const std::function<bool(const Eigen::Vector2d&)>& is_background) const {
+  scan.Validate();
+  ThrowUnless(X_ML.IsFinite(), "LaserPersonDetector: the laser pose X_ML must be finite");
+  const Eigen::Vector2d p_ML = X_ML.translation();
+
+  // Clusters of returns off the map on neighbouring beams, closer than cluster_gap in turn.
+  std::vector<std::vector<Eigen::Vector2d>> clusters;
+  std::vector<Eigen::Vector2d> current;
+  std::size_t last_beam = 0;
+  const auto close_cluster = [&] {
+    if (int(current.size()) >= config_.min_points) clusters.push_back(current);
+    current.clear();
+  };
+  for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
+    if (!scan.IsValidReturn(i) || scan.ranges[i] > config_.max_range) continue;
+    const double angle = scan.AngleAt(i);
+    const Eigen::Vector2d p_M =
+        X_ML * Eigen::Vector2d(scan.ranges[i] * std::cos(angle), scan.ranges[i] * std::sin(angle));
+    if (is_background && is_background(p_M)) continue;
+    if (!current.empty() &&
+        (i != last_beam + 1 || (p_M - current.back()).norm() > config_.cluster_gap)) {
+      close_cluster();
+    }
+    current.push_back(p_M);
+    last_beam = i;
+  }
+  close_cluster();
+
+  std::vector<LaserPersonDetection> people;
+  std::vector<LaserPersonDetection> legs;
+  for (const auto& points : clusters) {
+    const double width = (points.back() - points.front()).norm();
+    if (width < config_.leg_min_width || width > config_.body_max_width) continue;
+    Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+    for (const auto& p : points)
+      centroid += p;
+    centroid /= double(points.size());
+    const Eigen::Vector2d away = (centroid - p_ML).normalized();  // from the laser, through it
+    if (width <= config_.leg_max_width) {
+      const double radius = width / 2;
+      legs.push_back(
+          {centroid + away * kArcCentroidOffset * radius, radius, 1, int(points.size())});
+      continue;
+    }
+    // A body section: its circle's centre lies beyond the arc, seen from the laser.
+    LaserPersonDetection body{Eigen::Vector2d::Zero(), 0.0, 0, int(points.size())};
+    const std::optional<Circle> circle = points.size() >= 5 ? FitCircle(points) : std::nullopt;
+    if (circle && circle->radius >= config_.body_min_radius &&
+        circle->radius <= config_.body_max_radius && (circle->centre - centroid).dot(away) > 0.0) {
+      body.p_MP = circle->centre;
+      body.radius = circle->radius;
+    } else {
+      body.radius = std::clamp(width / 2, config_.body_min_radius, config_.body_max_radius);
+      body.p_MP = centroid + away * kArcCentroidOffset * body.radius;
+    }
+    people.push_back(body);
+  }
+
+  // Legs a stride apart at most are one person's: closest pairs first.
+  std::vector<bool> paired(legs.size(), false);
+  while (true) {
+    double best = config_.leg_pair_max_gap;
+    std::size_t a = legs.size(), b = legs.size();
+    for (std::size_t i = 0; i < legs.size(); ++i) {
+      for (std::size_t j = i + 1; j < legs.size(); ++j) {
+        if (paired[i] || paired[j]) continue;
+        const double d = (legs[i].p_MP - legs[j].p_MP).norm();
+        if (d <= best) {
+          best = d;
+          a = i;
+          b = j;
+        }
+      }
+    }
+    if (a == legs.size()) break;
+    paired[a] = paired[b] = true;
+    people.push_back({(legs[a].p_MP + legs[b].p_MP) / 2,
+                      best / 2 + std::max(legs[a].radius, legs[b].radius), 2,
+                      legs[a].points + legs[b].points});
+  }
+  for (std::size_t i = 0; i < legs.size(); ++i) {
+    if (!paired[i]) people.push_back(legs[i]);
+  }
+  return people;
+}
+
+}  // namespace egress::perception

@@ -1,0 +1,123 @@
+// LaserPersonDetector on ray-cast scans: legs, body sections, walls and furniture.
+
+#include "egress/perception/laser_person_detector.h"
+
+#include <numbers>
+
+#include <gmock/gmock.h>
+#include <gtest/gtest.h>
+
+#include "egress/hsr_interface/error.h"
+#include "synthetic.h"
+
+namespace egress::perception {
+namespace {
+
+using testing::CastScanAtDiscs;
+using testing::Disc;
+using testing::MakeScan;
+
+constexpr int kBeams = 1081;  // the HSR's base laser: 0.25 degree over 270 degrees
+
+std::vector<LaserPersonDetection> DetectDiscs(const std::vector<Disc>& discs,
+                                              const Pose2& X_ML = Pose2(),
+                                              const OccupancyGrid* grid = nullptr,
+                                              LaserPersonDetectorConfig config = {}) {
+  LaserScan scan = MakeScan(kBeams);
+  CastScanAtDiscs(discs, X_ML, &scan, grid);
+  const LaserPersonDetector detector(config);
+  if (grid == nullptr) return detector.Detect(scan, X_ML);
+  // A return within 0.15 m of an occupied cell is on the map.
+  return detector.Detect(scan, X_ML, [grid](const Eigen::Vector2d& p) {
+    for (double dx = -0.15; dx <= 0.15; dx += 0.05) {
+      for (double dy = -0.15; dy <= 0.15; dy += 0.05) {
+        if (grid->IsOccupied(p + Eigen::Vector2d(dx, dy))) return true;
+      }
+    }
+    return false;
+  });
+}
+
+TEST(LaserPersonDetectorTest, TwoLegsAreOnePersonBetweenThem) {
+  const auto people = DetectDiscs({{{2.0, 0.15}, 0.06}, {{2.05, -0.15}, 0.06}});
+  ASSERT_EQ(people.size(), 1u);
+  EXPECT_EQ(people[0].legs, 2);
+  EXPECT_NEAR(people[0].p_MP.x(), 2.025, 0.05);
+  EXPECT_NEAR(people[0].p_MP.y(), 0.0, 0.03);
+}
+
+TEST(LaserPersonDetectorTest, ABodySectionIsFoundAtItsCentreNotItsNearSide) {
+  for (const double range : {1.0, 3.0, 6.0}) {
+    const Eigen::Vector2d centre(range * std::cos(0.4), range * std::sin(0.4));
+    const auto people = DetectDiscs({{centre, 0.25}});
+    ASSERT_EQ(people.size(), 1u) << range;
+    EXPECT_EQ(people[0].legs, 0);
+    EXPECT_LT((people[0].p_MP - centre).norm(), 0.05) << range;
+    EXPECT_NEAR(people[0].radius, 0.25, 0.05) << range;
+  }
+}
+
+TEST(LaserPersonDetectorTest, PeopleAllRoundTheRobotAreFoundInTheMapFrame) {
+  // Behind the robot's right shoulder, beside it and ahead: where the head camera is not.
+  const Pose2 X_ML{5.0, 3.0, std::numbers::pi / 2};
+  const std::vector<Eigen::Vector2d> centres = {{6.5, 3.0}, {3.5, 3.2}, {5.0, 5.0}, {6.2, 2.0}};
+  std::vector<Disc> discs;
+  for (const auto& c : centres)
+    discs.push_back({c, 0.23});
+  const auto people = DetectDiscs(discs, X_ML);
+  ASSERT_EQ(people.size(), centres.size());
+  for (const auto& c : centres) {
+    double nearest = 1e9;
+    for (const auto& p : people)
+      nearest = std::min(nearest, (p.p_MP - c).norm());
+    EXPECT_LT(nearest, 0.06) << c.transpose();
+  }
+}
+
+TEST(LaserPersonDetectorTest, PeopleSideBySideStaySeparate) {
+  const auto people = DetectDiscs({{{3.0, 0.35}, 0.23}, {{3.0, -0.35}, 0.23}});
+  ASSERT_EQ(people.size(), 2u);
+  EXPECT_GT((people[0].p_MP - people[1].p_MP).norm(), 0.5);
+}
+
+TEST(LaserPersonDetectorTest, WallsAndWideFurnitureAreNotPeople) {
+  const OccupancyGrid map = testing::TwoRoomMap();
+  // From inside the west room, a person by the divider; the walls are mapped (background).
+  const Pose2 X_ML{3.0, 4.0, 0.0};
+  auto people = DetectDiscs({{{5.0, 4.6}, 0.23}}, X_ML, &map);
+  ASSERT_EQ(people.size(), 1u);
+  EXPECT_LT((people[0].p_MP - Eigen::Vector2d(5.0, 4.6)).norm(), 0.06);
+  // A crate 1.2 m across off the map: too wide to be anyone.
+  people = DetectDiscs({{{2.0, 0.0}, 0.6}});
+  EXPECT_TRUE(people.empty());
+  // Nothing but walls.
+  EXPECT_TRUE(DetectDiscs({}, X_ML, &map).empty());
+}
+
+TEST(LaserPersonDetectorTest, OneLegAloneIsStillReportedAndSpeckleIsNot) {
+  auto people = DetectDiscs({{{1.5, -0.5}, 0.06}});
+  ASSERT_EQ(people.size(), 1u);
+  EXPECT_EQ(people[0].legs, 1);
+  // A 1 cm wire at 4 m: a return or two, noise.
+  people = DetectDiscs({{{4.0, 0.0}, 0.005}});
+  EXPECT_TRUE(people.empty());
+}
+
+TEST(LaserPersonDetectorTest, BadInputIsRefusedNamingIt) {
+  LaserScan scan = MakeScan(kBeams);
+  const LaserPersonDetector detector;
+  const Pose2 not_finite{std::nan(""), 0.0, 0.0};
+  EXPECT_THROW(detector.Detect(scan, not_finite), InvalidArgument);
+  scan.angle_increment = -1.0;
+  EXPECT_THROW(detector.Detect(scan, Pose2()), InvalidArgument);
+  LaserPersonDetectorConfig config;
+  config.leg_max_width = 1.0;  // wider than body_max_width
+  EXPECT_THROW(LaserPersonDetector{config}, InvalidArgument);
+  // NaN and inf beams are skipped, not crashed on.
+  scan = MakeScan(kBeams);
+  scan.ranges[10] = std::nanf("");
+  EXPECT_TRUE(detector.Detect(scan, Pose2()).empty());
+}
+
+}  // namespace
+}  // namespace egress::perception
