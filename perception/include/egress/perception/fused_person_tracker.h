@@ -1,0 +1,94 @@
+#pragma once
+/// @file
+/// FusedPersonTracker: one set of people from two sensors — the head camera's placed person
+/// detections (58°, 8 Hz, 125-200 ms late) and the base laser's (LaserPersonDetector: 270°,
+/// 10 Hz). Each sensor's frame is an Update() with its own stamp; a frame stamped before the
+/// tracks' time (the camera's latency) is compared with where each track was then and moved
+/// forward by its velocity before it is fused. Association is greedy nearest-first within a gate;
+/// position and velocity are smoothed exponentially (the paper's alpha); velocity is taken from
+/// successive measurements of a track, whichever sensor made them, never from two frames a few
+/// milliseconds apart.
+///
+/// A track is *confirmed* (a person, not a table leg) once the camera has seen it, or the laser
+/// has seen it `confirm_laser_hits` times and it has moved `confirm_motion` from where it was
+/// first seen. A track is dropped when a sensor that covers its position has not measured it
+/// for `drop_after_s`, or when nothing has for `drop_unseen_s`.
+///
+/// Issue 21's second piece: not yet what the brain reads (PersonTracker still is).
+
+#include <array>
+#include <functional>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "egress/hsr_interface/time.h"
+#include "egress/perception/person_tracker.h"
+
+namespace egress::perception {
+
+enum class PersonSource { kCamera, kLaser };
+
+struct PersonObservation {
+  Eigen::Vector2d p_MP{Eigen::Vector2d::Zero()};  ///< In M [m].
+  PersonSource source{PersonSource::kLaser};
+};
+
+struct FusedPersonTrackerConfig {
+  double alpha{0.3};             ///< Exponential smoothing of position and velocity.
+  double gate_distance{0.8};     ///< Farthest an observation may be from a track's prediction [m].
+  double drop_after_s{1.0};      ///< Unmeasured this long where a sensor covers it: dropped [s].
+  double drop_unseen_s{3.0};     ///< Unmeasured this long anywhere: dropped [s].
+  int confirm_laser_hits{3};     ///< Laser measurements before a laser-only track can confirm.
+  double confirm_motion{0.3};    ///< ... and how far it must have moved from its birth [m].
+  double max_latency_s{0.5};     ///< Oldest a frame may be against the tracks' time [s].
+  double min_velocity_dt{0.05};  ///< Measurements closer in time than this update no velocity [s].
+  int forecast_steps{4};
+  double forecast_dt{0.2};  ///< [s]
+  /// @throws InvalidArgument naming the field that is out of range.
+  void Validate() const;
+};
+
+struct FusedTrack {
+  TrackedPerson person;  ///< id, smoothed p_MP / v_MP at the tracker's time, forecast, hits.
+  int camera_hits{0};
+  int laser_hits{0};
+  bool confirmed{false};
+  Eigen::Vector2d p_MBirth{Eigen::Vector2d::Zero()};
+  Time last_measured{};  ///< The latest stamp of a measurement of it, either sensor.
+  /// Per sensor (index PersonSource): its last measurement, for velocity from the same sensor
+  /// (the camera's placement and the laser's leg midpoint disagree by a few centimetres).
+  std::array<std::optional<std::pair<Time, Eigen::Vector2d>>, 2> last_by_source;
+};
+
+class FusedPersonTracker {
+ public:
+  explicit FusedPersonTracker(FusedPersonTrackerConfig config = {});
+
+  /// One sensor frame taken at `stamp`. `covers(p_M)` says whether that sensor could have seen
+  /// a person at p_M (its field of view and range); a track it covers and did not measure ages
+  /// towards drop_after_s. Null: the sensor covers everything.
+  /// @throws InvalidArgument for a non-finite observation or a frame older than max_latency_s.
+  void Update(const std::vector<PersonObservation>& observations, Time stamp,
+              const std::function<bool(const Eigen::Vector2d&)>& covers = {});
+
+  const std::vector<FusedTrack>& tracks() const { return tracks_; }
+  /// The confirmed tracks, as the rest of perception reads people.
+  std::vector<TrackedPerson> ConfirmedPeople() const;
+  /// The tracks' time: the latest stamp seen.
+  Time now() const { return now_; }
+
+ private:
+  void Predict(Time stamp);
+  void Forecast();
+
+  FusedPersonTrackerConfig config_;
+  std::vector<FusedTrack> tracks_;
+  int next_id_{1};
+  Time now_{};
+  bool started_{false};
+};
+
+}  // namespace egress::perception

@@ -1,0 +1,154 @@
+#include "egress/perception/fused_person_tracker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <tuple>
+
+#include "egress/hsr_interface/error.h"
+
+namespace egress::perception {
+
+void FusedPersonTrackerConfig::Validate() const {
+  const auto positive = [](double v, const char* field) {
+    ThrowUnless(std::isfinite(v) && v > 0.0, "FusedPersonTrackerConfig: ", field,
+                " must be finite and > 0");
+  };
+  ThrowUnless(alpha > 0.0 && alpha <= 1.0, "FusedPersonTrackerConfig: alpha must be in (0, 1]");
+  positive(gate_distance, "gate_distance");
+  positive(drop_after_s, "drop_after_s");
+  positive(drop_unseen_s, "drop_unseen_s");
+  positive(max_latency_s, "max_latency_s");
+  positive(min_velocity_dt, "min_velocity_dt");
+  positive(forecast_dt, "forecast_dt");
+  ThrowUnless(std::isfinite(confirm_motion) && confirm_motion >= 0.0,
+              "FusedPersonTrackerConfig: confirm_motion must be finite and >= 0");
+  ThrowUnless(confirm_laser_hits >= 1 && forecast_steps >= 0,
+              "FusedPersonTrackerConfig: confirm_laser_hits >= 1 and forecast_steps >= 0");
+}
+
+FusedPersonTracker::FusedPersonTracker(FusedPersonTrackerConfig config)
+    : config_(std::move(config)) {
+  config_.Validate();
+}
+
+void FusedPersonTracker::Predict(Time stamp) {
+  const double dt = ToSeconds(stamp - now_);
+  for (FusedTrack& track : tracks_)
+    track.person.p_MP += track.person.v_MP * dt;
+  now_ = stamp;
+}
+
+void FusedPersonTracker::Update(const std::vector<PersonObservation>& observations, Time stamp,
+                                const std::function<bool(const Eigen::Vector2d&)>& covers) {
+  for (const auto& o : observations)
+    ThrowUnless(o.p_MP.allFinite(), "FusedPersonTracker: an observation is not finite");
+  if (!started_) {
+    now_ = stamp;
+    started_ = true;
+  }
+  if (stamp > now_) Predict(stamp);
+  const double lag = ToSeconds(now_ - stamp);
+  ThrowUnless(lag <= config_.max_latency_s, "FusedPersonTracker: a frame ", lag,
+              " s older than the tracks (more than max_latency_s = ", config_.max_latency_s, " s)");
+
+  // Each track where it was when the frame was taken; nearest pairs first within the gate.
+  std::vector<Eigen::Vector2d> then(tracks_.size());
+  std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
+  for (std::size_t t = 0; t < tracks_.size(); ++t) {
+    then[t] = tracks_[t].person.p_MP - tracks_[t].person.v_MP * lag;
+    for (std::size_t k = 0; k < observations.size(); ++k) {
+      const double d = (observations[k].p_MP - then[t]).norm();
+      if (d <= config_.gate_distance) pairs.emplace_back(d, t, k);
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  std::vector<bool> used_t(tracks_.size(), false), used_k(observations.size(), false);
+  const double a = config_.alpha;
+  for (const auto& [d, t, k] : pairs) {
+    if (used_t[t] || used_k[k]) continue;
+    used_t[t] = used_k[k] = true;
+    FusedTrack& track = tracks_[t];
+    const PersonObservation& o = observations[k];
+    auto& last = track.last_by_source[std::size_t(o.source)];
+    if (last && stamp > last->first) {
+      const double dt = ToSeconds(stamp - last->first);
+      if (dt >= config_.min_velocity_dt) {
+        track.person.v_MP = a * (o.p_MP - last->second) / dt + (1.0 - a) * track.person.v_MP;
+      }
+    }
+    if (!last || stamp >= last->first) last = std::make_pair(stamp, o.p_MP);
+    // Fused where the person is now: the observation moved on by the (new) velocity.
+    track.person.p_MP = a * (o.p_MP + track.person.v_MP * lag) + (1.0 - a) * track.person.p_MP;
+    ++track.person.hits;
+    track.person.misses = 0;
+    track.last_measured = std::max(track.last_measured, stamp);
+    track.person.last_seen = track.last_measured;
+    if (o.source == PersonSource::kCamera) {
+      ++track.camera_hits;
+    } else {
+      ++track.laser_hits;
+    }
+    track.confirmed = track.confirmed || track.camera_hits > 0 ||
+                      (track.laser_hits >= config_.confirm_laser_hits &&
+                       (track.person.p_MP - track.p_MBirth).norm() >= config_.confirm_motion);
+  }
+
+  // Drop tracks this sensor should have seen and has not for drop_after_s, and tracks no sensor
+  // has measured for drop_unseen_s.
+  std::vector<FusedTrack> kept;
+  kept.reserve(tracks_.size());
+  for (std::size_t t = 0; t < tracks_.size(); ++t) {
+    FusedTrack& track = tracks_[t];
+    if (!used_t[t]) {
+      ++track.person.misses;
+      const double unmeasured = ToSeconds(stamp - track.last_measured);
+      const bool covered = !covers || covers(then[t]);
+      if ((covered && unmeasured > config_.drop_after_s) ||
+          ToSeconds(now_ - track.last_measured) > config_.drop_unseen_s) {
+        continue;
+      }
+    }
+    kept.push_back(std::move(track));
+  }
+  tracks_ = std::move(kept);
+
+  for (std::size_t k = 0; k < observations.size(); ++k) {
+    if (used_k[k]) continue;
+    FusedTrack track;
+    track.person.id = next_id_++;
+    track.person.p_MP = observations[k].p_MP;
+    track.person.hits = 1;
+    track.person.last_seen = stamp;
+    track.p_MBirth = observations[k].p_MP;
+    track.last_measured = stamp;
+    track.last_by_source[std::size_t(observations[k].source)] =
+        std::make_pair(stamp, observations[k].p_MP);
+    if (observations[k].source == PersonSource::kCamera) {
+      track.camera_hits = 1;
+      track.confirmed = true;
+    } else {
+      track.laser_hits = 1;
+    }
+    tracks_.push_back(std::move(track));
+  }
+  Forecast();
+}
+
+void FusedPersonTracker::Forecast() {
+  for (FusedTrack& track : tracks_) {
+    track.person.forecast.clear();
+    for (int s = 1; s <= config_.forecast_steps; ++s)
+      track.person.forecast.push_back(track.person.p_MP +
+                                      track.person.v_MP * (s * config_.forecast_dt));
+  }
+}
+
+std::vector<TrackedPerson> FusedPersonTracker::ConfirmedPeople() const {
+  std::vector<TrackedPerson> people;
+  for (const FusedTrack& track : tracks_) {
+    if (track.confirmed) people.push_back(track.person);
+  }
+  return people;
+}
+
+}  // namespace egress::perception

@@ -1,0 +1,107 @@
+// FusedPersonTracker: camera and laser frames of the same people, latency, confirmation, drops.
+
+#include "egress/perception/fused_person_tracker.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "egress/hsr_interface/error.h"
+
+namespace egress::perception {
+namespace {
+
+Time At(double seconds) {
+  return SecondsToDuration(seconds);
+}
+
+// A walker at 1 m/s along x from (0, 1); the laser sees it every 0.1 s (its leg midpoint, 3 cm
+// behind), the camera every 0.125 s with 150 ms latency (its frame stamped when taken).
+TEST(FusedPersonTrackerTest, CameraAndLaserOfOneWalkerMakeOneTrackWithItsVelocity) {
+  FusedPersonTracker tracker;
+  const auto walker = [](double t) { return Eigen::Vector2d(t, 1.0); };
+  double next_laser = 0.0, next_camera = 0.0;
+  for (double now = 0.0; now <= 3.0 + 1e-9; now += 0.025) {
+    if (now + 1e-9 >= next_laser) {
+      tracker.Update({{walker(now) - Eigen::Vector2d(0.03, 0.0), PersonSource::kLaser}}, At(now));
+      next_laser += 0.1;
+    }
+    if (now >= 0.15 && now + 1e-9 >= next_camera + 0.15) {
+      // Arrives now, taken 150 ms ago.
+      tracker.Update({{walker(next_camera), PersonSource::kCamera}}, At(next_camera));
+      next_camera += 0.125;
+    }
+  }
+  ASSERT_EQ(tracker.tracks().size(), 1u);
+  const FusedTrack& track = tracker.tracks().front();
+  EXPECT_TRUE(track.confirmed);
+  EXPECT_GT(track.camera_hits, 10);
+  EXPECT_GT(track.laser_hits, 20);
+  EXPECT_NEAR(track.person.v_MP.x(), 1.0, 0.15);
+  EXPECT_NEAR(track.person.v_MP.y(), 0.0, 0.05);
+  EXPECT_LT((track.person.p_MP - walker(ToSeconds(tracker.now()))).norm(), 0.1);
+  ASSERT_EQ(track.person.forecast.size(), 4u);
+  EXPECT_NEAR(track.person.forecast.back().x(), track.person.p_MP.x() + 0.8, 0.15);
+}
+
+TEST(FusedPersonTrackerTest, ALaserOnlyTrackConfirmsOnlyWhenItMoves) {
+  FusedPersonTracker tracker;
+  for (int i = 0; i < 10; ++i) {
+    const double t = 0.1 * i;
+    tracker.Update({{Eigen::Vector2d(2.0, 0.0), PersonSource::kLaser},             // a table leg
+                    {Eigen::Vector2d(0.0, 2.0 + 0.1 * i), PersonSource::kLaser}},  // a walker
+                   At(t));
+  }
+  ASSERT_EQ(tracker.tracks().size(), 2u);
+  const auto people = tracker.ConfirmedPeople();
+  ASSERT_EQ(people.size(), 1u);
+  EXPECT_NEAR(people[0].p_MP.x(), 0.0, 0.05);
+  EXPECT_GT(people[0].p_MP.y(), 2.5);
+}
+
+TEST(FusedPersonTrackerTest, APersonTheCameraCannotSeeIsKeptByTheLaser) {
+  FusedPersonTracker tracker;
+  // Behind the robot: the camera (looking along +x) covers x > 0 only.
+  const auto camera_covers = [](const Eigen::Vector2d& p) { return p.x() > 0.0; };
+  for (int i = 0; i < 30; ++i) {
+    const double t = 0.1 * i;
+    tracker.Update({{Eigen::Vector2d(-1.5, 0.2), PersonSource::kLaser}}, At(t));
+    tracker.Update({}, At(t + 0.05), camera_covers);  // the camera sees nobody ahead
+  }
+  EXPECT_EQ(tracker.tracks().size(), 1u);
+  // The laser stops seeing them where it covers them: dropped after drop_after_s.
+  for (int i = 30; i < 45; ++i)
+    tracker.Update({}, At(0.1 * i));
+  EXPECT_TRUE(tracker.tracks().empty());
+}
+
+TEST(FusedPersonTrackerTest, TwoPeoplePassingStayTwoTracks) {
+  FusedPersonTracker tracker;
+  for (int i = 0; i <= 40; ++i) {
+    const double t = 0.1 * i;
+    tracker.Update({{Eigen::Vector2d(-2.0 + t, 0.4), PersonSource::kLaser},
+                    {Eigen::Vector2d(2.0 - t, -0.4), PersonSource::kLaser}},
+                   At(t));
+  }
+  ASSERT_EQ(tracker.tracks().size(), 2u);
+  for (const FusedTrack& track : tracker.tracks()) {
+    EXPECT_NEAR(std::abs(track.person.v_MP.x()), 1.0, 0.1);
+    // Each kept its own side: no swap as they passed 0.8 m apart.
+    EXPECT_GT(track.person.p_MP.y() * track.person.v_MP.x(), 0.0);
+  }
+}
+
+TEST(FusedPersonTrackerTest, BadInputIsRefusedNamingIt) {
+  FusedPersonTracker tracker;
+  tracker.Update({}, At(1.0));
+  EXPECT_THROW(tracker.Update({}, At(0.2)), InvalidArgument);  // 0.8 s late
+  EXPECT_THROW(
+      tracker.Update({{Eigen::Vector2d(std::nan(""), 0.0), PersonSource::kCamera}}, At(1.1)),
+      InvalidArgument);
+  FusedPersonTrackerConfig config;
+  config.alpha = 0.0;
+  EXPECT_THROW(FusedPersonTracker{config}, InvalidArgument);
+}
+
+}  // namespace
+}  // namespace egress::perception
