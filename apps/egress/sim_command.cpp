@@ -72,6 +72,7 @@ struct SimOptions {
   bool overwrite{false};
   bool quiet{false};
   bool no_octomap{false};
+  bool laser_people{false};
   std::string bag;
   std::string btlog;
   std::optional<std::uint16_t> groot2_port;
@@ -226,6 +227,7 @@ void RunSim(const SimOptions& o) {
       }
     }
     trial_options.config.use_octomap = !o.no_octomap;
+    trial_options.config.perception.laser_people = o.laser_people;
     trial_options.run = options;
     // The video shows the running action, the planned path and, once a second, the costmap
     // (the map frame is W here: the brain starts from the twin's start pose).
@@ -356,6 +358,9 @@ void AddSimCommand(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   sim->add_flag("--overwrite", o->overwrite, "replace existing output files");
   sim->add_flag("-q,--quiet", o->quiet, "print only the verdict");
+  sim->add_flag("--laser-people", o->laser_people,
+                "experimental (issue 21): people from the base laser too, fused with the "
+                "camera's");
   sim->add_flag("--no-octomap", o->no_octomap,
                 "disconnect the brain's 3D obstacle map (the base laser alone), for comparison");
   sim->callback([o] { RunSim(*o); });

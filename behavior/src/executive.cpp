@@ -434,7 +434,9 @@ bool Executive::Step(RobotPort& port) {
     const Pose2 X_ML = X_ML3.ToPose2();
     costmap_->UpdateWithScan(*snapshot.scan, X_ML);
     if (m.X_BC)
-      m.perception.ProcessScan(*snapshot.scan, X_ML, m.intrinsics, X_BL.Inverse() * *m.X_BC);
+      m.perception.ProcessScan(
+          *snapshot.scan, X_ML, m.intrinsics, X_BL.Inverse() * *m.X_BC,
+          [this](const Eigen::Vector2d& p) { return costmap_->IsNearMappedObstacle(p, kOffMapM); });
   }
   // Where the base was when the detections' image was taken (the detector runs behind).
   pose_history_.emplace_back(now, belief_.X_MB);

@@ -1,5 +1,7 @@
 #include "egress/perception/world_state.h"
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
 
 #include "egress/hsr_interface/error.h"
@@ -7,7 +9,11 @@
 namespace egress::perception {
 
 PerceptionPipeline::PerceptionPipeline(std::vector<DoorModel> doors, PerceptionConfig config)
-    : config_(std::move(config)), objects_(config_.objects), people_(config_.people) {
+    : config_(std::move(config)),
+      objects_(config_.objects),
+      people_(config_.people),
+      laser_detector_(config_.laser_detector),
+      fused_(config_.fused_people) {
   for (auto& door : doors)
     doors_.emplace_back(std::move(door), config_.door_state);
 }
@@ -45,15 +51,51 @@ void PerceptionPipeline::ProcessCameraFrame(const std::vector<Detection2D>& dete
   }
   objects_.Update(placed, depth.stamp);
   people_.Update(people, depth.stamp);
+  if (config_.laser_people) {
+    // Which tracks the camera should have seen: ahead of it within its field of view and reach.
+    const Eigen::Vector3d forward_M = X_MC.rotation().col(2);
+    const double yaw = std::atan2(forward_M.y(), forward_M.x());
+    const double half_fov = std::atan2(intrinsics.width / 2.0, intrinsics.fx);
+    const Eigen::Vector2d p_MC = X_MC.translation().head<2>();
+    const double range = config_.camera_people_range;
+    std::vector<PersonObservation> observations;
+    for (const auto& p : people)
+      observations.push_back({p, PersonSource::kCamera});
+    // A frame older than the tracker accepts (a depth image held through a camera outage) is
+    // left out of the fusion rather than refused.
+    if (ToSeconds(fused_.now() - depth.stamp) > config_.fused_people.max_latency_s) return;
+    fused_.Update(observations, depth.stamp, [&](const Eigen::Vector2d& p) {
+      const Eigen::Vector2d d = p - p_MC;
+      return d.norm() < range && std::abs(WrapAngle(std::atan2(d.y(), d.x()) - yaw)) < half_fov;
+    });
+  }
 }
 
-void PerceptionPipeline::ProcessScan(const LaserScan& scan, const Pose2& X_ML,
-                                     const CameraIntrinsics& intrinsics, const Pose3& X_LC) {
+std::vector<TrackedPerson> PerceptionPipeline::CurrentPeople() const {
+  return config_.laser_people ? fused_.ConfirmedPeople() : people_.people();
+}
+
+void PerceptionPipeline::ProcessScan(
+    const LaserScan& scan, const Pose2& X_ML, const CameraIntrinsics& intrinsics, const Pose3& X_LC,
+    const std::function<bool(const Eigen::Vector2d&)>& is_background) {
+  if (config_.laser_people) {
+    std::vector<PersonObservation> observations;
+    for (const auto& d : laser_detector_.Detect(scan, X_ML, is_background))
+      observations.push_back({d.p_MP, PersonSource::kLaser});
+    // The laser covers its 270 degrees out to the detector's reach.
+    const double reach = config_.laser_detector.max_range;
+    fused_.Update(observations, scan.stamp, [&](const Eigen::Vector2d& p) {
+      const Eigen::Vector2d d = X_ML.Inverse() * p;
+      const double bearing = std::atan2(d.y(), d.x());
+      return d.norm() < reach && bearing >= scan.angle_min && bearing <= scan.angle_max();
+    });
+  }
   // People are not door leaves: returns from around a tracked person never vote for an angle.
+  const std::vector<TrackedPerson> tracked = CurrentPeople();
   std::vector<Eigen::Vector2d> points;
   for (const Eigen::Vector2d& p : ScanPoints(scan, X_ML)) {
     bool on_person = false;
-    for (const auto& person : people_.people())
+    for (const auto& person : tracked)
       on_person = on_person || (p - person.p_MP).norm() < config_.person_mask_radius;
     if (!on_person) points.push_back(p);
   }
@@ -131,10 +173,11 @@ WorldState PerceptionPipeline::Snapshot(Time stamp, const Pose2& X_MB,
   world.X_MB_covariance = X_MB_covariance;
   world.costmap = costmap;
   world.octree = std::move(octree);
+  const std::vector<TrackedPerson> people = CurrentPeople();
   for (const auto& tracker : doors_) {
     world.doors.push_back({tracker.door(), tracker.state()});
     const DoorZone zone{tracker.door(), config_.door_zone_depth};
-    world.door_zone_forecast[tracker.door().id] = ForecastZoneOccupancy(people_.people(), zone);
+    world.door_zone_forecast[tracker.door().id] = ForecastZoneOccupancy(people, zone);
   }
   for (const auto& object : objects_.Confirmed()) {
     if (object.label == labels::kPushButton || object.label == labels::kProximityPlate)
@@ -142,7 +185,7 @@ WorldState PerceptionPipeline::Snapshot(Time stamp, const Pose2& X_MB,
     if (object.label == labels::kBottle || object.label == labels::kFlashlight)
       world.payloads.push_back(object);
   }
-  for (const auto& person : people_.people()) {
+  for (const auto& person : people) {
     TrackedPersonWithIntent entry{person, PersonIntent::kUnknown, ""};
     double best = std::numeric_limits<double>::infinity();
     for (const auto& tracker : doors_) {

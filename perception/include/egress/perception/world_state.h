@@ -4,6 +4,7 @@
 /// PerceptionPipeline, which builds it from sensor data: per camera frame (confidence filter,
 /// 3D placement, object and person tracking), per scan (door angles, glass-door line fits).
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -14,6 +15,8 @@
 #include "egress/perception/costmap.h"
 #include "egress/perception/detection.h"
 #include "egress/perception/door_estimation.h"
+#include "egress/perception/fused_person_tracker.h"
+#include "egress/perception/laser_person_detector.h"
 #include "egress/perception/object_tracker.h"
 #include "egress/perception/person_tracker.h"
 
@@ -66,6 +69,14 @@ struct PerceptionConfig {
   /// Laser returns within this of a tracked person are left out of door-angle estimates [m].
   double person_mask_radius{0.5};
   LineFitConfig glass_line;
+  /// People from the base laser too (LaserPersonDetector), fused with the camera's in a
+  /// FusedPersonTracker whose confirmed tracks are the snapshot's people (issue 21). Off: the
+  /// camera's PersonTracker alone, as before.
+  bool laser_people{false};
+  LaserPersonDetectorConfig laser_detector;
+  FusedPersonTrackerConfig fused_people;
+  /// How far the camera's person detections reach, for which tracks it should have seen [m].
+  double camera_people_range{8.0};
 };
 
 class PerceptionPipeline {
@@ -85,8 +96,11 @@ class PerceptionPipeline {
   /// last frame's glass_door boxes (a RANSAC line in the scan slice under the box; when there
   /// is none, the box's edges against the leaf's projection).
   /// X_LC (camera in laser frame) maps those boxes to bearings.
+  /// With config.laser_people, people are also detected in the scan; `is_background(p_M)`
+  /// says a return lies on something mapped (walls, leaves), left out of that.
   void ProcessScan(const LaserScan& scan, const Pose2& X_ML, const CameraIntrinsics& intrinsics,
-                   const Pose3& X_LC);
+                   const Pose3& X_LC,
+                   const std::function<bool(const Eigen::Vector2d&)>& is_background = {});
 
   /// The current snapshot; intents refer to each person's nearest door.
   WorldState Snapshot(Time stamp, const Pose2& X_MB, const Eigen::Matrix3d& X_MB_covariance,
@@ -95,6 +109,10 @@ class PerceptionPipeline {
 
   const ObjectTracker& objects() const { return objects_; }
   const PersonTracker& people() const { return people_; }
+  /// The people the snapshot reports: the fused tracker's confirmed tracks with
+  /// config.laser_people, else the camera tracker's.
+  std::vector<TrackedPerson> CurrentPeople() const;
+  const FusedPersonTracker& fused_people() const { return fused_; }
   const std::vector<DoorStateTracker>& doors() const { return doors_; }
 
  private:
@@ -102,6 +120,8 @@ class PerceptionPipeline {
   std::vector<DoorStateTracker> doors_;
   ObjectTracker objects_;
   PersonTracker people_;
+  LaserPersonDetector laser_detector_;
+  FusedPersonTracker fused_;
   std::vector<Detection2D> glass_boxes_;
   int glass_image_width_{0};  ///< Width of the image those boxes are in [px].
   Pose3 glass_X_MC_;          ///< The camera when that image was taken.
