@@ -56,5 +56,42 @@ TEST(PerceptionPipelineTest, BuildsTheWorldState) {
   EXPECT_EQ(world.door_zone_forecast.at("lab").size(), 5u);
 }
 
+// With laser_people, someone beside the robot (where the camera is not looking) walking across
+// the room becomes one of the snapshot's people, and is forecast into the doorway it heads for;
+// without it, the camera-only pipeline does not know of them.
+TEST(PerceptionPipelineTest, LaserPeopleFindSomeoneTheCameraDoesNotSee) {
+  const DoorModel door{"lab", {6.0, 3.5}, {6.0, 4.5}, -1.0, std::numbers::pi / 2};
+  const CameraIntrinsics K = CameraIntrinsics::FromHorizontalFov(80, 60, 1.047);
+  const Pose2 X_ML{2.0, 4.0, std::numbers::pi / 2};  // facing +y: the walker is to its right
+  for (const bool laser_people : {false, true}) {
+    PerceptionConfig config;
+    config.laser_people = laser_people;
+    PerceptionPipeline pipeline({door}, config);
+    for (int frame = 0; frame <= 20; ++frame) {
+      const double t = 0.1 * frame;
+      // Walking towards the doorway at 1 m/s along y = 4, from x = 3.
+      const Eigen::Vector2d person(3.0 + t, 4.0);
+      LaserScan scan = testing::MakeScan(1081, 10.0);
+      testing::CastScanAtDiscs({{person + Eigen::Vector2d(0.0, 0.12), 0.06},
+                                {person - Eigen::Vector2d(0.0, 0.12), 0.06}},
+                               X_ML, &scan);
+      scan.stamp = milliseconds(100 * frame);
+      pipeline.ProcessScan(scan, X_ML, K, Pose3());
+    }
+    const WorldState world = pipeline.Snapshot(milliseconds(2000), {2.0, 4.0, std::numbers::pi / 2},
+                                               Eigen::Matrix3d::Identity() * 1e-4);
+    if (!laser_people) {
+      EXPECT_TRUE(world.people.empty());
+      continue;
+    }
+    ASSERT_EQ(world.people.size(), 1u);
+    EXPECT_NEAR(world.people[0].person.p_MP.x(), 5.0, 0.15);
+    EXPECT_NEAR(world.people[0].person.v_MP.x(), 1.0, 0.2);
+    // At 5 m heading for the door line at x = 6 at 1 m/s: in the zone within the forecast.
+    const auto& forecast = world.door_zone_forecast.at("lab");
+    EXPECT_TRUE(forecast.front());  // within the zone's 1 m depth already
+  }
+}
+
 }  // namespace
 }  // namespace egress::perception
