@@ -259,8 +259,7 @@ Groot2Publisher::Groot2Publisher(Tree& tree, const BehaviorTreeFactory& factory,
     const std::size_t offset = 3 * (std::size_t(node->uid()) - 1);
     const std::uint16_t uid = node->uid();
     std::memcpy(&p.status_buffer[offset], &uid, 2);
-    p.status_buffer[offset + 2] = WireStatus(NodeStatus::kIdle, node->status());
-    if (node->status() == NodeStatus::kIdle) p.status_buffer[offset + 2] = char(NodeStatus::kIdle);
+    p.status_buffer[offset + 2] = char(node->status());
     if (node->kind() == NodeKind::kSubTree && !node->children().empty()) {
       const std::string& child = node->children().front()->path();
       p.blackboards[child.substr(0, child.rfind('/'))] =
