@@ -70,7 +70,8 @@ LaserPersonDetector::LaserPersonDetector(LaserPersonDetectorConfig config)
 
 std::vector<LaserPersonDetection> LaserPersonDetector::Detect(
     const LaserScan& scan, const Pose2& X_ML,
-    const std::function<bool(const Eigen::Vector2d&)>& is_background) const {
+    const std::function<bool(const Eigen::Vector2d&)>& is_background,
+    const std::function<bool(const std::vector<Eigen::Vector2d>&)>& is_structure) const {
   scan.Validate();
   ThrowUnless(X_ML.IsFinite(), "LaserPersonDetector: the laser pose X_ML must be finite");
   const Eigen::Vector2d p_ML = X_ML.translation();
@@ -103,6 +104,7 @@ std::vector<LaserPersonDetection> LaserPersonDetector::Detect(
   for (const auto& points : clusters) {
     const double width = (points.back() - points.front()).norm();
     if (width < config_.leg_min_width || width > config_.body_max_width) continue;
+    if (is_structure && is_structure(points)) continue;
     Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
     for (const auto& p : points)
       centroid += p;

@@ -80,7 +80,34 @@ void PerceptionPipeline::ProcessScan(
     const std::function<bool(const Eigen::Vector2d&)>& is_background) {
   if (config_.laser_people) {
     std::vector<PersonObservation> observations;
-    for (const auto& d : laser_detector_.Detect(scan, X_ML, is_background))
+    // A cluster on a straight line through a door's hinge, within the leaf's reach, is the leaf
+    // (its angle estimate may lag a moving leaf, so it is not yet background); a person's legs
+    // or body are arcs, never on such a line.
+    const auto is_leaf = [this](const std::vector<Eigen::Vector2d>& points) {
+      constexpr double kLeafReachMarginM = 0.1,
+                       kLeafLineToleranceM = 0.05;  // a leaf is ~4 cm thick
+      for (const auto& tracker : doors_) {
+        const DoorModel& door = tracker.door();
+        const Eigen::Vector2d& h = door.p_MHinge;
+        const Eigen::Vector2d far = (points.front() - h).norm() > (points.back() - h).norm()
+                                        ? points.front()
+                                        : points.back();
+        if ((far - h).norm() < 1e-6) continue;
+        const Eigen::Vector2d along = (far - h).normalized();
+        bool on_leaf = true;
+        for (const auto& p : points) {
+          const Eigen::Vector2d d = p - h;
+          const double off_line = std::abs(along.x() * d.y() - along.y() * d.x());
+          if (d.norm() > door.width() + kLeafReachMarginM || off_line > kLeafLineToleranceM) {
+            on_leaf = false;
+            break;
+          }
+        }
+        if (on_leaf) return true;
+      }
+      return false;
+    };
+    for (const auto& d : laser_detector_.Detect(scan, X_ML, is_background, is_leaf))
       observations.push_back({d.p_MP, PersonSource::kLaser});
     // The laser covers its 270 degrees out to the detector's reach.
     const double reach = config_.laser_detector.max_range;

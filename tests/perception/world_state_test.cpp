@@ -93,5 +93,35 @@ TEST(PerceptionPipelineTest, LaserPeopleFindSomeoneTheCameraDoesNotSee) {
   }
 }
 
+// A door leaf swinging open while its angle estimate lags: the part of it off the map moves like
+// a person would, but it lies on a line through the hinge, so it is not taken for one.
+TEST(PerceptionPipelineTest, ASwingingLeafsEdgeIsNotAPerson) {
+  const DoorModel door{"lab", {6.0, 3.5}, {6.0, 4.5}, -1.0, std::numbers::pi / 2};
+  const CameraIntrinsics K = CameraIntrinsics::FromHorizontalFov(80, 60, 1.047);
+  PerceptionConfig config;
+  config.laser_people = true;
+  PerceptionPipeline pipeline({door}, config);
+  const Pose2 X_ML{8.0, 4.0, std::numbers::pi};
+  for (int frame = 0; frame <= 15; ++frame) {
+    const double angle = 0.05 * frame;  // opening at 0.5 rad/s
+    const Eigen::Vector2d tip = door.LeafTip(angle);
+    const OccupancyGrid leaf = OccupancyGrid::FromBoxes(
+        {{{(6.0 + tip.x()) / 2, (3.5 + tip.y()) / 2, std::atan2(tip.y() - 3.5, tip.x() - 6.0)},
+          {1.0, 0.04}}},
+        {0, 0}, {12, 8}, 0.02);
+    LaserScan scan = testing::MakeScan(1081, 10.0);
+    testing::CastScan(leaf, X_ML, &scan);
+    scan.stamp = milliseconds(100 * frame);
+    // The map knows the leaf only near its hinge (the estimate lags): the outer 0.5 m is off it.
+    pipeline.ProcessScan(scan, X_ML, K, Pose3(), [&](const Eigen::Vector2d& p) {
+      return (p - door.p_MHinge).norm() < 0.5;
+    });
+  }
+  const WorldState world = pipeline.Snapshot(milliseconds(1500), {8.0, 4.0, std::numbers::pi},
+                                             Eigen::Matrix3d::Identity() * 1e-4);
+  EXPECT_TRUE(world.people.empty());
+  EXPECT_TRUE(pipeline.fused_people().tracks().empty());
+}
+
 }  // namespace
 }  // namespace egress::perception

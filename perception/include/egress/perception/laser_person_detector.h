@@ -50,9 +50,12 @@ class LaserPersonDetector {
   /// People in `scan`, taken by a laser at X_ML. `is_background(p_M)` says a return lies on
   /// something mapped (walls, known door leaves); those are left out (none when null).
   /// @throws InvalidArgument for a malformed scan or a non-finite X_ML.
+  /// `is_structure(points)`, if given, is asked of each cluster that could be a person; true
+  /// leaves it out (a door leaf's edge seen off the map while its angle estimate lags).
   std::vector<LaserPersonDetection> Detect(
       const LaserScan& scan, const Pose2& X_ML,
-      const std::function<bool(const Eigen::Vector2d&)>& is_background = {}) const;
+      const std::function<bool(const Eigen::Vector2d&)>& is_background = {},
+      const std::function<bool(const std::vector<Eigen::Vector2d>&)>& is_structure = {}) const;
 
   const LaserPersonDetectorConfig& config() const { return config_; }
 
