@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <tuple>
 
 #include "egress/hsr_interface/error.h"
+#include "nearest_first_association.h"
 
 namespace egress::perception {
 
@@ -53,20 +53,15 @@ void FusedPersonTracker::Update(const std::vector<PersonObservation>& observatio
 
   // Each track where it was when the frame was taken; nearest pairs first within the gate.
   std::vector<Eigen::Vector2d> then(tracks_.size());
-  std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
-  for (std::size_t t = 0; t < tracks_.size(); ++t) {
+  for (std::size_t t = 0; t < tracks_.size(); ++t)
     then[t] = tracks_[t].person.p_MP - tracks_[t].person.v_MP * lag;
-    for (std::size_t k = 0; k < observations.size(); ++k) {
-      const double d = (observations[k].p_MP - then[t]).norm();
-      if (d <= config_.gate_distance) pairs.emplace_back(d, t, k);
-    }
-  }
-  std::sort(pairs.begin(), pairs.end());
-  std::vector<bool> used_t(tracks_.size(), false), used_k(observations.size(), false);
+  const internal::Association match = internal::AssociateNearestFirst(
+      tracks_.size(), observations.size(), config_.gate_distance,
+      [&](std::size_t t, std::size_t k) { return (observations[k].p_MP - then[t]).norm(); });
+  const std::vector<bool>& used_t = match.track_matched;
+  const std::vector<bool>& used_k = match.detection_matched;
   const double a = config_.alpha;
-  for (const auto& [d, t, k] : pairs) {
-    if (used_t[t] || used_k[k]) continue;
-    used_t[t] = used_k[k] = true;
+  for (const auto& [t, k] : match.pairs) {
     FusedTrack& track = tracks_[t];
     const PersonObservation& o = observations[k];
     auto& last = track.last_by_source[std::size_t(o.source)];

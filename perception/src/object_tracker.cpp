@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "egress/hsr_interface/error.h"
+#include "nearest_first_association.h"
 
 namespace egress::perception {
 
@@ -83,19 +85,15 @@ void ObjectTracker::Update(const std::vector<PlacedDetection>& detections, Time 
                 "': position must be finite.");
   }
   // Greedy association by distance: all (track, detection) pairs within the gate, nearest first.
-  std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
-  for (std::size_t t = 0; t < tracks_.size(); ++t) {
-    for (std::size_t k = 0; k < detections.size(); ++k) {
-      if (detections[k].detection.label != tracks_[t].label) continue;
-      const double distance = (detections[k].p_MO - tracks_[t].p_MO).norm();
-      if (distance <= config_.gate_distance) pairs.emplace_back(distance, t, k);
-    }
-  }
-  std::sort(pairs.begin(), pairs.end());
-  std::vector<bool> track_used(tracks_.size(), false), detection_used(detections.size(), false);
-  for (const auto& [distance, t, k] : pairs) {
-    if (track_used[t] || detection_used[k]) continue;
-    track_used[t] = detection_used[k] = true;
+  const internal::Association match = internal::AssociateNearestFirst(
+      tracks_.size(), detections.size(), config_.gate_distance, [&](std::size_t t, std::size_t k) {
+        return detections[k].detection.label == tracks_[t].label
+                   ? (detections[k].p_MO - tracks_[t].p_MO).norm()
+                   : std::numeric_limits<double>::infinity();
+      });
+  const std::vector<bool>& track_used = match.track_matched;
+  const std::vector<bool>& detection_used = match.detection_matched;
+  for (const auto& [t, k] : match.pairs) {
     TrackedObject& track = tracks_[t];
     track.p_MO += config_.smoothing * (detections[k].p_MO - track.p_MO);
     track.confidence += config_.smoothing * (detections[k].detection.confidence - track.confidence);

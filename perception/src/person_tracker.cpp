@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <tuple>
 
 #include "egress/hsr_interface/error.h"
+#include "nearest_first_association.h"
 
 namespace egress::perception {
 
@@ -47,20 +47,16 @@ void PersonTracker::Update(const std::vector<Eigen::Vector2d>& p_MDetections, Ti
   last_stamp_ = stamp;
   has_stamp_ = true;
   // Predict, then associate each detection to the nearest predicted person within the gate.
-  std::vector<std::tuple<double, std::size_t, std::size_t>> pairs;
-  for (std::size_t t = 0; t < people_.size(); ++t) {
-    const Eigen::Vector2d predicted = people_[t].p_MP + people_[t].v_MP * dt;
-    for (std::size_t k = 0; k < p_MDetections.size(); ++k) {
-      const double d = (p_MDetections[k] - predicted).norm();
-      if (d <= config_.gate_distance) pairs.emplace_back(d, t, k);
-    }
-  }
-  std::sort(pairs.begin(), pairs.end());
-  std::vector<bool> used_t(people_.size(), false), used_k(p_MDetections.size(), false);
+  std::vector<Eigen::Vector2d> predicted;
+  for (const TrackedPerson& person : people_)
+    predicted.push_back(person.p_MP + person.v_MP * dt);
+  const internal::Association match = internal::AssociateNearestFirst(
+      people_.size(), p_MDetections.size(), config_.gate_distance,
+      [&](std::size_t t, std::size_t k) { return (p_MDetections[k] - predicted[t]).norm(); });
+  const std::vector<bool>& used_t = match.track_matched;
+  const std::vector<bool>& used_k = match.detection_matched;
   const double a = config_.alpha;
-  for (const auto& [d, t, k] : pairs) {
-    if (used_t[t] || used_k[k]) continue;
-    used_t[t] = used_k[k] = true;
+  for (const auto& [t, k] : match.pairs) {
     TrackedPerson& person = people_[t];
     const Eigen::Vector2d previous = person.p_MP;
     // The paper's filter: exponential smoothing of position and of velocity (alpha = 0.3).
