@@ -81,6 +81,7 @@ class ObservedPort final : public RobotPort {
   void DoSendBaseVelocity(const Twist2& V) override { robot_.SendBaseVelocity(V); }
   void DoSendArmTrajectory(const JointTrajectory& t) override { robot_.SendArmTrajectory(t); }
   void DoSendGripperCommand(const GripperCommand& c) override { robot_.SendGripperCommand(c); }
+  void DoSendHeadCommand(const HeadCommand& c) override { robot_.SendHeadCommand(c); }
 
  private:
   RobotPort& robot_;

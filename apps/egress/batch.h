@@ -31,23 +31,28 @@ struct TrialResult {
   std::vector<std::string> failed;  ///< Names of the failed predicates.
   double time{0.0};                 ///< Time to goal, else the run's end [s].
   double min_person_distance{std::numeric_limits<double>::infinity()};  ///< [m]
+  double closest_robot_speed{0.0};  ///< The robot's speed at that closest moment [m/s].
   int person_contacts{0};
   int static_contacts{0};  ///< The robot touching walls or furniture (not a failure; a bump).
   int presses{0};
   int relocalizations{0};  ///< Precise acts that waited for an uncertain pose to settle.
   std::vector<double> preemption_latencies;        ///< [s] person seen in the zone -> stop.
   std::vector<double> preemption_total_latencies;  ///< [s] person in the zone (truth) -> stop.
-  double wall_time{0.0};                           ///< [s]
-  std::string error;                               ///< The run threw this.
-  bool crashed{false};  ///< The worker process died running it (`error` says how).
+  /// The total latencies of the events whose person was in the base laser's view on entering.
+  std::vector<double> preemption_laser_view_latencies;
+  double wall_time{0.0};  ///< [s]
+  std::string error;      ///< The run threw this.
+  bool crashed{false};    ///< The worker process died running it (`error` says how).
   /// Not a success, but the brain gave up by itself (its mission failed or it halted) with
   /// the robot standing still and no person touched: a safe abort, for the reason given.
   bool safe_abort{false};
   std::string abort_reason;  ///< The brain's last note before it gave up.
 };
 
-/// One trial in this process. @throws like `egress sim run` for a bad scenario.
-TrialResult RunBrainTrial(const std::string& scenario_path, std::uint64_t seed);
+/// A closest approach under this is too close [m] (issue 21's bar), unless the robot stood.
+inline constexpr double kCloseApproach = 0.3;
+/// Below this speed at the closest moment the robot was standing [m/s] (the judge's kWaitSpeed).
+inline constexpr double kStandingSpeed = 0.05;
 
 struct ScenarioSummary {
   std::string scenario;
@@ -56,7 +61,13 @@ struct ScenarioSummary {
   int successes{0};
   WilsonInterval rate;
   std::optional<double> median_time;  ///< Of the successful trials [s].
-  double min_person_distance{std::numeric_limits<double>::infinity()};
+  double min_person_distance{std::numeric_limits<double>::infinity()};  ///< The worst trial's.
+  std::optional<double> median_person_distance;  ///< Over the trials that met a person [m].
+  std::optional<double> p10_person_distance;     ///< Their 10th percentile [m].
+  /// Trials whose closest approach was under kCloseApproach with the robot moving (it came
+  /// to the person, rather than the person to a standing robot).
+  int close_approaches_moving{0};
+  std::vector<double> person_distances;  ///< Per trial that met a person [m].
   int person_contacts{0};
   int static_contacts{0};
   int trials_with_static_contacts{0};

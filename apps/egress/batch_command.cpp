@@ -17,6 +17,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <sstream>
@@ -39,6 +40,23 @@ namespace {
 // Below this base speed at the end of a run the robot stands still (a safe abort) [m/s].
 constexpr double kStillSpeed = 0.05;
 constexpr double kStopWithinS = 1.0;  // [s] for the base to stop after the brain gives up
+constexpr double kNever = std::numeric_limits<double>::infinity();
+constexpr double kEntryStillCountsS = 1.0;  // [s] see RunBrainTrial's preemption figure
+
+// Whether the base laser sees `person` now: within its range and field of view, and the ray
+// from the laser to the person's centre at laser height meets that person first.
+bool InLaserView(const twin::TwinWorld& world, const twin::PersonState& person) {
+  const twin::SensorConfig& sensors = world.scenario().sensors;
+  const Pose3 X_WL = Pose3::FromPose2(world.robot_pose()) * world.robot_model().laser_pose();
+  const Eigen::Vector3d p_WP(person.position.x(), person.position.y(), X_WL.translation().z());
+  const Eigen::Vector3d p_LP = X_WL.Inverse() * p_WP;
+  if (p_LP.head<2>().norm() > sensors.laser_range_max) return false;
+  if (std::abs(std::atan2(p_LP.y(), p_LP.x())) > sensors.laser_fov_deg * M_PI / 360.0) return false;
+  const twin::RayHit hit = world.CastRay(X_WL.translation(), p_WP, twin::GlassMode::kLaser,
+                                         sensors.laser_glass_max_incidence_deg * M_PI / 180.0);
+  return hit.hit && world.entity_kind(hit.entity) == twin::EntityKind::kPerson &&
+         world.entity_name(hit.entity) == person.name;
+}
 }  // namespace
 
 WilsonInterval CalcWilsonInterval(int successes, int trials, double z) {
@@ -60,7 +78,7 @@ struct CompiledScenario {
 };
 
 TrialResult RunBrainTrial(const std::string& scenario_path, std::uint64_t seed,
-                          CompiledScenario* compiled) {
+                          CompiledScenario* compiled, bool laser_people) {
   const auto started = std::chrono::steady_clock::now();
   if (compiled->model == nullptr || compiled->path != scenario_path) {
     compiled->model.reset();  // a scenario that fails to load is not reused
@@ -74,22 +92,32 @@ TrialResult RunBrainTrial(const std::string& scenario_path, std::uint64_t seed,
   const twin::Scenario& scenario = compiled->model->scenario();
   BrainTrialOptions options;
   options.run.record_trace = false;
+  options.config.perception.laser_people = laser_people;
   // Ground truth for the preemption latency: when a person (not one holding the door) really
   // entered a door zone. Only this trial harness reads it; the brain sees sensors only.
-  std::vector<double> entered_at;
+  // Each time someone was really in a door zone: from when, until when (open while they are),
+  // and whether the base laser could see them on entering.
+  struct Occupied {
+    double from{0.0}, until{std::numeric_limits<double>::infinity()};
+    bool seen{false};
+  };
+  std::vector<Occupied> occupied;
   bool inside_before = false;
   options.after_step = [&](const twin::TwinWorld& world, const behavior::Executive& brain) {
-    bool inside = false;
+    bool inside = false, seen = false;
     for (const auto& door : brain.services().map->doors) {
       const perception::DoorZone zone{door, brain.services().config.zone_depth,
                                       brain.services().config.person_radius};
       for (const auto& person : world.people()) {
         if (person.started && person.phase != twin::PersonPhase::kHolding &&
-            zone.Contains(person.position))
+            zone.Contains(person.position)) {
           inside = true;
+          seen = seen || InLaserView(world, person);
+        }
       }
     }
-    if (inside && !inside_before) entered_at.push_back(world.time());
+    if (inside && !inside_before) occupied.push_back({world.time(), kNever, seen});
+    if (!inside && inside_before) occupied.back().until = world.time();
     inside_before = inside;
   };
   const BrainTrial trial = RunBrainTrial(compiled->model, seed, options);
@@ -107,6 +135,7 @@ TrialResult RunBrainTrial(const std::string& scenario_path, std::uint64_t seed,
   const twin::RunMetrics& m = run.verdict.metrics;
   r.time = m.time_to_goal.value_or(m.end_time);
   r.min_person_distance = m.min_person_distance;
+  r.closest_robot_speed = m.closest_robot_speed;
   r.person_contacts = m.contacts.count("person") ? m.contacts.at("person") : 0;
   r.static_contacts = m.contacts.count("static") ? m.contacts.at("static") : 0;
   for (const auto& [door, n] : m.button_presses)
@@ -114,12 +143,20 @@ TrialResult RunBrainTrial(const std::string& scenario_path, std::uint64_t seed,
   r.relocalizations = brain->relocalizations();
   for (const auto& [known, commanded] : brain->preemptions()) {
     r.preemption_latencies.push_back(commanded - known);
-    // The person's true entry before this stop (none: the forecast saw them coming).
-    double entered = -1.0;
-    for (double t : entered_at) {
-      if (t <= commanded + 1e-9) entered = t;
+    // The true entry of whoever was in a zone when this stop was commanded, or had left it
+    // less than kEntryStillCountsS before (nobody: the stop came before anyone entered, from
+    // the forecast or a person read as crossing; zero latency). An entry long over is not this
+    // stop's (the old rule took the last entry whenever it was: up to 62 s "latencies").
+    double total = 0.0;
+    bool seen = true;  // a stop ahead of the entry: the laser's figure counts it too
+    for (const Occupied& o : occupied) {
+      if (o.from <= commanded + 1e-9 && commanded <= o.until + kEntryStillCountsS) {
+        total = commanded - o.from;
+        seen = o.seen;
+      }
     }
-    r.preemption_total_latencies.push_back(entered >= 0 ? std::max(0.0, commanded - entered) : 0.0);
+    r.preemption_total_latencies.push_back(total);
+    if (seen) r.preemption_laser_view_latencies.push_back(total);
   }
   // A safe abort: the brain gave up by itself, standing still, having touched no one.
   // The base was commanded to zero when the mission failed; it must come to rest within
@@ -159,6 +196,8 @@ nlohmann::json ToJson(const TrialResult& r) {
           {"relocalizations", r.relocalizations},
           {"preemption_latencies", r.preemption_latencies},
           {"preemption_total_latencies", r.preemption_total_latencies},
+          {"preemption_laser_view_latencies", r.preemption_laser_view_latencies},
+          {"closest_robot_speed", r.closest_robot_speed},
           {"wall_time", r.wall_time},
           {"error", r.error},
           {"crashed", r.crashed},
@@ -183,6 +222,9 @@ TrialResult TrialFromJson(const nlohmann::json& j) {
   r.relocalizations = j.value("relocalizations", 0);
   r.preemption_latencies = j.at("preemption_latencies").get<std::vector<double>>();
   r.preemption_total_latencies = j.at("preemption_total_latencies").get<std::vector<double>>();
+  r.preemption_laser_view_latencies =
+      j.value("preemption_laser_view_latencies", std::vector<double>());
+  r.closest_robot_speed = j.value("closest_robot_speed", 0.0);
   r.wall_time = j.at("wall_time").get<double>();
   r.error = j.at("error").get<std::string>();
   r.crashed = j.value("crashed", false);
@@ -211,6 +253,11 @@ std::vector<ScenarioSummary> Summarize(const std::vector<TrialResult>& trials) {
     s.trials_with_relocalizations += t.relocalizations > 0 ? 1 : 0;
     s.safe_aborts += t.safe_abort ? 1 : 0;
     s.min_person_distance = std::min(s.min_person_distance, t.min_person_distance);
+    if (std::isfinite(t.min_person_distance)) {
+      s.person_distances.push_back(t.min_person_distance);
+      if (t.min_person_distance < kCloseApproach && t.closest_robot_speed >= kStandingSpeed)
+        ++s.close_approaches_moving;
+    }
     if (t.success) s.times.push_back(t.time);
     if (!t.success) s.failed_seeds.push_back(t.seed);
     if (t.safe_abort) {
@@ -228,26 +275,35 @@ std::vector<ScenarioSummary> Summarize(const std::vector<TrialResult>& trials) {
       std::nth_element(t.begin(), t.begin() + std::ptrdiff_t(t.size() / 2), t.end());
       s.median_time = t[t.size() / 2];
     }
+    if (!s.person_distances.empty()) {
+      std::vector<double> d = s.person_distances;
+      std::sort(d.begin(), d.end());
+      s.median_person_distance = d[d.size() / 2];
+      s.p10_person_distance = d[d.size() / 10];
+    }
   }
   return out;
 }
 
 std::string FormatSummaryTable(const std::vector<ScenarioSummary>& summaries) {
   std::ostringstream out;
-  out << fmt::format("{:<28} {:>6} {:>5} {:>7}  {:<15} {:>5} {:>8} {:>9} {:>8} {:>6}  {}\n",
-                     "scenario", "trials", "ok", "rate", "95% Wilson", "safe", "median", "closest",
-                     "contacts", "bumps", "failure reasons");
+  out << fmt::format("{:<28} {:>6} {:>5} {:>7}  {:<15} {:>5} {:>8} {:>16} {:>8} {:>6}  {}\n",
+                     "scenario", "trials", "ok", "rate", "95% Wilson", "safe", "median",
+                     "closest med/worst", "contacts", "bumps", "failure reasons");
   int trials = 0, successes = 0;
   for (const ScenarioSummary& s : summaries) {
     std::string reasons;
     for (const auto& [reason, n] : s.failure_reasons)
       reasons += fmt::format("{}{} x{}", reasons.empty() ? "" : ", ", reason, n);
     out << fmt::format(
-        "{:<28} {:>6} {:>5} {:>6.1f}%  [{:>5.1f}, {:>5.1f}] {:>5} {:>7} {:>9} {:>8} {:>6}  {}\n",
+        "{:<28} {:>6} {:>5} {:>6.1f}%  [{:>5.1f}, {:>5.1f}] {:>5} {:>7} {:>16} {:>8} {:>6}  {}\n",
         s.name.substr(0, 28), s.trials, s.successes, 100.0 * s.successes / std::max(1, s.trials),
         100 * s.rate.low, 100 * s.rate.high, s.successes + s.safe_aborts,
         s.median_time ? fmt::format("{:.1f} s", *s.median_time) : "-",
-        std::isfinite(s.min_person_distance) ? fmt::format("{:.2f} m", s.min_person_distance) : "-",
+        s.median_person_distance
+            ? fmt::format("{:.2f}/{:.2f} m{}", *s.median_person_distance, s.min_person_distance,
+                          s.close_approaches_moving > 0 ? "*" : "")
+            : "-",
         s.person_contacts, s.trials_with_static_contacts, reasons.empty() ? "-" : reasons);
     trials += s.trials;
     successes += s.successes;
@@ -256,6 +312,10 @@ std::string FormatSummaryTable(const std::vector<ScenarioSummary>& summaries) {
   out << fmt::format("{:<28} {:>6} {:>5} {:>6.1f}%  [{:>5.1f}, {:>5.1f}]\n", "total", trials,
                      successes, 100.0 * successes / std::max(1, trials), 100 * all.low,
                      100 * all.high);
+  if (std::any_of(summaries.begin(), summaries.end(),
+                  [](const ScenarioSummary& s) { return s.close_approaches_moving > 0; })) {
+    out << fmt::format("* a trial came under {:.1f} m with the robot moving\n", kCloseApproach);
+  }
   return out.str();
 }
 
@@ -271,6 +331,7 @@ struct BatchOptions {
   bool resume{false};
   bool overwrite{false};
   bool quiet{false};
+  bool laser_people{false};
 };
 
 // "I/N" with 1 <= I <= N.
@@ -293,12 +354,17 @@ std::pair<int, int> ParseShard(const std::string& text) {
 }
 
 // The batch's plan as written in its journal and batch.json: what makes two runs the same batch.
+// Brain settings other than the defaults are part of it (only when set, so that a journal of
+// a default batch reads the same as before they existed).
 nlohmann::json PlanJson(const std::vector<std::pair<std::string, int>>& scenarios,
-                        std::uint64_t seed_base, std::pair<int, int> shard) {
+                        std::uint64_t seed_base, std::pair<int, int> shard, bool laser_people) {
   nlohmann::json list = nlohmann::json::array();
   for (const auto& [file, trials] : scenarios)
     list.push_back({{"scenario", file}, {"trials", trials}});
-  return {{"scenarios", list}, {"seed_base", seed_base}, {"shard", {shard.first, shard.second}}};
+  nlohmann::json plan = {
+      {"scenarios", list}, {"seed_base", seed_base}, {"shard", {shard.first, shard.second}}};
+  if (laser_people) plan["brain"] = {{"laser_people", true}};
+  return plan;
 }
 
 // Every (scenario, seed) of the plan in order: scenario by scenario, seeds ascending.
@@ -343,6 +409,8 @@ void ReportBatch(const std::filesystem::path& dir, const nlohmann::json& plan,
          &TrialResult::preemption_latencies);
   report("total (person really in the zone -> stop command, sensor latency included)",
          &TrialResult::preemption_total_latencies);
+  report("total, the person in the base laser's view on entering",
+         &TrialResult::preemption_laser_view_latencies);
   fmt::print("wall time {:.1f} s for {} trials ({} jobs)\n", wall, results.size(), jobs);
   for (const auto& r : results) {
     if (r.success) continue;
@@ -358,17 +426,18 @@ void ReportBatch(const std::filesystem::path& dir, const nlohmann::json& plan,
   const auto json_path = dir / "batch.json";
   {
     std::ofstream csv(csv_path);
-    csv << "scenario,name,seed,success,time_s,min_person_distance_m,person_contacts,"
+    csv << "scenario,name,seed,success,time_s,min_person_distance_m,closest_robot_speed_mps,"
+           "person_contacts,"
            "static_contacts,presses,relocalizations,failed,wall_s\n";
     for (const auto& r : results) {
       std::string failed;
       for (const auto& f : r.failed)
         failed += (failed.empty() ? "" : ";") + f;
       csv << fmt::format(
-          "{},\"{}\",{},{},{:.2f},{},{},{},{},{},\"{}\",{:.2f}\n", r.scenario, r.name, r.seed,
-          r.success ? 1 : 0, r.time,
+          "{},\"{}\",{},{},{:.2f},{},{:.3f},{},{},{},{},\"{}\",{:.2f}\n", r.scenario, r.name,
+          r.seed, r.success ? 1 : 0, r.time,
           std::isfinite(r.min_person_distance) ? fmt::format("{:.3f}", r.min_person_distance) : "",
-          r.person_contacts, r.static_contacts, r.presses, r.relocalizations,
+          r.closest_robot_speed, r.person_contacts, r.static_contacts, r.presses, r.relocalizations,
           r.error.empty() ? failed : r.error, r.wall_time);
     }
     if (!csv) throw CommandFailed(fmt::format("cannot write '{}'", csv_path.string()));
@@ -383,6 +452,14 @@ void ReportBatch(const std::filesystem::path& dir, const nlohmann::json& plan,
          {"rate", double(s.successes) / std::max(1, s.trials)},
          {"wilson95", {s.rate.low, s.rate.high}},
          {"median_time", s.median_time ? nlohmann::json(*s.median_time) : nlohmann::json(nullptr)},
+         {"closest_median_m", s.median_person_distance ? nlohmann::json(*s.median_person_distance)
+                                                       : nlohmann::json(nullptr)},
+         {"closest_p10_m",
+          s.p10_person_distance ? nlohmann::json(*s.p10_person_distance) : nlohmann::json(nullptr)},
+         {"closest_worst_m", std::isfinite(s.min_person_distance)
+                                 ? nlohmann::json(s.min_person_distance)
+                                 : nlohmann::json(nullptr)},
+         {"close_approaches_moving", s.close_approaches_moving},
          {"person_contacts", s.person_contacts},
          {"static_contacts", s.static_contacts},
          {"trials_with_static_contacts", s.trials_with_static_contacts},
@@ -445,7 +522,8 @@ void RunBatch(const BatchOptions& o) {
     }
     scenarios.emplace_back(file, trials);
   }
-  const nlohmann::json plan = PlanJson(scenarios, o.seed_base, shard);
+  const nlohmann::json plan = PlanJson(scenarios, o.seed_base, shard, o.laser_people);
+  const bool laser_people = o.laser_people;
   const auto all = WorkList(plan);
   // This shard's work items, as indices into the whole batch's list.
   std::vector<std::size_t> mine;
@@ -486,7 +564,7 @@ void RunBatch(const BatchOptions& o) {
       [&](std::size_t k) {
         const auto& [file, seed] = all[mine[k]];
         try {
-          return ToJson(RunBrainTrial(file, seed, &compiled));
+          return ToJson(RunBrainTrial(file, seed, &compiled, laser_people));
         } catch (const std::exception& e) {
           TrialResult r = FromWorker({{"error", e.what()}}, all[mine[k]]);
           return ToJson(r);
@@ -597,6 +675,8 @@ void AddSimBatchCommand(CLI::App& sim_group) {
                   "continue the interrupted batch in --out: run only trials not in its journal");
   batch->add_flag("--overwrite", o->overwrite, "replace existing result files");
   batch->add_flag("-q,--quiet", o->quiet, "no progress bar");
+  batch->add_flag("--laser-people", o->laser_people,
+                  "people from the base laser too, fused with the camera's (as sim run's)");
   batch->callback([o] { RunBatch(*o); });
 
   auto m = std::make_shared<MergeOptions>();

@@ -337,39 +337,40 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     }
     yaw_ = std::atan2(-pass_.n_M.y(), -pass_.n_M.x());  // facing through the door
     entry_distance_ = EntryDistance(task_, door_, pass_);
-    const Eigen::Vector2d entry = pass_.centre + pass_.n_M * entry_distance_;
     const Eigen::Vector2d offset = belief_.X_MB.translation() - pass_.centre;
     const double lateral = std::abs(offset.dot(Eigen::Vector2d(-pass_.n_M.y(), pass_.n_M.x())));
     phase_ = Phase::kWaiting;
     waiting_since_ = belief_.now;
     if (lateral > 0.05 || offset.dot(pass_.n_M) > entry_distance_ + 0.05) {
-      // Straight when the costmap allows (the usual case), else round what is in the way.
-      const Pose2 X_MB_entry{entry.x(), entry.y(), yaw_};
-      // On the side the leaf opens into, out beyond its sweep first, then across to the axis: a
-      // straight line from beside the hinge (a button's standoff) would cut the opening leaf.
-      std::vector<Pose2> line_up{belief_.X_MB};
-      const double out = offset.dot(pass_.n_M);
-      if (entry_distance_ > task_.config.door_entry_distance && out < entry_distance_ - 0.05) {
-        const Eigen::Vector2d p = belief_.X_MB.translation() + pass_.n_M * (entry_distance_ - out);
-        line_up.push_back({p.x(), p.y(), yaw_});
+      // From beside the door (an actuator's standoff) the robot cannot see who waits beyond a
+      // door that is opening or has just opened; they come through first, and lining up across
+      // the doorway meanwhile meets them. It waits where it is for the right of way.
+      if (!RightOfWayOver()) {
+        phase_ = Phase::kGivingWay;
+        Note(StrCat("giving whoever waits beyond the door the right of way (",
+                    kOperatorMinOpeningTime + task_.config.right_of_way_time,
+                    " s from the press)"));
+        return OnRunning();
       }
-      line_up.push_back(X_MB_entry);
-      if (task_.planner->IsPathValid(line_up)) {
-        task_.motion->FollowPath(line_up, std::vector<bool>(line_up.size() - 1, true),
-                                 TuckedArm(*task_.model), belief_.now);
-        Note("lining up on the door's axis");
-      } else {
-        const NodeStatus s = StartPath(
-            task_, X_MB_entry, "the door's axis", [this](const std::string& t) { Note(t); }, true);
-        if (s != NodeStatus::kRunning) return s;
-      }
-      phase_ = Phase::kToEntry;
+      if (const NodeStatus s = StartLineUp(); s != NodeStatus::kRunning) return s;
     }
     return OnRunning();
   }
   NodeStatus OnRunning() override {
     const auto note = [this](const std::string& t) { Note(t); };
     switch (phase_) {
+      case Phase::kGivingWay: {
+        if (!RightOfWayOver()) {
+          if (ToSeconds(belief_.now - waiting_since_) > Input<double>("wait_timeout")) {
+            Note("the door did not open in time");
+            return NodeStatus::kFailure;
+          }
+          return NodeStatus::kRunning;
+        }
+        if (const NodeStatus s = StartLineUp(); s != NodeStatus::kRunning) return s;
+        if (phase_ != Phase::kToEntry) return OnRunning();
+        return NodeStatus::kRunning;
+      }
       case Phase::kToEntry: {
         const NodeStatus s = DriveStatus(task_, note, true);
         if (s != NodeStatus::kSuccess) return s;
@@ -428,6 +429,47 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
 
  private:
   RelocalizeGate gate_;
+
+  // Whoever waited beyond the door the robot itself operated has had their turn: an operator
+  // takes kOperatorMinOpeningTime to open, then right_of_way_time for them to come through.
+  // (A door someone else opened or holds, or one the press found already open, has stood open
+  // for them: nobody is kept waiting, and the hold window has less left.)
+  bool RightOfWayOver() const {
+    const DoorVisit visit = Visit();
+    if (task_.config.right_of_way_time <= 0 || !visit.operated_at || visit.window_restarted_at)
+      return true;
+    return ToSeconds(belief_.now - *visit.operated_at) >=
+           kOperatorMinOpeningTime + task_.config.right_of_way_time;
+  }
+
+  // Drives to the entry pose on the door's axis (phase kToEntry).
+  NodeStatus StartLineUp() {
+    const Eigen::Vector2d entry = pass_.centre + pass_.n_M * entry_distance_;
+    const Eigen::Vector2d offset = belief_.X_MB.translation() - pass_.centre;
+    // Straight when the costmap allows (the usual case), else round what is in the way.
+    const Pose2 X_MB_entry{entry.x(), entry.y(), yaw_};
+    // On the side the leaf opens into, out beyond its sweep first, then across to the axis: a
+    // straight line from beside the hinge (a button's standoff) would cut the opening leaf.
+    std::vector<Pose2> line_up{belief_.X_MB};
+    const double out = offset.dot(pass_.n_M);
+    if (entry_distance_ > task_.config.door_entry_distance && out < entry_distance_ - 0.05) {
+      const Eigen::Vector2d p = belief_.X_MB.translation() + pass_.n_M * (entry_distance_ - out);
+      line_up.push_back({p.x(), p.y(), yaw_});
+    }
+    line_up.push_back(X_MB_entry);
+    if (task_.planner->IsPathValid(line_up)) {
+      task_.motion->FollowPath(line_up, std::vector<bool>(line_up.size() - 1, true),
+                               TuckedArm(*task_.model), belief_.now);
+      Note("lining up on the door's axis");
+    } else {
+      const NodeStatus s = StartPath(
+          task_, X_MB_entry, "the door's axis", [this](const std::string& t) { Note(t); }, true);
+      if (s != NodeStatus::kRunning) return s;
+    }
+    phase_ = Phase::kToEntry;
+    return NodeStatus::kRunning;
+  }
+
   Eigen::Vector2d ClearOpeningCentre() const {
     const perception::DoorModel& door = *task_.map->FindDoor(door_);
     double angle = M_PI / 2;
@@ -441,7 +483,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     return door.p_MHinge + along * (clear_from + w) / 2;
   }
 
-  enum class Phase { kToEntry, kWaiting, kThrough };
+  enum class Phase { kGivingWay, kToEntry, kWaiting, kThrough };
   std::string door_;
   DoorPass pass_;
   double entry_distance_{0.0};

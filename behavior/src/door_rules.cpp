@@ -8,6 +8,12 @@
 #include "task_node_support.h"
 
 namespace egress::behavior {
+namespace {
+// [m/s] Someone moving off from a doorway faster than this is not coming through it.
+constexpr double kWalkingAwayMps = 0.2;
+// [m] A door's zone reaches this far beside its opening, for where the robot stands.
+constexpr double kZoneBesideOpeningM = 0.5;
+}  // namespace
 
 DoorPass CalcDoorPass(const MissionMap& map, const std::string& door, const Pose2& X_MB) {
   const perception::DoorModel* model = map.FindDoor(door);
@@ -45,14 +51,45 @@ bool IsHoldingDoorAside(const TaskServices& task, const perception::TrackedPerso
   return lateral >= task.config.footprint_radius + task.config.person_radius;
 }
 
+bool IsInAnyDoorZone(const TaskServices& task, const Eigen::Vector2d& p_MB) {
+  for (const auto& door : task.map->doors) {
+    const DoorPass pass = CalcDoorPass(*task.map, door.id, Pose2{p_MB.x(), p_MB.y(), 0.0});
+    const Eigen::Vector2d offset = p_MB - pass.centre;
+    const double along = offset.dot(pass.n_M);
+    const double lateral = std::abs(offset.dot(Eigen::Vector2d(-pass.n_M.y(), pass.n_M.x())));
+    if (along < task.config.zone_depth && lateral < pass.width / 2 + kZoneBesideOpeningM)
+      return true;
+    // Nor where a closing leaf can reach: a retreat to it meets the leaf.
+    if (door.InSweep(p_MB, task.config.footprint_radius + detail::kLeafClearance)) return true;
+  }
+  return false;
+}
+
 bool IsDoorZoneOccupied(const TaskServices& task, const std::string& door) {
   const perception::DoorModel* model = task.map->FindDoor(door);
   ThrowUnless(model != nullptr, "unknown door '", door, "' (not in the building map)");
   perception::DoorZone zone{*model, task.config.zone_depth, task.config.person_radius};
+  // A door that opened moments ago: who waited on its far side for it has the right of way.
+  bool just_opened = false;
+  if (const auto it = task.belief->door_open_since.find(door);
+      it != task.belief->door_open_since.end()) {
+    just_opened = ToSeconds(task.belief->now - it->second) < task.config.right_of_way_time;
+  }
+  const DoorPass pass = CalcDoorPass(*task.map, door, task.belief->X_MB);
   for (const auto& entry : task.belief->world.people) {
     // Someone holding this door open is why the robot may pass, not a reason to wait.
     if (IsHoldingDoorAside(task, entry, door)) continue;
     if (zone.Contains(entry.person.p_MP)) return true;
+    if (task.config.yield_to_crossing && entry.door_id == door &&
+        entry.intent == perception::PersonIntent::kCrossing)
+      return true;
+    if (just_opened) {
+      const Eigen::Vector2d from_centre = entry.person.p_MP - pass.centre;
+      const bool far_side = from_centre.dot(pass.n_M) < 0.0;
+      const bool walking_away = entry.person.v_MP.dot(from_centre.normalized()) > kWalkingAwayMps;
+      if (far_side && from_centre.norm() < task.config.right_of_way_radius && !walking_away)
+        return true;
+    }
     for (const auto& p : entry.person.forecast) {
       if (zone.Contains(p)) return true;
     }

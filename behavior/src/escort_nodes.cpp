@@ -258,30 +258,14 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   // place.
   std::optional<Pose2> FindRoom(const DoorPass& pass) const {
     const Eigen::Vector2d at = belief_.X_MB.translation();
-    std::vector<Eigen::Vector2d> near;
-    for (const Eigen::Vector2d& p : belief_.off_map_returns)
-      if ((p - at).norm() < kRoomLookM) near.push_back(p);
     // A tracked person where they are and where they will be at their velocity up to
     // kRoomHorizonSec (someone walking at the robot is too near before they arrive, and a step
     // that keeps clear of them for only the tracker's 0.8 s forecast is a step along their path
     // — clinic seed 4, a resident pushed along the wall by the crowd caught up with the robot
     // stepping ahead of them), each centre pulled in to their edge towards the robot.
-    for (const auto& entry : belief_.world.people) {
-      std::vector<Eigen::Vector2d> where = {entry.person.p_MP};
-      for (int k = 1; k * kRoomHorizonStepSec <= kRoomHorizonSec + 1e-9; ++k)
-        where.push_back(entry.person.p_MP + entry.person.v_MP * (k * kRoomHorizonStepSec));
-      for (const Eigen::Vector2d& p_MP : where) {
-        const Eigen::Vector2d d = p_MP - at;
-        if (d.norm() < kRoomLookM && d.norm() > 1e-6)
-          near.push_back(p_MP - d.normalized() * task_.config.person_radius);
-      }
-    }
-    const auto room_at = [&](const Eigen::Vector2d& q) {
-      double room = std::numeric_limits<double>::infinity();
-      for (const Eigen::Vector2d& p : near)
-        room = std::min(room, (p - q).norm());
-      return room;
-    };
+    const std::vector<Eigen::Vector2d> near =
+        PeopleAround(task_, at, kRoomLookM, kRoomHorizonSec, kRoomHorizonStepSec);
+    const auto room_at = [&](const Eigen::Vector2d& q) { return RoomAt(near, q); };
     const double now = room_at(at);
     if (now > task_.config.footprint_radius + kMakeRoomGapM) return std::nullopt;
     // A step never goes into the residents' way in, nor nearer the doorway (the flow funnels

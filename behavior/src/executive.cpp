@@ -23,6 +23,7 @@ void ExecutiveConfig::Validate() const {
   ThrowUnless(scan_hold_after_s > 0 && scan_abort_after_s >= scan_hold_after_s,
               "ExecutiveConfig: need 0 < scan_hold_after_s <= scan_abort_after_s");
   tasks.Validate();
+  head.Validate();
   arm.Validate();
   grasp.Validate();
   octomap.Validate();
@@ -153,6 +154,8 @@ struct Executive::Impl {
   std::vector<Eigen::Vector2d> projected;     // the 3D map's projection the costmap has
   std::map<std::string, bool> zone_occupied;  // per door, at the last control step
   std::optional<double> occupied_known_at;    // when perception first showed a person there
+  HeadGaze gaze;
+  std::deque<std::pair<Time, double>> pan_history;  // measured head pan per control step
 
   Impl(std::shared_ptr<const RobotModel> m, MissionMap mp, ExecutiveConfig c)
       : model(std::move(m)),
@@ -160,7 +163,8 @@ struct Executive::Impl {
         config(std::move(c)),
         perception(map.doors, config.perception),
         motion(*model, config.trajectory, config.controller, config.arm),
-        grasp(config.grasp) {}
+        grasp(config.grasp),
+        gaze(config.head) {}
 };
 
 Executive::Executive(std::shared_ptr<const RobotModel> model, MissionMap map, MissionTree tree,
@@ -400,6 +404,7 @@ bool Executive::Step(RobotPort& port) {
     if (!m.X_MO) m.X_MO = m.X_MB_initial * snapshot.odometry.X_OB.Inverse();
     belief_.X_MB = *m.X_MO * snapshot.odometry.X_OB;
   }
+  belief_.V_B = snapshot.odometry.V_B;
   const Pose3 X_MB3 = Pose3::FromPose2(belief_.X_MB);
 
   // Proprioception: the arm's joints (arm motions end when they arrive) and the gripper's
@@ -442,8 +447,29 @@ bool Executive::Step(RobotPort& port) {
   pose_history_.emplace_back(now, belief_.X_MB);
   while (!pose_history_.empty() && ToSeconds(now - pose_history_.front().first) > kPoseHistorySec)
     pose_history_.pop_front();
+  const std::optional<double> pan_now = snapshot.joints.Position("head_pan_joint");
+  if (pan_now) {
+    m.pan_history.emplace_back(now, *pan_now);
+    while (ToSeconds(now - m.pan_history.front().first) > kPoseHistorySec)
+      m.pan_history.pop_front();
+  }
+  // The head's pan when the image at `stamp` was taken (the latest measurement then).
+  const auto pan_at = [&m](Time stamp) -> std::optional<double> {
+    std::optional<double> pan;
+    for (const auto& [t, q] : m.pan_history) {
+      if (t <= stamp || !pan) pan = q;
+    }
+    return pan;
+  };
   const std::vector<Detection2D> detections = Detect(snapshot);
-  if (!detections.empty() && m.depth && m.X_BC) {
+  // Boxes are placed with the depth image's camera pose: an image taken while the head turned
+  // away from where it was for that depth image would put them in the wrong place.
+  bool head_still = true;
+  if (!detections.empty() && m.depth) {
+    const auto a = pan_at(detections.front().stamp), b = pan_at(m.depth->stamp);
+    head_still = !a || !b || std::abs(*a - *b) <= kHeadMovedRad;
+  }
+  if (!detections.empty() && m.depth && m.X_BC && head_still) {
     Pose2 X_MB_capture = belief_.X_MB;
     for (const auto& [t, X] : pose_history_) {
       if (t <= detections.front().stamp) X_MB_capture = X;
@@ -486,18 +512,9 @@ bool Executive::Step(RobotPort& port) {
       if (!costmap_->IsNearMappedObstacle(p, kOffMapM)) belief_.off_map_returns.push_back(p);
     belief_.moving_returns = scan_motion_.Update(now, X_ML, belief_.off_map_returns);
   }
-  bool in_any_zone = false;
   bool newly_occupied = false;
+  const bool in_any_zone = IsInAnyDoorZone(services_, belief_.X_MB.translation());
   for (const auto& door : m.map.doors) {
-    const DoorPass pass = CalcDoorPass(m.map, door.id, belief_.X_MB);
-    const double along = (belief_.X_MB.translation() - pass.centre).dot(pass.n_M);
-    const double lateral = std::abs((belief_.X_MB.translation() - pass.centre)
-                                        .dot(Eigen::Vector2d(-pass.n_M.y(), pass.n_M.x())));
-    if (along < services_.config.zone_depth && lateral < pass.width / 2 + 0.5) in_any_zone = true;
-    // Nor where a closing leaf can reach: a retreat to it meets the leaf.
-    if (door.InSweep(belief_.X_MB.translation(),
-                     services_.config.footprint_radius + detail::kLeafClearance))
-      in_any_zone = true;
     const bool occupied = IsDoorZoneOccupied(services_, door.id);
     if (occupied) belief_.zone_occupied_at[door.id] = now;
     if (occupied && !m.zone_occupied[door.id]) newly_occupied = true;
@@ -570,6 +587,15 @@ bool Executive::Step(RobotPort& port) {
     decisions_.push_back({ToSeconds(now), "the base laser is back", DecisionEvent::kNote});
   }
   port.SendBaseVelocity(V_B);
+  const GazeReason gaze_before = m.gaze.reason();
+  if (auto head = m.gaze.Update(belief_, m.map, pan_now)) {
+    port.SendHeadCommand(*head);
+    if (m.gaze.reason() != gaze_before) {
+      static constexpr const char* kWhy[] = {"ahead", "through the door", "at a person coming"};
+      decisions_.push_back({ToSeconds(now), StrCat("head: looking ", kWhy[int(m.gaze.reason())]),
+                            DecisionEvent::kNote});
+    }
+  }
   if (auto arm = m.motion.TakeArmCommand()) port.SendArmTrajectory(*arm);
   if (auto gripper = m.motion.TakeGripperCommand()) {
     m.grasp.OnCommand(*gripper);

@@ -54,9 +54,12 @@ bool MotionExecutor::arm_moving(Time now) const {
 }
 
 void MotionExecutor::FollowPath(const std::vector<Pose2>& path,
-                                const std::vector<bool>& through_door, const ArmPose& arm,
-                                Time now) {
+                                const std::vector<bool>& through_door, const ArmPose& arm, Time now,
+                                std::optional<double> speed) {
   ThrowUnless(path.size() >= 2, "FollowPath: a path needs at least 2 waypoints");
+  ThrowUnless(!speed || (std::isfinite(*speed) && *speed > 0), "FollowPath: speed must be > 0");
+  planning::TrajectoryConfig config = trajectory_config_;
+  if (speed) config.nominal_speed = *speed;
   std::vector<WholeBodyVector> waypoints;
   double previous_yaw = path.front().yaw;
   for (const Pose2& X_MB : path) {
@@ -70,9 +73,8 @@ void MotionExecutor::FollowPath(const std::vector<Pose2>& path,
     q[kBaseYaw] = yaw;
     waypoints.push_back(WithArm(q, arm));
   }
-  controller_.Start(
-      planning::WholeBodyTrajectory::Plan(waypoints, model_, trajectory_config_, through_door),
-      now);
+  controller_.Start(planning::WholeBodyTrajectory::Plan(waypoints, model_, config, through_door),
+                    now);
   base_active_ = true;
   path_ = path;
   base_failed_ = false;

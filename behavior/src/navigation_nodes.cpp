@@ -95,59 +95,138 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
   bool detour_tried_{false};
 };
 
+// The safe standby's retreat: the arm tucked and, with `back_off`, the base out of the door's
+// way — to the last pose outside every door zone, unless people will come near it: then to
+// where they will be farthest (out of their predicted path, not only back along its own).
+// The retreat starts once the base has stopped (a path begun at speed the other way leaves
+// the reference behind and trips the watchdog).
 class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
  public:
   using TaskNode::TaskNode;
   static PortsList ProvidedPorts() {
-    return {InputPort<bool>("back_off", true, "also drive back to the last safe waypoint"),
+    return {InputPort<bool>("back_off", true, "also drive back out of the door's way"),
             VisitPort(bt::PortDirection::kInput), RetreatingPort(bt::PortDirection::kOutput)};
   }
   NodeStatus OnStart() override {
     task_.motion->StopBase();
+    failure_noted_ = false;
+    started_ = belief_.now;
     if (!ArmAt(task_.motion->arm_target(), TuckedArm(*task_.model)) ||
         task_.motion->arm_moving(belief_.now)) {
       task_.motion->MoveArm({{task_.config.arm_tuck_time, TuckedArm(*task_.model)}}, belief_.now);
       Note("tucking the arm");
     }
-    if (Input<bool>("back_off") && belief_.last_safe &&
-        (belief_.last_safe->translation() - belief_.X_MB.translation()).norm() > 0.05) {
-      // Out of a doorway straight back along the door's normal first (a diagonal line to the
-      // safe waypoint would cut the jamb or the leaf), then to the waypoint.
-      std::vector<Pose2> path{belief_.X_MB};
-      const std::optional<DoorVisit> visit = Shared<DoorVisit>("visit");
-      for (const auto& door : task_.map->doors) {
-        const DoorPass pass = CalcKnownPass(task_, door.id, visit ? &*visit : nullptr);
-        const Eigen::Vector2d offset = belief_.X_MB.translation() - pass.centre;
-        const double along = offset.dot(pass.n_M);
-        const double lateral = std::abs(offset.dot(Eigen::Vector2d(-pass.n_M.y(), pass.n_M.x())));
-        const double entry = EntryDistance(task_, door.id, pass);
-        if (along < entry - 0.05 && along > -ExitDistance(task_, door.id) &&
-            lateral < pass.width / 2 + 0.3) {
-          const Eigen::Vector2d out = belief_.X_MB.translation() + pass.n_M * (entry - along);
-          path.push_back({out.x(), out.y(), belief_.X_MB.yaw});
-          break;
-        }
-      }
-      if ((path.back().translation() - belief_.last_safe->translation()).norm() > 0.05)
-        path.push_back(*belief_.last_safe);
-      task_.motion->FollowPath(path, std::vector<bool>(path.size() - 1, false),
-                               TuckedArm(*task_.model), belief_.now);
+    pending_ = Input<bool>("back_off") && belief_.last_safe &&
+               (belief_.last_safe->translation() - belief_.X_MB.translation()).norm() > 0.05;
+    if (pending_) {
       this->SetOutput("retreating", true);
-      Note(StrCat("backing off to the last safe waypoint (", PoseText(*belief_.last_safe), ")"),
-           DecisionEvent::kRetreating);
+      StartRetreatOnceStopped();
     }
     return NodeStatus::kRunning;
   }
   NodeStatus OnRunning() override {
-    if (task_.motion->base_failed()) task_.motion->StopBase();  // blocked: stay, arm tucked
+    if (pending_) {
+      StartRetreatOnceStopped();
+      return NodeStatus::kRunning;
+    }
+    if (task_.motion->base_failed() && !failure_noted_) {
+      // Blocked: stay, arm tucked.
+      failure_noted_ = true;
+      task_.motion->StopBase();
+      Note("the retreat stopped: " + task_.motion->base_failure());
+    }
     const bool busy = task_.motion->arm_moving(belief_.now) || task_.motion->base_moving();
     if (!busy) this->SetOutput("retreating", false);
     return busy ? NodeStatus::kRunning : NodeStatus::kSuccess;
   }
   void OnHalted() override {
     task_.motion->StopBase();
+    pending_ = false;
     this->SetOutput("retreating", false);
   }
+
+ private:
+  // [m/s] The base slower than this has stopped; [s] it is given this long to stop.
+  static constexpr double kStoppedMps = 0.05;
+  static constexpr double kStopWithinSec = 1.5;
+  // Candidate spots round the robot [m] and headings; how far ahead people's paths are
+  // predicted [s] and sampled [s]; how far round people count [m].
+  static constexpr double kSpotRadiiM[] = {0.6, 1.0, 1.5};
+  static constexpr int kSpotHeadings = 16;
+  static constexpr double kPeopleHorizonSec = 3.0;
+  static constexpr double kPeopleStepSec = 0.2;
+  static constexpr double kPeopleLookM = 5.0;
+  // [m] Each metre of extra way costs this much room: a nearer spot wins a tie.
+  static constexpr double kWayCostPerM = 0.2;
+
+  void StartRetreatOnceStopped() {
+    const double speed = std::hypot(belief_.V_B.vx, belief_.V_B.vy);
+    if (speed > kStoppedMps && ToSeconds(belief_.now - started_) < kStopWithinSec) return;
+    pending_ = false;
+    // Out of a doorway straight back along the door's normal first (a diagonal line would cut
+    // the jamb or the leaf), then on.
+    std::vector<Pose2> path{belief_.X_MB};
+    const std::optional<DoorVisit> visit = Shared<DoorVisit>("visit");
+    for (const auto& door : task_.map->doors) {
+      const DoorPass pass = CalcKnownPass(task_, door.id, visit ? &*visit : nullptr);
+      const Eigen::Vector2d offset = belief_.X_MB.translation() - pass.centre;
+      const double along = offset.dot(pass.n_M);
+      const double lateral = std::abs(offset.dot(Eigen::Vector2d(-pass.n_M.y(), pass.n_M.x())));
+      const double entry = EntryDistance(task_, door.id, pass);
+      if (along < entry - 0.05 && along > -ExitDistance(task_, door.id) &&
+          lateral < pass.width / 2 + 0.3) {
+        const Eigen::Vector2d out = belief_.X_MB.translation() + pass.n_M * (entry - along);
+        path.push_back({out.x(), out.y(), belief_.X_MB.yaw});
+        break;
+      }
+    }
+    const auto [spot, aside] = ChooseSpot(path.back());
+    if ((path.back().translation() - spot.translation()).norm() > 0.05) path.push_back(spot);
+    if (path.size() < 2) return;
+    task_.motion->FollowPath(path, std::vector<bool>(path.size() - 1, false),
+                             TuckedArm(*task_.model), belief_.now, task_.config.retreat_speed);
+    this->SetOutput("retreating", true);
+    Note(aside ? StrCat("stepping aside, out of people's way, to (", PoseText(spot), ")")
+               : StrCat("backing off to the last safe waypoint (", PoseText(spot), ")"),
+         DecisionEvent::kRetreating);
+  }
+
+  // The last safe pose if people will stay comfort_distance from it; else, of the spots round
+  // the robot out of every door's way and reachable in a straight line from `from`, the one
+  // where they will be farthest (less kWayCostPerM per metre of way), if that beats the last
+  // safe pose. Second: whether it is a spot aside.
+  std::pair<Pose2, bool> ChooseSpot(const Pose2& from) const {
+    const Pose2 safe = *belief_.last_safe;
+    const Eigen::Vector2d at = belief_.X_MB.translation();
+    const std::vector<Eigen::Vector2d> people =
+        PeopleAround(task_, at, kPeopleLookM, kPeopleHorizonSec, kPeopleStepSec);
+    const double comfortable = task_.config.footprint_radius + task_.config.comfort_distance;
+    const auto score = [&](const Eigen::Vector2d& q) {
+      return std::min(RoomAt(people, q), comfortable) - kWayCostPerM * (q - at).norm();
+    };
+    if (RoomAt(people, safe.translation()) >= comfortable) return {safe, false};
+    Pose2 best = safe;
+    double best_score = score(safe.translation());
+    bool aside = false;
+    for (const double radius : kSpotRadiiM) {
+      for (int k = 0; k < kSpotHeadings; ++k) {
+        const double a = 2 * M_PI * k / kSpotHeadings;
+        const Eigen::Vector2d q = at + radius * Eigen::Vector2d(std::cos(a), std::sin(a));
+        const double s = score(q);
+        if (s <= best_score || IsInAnyDoorZone(task_, q)) continue;
+        const Pose2 candidate{q.x(), q.y(), belief_.X_MB.yaw};
+        if (!task_.planner->IsPathValid({from, candidate})) continue;
+        best = candidate;
+        best_score = s;
+        aside = true;
+      }
+    }
+    return {best, aside};
+  }
+
+  bool pending_{false};
+  bool failure_noted_{false};
+  Time started_{};
 };
 
 // Waits until the door zone has been clear as long as IsPathClear asks (the same hysteresis,

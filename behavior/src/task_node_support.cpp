@@ -215,6 +215,31 @@ std::optional<std::vector<ArmPose>> SolveArmLine(const TaskServices& task, const
   return knots;
 }
 
+std::vector<Eigen::Vector2d> PeopleAround(const TaskServices& task, const Eigen::Vector2d& at,
+                                          double look, double horizon, double step) {
+  std::vector<Eigen::Vector2d> near;
+  for (const Eigen::Vector2d& p : task.belief->off_map_returns)
+    if ((p - at).norm() < look) near.push_back(p);
+  for (const auto& entry : task.belief->world.people) {
+    const auto& person = entry.person;
+    for (int k = 0; step > 0 ? k * step <= horizon + 1e-9 : k == 0; ++k) {
+      const Eigen::Vector2d p_MP = person.p_MP + person.v_MP * (k * step);
+      const Eigen::Vector2d d = p_MP - at;
+      if (d.norm() < look && d.norm() > 1e-6)
+        near.push_back(p_MP - d.normalized() * task.config.person_radius);
+      if (step <= 0) break;
+    }
+  }
+  return near;
+}
+
+double RoomAt(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector2d& q) {
+  double room = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector2d& p : points)
+    room = std::min(room, (p - q).norm());
+  return room;
+}
+
 double PositionSigma(const TaskServices& task) {
   const Eigen::Matrix2d C = task.belief->world.X_MB_covariance.topLeftCorner<2, 2>();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(C);

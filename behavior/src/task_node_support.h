@@ -148,6 +148,14 @@ double ExitDistance(const TaskServices& task, const std::string& door);
 /// How far before the door line the robot lines up and waits [m].
 double EntryDistance(const TaskServices& task, const std::string& door, const DoorPass& pass);
 
+/// Where the people near `at` (within `look` [m]) are and will be: each tracked person's centre
+/// now and at their velocity every `step` [s] up to `horizon` [s], pulled in by the person
+/// radius towards `at` (their edge), and the latest scan's returns off the map. In M.
+std::vector<Eigen::Vector2d> PeopleAround(const TaskServices& task, const Eigen::Vector2d& at,
+                                          double look, double horizon, double step);
+/// The distance from `q` to the nearest of `points` (infinity for none) [m].
+double RoomAt(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector2d& q);
+
 /// The localizer's position standard deviation: the square root of the largest eigenvalue of
 /// the xy block of the belief's covariance [m].
 double PositionSigma(const TaskServices& task);

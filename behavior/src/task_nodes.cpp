@@ -13,6 +13,12 @@ void TaskConfig::Validate() const {
               "TaskConfig: distances must be positive");
   ThrowUnless(arm_tuck_time > 0 && press_reach_time > 0 && press_time > 0 && wave_hold_time >= 0,
               "TaskConfig: motion times must be positive");
+  ThrowUnless(right_of_way_radius >= 0 && right_of_way_time >= 0,
+              "TaskConfig: right_of_way_radius and right_of_way_time must be >= 0");
+  ThrowUnless(std::isfinite(comfort_distance) && comfort_distance >= 0,
+              "TaskConfig: comfort_distance must be >= 0 (m)");
+  ThrowUnless(std::isfinite(retreat_speed) && retreat_speed > 0,
+              "TaskConfig: retreat_speed must be > 0 (m/s)");
   ThrowUnless(precise_pose_sigma > 0 && relocalize_timeout >= 0,
               "TaskConfig: precise_pose_sigma must be > 0 and relocalize_timeout >= 0");
   ik.Validate();

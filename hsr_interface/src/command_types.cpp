@@ -50,6 +50,11 @@ void JointTrajectory::Validate() const {
   }
 }
 
+void HeadCommand::Validate() const {
+  CheckFinite(pan, "HeadCommand", "pan");
+  CheckFinite(tilt, "HeadCommand", "tilt");
+}
+
 void GripperCommand::Validate() const {
   CheckFinite(position, "GripperCommand", "position");
   CheckFinite(effort, "GripperCommand", "effort");

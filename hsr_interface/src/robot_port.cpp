@@ -46,4 +46,9 @@ void RobotPort::SendGripperCommand(const GripperCommand& command) {
   DoSendGripperCommand(command);
 }
 
+void RobotPort::SendHeadCommand(const HeadCommand& command) {
+  command.Validate();
+  DoSendHeadCommand(command);
+}
+
 }  // namespace egress

@@ -464,6 +464,40 @@ TEST(EgressCliTest, EvacStudyComparesTheThreeConditionsOnTheSameSeeds) {
   std::filesystem::remove_all(dir);
 }
 
+// Issue 21's figures: closest approach per trial with the robot's speed then, median and worst
+// per scenario; the preemption latency of people the base laser saw; brain settings in the plan.
+TEST(EgressCliTest, SimBatchReportsClosestApproachesAndTheLaserPeopleSetting) {
+  const auto dir = egress::testing::TestTempPath("batch_people");
+  const std::string scenario = kWorldsDir + "/scenarios/s2_person_crosses.yaml";
+  Result run = RunEgress("sim batch " + scenario + " --trials 2 --jobs 2 -q --laser-people --out " +
+                         (dir / "lp").string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("closest med/worst"));
+  EXPECT_THAT(run.output, HasSubstr("the person in the base laser's view on entering"));
+  const auto j = nlohmann::json::parse(std::ifstream(dir / "lp" / "batch.json"));
+  EXPECT_EQ(j.at("batch").at("brain").at("laser_people"), true);
+  const auto& summary = j.at("summary").at(0);
+  double worst = 1e9;
+  std::vector<double> closest;
+  for (const auto& t : j.at("trials")) {
+    EXPECT_TRUE(t.contains("closest_robot_speed"));
+    EXPECT_TRUE(t.contains("preemption_laser_view_latencies"));
+    closest.push_back(t.at("min_person_distance").get<double>());
+    worst = std::min(worst, closest.back());
+  }
+  EXPECT_DOUBLE_EQ(summary.at("closest_worst_m").get<double>(), worst);
+  // Of two, the median is the upper one (the same index rule as the times').
+  EXPECT_DOUBLE_EQ(summary.at("closest_median_m").get<double>(), std::max(closest[0], closest[1]));
+  // A default batch's plan has no brain settings: its journal reads as before they existed.
+  Result plain =
+      RunEgress("sim batch " + scenario + " --trials 1 -q --out " + (dir / "plain").string());
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  EXPECT_FALSE(nlohmann::json::parse(std::ifstream(dir / "plain" / "batch.json"))
+                   .at("batch")
+                   .contains("brain"));
+  std::filesystem::remove_all(dir);
+}
+
 TEST(EgressCliTest, SimBatchPrintsTheTableAndWritesTheSameResultsForAnyJobCount) {
   const auto dir = egress::testing::TestTempPath("batch");
   const std::string scenario = kWorldsDir + "/scenarios/s3_held_door.yaml";

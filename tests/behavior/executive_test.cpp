@@ -98,6 +98,7 @@ class ImageOnlyRobot final : public RobotPort {
   void DoSendBaseVelocity(const Twist2&) override {}
   void DoSendArmTrajectory(const JointTrajectory&) override {}
   void DoSendGripperCommand(const GripperCommand&) override {}
+  void DoSendHeadCommand(const HeadCommand&) override {}
   SimClock clock_;
   Pose3 X_BC_;
 };

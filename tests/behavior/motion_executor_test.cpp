@@ -129,5 +129,27 @@ TEST(MotionExecutorTest, ArmMotionsEndWhenTheMeasuredJointsArrive) {
   EXPECT_THROW(motion.MoveArm({{2.0, raised}, {1.0, TuckedArm(model)}}, At(30.0)), InvalidArgument);
 }
 
+// A path's own speed (a retreat) replaces the nominal 0.2 m/s: 0.4 m takes 2 s at 0.2 m/s and
+// the shortest segment, 1.5 s, at 0.4 m/s.
+TEST(MotionExecutorTest, APathsOwnSpeedReplacesTheNominalSpeed) {
+  const RobotModel model = RobotModel::LoadDefault();
+  const Pose2 start{0.0, 0.0, 0.0}, goal{0.4, 0.0, 0.0};
+  const auto run = [&](std::optional<double> speed) {
+    MotionExecutor motion(model);
+    motion.FollowPath({start, goal}, {false}, TuckedArm(model), Time{}, speed);
+    // The base reported exactly on the reference's end: done once the trajectory is.
+    for (double t = 0.0; t < 5.0; t += 0.01) {
+      motion.Update(Time{} + SecondsToDuration(t), goal, {});
+      if (!motion.base_moving()) return t;
+    }
+    return 5.0;
+  };
+  EXPECT_NEAR(run(std::nullopt), 2.0, 0.02);
+  EXPECT_NEAR(run(0.4), 1.5, 0.02);
+  MotionExecutor motion(model);
+  EXPECT_THROW(motion.FollowPath({start, goal}, {false}, TuckedArm(model), Time{}, 0.0),
+               InvalidArgument);
+}
+
 }  // namespace
 }  // namespace egress::behavior

@@ -85,5 +85,50 @@ TEST_F(NavigationNodesTest, WaitForClearWaitsForTheZoneAndGivesUpAfterItsTimeout
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
 }
 
+// A retreat begun while the base still rolls the other way would leave its reference behind
+// and trip the watchdog (H2 seed 2002): it starts once the base has stopped.
+TEST_F(NavigationNodesTest, RetractToSafeWaitsForTheBaseToStopBeforeBackingOff) {
+  auto blackboard = bt::Blackboard::Create();
+  bt::Tree tree = Tree(R"(<RetractToSafe/>)", blackboard);
+  belief_.X_MB = {0.0, 2.9, M_PI / 2};
+  belief_.last_safe = Pose2{0.0, 1.5, M_PI / 2};
+  belief_.V_B = {0.4, 0.0, 0.0};
+  belief_.now = At(1.0);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_EQ(blackboard->Get<bool>("retreating"), true);  // under way: IsPathClear keeps failing
+  EXPECT_FALSE(motion_.base_moving());
+  EXPECT_FALSE(Noted(DecisionEvent::kRetreating));
+  belief_.now = At(1.3);
+  belief_.V_B = {};
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(motion_.base_moving());
+  EXPECT_TRUE(Noted(DecisionEvent::kRetreating));
+}
+
+TEST_F(NavigationNodesTest, RetractToSafeStepsOutOfAPersonsPredictedPath) {
+  auto blackboard = bt::Blackboard::Create();
+  bt::Tree tree = Tree(R"(<RetractToSafe/>)", blackboard);
+  belief_.X_MB = {0.0, 2.4, M_PI / 2};
+  belief_.last_safe = Pose2{0.0, 1.2, M_PI / 2};
+  // Through the door towards the south-west, past the last safe pose within 3 s.
+  auto crosser = Person({-0.1, 3.4}, perception::PersonIntent::kCrossing);
+  crosser.person.v_MP = {-0.3, -1.3};
+  belief_.world.people = {crosser};
+  belief_.now = At(1.0);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  ASSERT_GE(motion_.path().size(), 2u);
+  const Eigen::Vector2d spot = motion_.path().back().translation();
+  EXPECT_GT(spot.x(), 0.4) << "away from the person's way, not back along the robot's own";
+  EXPECT_FALSE(IsInAnyDoorZone(services_, spot));
+  // Nobody near: back to the last safe pose as before.
+  motion_.StopBase();
+  belief_.world.people.clear();
+  tree.HaltTree();
+  belief_.now = At(5.0);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  ASSERT_GE(motion_.path().size(), 2u);
+  EXPECT_LT((motion_.path().back().translation() - Eigen::Vector2d(0.0, 1.2)).norm(), 1e-6);
+}
+
 }  // namespace
 }  // namespace egress::behavior

@@ -156,5 +156,63 @@ TEST_F(DoorZoneRulesTest, AnUnknownDoorIsAClearError) {
   EXPECT_THROW(IsDoorZoneOccupied(services_, "door_z"), InvalidArgument);
 }
 
+// Issue 21: a person the tracker reads as crossing (through the opening within its 2 s horizon)
+// occupies the zone already, before the paper's 0.8 s forecast reaches it.
+TEST_F(DoorZoneRulesTest, APersonCrossingOccupiesTheZoneBeforeTheForecastReachesIt) {
+  auto coming = StillPerson({-0.2, 5.6}, perception::PersonIntent::kCrossing);
+  coming.person.v_MP = {0.0, -1.3};
+  coming.person.forecast = {{-0.2, 5.3}, {-0.2, 5.1}};  // 0.8 s: not yet in the zone
+  belief_.world.people = {coming};
+  EXPECT_TRUE(IsDoorZoneOccupied(services_, "lab_door"));
+  services_.config.yield_to_crossing = false;
+  EXPECT_FALSE(IsDoorZoneOccupied(services_, "lab_door"));
+  // Crossing another door: not this one's.
+  services_.config.yield_to_crossing = true;
+  coming.door_id = "door_b";
+  belief_.world.people = {coming};
+  EXPECT_FALSE(IsDoorZoneOccupied(services_, "lab_door"));
+}
+
+TEST_F(DoorZoneRulesTest, SomeoneWaitingBeyondADoorThatJustOpenedHasTheRightOfWay) {
+  services_.config.right_of_way_time = 2.0;
+  belief_.now = Time{} + SecondsToDuration(50.0);
+  const auto opened = [&](double ago) {
+    belief_.door_open_since["lab_door"] = belief_.now - SecondsToDuration(ago);
+  };
+  const auto waiting = StillPerson({-0.3, 4.7}, perception::PersonIntent::kStationary);
+  belief_.world.people = {waiting};
+  opened(1.0);
+  EXPECT_TRUE(IsDoorZoneOccupied(services_, "lab_door"));
+  opened(2.5);  // still standing there once the right of way is over: not coming
+  EXPECT_FALSE(IsDoorZoneOccupied(services_, "lab_door"));
+  belief_.door_open_since.clear();  // not open yet: the robot has to open it first
+  EXPECT_FALSE(IsDoorZoneOccupied(services_, "lab_door"));
+  opened(1.0);
+  auto leaving = waiting;
+  leaving.person.v_MP = {-0.3, 1.0};  // walking off from the doorway
+  belief_.world.people = {leaving};
+  EXPECT_FALSE(IsDoorZoneOccupied(services_, "lab_door"));
+  // Beyond the radius, or on the robot's own side: no right of way over the robot.
+  belief_.world.people = {StillPerson({-0.3, 5.7}, perception::PersonIntent::kStationary)};
+  EXPECT_FALSE(IsDoorZoneOccupied(services_, "lab_door"));
+  belief_.world.people = {StillPerson({-1.3, 1.6}, perception::PersonIntent::kStationary)};
+  EXPECT_FALSE(IsDoorZoneOccupied(services_, "lab_door"));
+  services_.config.right_of_way_time = 0.0;
+  belief_.world.people = {waiting};
+  EXPECT_FALSE(IsDoorZoneOccupied(services_, "lab_door"));
+}
+
+TEST_F(DoorZoneRulesTest, DoorZonesReachZoneDepthFromTheLineAndCoverTheLeafsSweep) {
+  // South (the robot's side), on the axis: within zone_depth (1 m) of the line or not.
+  EXPECT_TRUE(IsInAnyDoorZone(services_, {0.0, 2.1}));
+  EXPECT_FALSE(IsInAnyDoorZone(services_, {0.0, 1.9}));
+  // Beside the opening by more than half a metre past the jamb: not in the way.
+  EXPECT_TRUE(IsInAnyDoorZone(services_, {0.9, 2.5}));
+  EXPECT_FALSE(IsInAnyDoorZone(services_, {1.2, 2.5}));
+  // North, where the leaf swings: in its sweep though beside the opening.
+  EXPECT_TRUE(IsInAnyDoorZone(services_, {1.0, 3.3}));
+  EXPECT_FALSE(IsInAnyDoorZone(services_, {2.0, 3.3}));
+}
+
 }  // namespace
 }  // namespace egress::behavior

@@ -1,6 +1,7 @@
 #include "egress/hsr_interface/robot_port.h"
 
 #include <cmath>
+#include <limits>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -20,6 +21,7 @@ class RecordingPort final : public RobotPort {
   std::vector<Twist2> base_commands;
   std::vector<JointTrajectory> arm_commands;
   std::vector<GripperCommand> gripper_commands;
+  std::vector<HeadCommand> head_commands;
   SimClock sim_clock;
 
   const Clock& clock() const override { return sim_clock; }
@@ -29,6 +31,7 @@ class RecordingPort final : public RobotPort {
   void DoSendBaseVelocity(const Twist2& V_B) override { base_commands.push_back(V_B); }
   void DoSendArmTrajectory(const JointTrajectory& t) override { arm_commands.push_back(t); }
   void DoSendGripperCommand(const GripperCommand& c) override { gripper_commands.push_back(c); }
+  void DoSendHeadCommand(const HeadCommand& c) override { head_commands.push_back(c); }
 };
 
 TEST(RobotPortTest, ValidCommandsPassThrough) {
@@ -39,7 +42,10 @@ TEST(RobotPortTest, ValidCommandsPassThrough) {
   trajectory.points = {{{-0.5}, {}, {}, std::chrono::seconds(2)}};
   port.SendArmTrajectory(trajectory);
   port.SendGripperCommand({GripperCommand::Mode::kOpen, 0.0, 0.0});
+  port.SendHeadCommand({0.5, -0.1});
   ASSERT_EQ(port.base_commands.size(), 1u);
+  ASSERT_EQ(port.head_commands.size(), 1u);
+  EXPECT_DOUBLE_EQ(port.head_commands[0].pan, 0.5);
   EXPECT_DOUBLE_EQ(port.base_commands[0].vx, 0.2);
   EXPECT_EQ(port.arm_commands.size(), 1u);
   EXPECT_EQ(port.gripper_commands.size(), 1u);
@@ -50,6 +56,9 @@ TEST(RobotPortTest, MalformedCommandsNeverReachTheRobot) {
   EXPECT_THROW(port.SendBaseVelocity({std::nan(""), 0.0, 0.0}), InvalidArgument);
   EXPECT_THROW(port.SendArmTrajectory(JointTrajectory{}), InvalidArgument);
   EXPECT_THROW(port.SendGripperCommand({GripperCommand::Mode::kGrasp, 0.0, -1.0}), InvalidArgument);
+  EXPECT_THROW(port.SendHeadCommand({0.0, std::numeric_limits<double>::infinity()}),
+               InvalidArgument);
+  EXPECT_TRUE(port.head_commands.empty());
   EXPECT_TRUE(port.base_commands.empty());
   EXPECT_TRUE(port.arm_commands.empty());
   EXPECT_TRUE(port.gripper_commands.empty());

@@ -113,6 +113,12 @@ TEST(ScenarioJudgeTest, PersonalSpaceAndPersonContactsAreMeasured) {
       "wait_s: 60}]\n");
   EXPECT_LT(v.metrics.min_person_distance, 0.0);
   EXPECT_GT(v.metrics.time_in_personal_space, 0.2);
+  // The closest moment was at the start, the robot standing (it waits 5 s): the judge tells a
+  // person coming to a standing robot from the robot coming to them by its speed (issue 21).
+  EXPECT_LT(v.metrics.closest_robot_speed, 0.05);
+  EXPECT_LT(v.metrics.closest_time, 0.5);
+  EXPECT_THAT(FormatVerdict(v), HasSubstr("robot at"));
+  EXPECT_THAT(VerdictToJson(v), HasSubstr("\"closest_robot_speed\":"));
   EXPECT_GE(v.metrics.contacts.count("person") ? v.metrics.contacts.at("person") : 0, 1);
   EXPECT_FALSE(v.success);
 }

@@ -64,6 +64,9 @@ TEST(ScenarioTest, ErrorsNameFileLineAndField) {
   ExpectError(Minimal("people:\n  - behavior: hold_door\n    start: [0, 0]\n"), "people[0].door",
               "is required");
   ExpectError(Minimal("people:\n  - behavior: walk_past\n    start: [0, 0]\n    goal: [1, 1]\n"
+                      "    leave: [2, 2]\n"),
+              "people[0].leave", "approach_and_wait only");
+  ExpectError(Minimal("people:\n  - behavior: walk_past\n    start: [0, 0]\n    goal: [1, 1]\n"
                       "    trigger: {event: opened}\n"),
               "trigger.event", "button_pressed:<door>");
   ExpectError("world: [lab.sdf\n", "bad.yaml:", "not valid YAML");

@@ -432,5 +432,57 @@ TEST(TwinWorldTest, SameSeedSameTraceOtherSeedOtherTrace) {
   EXPECT_NE(a.first, c.first);
 }
 
+// Issue 21: the head is commanded apart from the arm; the twin turns it at the URDF's 1 rad/s
+// within its limits, and the head camera (what the detector sees from) turns with it.
+TEST(TwinWorldTest, AHeadCommandTurnsTheHeadAtItsSpeedAndTheCameraWithIt) {
+  const auto loaded = LoadText(LabScenario({0.0, 1.0, M_PI / 2}), WorldsDir() / "lab");
+  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+  const Pose3 before = world.head_camera_pose();
+  world.SetHeadCommand({0.8, -0.2});
+  world.StepFor(0.4);
+  EXPECT_NEAR(world.arm_joint("head_pan_joint"), 0.4, 0.02);  // 1 rad/s: not there yet
+  world.StepFor(1.0);
+  EXPECT_NEAR(world.arm_joint("head_pan_joint"), 0.8, 1e-9);
+  EXPECT_NEAR(world.arm_joint("head_tilt_joint"), -0.2, 1e-9);
+  // The camera's optical axis (z) turned left by the pan, in the floor's plane.
+  const Eigen::Vector3d z0 = before.rotation().col(2),
+                        z1 = world.head_camera_pose().rotation().col(2);
+  const double turned = std::atan2(z1.y(), z1.x()) - std::atan2(z0.y(), z0.x());
+  EXPECT_NEAR(turned, 0.8, 0.02);
+  // Beyond the joint's limit (head_pan_joint upper 1.75 rad): clamped.
+  world.SetHeadCommand({3.0, 0.0});
+  world.StepFor(3.0);
+  EXPECT_NEAR(world.arm_joint("head_pan_joint"), 1.75, 1e-9);
+  // An arm trajectory naming a head joint takes the head over again.
+  JointTrajectory head;
+  head.joint_names = {"head_pan_joint"};
+  JointTrajectoryPoint p;
+  p.positions = {0.0};
+  p.time_from_start = SecondsToDuration(0.1);
+  head.points.push_back(p);
+  world.SetArmTrajectory(head);
+  world.StepFor(2.5);
+  EXPECT_NEAR(world.arm_joint("head_pan_joint"), 0.0, 1e-9);
+  EXPECT_THROW(world.SetHeadCommand({std::nan(""), 0.0}), InvalidArgument);
+}
+
+TEST(TwinWorldTest, SomeoneWhoWaitedLeavesForTheirLeavePoint) {
+  const auto loaded =
+      LoadText(LabScenario({0.0, 1.0, M_PI / 2}) +
+                   "people:\n  - {name: talker, behavior: approach_and_wait, start: [-1.5, 5.0],"
+                   " goal: [-1.5, 4.0], wait_s: 2, leave: [-2.0, 6.0]}\n",
+               WorldsDir() / "lab");
+  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+  world.StepFor(2.0);
+  EXPECT_LT((world.people()[0].position - Eigen::Vector2d(-1.5, 4.0)).norm(), 0.2);
+  // (The walls' social forces keep a standing walker a little off a point 1 m from them.)
+  world.StepFor(6.0);
+  const Eigen::Vector2d there = world.people()[0].position;
+  EXPECT_LT((there - Eigen::Vector2d(-2.0, 6.0)).norm(), 0.5);
+  world.StepFor(4.0);  // and stays there
+  EXPECT_LT((world.people()[0].position - Eigen::Vector2d(-2.0, 6.0)).norm(), 0.5);
+  EXPECT_LT((world.people()[0].position - there).norm(), 0.25);
+}
+
 }  // namespace
 }  // namespace egress::twin

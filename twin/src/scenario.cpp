@@ -298,7 +298,7 @@ Scenario Parse(const YAML::Node& root, const FieldReader& r,
       r.CheckKeys(
           n, f,
           {"name", "behavior", "start", "goal", "via", "door", "speed", "trigger", "hold_angle_deg",
-           "hold_duration", "wait_s", "count", "radius", "mobility", "route"});
+           "hold_duration", "wait_s", "count", "radius", "mobility", "route", "leave"});
       PersonSpec p;
       p.name = n["name"] ? r.String(n["name"], f + ".name") : "person_" + std::to_string(i);
       p.behavior = ParseBehavior(r, r.Required(n, f, "behavior"), f + ".behavior");
@@ -311,6 +311,12 @@ Scenario Parse(const YAML::Node& root, const FieldReader& r,
         }
       }
       if (n["door"]) p.door = r.String(n["door"], f + ".door");
+      if (n["leave"]) {
+        if (p.behavior != PersonBehavior::kApproachAndWait)
+          r.Fail(n["leave"], f + ".leave",
+                 "is for approach_and_wait only (where to go after the wait)");
+        p.leave = r.Point(n["leave"], f + ".leave");
+      }
       if (const YAML::Node route = n["route"]) {
         if (!route.IsSequence() || route.size() == 0)
           r.Fail(route, f + ".route", "expected a list of door names (the exit route, in order)");

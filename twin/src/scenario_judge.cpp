@@ -59,7 +59,12 @@ void ScenarioJudge::Observe(const TwinWorld& world) {
     if (p.out) continue;  // left the scene
     nearest = std::min(nearest, (p.position - X_WB.translation()).norm() - robot_r - p.radius);
   }
-  metrics_.min_person_distance = std::min(metrics_.min_person_distance, nearest);
+  if (nearest < metrics_.min_person_distance) {
+    metrics_.min_person_distance = nearest;
+    const Twist2 V_B = world.robot_velocity();
+    metrics_.closest_robot_speed = std::hypot(V_B.vx, V_B.vy);
+    metrics_.closest_time = t;
+  }
   if (nearest < kPersonalSpace) metrics_.time_in_personal_space += dt;
   for (std::size_t i = 0; i < world.door_count(); ++i) {
     const DoorDescription& d = world.door(i);
@@ -210,7 +215,10 @@ std::string FormatVerdict(const Verdict& v) {
   if (m.time_to_goal) out << ", to goal " << Fmt(*m.time_to_goal, 1) << " s";
   out << ", path " << Fmt(m.path_length) << " m";
   out << ", min person gap "
-      << (std::isfinite(m.min_person_distance) ? Fmt(m.min_person_distance) + " m" : "-");
+      << (std::isfinite(m.min_person_distance)
+              ? Fmt(m.min_person_distance) + " m (at " + Fmt(m.closest_time, 1) + " s, robot at " +
+                    Fmt(m.closest_robot_speed) + " m/s)"
+              : "-");
   out << ", personal space " << Fmt(m.time_in_personal_space, 1) << " s";
   int contacts = 0;
   for (const auto& [k, n] : m.contacts)
@@ -250,6 +258,10 @@ std::string VerdictToJson(const Verdict& v) {
   s += Fmt(m.path_length, 3);
   s += ",\"min_person_distance\":";
   s += std::isfinite(m.min_person_distance) ? Fmt(m.min_person_distance, 3) : std::string("null");
+  s += ",\"closest_robot_speed\":";
+  s += Fmt(m.closest_robot_speed, 3);
+  s += ",\"closest_time\":";
+  s += Fmt(m.closest_time, 3);
   s += ",\"time_in_personal_space\":";
   s += Fmt(m.time_in_personal_space, 3);
   s += ",\"presses_per_traversal\":";

@@ -137,5 +137,8 @@ void TwinRobot::DoSendArmTrajectory(const JointTrajectory& trajectory) {
 void TwinRobot::DoSendGripperCommand(const GripperCommand& command) {
   world_->SetGripperCommand(command);
 }
+void TwinRobot::DoSendHeadCommand(const HeadCommand& command) {
+  world_->SetHeadCommand(command);
+}
 
 }  // namespace egress::twin

@@ -182,6 +182,7 @@ void TwinWorld::Impl::UpdateRobot() {
     const auto& pts = trajectory->points;
     for (std::size_t j = 0; j < trajectory->joint_names.size(); ++j) {
       const std::string& name = trajectory->joint_names[j];
+      if (head_command && (name == "head_pan_joint" || name == "head_tilt_joint")) continue;
       double target = pts.back().positions[j];
       double prev_t = 0.0, prev_q = trajectory_q0[j];
       for (const auto& pt : pts) {
@@ -194,6 +195,15 @@ void TwinWorld::Impl::UpdateRobot() {
         prev_t = pt_t;
         prev_q = pt.positions[j];
       }
+      const JointLimits lim = model->GetJointLimits(name);
+      double& q = arm_q[name];
+      const double max_step = lim.velocity > 0 ? lim.velocity * dt : 1e9;
+      q = std::clamp(q + std::clamp(target - q, -max_step, max_step), lim.lower, lim.upper);
+    }
+  }
+  if (head_command) {
+    for (const auto& [name, target] : {std::pair{"head_pan_joint", head_command->pan},
+                                       {"head_tilt_joint", head_command->tilt}}) {
       const JointLimits lim = model->GetJointLimits(name);
       double& q = arm_q[name];
       const double max_step = lim.velocity > 0 ? lim.velocity * dt : 1e9;

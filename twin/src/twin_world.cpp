@@ -254,10 +254,18 @@ void TwinWorld::SetArmTrajectory(const JointTrajectory& trajectory) {
     }
     q0.push_back(it->second);
   }
+  for (const auto& name : trajectory.joint_names) {
+    if (name == "head_pan_joint" || name == "head_tilt_joint") impl_->head_command.reset();
+  }
   impl_->trajectory = trajectory;
   impl_->trajectory_q0 = std::move(q0);
   impl_->trajectory_start =
       trajectory.start.count() == 0 ? impl_->time : ToSeconds(trajectory.start);
+}
+
+void TwinWorld::SetHeadCommand(const HeadCommand& command) {
+  command.Validate();
+  impl_->head_command = command;
 }
 
 void TwinWorld::SetGripperCommand(const GripperCommand& command) {

@@ -284,6 +284,7 @@ struct TwinWorld::Impl {
   double trajectory_start{0.0};
   double hand_q{kHandOpen};
   GripperCommand gripper_command;
+  std::optional<HeadCommand> head_command;
   int held{-1};
   std::set<int> grasp_tried;
   Pose3 palm;

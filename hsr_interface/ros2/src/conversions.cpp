@@ -353,6 +353,48 @@ JointTrajectory FromRos(const trajectory_msgs::msg::JointTrajectory& msg) {
   return trajectory;
 }
 
+JointTrajectory HeadTrajectory(const HeadCommand& command, const std::optional<JointState>& from) {
+  constexpr double kMinMoveSec = 0.1;
+  double travel = 0.0;
+  if (from) {
+    if (const auto pan = from->Position("head_pan_joint"))
+      travel = std::max(travel, std::abs(command.pan - *pan));
+    if (const auto tilt = from->Position("head_tilt_joint"))
+      travel = std::max(travel, std::abs(command.tilt - *tilt));
+  }
+  JointTrajectory trajectory;
+  trajectory.joint_names = {"head_pan_joint", "head_tilt_joint"};
+  JointTrajectoryPoint point;
+  point.positions = {command.pan, command.tilt};
+  point.time_from_start = SecondsToDuration(std::max(kMinMoveSec, travel / kHeadSpeedRadPerSec));
+  trajectory.points.push_back(std::move(point));
+  return trajectory;
+}
+
+HeadCommand HeadFromTrajectory(const JointTrajectory& trajectory) {
+  trajectory.Validate();
+  ThrowUnless(!trajectory.points.empty(), "head trajectory: no points");
+  ThrowUnless(trajectory.joint_names.size() == 2, "head trajectory: expected head_pan_joint and ",
+              "head_tilt_joint, got ", trajectory.joint_names.size(), " joint(s)");
+  std::optional<double> pan, tilt;
+  const auto& last = trajectory.points.back().positions;
+  for (std::size_t j = 0; j < 2; ++j) {
+    const std::string& name = trajectory.joint_names[j];
+    if (name == "head_pan_joint") {
+      pan = last[j];
+    } else if (name == "head_tilt_joint") {
+      tilt = last[j];
+    } else {
+      throw InvalidArgument(StrCat("head trajectory: '", name,
+                                   "' is not a head joint (head_pan_joint, head_tilt_joint)"));
+    }
+  }
+  ThrowUnless(pan && tilt, "head trajectory: needs both head_pan_joint and head_tilt_joint");
+  HeadCommand command{*pan, *tilt};
+  command.Validate();
+  return command;
+}
+
 GripperGoal GripperToRos(const GripperCommand& command, double open_torque) {
   GripperGoal out;
   switch (command.mode) {

@@ -120,6 +120,18 @@ RobotPortServer::RobotPortServer(RobotPort& robot, Ros2Topics topics, int domain
             m.Queue(m.topics.arm_trajectory,
                     [&m, msg] { m.robot.SendArmTrajectory(FromRos(msg)); });
           }));
+  m.subscriptions.push_back(
+      m.node.CreateSubscription<trajectory_msgs::msg::JointTrajectoryPubSubType>(
+          t.head_trajectory, reliable, [&m](const trajectory_msgs::msg::JointTrajectory& msg) {
+            try {
+              const HeadCommand command = HeadFromTrajectory(FromRos(msg));
+              m.Queue(m.topics.head_trajectory,
+                      [&m, command] { m.robot.SendHeadCommand(command); });
+            } catch (const std::exception& e) {
+              const std::lock_guard<std::mutex> lock(m.mutex);
+              m.rejected.push_back(m.topics.head_trajectory + ": " + e.what());
+            }
+          }));
   // The gripper controller's action goals: accepted (and queued) or refused with why.
   const auto serve_goals = [&m](const std::string& action, GripperGoal::Action kind) {
     return m.node.CreateServiceServer<

@@ -85,6 +85,7 @@ struct Ros2RobotPort::Impl {
   std::vector<std::unique_ptr<eprosima::fastdds::dds::DataReaderListener>> subscriptions;
   std::unique_ptr<Publisher<geometry_msgs::msg::TwistPubSubType>> cmd_vel;
   std::unique_ptr<Publisher<trajectory_msgs::msg::JointTrajectoryPubSubType>> arm;
+  std::unique_ptr<Publisher<trajectory_msgs::msg::JointTrajectoryPubSubType>> head;
   using GripperGoalClient =
       ServiceClient<tmc_control_msgs::action::GripperApplyEffort_SendGoal_RequestPubSubType,
                     tmc_control_msgs::action::GripperApplyEffort_SendGoal_ResponsePubSubType>;
@@ -198,6 +199,8 @@ Ros2RobotPort::Ros2RobotPort(Ros2RobotPortConfig config, std::string_view node_n
   m.cmd_vel = m.node.CreatePublisher<geometry_msgs::msg::TwistPubSubType>(t.cmd_vel, reliable);
   m.arm = m.node.CreatePublisher<trajectory_msgs::msg::JointTrajectoryPubSubType>(t.arm_trajectory,
                                                                                   reliable);
+  m.head = m.node.CreatePublisher<trajectory_msgs::msg::JointTrajectoryPubSubType>(
+      t.head_trajectory, reliable);
   const auto goal_client = [&m](const std::string& action) {
     return m.node.CreateServiceClient<
         tmc_control_msgs::action::GripperApplyEffort_SendGoal_RequestPubSubType,
@@ -407,6 +410,15 @@ void Ros2RobotPort::DoSendArmTrajectory(const JointTrajectory& trajectory) {
                 " s old (command_timeout_s ", impl_->config.command_timeout_s, "): not sent");
   }
   impl_->arm->Publish(ToRos(trajectory));
+}
+
+void Ros2RobotPort::DoSendHeadCommand(const HeadCommand& command) {
+  std::optional<JointState> joints;
+  {
+    const std::lock_guard<std::mutex> lock(impl_->mutex);
+    joints = impl_->joints;
+  }
+  impl_->head->Publish(ToRos(HeadTrajectory(command, joints)));
 }
 
 int Ros2RobotPort::stale_base_commands() const {

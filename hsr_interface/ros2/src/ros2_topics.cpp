@@ -22,6 +22,7 @@ std::vector<std::pair<const char*, std::string Ros2Topics::*>> Entries() {
           {"detections", &Ros2Topics::detections},
           {"cmd_vel", &Ros2Topics::cmd_vel},
           {"arm_trajectory", &Ros2Topics::arm_trajectory},
+          {"head_trajectory", &Ros2Topics::head_trajectory},
           {"gripper_grasp_action", &Ros2Topics::gripper_grasp_action},
           {"gripper_apply_force_action", &Ros2Topics::gripper_apply_force_action},
           {"status", &Ros2Topics::status},

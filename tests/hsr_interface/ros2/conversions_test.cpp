@@ -162,6 +162,38 @@ TEST(Ros2ConversionsTest, TwistTransformAndTrajectory) {
   EXPECT_NO_THROW(t_back.Validate());
 }
 
+// The HSR's head controller takes a trajectory for its two joints; one point, timed at the
+// joints' 1 rad/s from where they are (at least 0.1 s); the twin's side reads the target back.
+TEST(Ros2ConversionsTest, HeadCommandsAsTheHeadControllersTrajectory) {
+  JointState joints;
+  joints.names = {"arm_lift_joint", "head_pan_joint", "head_tilt_joint"};
+  joints.positions = {0.1, -0.5, 0.0};
+  const JointTrajectory t = HeadTrajectory({0.7, -0.2}, joints);
+  EXPECT_EQ(t.joint_names, (std::vector<std::string>{"head_pan_joint", "head_tilt_joint"}));
+  ASSERT_EQ(t.points.size(), 1u);
+  EXPECT_NEAR(std::chrono::duration<double>(t.points[0].time_from_start).count(), 1.2, 1e-9);
+  EXPECT_NEAR(
+      std::chrono::duration<double>(HeadTrajectory({-0.5, 0.0}, joints).points[0].time_from_start)
+          .count(),
+      0.1, 1e-9);
+  EXPECT_NEAR(std::chrono::duration<double>(
+                  HeadTrajectory({0.7, 0.0}, std::nullopt).points[0].time_from_start)
+                  .count(),
+              0.1, 1e-9);
+  const HeadCommand back = HeadFromTrajectory(FromRos(ToRos(t)));
+  EXPECT_DOUBLE_EQ(back.pan, 0.7);
+  EXPECT_DOUBLE_EQ(back.tilt, -0.2);
+  JointTrajectory arm = t;
+  arm.joint_names = {"head_pan_joint", "arm_flex_joint"};
+  EXPECT_THAT([&] { HeadFromTrajectory(arm); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("'arm_flex_joint' is not a head joint")));
+  JointTrajectory one = t;
+  one.joint_names = {"head_pan_joint"};
+  one.points[0].positions = {0.1};
+  EXPECT_THAT([&] { HeadFromTrajectory(one); },
+              ThrowsMessage<InvalidArgument>(HasSubstr("head_tilt_joint")));
+}
+
 // The HSR's gripper controller: a grasp is its apply_force action with the force [N], open its
 // grasp action with a positive torque; what the twin cannot do is refused by name.
 TEST(Ros2ConversionsTest, GripperCommandsAsTheHsrsActionGoals) {

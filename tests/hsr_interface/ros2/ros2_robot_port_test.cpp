@@ -139,6 +139,9 @@ TEST(Ros2RobotPortTest, SensorsAndCommandsCrossTheBridge) {
   arm.joint_names = {"arm_lift_joint"};
   arm.points = {{{0.3}, {}, {}, Duration{1'000'000'000}}};
   b.brain.SendArmTrajectory(arm);
+  // The head: a head_trajectory_controller point timed from the joint states (pan -0.1 -> 0.6
+  // at 1 rad/s), the server hands the robot the head command it ends in.
+  b.brain.SendHeadCommand({0.6, -0.3});
   // The gripper's goals go to the controller's actions (services: a goal sent before the
   // server is matched is lost, as with ROS 2's own clients).
   ASSERT_TRUE(Eventually([&] { return b.brain.GripperConnected(); }));
@@ -152,8 +155,11 @@ TEST(Ros2RobotPortTest, SensorsAndCommandsCrossTheBridge) {
   ASSERT_TRUE(Eventually([&] {
     b.server.ApplyCommands();
     return !b.robot.velocities.empty() && !b.robot.trajectories.empty() &&
-           b.robot.gripper.size() >= 2 && b.brain.gripper_goals().first == 2;
+           b.robot.gripper.size() >= 2 && b.brain.gripper_goals().first == 2 &&
+           !b.robot.head.empty();
   }));
+  EXPECT_DOUBLE_EQ(b.robot.head[0].pan, 0.6);
+  EXPECT_DOUBLE_EQ(b.robot.head[0].tilt, -0.3);
   EXPECT_EQ(b.brain.gripper_goals().second, 0);
   EXPECT_DOUBLE_EQ(b.robot.velocities[0].vy, -0.1);
   EXPECT_EQ(b.robot.trajectories[0].joint_names, arm.joint_names);

@@ -15,6 +15,7 @@ class ScriptedRobot final : public RobotPort {
   std::vector<Twist2> velocities;
   std::vector<JointTrajectory> trajectories;
   std::vector<GripperCommand> gripper;
+  std::vector<HeadCommand> head;
   SimClock sim_clock;
   const Clock& clock() const override { return sim_clock; }
 
@@ -23,6 +24,7 @@ class ScriptedRobot final : public RobotPort {
   void DoSendBaseVelocity(const Twist2& V) override { velocities.push_back(V); }
   void DoSendArmTrajectory(const JointTrajectory& t) override { trajectories.push_back(t); }
   void DoSendGripperCommand(const GripperCommand& c) override { gripper.push_back(c); }
+  void DoSendHeadCommand(const HeadCommand& c) override { head.push_back(c); }
 };
 
 }  // namespace egress::ros2::test_support

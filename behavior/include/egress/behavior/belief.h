@@ -27,6 +27,7 @@ inline constexpr double kOffMapM = 0.15;
 struct Belief {
   Time now{};  ///< The robot clock at this step.
   Pose2 X_MB;  ///< The localized base pose.
+  Twist2 V_B;  ///< The base's measured velocity (wheel odometry), in B.
   perception::WorldState world;
   bool holding_object{false};  ///< From the gripper's own measurement (GraspMonitor).
   /// The fingers moved after the last gripper command and have come to rest (GraspMonitor).

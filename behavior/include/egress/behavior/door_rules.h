@@ -33,8 +33,13 @@ DoorPass CalcApproachPass(const TaskServices& task, DoorVisit& visit);
 /// doorway face to face with the robot is still, next to an open leaf, and not holding it).
 bool IsHoldingDoorAside(const TaskServices& task, const perception::TrackedPersonWithIntent& entry,
                         const std::string& door);
+/// Whether a robot standing at p_MB would be in a door's way: within config.zone_depth of a
+/// door line (and half a metre beside its opening), or where a door's leaf sweeps (with the
+/// leaf clearance). A retreat ends outside them; the executive's last safe pose is outside.
+bool IsInAnyDoorZone(const TaskServices& task, const Eigen::Vector2d& p_MB);
 /// True when a person (not one holding this door aside) is in, or forecast into, the zone of
-/// `door`.
+/// `door`; or crossing it (TaskConfig::yield_to_crossing); or, on its far side, waiting for it
+/// while its opening is young (TaskConfig::right_of_way_time).
 bool IsDoorZoneOccupied(const TaskServices& task, const std::string& door);
 /// The zone of `door` has been free of people (IsDoorZoneOccupied false) for at least
 /// `clear_for` [s], by the belief's zone_occupied_at.

@@ -18,6 +18,7 @@
 
 #include "egress/behavior/belief.h"
 #include "egress/behavior/grasp_monitor.h"
+#include "egress/behavior/head_gaze.h"
 #include "egress/behavior/mission_map.h"
 #include "egress/behavior/motion_executor.h"
 #include "egress/behavior/task_services.h"
@@ -46,6 +47,7 @@ struct ExecutiveConfig {
   double tick_rate_hz{10.0};      ///< Behavior-tree ticks (the paper's 10 Hz).
   double control_rate_hz{100.0};  ///< Controller steps; Step() is called at this rate.
   TaskConfig tasks;
+  HeadGazeConfig head;  ///< Where the head camera looks (HeadGaze).
   planning::TrajectoryConfig trajectory;
   planning::ControllerConfig controller;
   ArmMotionConfig arm;       ///< When an arm motion is done (measured joints) or failed.
@@ -185,7 +187,10 @@ class Executive {
   bt::NodeStatus status_{bt::NodeStatus::kIdle};
   std::vector<Decision> decisions_;
   std::vector<std::pair<double, double>> preemptions_;
-  static constexpr double kPoseHistorySec = 1.0;     ///< Longer than the detector's latency.
+  static constexpr double kPoseHistorySec = 1.0;  ///< Longer than the detector's latency.
+  /// [rad] The head turned more than this between an image and the depth image that places its
+  /// boxes: the boxes are dropped.
+  static constexpr double kHeadMovedRad = 0.02;
   std::deque<std::pair<Time, Pose2>> pose_history_;  ///< Localized X_MB per control step.
   perception::ScanMotion
       scan_motion_;  ///< Which returns off the map moved (belief_.moving_returns).

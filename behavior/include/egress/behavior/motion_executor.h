@@ -53,10 +53,11 @@ class MotionExecutor {
                  planning::ControllerConfig controller = {}, ArmMotionConfig arm = {});
 
   /// Follows `path` (X_MB waypoints, the first one the current pose); `through_door[i]` marks
-  /// segment i as a door crossing (0.4 m/s). The arm holds `arm`.
-  /// @throws InvalidArgument for fewer than 2 waypoints or non-finite poses.
+  /// segment i as a door crossing (0.4 m/s). The arm holds `arm`. `speed` [m/s], if given,
+  /// replaces the nominal speed of the other segments (a retreat from someone).
+  /// @throws InvalidArgument for fewer than 2 waypoints, non-finite poses or a speed <= 0.
   void FollowPath(const std::vector<Pose2>& path, const std::vector<bool>& through_door,
-                  const ArmPose& arm, Time now);
+                  const ArmPose& arm, Time now, std::optional<double> speed = std::nullopt);
   /// Drives the base to `p_MGoal` with the Bug2 local planner instead (head for the goal,
   /// follow an obstacle's boundary round it, stop for people ahead) — the detour when the
   /// costmap has no path. It sees what SetSurroundings last gave it.

@@ -34,8 +34,29 @@ struct TaskConfig {
   /// A door still steady this long past the window is held by someone out of sight (the
   /// holder often stands behind the jamb) [s].
   double door_hold_margin{2.0};
-  double zone_depth{1.0};        ///< People-free zone each side of a door line [m].
-  double person_radius{0.3};     ///< [m]
+  double zone_depth{1.0};     ///< People-free zone each side of a door line [m].
+  double person_radius{0.3};  ///< [m]
+  /// A person the tracker classifies as crossing a door (their straight path goes through its
+  /// opening within IntentConfig::crossing_horizon, 2 s) occupies its zone already: the robot
+  /// yields before they arrive, not when they are 0.8 s away (the paper's forecast).
+  bool yield_to_crossing{true};
+  /// Right of way at a door that has just opened: someone on its far side within this of the
+  /// doorway's centre, not walking away, was waiting for it and comes through first [m] ...
+  double right_of_way_radius{2.5};
+  /// ... while the opening is younger than this; someone still standing there after it is
+  /// not coming, and the robot goes. After operating a door itself, the robot waits beside it
+  /// (not lining up across the doorway) this long after the operator's shortest opening time,
+  /// for people it cannot see from there [s]. 0 (the default): no right of way — the wait eats
+  /// into the operator's hold window, and a robot re-pressing a door it cannot see open from
+  /// the actuator then finds too little of the window left (S2 seeds 2000-2003: 4/4 -> 0/4 with 2
+  /// s).
+  double right_of_way_time{0.0};
+  /// The gap the robot keeps from people where it can (surface to surface; personal space is
+  /// 0.45-1.2 m): a standby retreat goes where people will stay at least this far [m].
+  double comfort_distance{0.8};
+  /// A standby retreat's speed: a quintic from rest at the paper's 0.2 m/s covers 4 cm in its
+  /// first second [m/s].
+  double retreat_speed{0.4};
   double arm_tuck_time{1.5};     ///< [s]
   double press_reach_time{2.0};  ///< Tucked → pre-press [s].
   double press_time{1.0};        ///< Pre-press → press → pre-press, each way [s].

@@ -29,6 +29,15 @@ struct JointTrajectory {
   void Validate() const;
 };
 
+/// Where the head points: pan and tilt joint targets [rad] (the HSR's head_pan_joint and
+/// head_tilt_joint; the robot moves there at its joints' own speed and clamps to their limits).
+struct HeadCommand {
+  double pan{0.0};   ///< head_pan_joint target [rad], + to the left.
+  double tilt{0.0};  ///< head_tilt_joint target [rad], + up.
+  /// @throws InvalidArgument on a non-finite target.
+  void Validate() const;
+};
+
 /// A command to the gripper.
 struct GripperCommand {
   enum class Mode {

@@ -5,7 +5,7 @@
 /// else of the robot.
 ///
 /// One control cycle: the executive calls Sense() once, updates its world model, decides, then
-/// sends any of the three commands. Commands are validated here, before they reach an
+/// sends any of the four commands. Commands are validated here, before they reach an
 /// implementation, so a NaN or malformed command never drives a motor.
 
 #include <optional>
@@ -55,6 +55,9 @@ class RobotPort {
   void SendArmTrajectory(const JointTrajectory& trajectory);
   /// Commands the gripper. @throws InvalidArgument if malformed.
   void SendGripperCommand(const GripperCommand& command);
+  /// Points the head (pan, tilt), replacing any head target an arm trajectory set.
+  /// @throws InvalidArgument for a non-finite target.
+  void SendHeadCommand(const HeadCommand& command);
   /// The robot's clock: simulated in the twin, steady on the real robot.
   virtual const Clock& clock() const = 0;
 
@@ -64,6 +67,7 @@ class RobotPort {
   virtual void DoSendBaseVelocity(const Twist2& V_B) = 0;
   virtual void DoSendArmTrajectory(const JointTrajectory& trajectory) = 0;
   virtual void DoSendGripperCommand(const GripperCommand& command) = 0;
+  virtual void DoSendHeadCommand(const HeadCommand& command) = 0;
 };
 
 }  // namespace egress

@@ -83,8 +83,10 @@ struct PersonSpec {
   Eigen::Vector2d start{Eigen::Vector2d::Zero()};  ///< In W [m].
   Eigen::Vector2d goal{Eigen::Vector2d::Zero()};   ///< Final goal in W [m].
   std::vector<Eigen::Vector2d> via;  ///< Extra waypoints before the goal (walk_past, ...).
-  std::string door;                  ///< Door the behavior is about (cross/hold/evacuate).
-  Range speed{1.2, 1.4};             ///< Desired walking speed [m/s].
+  /// approach_and_wait: where they walk after the wait (none: they stay at the goal).
+  std::optional<Eigen::Vector2d> leave;
+  std::string door;       ///< Door the behavior is about (cross/hold/evacuate).
+  Range speed{1.2, 1.4};  ///< Desired walking speed [m/s].
   TriggerSpec trigger;
   double hold_angle_deg{80.0};  ///< hold_door: opening angle to hold the leaf at [deg].
   double hold_duration{8.0};    ///< hold_door: time to hold it [s]; approach_and_wait: wait.

@@ -41,6 +41,10 @@ struct RunMetrics {
   std::optional<double> time_to_goal;                                   ///< [s]
   double path_length{0.0};                                              ///< [m]
   double min_person_distance{std::numeric_limits<double>::infinity()};  ///< Surface gap [m]
+  /// The robot's speed at the moment of min_person_distance [m/s]: below kWaitSpeed the
+  /// person came to a standing robot, above it the robot came to the person.
+  double closest_robot_speed{0.0};
+  double closest_time{0.0};             ///< When it was [s].
   double time_in_personal_space{0.0};   ///< [s] with a surface gap < 1.2 m
   std::map<std::string, int> contacts;  ///< By kind: person, static, door, payload, carried
   /// By the model touched (the robot's body or arm, or the payload it holds).

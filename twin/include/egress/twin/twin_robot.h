@@ -39,6 +39,7 @@ class TwinRobot final : public RobotPort {
   void DoSendBaseVelocity(const Twist2& V_B) override;
   void DoSendArmTrajectory(const JointTrajectory& trajectory) override;
   void DoSendGripperCommand(const GripperCommand& command) override;
+  void DoSendHeadCommand(const HeadCommand& command) override;
   void StepOnce();
 
   template <typename T>

@@ -142,6 +142,9 @@ class TwinWorld {
   /// Replaces the arm/head trajectory. @throws InvalidArgument for an unknown joint name.
   void SetArmTrajectory(const JointTrajectory& trajectory);
   void SetGripperCommand(const GripperCommand& command);
+  /// Head pan/tilt targets: the joints move there at their URDF velocity limits, within their
+  /// limits; an arm trajectory that names a head joint takes the head over again.
+  void SetHeadCommand(const HeadCommand& command);
 
   // --- Ground truth (sensors, judge, tests). --------------------------------------------
   Pose2 robot_pose() const;       ///< X_WB

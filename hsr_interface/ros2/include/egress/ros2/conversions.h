@@ -13,6 +13,7 @@
 /// InvalidArgument naming the message type and field; the egress values' own checks (finite,
 /// ordered) are the RobotPort boundary's (SensorSnapshot::Validate).
 
+#include <optional>
 #include <string_view>
 #include <vector>
 
@@ -103,6 +104,18 @@ GripperGoal GripperToRos(const GripperCommand& command, double open_torque = kHa
 /// @throws InvalidArgument for a goal the twin cannot carry out (a closing `grasp` torque: the
 /// twin grips with a force, take `apply_force`), or a non-finite or negative force.
 GripperCommand GripperFromRos(const GripperGoal& goal);
+
+/// [rad/s] The HSR's head joints' speed (hsrb.urdf's velocity limit): a head command's point
+/// is timed to reach its target no faster.
+inline constexpr double kHeadSpeedRadPerSec = 1.0;
+/// A head command as the HSR's head_trajectory_controller takes it: one point for
+/// head_pan_joint and head_tilt_joint, timed from the measured head joints in `from` (if it has
+/// them) at kHeadSpeedRadPerSec, at least 0.1 s.
+JointTrajectory HeadTrajectory(const HeadCommand& command, const std::optional<JointState>& from);
+/// The head command a head trajectory ends in (its last point).
+/// @throws InvalidArgument unless it names head_pan_joint and head_tilt_joint (and nothing
+/// else) and has a point.
+HeadCommand HeadFromTrajectory(const JointTrajectory& trajectory);
 
 /// Detections of one image (all with its capture stamp): one Detection2D per box, its label the
 /// hypothesis' class_id and its confidence the score.

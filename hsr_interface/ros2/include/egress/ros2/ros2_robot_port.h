@@ -102,6 +102,8 @@ class Ros2RobotPort final : public RobotPort {
   /// (GripperToRos). @throws InvalidArgument for a position command (no HSR action built),
   /// std::runtime_error if the action server is not matched within 2 s.
   void DoSendGripperCommand(const GripperCommand& command) override;
+  /// Publishes a head_trajectory point (HeadTrajectory, timed from the latest joint states).
+  void DoSendHeadCommand(const HeadCommand& command) override;
 
  private:
   struct Impl;

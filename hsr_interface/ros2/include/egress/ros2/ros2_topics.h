@@ -24,6 +24,8 @@ struct Ros2Topics {
   // The brain publishes:
   std::string cmd_vel{"/omni_base_controller/cmd_vel"};  ///< geometry_msgs/Twist
   std::string arm_trajectory{"/arm_trajectory_controller/joint_trajectory"};
+  /// trajectory_msgs/JointTrajectory for head_pan_joint and head_tilt_joint.
+  std::string head_trajectory{"/head_trajectory_controller/joint_trajectory"};
   /// The gripper controller's actions (tmc_control_msgs/action/GripperApplyEffort; their goals
   /// go to `<name>/_action/send_goal`): `grasp` takes a motor torque [Nm] (egress opens with
   /// it), `apply_force` a grip force [N] (egress grasps with it).

@@ -1,0 +1,147 @@
+#include "egress/behavior/head_gaze.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "egress/hsr_interface/error.h"
+
+namespace egress::behavior {
+namespace {
+
+Time At(double t) {
+  return Time{} + SecondsToDuration(t);
+}
+
+// The lab's door (wall y = 3, opening x -0.475..0.475); the robot south of it, facing it.
+perception::TrackedDoor LabDoor(double open_fraction) {
+  perception::TrackedDoor door;
+  door.model.id = "lab_door";
+  door.model.p_MHinge = {0.475, 3.0};
+  door.model.p_MLatch = {-0.475, 3.0};
+  door.model.swing_sign = -1.0;
+  door.state.observed = true;
+  door.state.open_fraction = open_fraction;
+  return door;
+}
+
+perception::TrackedPersonWithIntent Walker(int id, const Eigen::Vector2d& p_MP,
+                                           const Eigen::Vector2d& v_MP) {
+  perception::TrackedPersonWithIntent entry;
+  entry.person.id = id;
+  entry.person.p_MP = p_MP;
+  entry.person.v_MP = v_MP;
+  return entry;
+}
+
+class HeadGazeTest : public ::testing::Test {
+ protected:
+  HeadGazeTest() {
+    belief_.X_MB = {1.15, 2.4, M_PI / 2};  // at the button's standoff, facing the wall
+    belief_.now = At(1.0);
+  }
+  std::optional<HeadCommand> Update(double pan_now) { return gaze_.Update(belief_, map_, pan_now); }
+  Belief belief_;
+  MissionMap map_;
+  HeadGaze gaze_;
+};
+
+TEST_F(HeadGazeTest, LooksAheadWithNothingToLookAtAndSendsOnlyChanges) {
+  const auto first = Update(0.3);
+  ASSERT_TRUE(first.has_value());
+  EXPECT_DOUBLE_EQ(first->pan, 0.0);
+  EXPECT_DOUBLE_EQ(first->tilt, 0.0);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kAhead);
+  belief_.now = At(1.01);
+  EXPECT_FALSE(Update(0.0).has_value());  // the same target: nothing new to send
+}
+
+TEST_F(HeadGazeTest, LooksThroughADoorThatOpensToItsFarSide) {
+  belief_.world.doors = {LabDoor(0.0)};
+  Update(0.0);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kAhead);  // closed: nothing to see through it
+  belief_.world.doors = {LabDoor(0.3)};
+  const auto look = Update(0.0);
+  ASSERT_TRUE(look.has_value());
+  EXPECT_EQ(gaze_.reason(), GazeReason::kDoor);
+  // At the point 1.5 m beyond the doorway's centre: (0, 4.5) from (1.15, 2.4), facing +y.
+  const double expected = std::atan2(4.5 - 2.4, 0.0 - 1.15) - M_PI / 2;
+  EXPECT_NEAR(look->pan, expected, 1e-9);
+  EXPECT_GT(look->pan, 0.0);  // to the left
+  // Through it and facing away (the door behind): ahead again, to what the robot goes to.
+  belief_.X_MB = {0.0, 4.0, M_PI / 2};
+  const auto passed = Update(look->pan);
+  ASSERT_TRUE(passed.has_value());
+  EXPECT_DOUBLE_EQ(passed->pan, 0.0);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kAhead);
+  Update(0.0);
+  belief_.X_MB = {1.15, 2.4, M_PI / 2};
+  ASSERT_TRUE(Update(0.0).has_value());
+  // Out of range: ahead again.
+  belief_.X_MB = {1.15, -1.0, M_PI / 2};
+  const auto away = Update(look->pan);
+  ASSERT_TRUE(away.has_value());
+  EXPECT_DOUBLE_EQ(away->pan, 0.0);
+}
+
+TEST_F(HeadGazeTest, GlancesAtSomeoneComingFromBehindThenLooksBackAndNotAgainAtOnce) {
+  belief_.world.doors = {LabDoor(0.5)};
+  // Walking up from the left, towards the robot, outside the camera's view.
+  belief_.world.people = {Walker(7, {-0.8, 2.2}, {1.0, 0.0})};
+  const auto glance = Update(0.0);
+  ASSERT_TRUE(glance.has_value());
+  EXPECT_EQ(gaze_.reason(), GazeReason::kPerson);
+  const double bearing = std::atan2(2.2 - 2.4, -0.8 - 1.15) - M_PI / 2;
+  EXPECT_NEAR(glance->pan, std::remainder(bearing, 2 * M_PI), 1e-9);
+  // Held for glance_time while the person is tracked, following them.
+  belief_.now = At(1.5);
+  belief_.world.people = {Walker(7, {-0.3, 2.2}, {1.0, 0.0})};
+  Update(glance->pan);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kPerson);
+  // Then back through the door; and not straight back at them (the cooldown).
+  belief_.now = At(2.1);
+  const auto back = Update(glance->pan);
+  ASSERT_TRUE(back.has_value());
+  EXPECT_EQ(gaze_.reason(), GazeReason::kDoor);
+  belief_.now = At(2.2);
+  Update(back->pan);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kDoor);
+}
+
+TEST_F(HeadGazeTest, NoGlanceAtSomeoneInViewStandingOrWalkingAway) {
+  belief_.world.people = {Walker(1, {1.15, 4.0}, {0.0, -1.0})};  // ahead, in view
+  Update(0.0);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kAhead);
+  belief_.world.people = {Walker(2, {1.15, 0.5}, {0.0, 0.0})};  // behind, standing
+  Update(0.0);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kAhead);
+  belief_.world.people = {Walker(3, {1.15, 0.5}, {0.0, -1.0})};  // behind, walking away
+  Update(0.0);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kAhead);
+}
+
+TEST_F(HeadGazeTest, PanStaysWithinItsLimit) {
+  HeadGazeConfig config;
+  config.max_pan_deg = 90.0;
+  HeadGaze gaze(config);
+  belief_.world.people = {Walker(4, {1.15, 0.9}, {0.0, 1.0})};  // straight behind
+  const auto look = gaze.Update(belief_, map_, 0.0);
+  ASSERT_TRUE(look.has_value());
+  EXPECT_NEAR(std::abs(look->pan), M_PI / 2, 1e-9);
+}
+
+TEST_F(HeadGazeTest, DisabledSendsNothingAndBadConfigsAreRefused) {
+  HeadGazeConfig config;
+  config.enabled = false;
+  HeadGaze off(config);
+  EXPECT_FALSE(off.Update(belief_, map_, 0.0).has_value());
+  for (auto bad : {&HeadGazeConfig::camera_hfov_deg, &HeadGazeConfig::glance_range,
+                   &HeadGazeConfig::door_open_fraction, &HeadGazeConfig::max_pan_deg}) {
+    HeadGazeConfig c;
+    c.*bad = -1.0;
+    EXPECT_THROW(HeadGaze{c}, InvalidArgument);
+  }
+}
+
+}  // namespace
+}  // namespace egress::behavior
