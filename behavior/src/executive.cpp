@@ -24,6 +24,7 @@ void ExecutiveConfig::Validate() const {
               "ExecutiveConfig: need 0 < scan_hold_after_s <= scan_abort_after_s");
   tasks.Validate();
   head.Validate();
+  proxemics.Validate();
   arm.Validate();
   grasp.Validate();
   octomap.Validate();
@@ -561,6 +562,11 @@ bool Executive::Step(RobotPort& port) {
         perception::ScanPoints(*snapshot.scan, (Pose3::FromPose2(belief_.X_MB) * X_BL).ToPose2()),
         std::move(people));
   }
+  std::optional<Eigen::Vector2d> p_MGoal;
+  if (!m.motion.path().empty()) p_MGoal = m.motion.path().back().translation();
+  m.motion.SetSpeedScale(ApproachSpeedScale(belief_.X_MB, m.motion.planned_velocity(), p_MGoal,
+                                            belief_.world.people, m.config.tasks.footprint_radius,
+                                            m.config.tasks.person_radius, m.config.proxemics));
   Twist2 V_B = m.motion.Update(now, belief_.X_MB, snapshot.odometry.V_B);
   if (scan_silence > m.config.scan_hold_after_s) {
     V_B = Twist2{};  // blind: stand still until scans come again

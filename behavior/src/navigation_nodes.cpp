@@ -158,6 +158,11 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
   static constexpr double kPeopleLookM = 5.0;
   // [m] Each metre of extra way costs this much room: a nearer spot wins a tie.
   static constexpr double kWayCostPerM = 0.2;
+  // [m] A retreat passes people's edges no nearer than the footprint and this; checked every
+  // kPathSampleM along its way.
+  static constexpr double kPassMarginM = 0.1;
+  static constexpr double kPathSampleM = 0.05;
+  static constexpr double kSweepMarginRad = 10.0 * M_PI / 180.0;
 
   void StartRetreatOnceStopped() {
     const double speed = std::hypot(belief_.V_B.vx, belief_.V_B.vy);
@@ -180,7 +185,12 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
         break;
       }
     }
-    const auto [spot, aside] = ChooseSpot(path.back());
+    const auto chosen = ChooseSpot(path);
+    if (!chosen) {
+      Note("nowhere to back off to without passing someone: standing still");
+      return;
+    }
+    const auto [spot, aside] = *chosen;
     if ((path.back().translation() - spot.translation()).norm() > 0.05) path.push_back(spot);
     if (path.size() < 2) return;
     task_.motion->FollowPath(path, std::vector<bool>(path.size() - 1, false),
@@ -191,37 +201,74 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
          DecisionEvent::kRetreating);
   }
 
-  // The last safe pose if people will stay comfort_distance from it; else, of the spots round
-  // the robot out of every door's way and reachable in a straight line from `from`, the one
+  // Where the retreat that begins with `way` (the robot's pose, maybe a point out of the
+  // doorway) ends: the last safe pose if people will stay comfort_distance from it; else, of the
+  // spots round the robot out of every door's way and reachable in a straight line, the one
   // where they will be farthest (less kWayCostPerM per metre of way), if that beats the last
-  // safe pose. Second: whether it is a spot aside.
-  std::pair<Pose2, bool> ChooseSpot(const Pose2& from) const {
+  // safe pose. No way may pass nearer anyone than the footprint and kPassMarginM (people where
+  // they are now: a retreat into someone standing behind the robot, P1 seed 2000). nullopt:
+  // every way does. Second: whether it is a spot aside.
+  std::optional<std::pair<Pose2, bool>> ChooseSpot(const std::vector<Pose2>& way) const {
     const Pose2 safe = *belief_.last_safe;
     const Eigen::Vector2d at = belief_.X_MB.translation();
     const std::vector<Eigen::Vector2d> people =
         PeopleAround(task_, at, kPeopleLookM, kPeopleHorizonSec, kPeopleStepSec);
+    const std::vector<Eigen::Vector2d> people_now = PeopleAround(task_, at, kPeopleLookM, 0.0, 0.0);
     const double comfortable = task_.config.footprint_radius + task_.config.comfort_distance;
+    const double passable = task_.config.footprint_radius + kPassMarginM;
+    // Where the base laser looks (its latest scan's sweep, in B; a margin inside its edges):
+    // behind the robot, in its blind sector, nobody is seen (P1 seed 2000: a person waiting
+    // right behind it was backed into).
+    const Pose2 X_ML = belief_.X_MB * belief_.X_BL;
+    const auto seen = [&](const Eigen::Vector2d& p) {
+      if (!belief_.scan || (p - at).norm() <= task_.config.footprint_radius) return true;
+      const Eigen::Vector2d p_L = X_ML.Inverse() * p;
+      const double bearing = std::atan2(p_L.y(), p_L.x());
+      return bearing >= belief_.scan->angle_min + kSweepMarginRad &&
+             bearing <= belief_.scan->angle_max() - kSweepMarginRad;
+    };
+    // The straight lines of `way` and on to q keep clear of everyone now, within the laser's view.
+    const auto clear_way = [&](const Eigen::Vector2d& q) {
+      std::vector<Eigen::Vector2d> corners;
+      for (const Pose2& p : way)
+        corners.push_back(p.translation());
+      corners.push_back(q);
+      for (std::size_t i = 0; i + 1 < corners.size(); ++i) {
+        const double length = (corners[i + 1] - corners[i]).norm();
+        const int steps = std::max(1, int(std::ceil(length / kPathSampleM)));
+        for (int k = 1; k <= steps; ++k) {
+          const Eigen::Vector2d p =
+              corners[i] + (corners[i + 1] - corners[i]) * (double(k) / steps);
+          if (RoomAt(people_now, p) < passable || !seen(p)) return false;
+        }
+      }
+      return true;
+    };
     const auto score = [&](const Eigen::Vector2d& q) {
       return std::min(RoomAt(people, q), comfortable) - kWayCostPerM * (q - at).norm();
     };
-    if (RoomAt(people, safe.translation()) >= comfortable) return {safe, false};
-    Pose2 best = safe;
-    double best_score = score(safe.translation());
-    bool aside = false;
+    const bool safe_ok = clear_way(safe.translation());
+    if (safe_ok && RoomAt(people, safe.translation()) >= comfortable) return std::pair{safe, false};
+    std::optional<std::pair<Pose2, bool>> best;
+    double best_score = -std::numeric_limits<double>::infinity();
+    if (safe_ok) {
+      best = std::pair{safe, false};
+      best_score = score(safe.translation());
+    }
+    const Pose2& from = way.back();
     for (const double radius : kSpotRadiiM) {
       for (int k = 0; k < kSpotHeadings; ++k) {
         const double a = 2 * M_PI * k / kSpotHeadings;
         const Eigen::Vector2d q = at + radius * Eigen::Vector2d(std::cos(a), std::sin(a));
         const double s = score(q);
-        if (s <= best_score || IsInAnyDoorZone(task_, q)) continue;
+        if (s <= best_score || IsInAnyDoorZone(task_, q) || !clear_way(q)) continue;
         const Pose2 candidate{q.x(), q.y(), belief_.X_MB.yaw};
         if (!task_.planner->IsPathValid({from, candidate})) continue;
-        best = candidate;
+        best = std::pair{candidate, true};
         best_score = s;
-        aside = true;
       }
     }
-    return {best, aside};
+    return best;
   }
 
   bool pending_{false};

@@ -23,14 +23,22 @@ TrackingController::TrackingController(ControllerConfig config) : config_(config
 void TrackingController::Start(WholeBodyTrajectory trajectory, Time t0) {
   trajectory_ = std::move(trajectory);
   t0_ = t0;
+  lag_ = 0.0;
   tripped_ = false;
   trip_reason_.clear();
   last_command_ = {};
   last_time_.reset();
 }
 
+void TrackingController::SetTimeScale(double scale) {
+  ThrowUnless(std::isfinite(scale) && scale >= 0.0 && scale <= 1.0,
+              "TrackingController: the time scale must be in [0, 1], got ", scale);
+  time_scale_ = scale;
+}
+
 void TrackingController::Stop() {
   trajectory_.reset();
+  planned_v_M_.setZero();
   last_command_ = {};
 }
 
@@ -43,8 +51,13 @@ ControlCommand TrackingController::Update(Time now, const Pose2& X_MB, const Twi
     command.watchdog_reason = trip_reason_;
     return command;
   }
-  const double t = ToSeconds(now - t0_);
-  const TrajectorySample ref = trajectory_->Sample(t);
+  // The reference's time: the clock's, less what scaling held it back (exactly the clock's
+  // while the scale is 1).
+  if (last_time_ && time_scale_ < 1.0) lag_ += (1.0 - time_scale_) * ToSeconds(now - *last_time_);
+  const double t = ToSeconds(now - t0_) - lag_;
+  TrajectorySample ref = trajectory_->Sample(t);
+  planned_v_M_ = {ref.qd[kBaseX], ref.qd[kBaseY]};
+  if (time_scale_ < 1.0) ref.qd *= time_scale_;
   for (int j = 0; j < 5; ++j) {
     command.arm_q[std::size_t(j)] = ref.q[kArmLift + j];
     command.arm_qd[std::size_t(j)] = ref.qd[kArmLift + j];

@@ -130,5 +130,40 @@ TEST_F(NavigationNodesTest, RetractToSafeStepsOutOfAPersonsPredictedPath) {
   EXPECT_LT((motion_.path().back().translation() - Eigen::Vector2d(0.0, 1.2)).norm(), 1e-6);
 }
 
+// Nobody is seen in the laser's blind sector behind the robot, nor may a retreat pass through
+// someone it can see (P1 seed 2000: backed into a person waiting behind it).
+TEST_F(NavigationNodesTest, RetractToSafeKeepsToWhereTheLaserSeesAndPassesNobody) {
+  auto blackboard = bt::Blackboard::Create();
+  bt::Tree tree = Tree(R"(<RetractToSafe/>)", blackboard);
+  belief_.X_MB = {0.0, 2.4, M_PI / 2};
+  belief_.last_safe = Pose2{0.0, 1.2, M_PI / 2};  // straight behind: the laser's blind sector
+  LaserScan scan;
+  scan.angle_min = -0.75 * M_PI;
+  scan.angle_increment = 1.5 * M_PI / 100;
+  scan.ranges.assign(101, 5.0f);
+  scan.range_max = 20.0;
+  belief_.scan = scan;
+  belief_.X_BL = Pose2{};
+  belief_.now = At(1.0);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  if (motion_.base_moving()) {
+    const Eigen::Vector2d spot = motion_.path().back().translation();
+    const Eigen::Vector2d d = spot - belief_.X_MB.translation();
+    // In B the spot's bearing is within the sweep (less its margin), not straight back.
+    const double bearing = std::remainder(std::atan2(d.y(), d.x()) - M_PI / 2, 2 * M_PI);
+    EXPECT_LT(std::abs(bearing), 0.75 * M_PI);
+  }
+  // Someone standing beside the robot on the way to every spot but the far one: never passed.
+  tree.HaltTree();
+  motion_.StopBase();
+  belief_.scan.reset();
+  belief_.last_safe = Pose2{1.5, 2.4, M_PI / 2};
+  belief_.world.people = {Person({0.75, 2.4}, perception::PersonIntent::kStationary)};
+  belief_.now = At(3.0);
+  tree.TickOnce();
+  for (const Pose2& p : motion_.path())
+    EXPECT_LT(p.x, 0.75 - 0.3 - 0.215) << "the way would pass through the person at x = 0.75";
+}
+
 }  // namespace
 }  // namespace egress::behavior

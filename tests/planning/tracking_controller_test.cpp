@@ -97,5 +97,41 @@ TEST(TrackingControllerTest, LimitsSpeedAndAcceleration) {
   EXPECT_THROW(controller.Update(Time{0}, Pose2{std::nan(""), 0, 0}, Twist2{}), InvalidArgument);
 }
 
+// Scaled time (issue 21, slowing near people): at 0 the reference waits where it is and the base
+// stops on it without the watchdog tripping; at 1 it goes on; the planned velocity still says
+// which way the path goes.
+TEST(TrackingControllerTest, ATimeScaleHoldsTheReferenceBackWithoutTrippingTheWatchdog) {
+  const RobotModel model = RobotModel::LoadDefault();
+  TrackingController controller;
+  const WholeBodyTrajectory trajectory = Straight(model, 1.0);
+  controller.Start(trajectory, Time{0});
+  Pose2 X_MB;
+  Twist2 V_B;
+  ControlCommand command;
+  const auto run = [&](int from, int to) {
+    for (int k = from; k < to && !command.finished; ++k) {
+      command = controller.Update(std::chrono::milliseconds(10 * k), X_MB, V_B);
+      ASSERT_FALSE(command.watchdog_tripped) << command.watchdog_reason;
+      X_MB = X_MB * Pose2{V_B.vx * 0.01, V_B.vy * 0.01, V_B.wz * 0.01};
+      V_B = command.V_B;
+    }
+  };
+  run(0, 200);  // 2 s as planned
+  const double x_at_2s = X_MB.x;
+  EXPECT_GT(controller.planned_velocity().x(), 0.05);
+  controller.SetTimeScale(0.0);
+  run(200, 1000);  // 8 s held: the base stops near where the reference waits
+  EXPECT_FALSE(command.finished);
+  EXPECT_NEAR(X_MB.x, x_at_2s, 0.08);
+  EXPECT_NEAR(V_B.vx, 0.0, 1e-3);
+  EXPECT_GT(controller.planned_velocity().x(), 0.05);  // still going +x, at its planned pace
+  controller.SetTimeScale(1.0);
+  run(1000, 2000);
+  EXPECT_TRUE(command.finished);
+  EXPECT_NEAR(X_MB.x, 1.0, 0.01);
+  EXPECT_THROW(controller.SetTimeScale(1.5), InvalidArgument);
+  EXPECT_THROW(controller.SetTimeScale(std::nan("")), InvalidArgument);
+}
+
 }  // namespace
 }  // namespace egress::planning

@@ -21,6 +21,7 @@
 #include "egress/behavior/head_gaze.h"
 #include "egress/behavior/mission_map.h"
 #include "egress/behavior/motion_executor.h"
+#include "egress/behavior/proxemics.h"
 #include "egress/behavior/task_services.h"
 #include "egress/bt/status.h"
 
@@ -47,7 +48,8 @@ struct ExecutiveConfig {
   double tick_rate_hz{10.0};      ///< Behavior-tree ticks (the paper's 10 Hz).
   double control_rate_hz{100.0};  ///< Controller steps; Step() is called at this rate.
   TaskConfig tasks;
-  HeadGazeConfig head;  ///< Where the head camera looks (HeadGaze).
+  HeadGazeConfig head;        ///< Where the head camera looks (HeadGaze).
+  ProxemicsConfig proxemics;  ///< Paths slow down towards people (ApproachSpeedScale).
   planning::TrajectoryConfig trajectory;
   planning::ControllerConfig controller;
   ArmMotionConfig arm;       ///< When an arm motion is done (measured joints) or failed.

@@ -67,6 +67,13 @@ class MotionExecutor {
   void SetSurroundings(std::vector<Eigen::Vector2d> p_MObstacles,
                        std::vector<Eigen::Vector2d> p_MPeople);
   bool bug_active() const { return bug_.has_value(); }
+  /// Base paths go at this fraction of their planned pace from the next Update (0..1; the
+  /// executive slows near people). @throws InvalidArgument outside [0, 1].
+  void SetSpeedScale(double scale) { controller_.SetTimeScale(scale); }
+  /// Which way the path being followed goes now, at its planned pace (M; zero when idle).
+  Eigen::Vector2d planned_velocity() const {
+    return base_active_ && !bug_ ? controller_.planned_velocity() : Eigen::Vector2d::Zero();
+  }
   /// Stops the base: zero velocity from the next control step.
   void StopBase();
   /// Moves the arm through `knots` (seconds from now, pose). Sent with the next control step.

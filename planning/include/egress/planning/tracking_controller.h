@@ -49,13 +49,24 @@ class TrackingController {
   ControlCommand Update(Time now, const Pose2& X_MB, const Twist2& V_B_measured);
   /// Stops: zero commands until the next Start.
   void Stop();
+  /// From the next Update on, the reference advances at `scale` times the clock (0: it waits
+  /// where it is, 1: as planned) and its velocities are scaled alike: slowing down near people
+  /// without the reference running away from the base (and the watchdog tripping).
+  /// @throws InvalidArgument unless 0 <= scale <= 1.
+  void SetTimeScale(double scale);
   bool tripped() const { return tripped_; }
+  /// The planned base velocity in M where the reference was at the last Update, before any
+  /// time scaling (zero when idle): which way the base is going.
+  const Eigen::Vector2d& planned_velocity() const { return planned_v_M_; }
   const std::string& trip_reason() const { return trip_reason_; }
 
  private:
   ControllerConfig config_;
   std::optional<WholeBodyTrajectory> trajectory_;
   Time t0_{};
+  double time_scale_{1.0};
+  double lag_{0.0};  ///< [s] the reference is behind the clock by this (time scaled below 1)
+  Eigen::Vector2d planned_v_M_{Eigen::Vector2d::Zero()};
   bool tripped_{false};
   std::string trip_reason_;
   Twist2 last_command_;

@@ -1,0 +1,40 @@
+#pragma once
+/// @file
+/// Proxemics: how close the robot lets itself come to people. Personal space is 0.45-1.2 m
+/// (Hall); the robot slows its paths when it heads towards someone within `slow_gap` of its
+/// edge (where they are, or will be within `horizon` at their velocity), down to a stop at
+/// `stop_gap`. Moving away from or past someone is never slowed: a retreat must be quick.
+/// Gaps are surface to surface, as the judge measures them.
+
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "egress/hsr_interface/geometry.h"
+#include "egress/perception/world_state.h"
+
+namespace egress::behavior {
+
+struct ProxemicsConfig {
+  bool slow_near_people{true};  ///< False: paths keep their planned pace whoever is near.
+  double slow_gap{1.2};         ///< Slowing starts this near [m] (personal space's edge).
+  double stop_gap{0.45};        ///< ... and reaches a standstill this near [m].
+  double horizon{1.0};          ///< People's positions this far ahead count too [s].
+  double cone_deg{60.0};        ///< Within this of the way the robot goes, it goes to them.
+  /// Someone this near where the path ends is whom the robot goes to (a hand-over, a
+  /// responder): not slowed for [m].
+  double goal_radius{1.5};
+  /// @throws InvalidArgument naming the field.
+  void Validate() const;
+};
+
+/// The fraction of its planned pace the robot may go at (in [0, 1]) heading along v_M from
+/// X_MB to p_MGoal (where its path ends, if it has one), with `people` around. Radii: the
+/// robot's footprint and a person's [m].
+double ApproachSpeedScale(const Pose2& X_MB, const Eigen::Vector2d& v_M,
+                          const std::optional<Eigen::Vector2d>& p_MGoal,
+                          const std::vector<perception::TrackedPersonWithIntent>& people,
+                          double robot_radius, double person_radius, const ProxemicsConfig& config);
+
+}  // namespace egress::behavior

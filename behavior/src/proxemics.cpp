@@ -1,0 +1,50 @@
+#include "egress/behavior/proxemics.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "egress/hsr_interface/error.h"
+
+namespace egress::behavior {
+namespace {
+constexpr double kMovingMps = 1e-3;  // [m/s] slower than this the robot goes nowhere
+}  // namespace
+
+void ProxemicsConfig::Validate() const {
+  ThrowUnless(
+      std::isfinite(slow_gap) && std::isfinite(stop_gap) && stop_gap >= 0 && slow_gap > stop_gap,
+      "ProxemicsConfig: need 0 <= stop_gap < slow_gap (m)");
+  ThrowUnless(std::isfinite(horizon) && horizon >= 0, "ProxemicsConfig: horizon must be >= 0");
+  ThrowUnless(cone_deg > 0 && cone_deg <= 180, "ProxemicsConfig: cone_deg must be in (0, 180]");
+  ThrowUnless(std::isfinite(goal_radius) && goal_radius >= 0,
+              "ProxemicsConfig: goal_radius must be >= 0");
+}
+
+double ApproachSpeedScale(const Pose2& X_MB, const Eigen::Vector2d& v_M,
+                          const std::optional<Eigen::Vector2d>& p_MGoal,
+                          const std::vector<perception::TrackedPersonWithIntent>& people,
+                          double robot_radius, double person_radius,
+                          const ProxemicsConfig& config) {
+  if (!config.slow_near_people || v_M.norm() < kMovingMps) return 1.0;
+  const Eigen::Vector2d way = v_M.normalized();
+  const double cos_cone = std::cos(config.cone_deg * M_PI / 180.0);
+  double scale = 1.0;
+  for (const auto& entry : people) {
+    const auto& person = entry.person;
+    if (p_MGoal && (person.p_MP - *p_MGoal).norm() < config.goal_radius) continue;
+    for (const Eigen::Vector2d& p_MP :
+         {person.p_MP, Eigen::Vector2d(person.p_MP + person.v_MP * config.horizon)}) {
+      const Eigen::Vector2d d = p_MP - X_MB.translation();
+      const double distance = d.norm();
+      const double gap = distance - robot_radius - person_radius;
+      if (gap >= config.slow_gap) continue;
+      if (distance > 1e-9 && way.dot(d / distance) < cos_cone) continue;  // not towards them
+      scale = std::min(
+          scale,
+          std::clamp((gap - config.stop_gap) / (config.slow_gap - config.stop_gap), 0.0, 1.0));
+    }
+  }
+  return scale;
+}
+
+}  // namespace egress::behavior

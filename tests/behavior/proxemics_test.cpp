@@ -1,0 +1,72 @@
+#include "egress/behavior/proxemics.h"
+
+#include <gtest/gtest.h>
+
+#include "egress/hsr_interface/error.h"
+
+namespace egress::behavior {
+namespace {
+
+constexpr double kRobotRadius = 0.215, kPersonRadius = 0.3;
+
+perception::TrackedPersonWithIntent At(const Eigen::Vector2d& p_MP,
+                                       const Eigen::Vector2d& v_MP = Eigen::Vector2d::Zero()) {
+  perception::TrackedPersonWithIntent entry;
+  entry.person.p_MP = p_MP;
+  entry.person.v_MP = v_MP;
+  return entry;
+}
+
+double Scale(const std::vector<perception::TrackedPersonWithIntent>& people,
+             const Eigen::Vector2d& v_M = {0.2, 0.0}, const ProxemicsConfig& config = {}) {
+  return ApproachSpeedScale({0.0, 0.0, 0.0}, v_M, std::nullopt, people, kRobotRadius, kPersonRadius,
+                            config);
+}
+
+// Gaps are surface to surface: a person centred d ahead is d - 0.515 m from the robot's edge.
+TEST(ProxemicsTest, HeadingTowardsSomeoneSlowsFromPersonalSpaceToAStop) {
+  EXPECT_DOUBLE_EQ(Scale({}), 1.0);
+  EXPECT_DOUBLE_EQ(Scale({At({0.515 + 1.3, 0.0})}), 1.0);     // beyond 1.2 m
+  EXPECT_NEAR(Scale({At({0.515 + 0.825, 0.0})}), 0.5, 1e-9);  // half way
+  EXPECT_DOUBLE_EQ(Scale({At({0.515 + 0.4, 0.0})}), 0.0);     // inside 0.45 m
+  // Where they will be in a second counts: walking into the robot's way from 2 m ahead.
+  EXPECT_LT(Scale({At({0.515 + 2.0, 0.0}, {-1.2, 0.0})}), 0.5);
+  // The nearest sets the pace.
+  EXPECT_DOUBLE_EQ(Scale({At({0.515 + 0.825, 0.0}), At({0.515 + 0.4, 0.1})}), 0.0);
+}
+
+TEST(ProxemicsTest, MovingAwayOrPastSomeoneIsNeverSlowed) {
+  const auto behind = At({-0.515 - 0.2, 0.0});
+  EXPECT_DOUBLE_EQ(Scale({behind}), 1.0);                              // retreating from them
+  EXPECT_DOUBLE_EQ(Scale({At({0.0, 0.515 + 0.2})}), 1.0);              // beside, going past
+  EXPECT_DOUBLE_EQ(Scale({At({0.515 + 0.2, 0.0})}, {0.0, 0.0}), 1.0);  // standing
+  ProxemicsConfig off;
+  off.slow_near_people = false;
+  EXPECT_DOUBLE_EQ(Scale({At({0.515 + 0.2, 0.0})}, {0.2, 0.0}, off), 1.0);
+}
+
+// Going to someone on purpose (a hand-over: the path ends at reach of the responder).
+TEST(ProxemicsTest, SomeoneWhereThePathEndsIsWhomTheRobotGoesTo) {
+  const std::vector people = {At({0.515 + 0.4, 0.0})};
+  EXPECT_DOUBLE_EQ(ApproachSpeedScale({0.0, 0.0, 0.0}, {0.2, 0.0}, Eigen::Vector2d(0.3, 0.0),
+                                      people, kRobotRadius, kPersonRadius, {}),
+                   1.0);
+  EXPECT_DOUBLE_EQ(ApproachSpeedScale({0.0, 0.0, 0.0}, {0.2, 0.0}, Eigen::Vector2d(-3.0, 0.0),
+                                      people, kRobotRadius, kPersonRadius, {}),
+                   0.0);
+}
+
+TEST(ProxemicsTest, BadConfigsAreRefusedNamingTheField) {
+  ProxemicsConfig c;
+  c.stop_gap = 2.0;  // beyond slow_gap
+  EXPECT_THROW(c.Validate(), InvalidArgument);
+  c = {};
+  c.cone_deg = 0.0;
+  EXPECT_THROW(c.Validate(), InvalidArgument);
+  c = {};
+  c.horizon = -1.0;
+  EXPECT_THROW(c.Validate(), InvalidArgument);
+}
+
+}  // namespace
+}  // namespace egress::behavior
