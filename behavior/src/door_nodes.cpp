@@ -342,16 +342,6 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     phase_ = Phase::kWaiting;
     waiting_since_ = belief_.now;
     if (lateral > 0.05 || offset.dot(pass_.n_M) > entry_distance_ + 0.05) {
-      // From beside the door (an actuator's standoff) the robot cannot see who waits beyond a
-      // door that is opening or has just opened; they come through first, and lining up across
-      // the doorway meanwhile meets them. It waits where it is for the right of way.
-      if (!RightOfWayOver()) {
-        phase_ = Phase::kGivingWay;
-        Note(StrCat("giving whoever waits beyond the door the right of way (",
-                    kOperatorMinOpeningTime + task_.config.right_of_way_time,
-                    " s from the press)"));
-        return OnRunning();
-      }
       if (const NodeStatus s = StartLineUp(); s != NodeStatus::kRunning) return s;
     }
     return OnRunning();
@@ -359,18 +349,6 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
   NodeStatus OnRunning() override {
     const auto note = [this](const std::string& t) { Note(t); };
     switch (phase_) {
-      case Phase::kGivingWay: {
-        if (!RightOfWayOver()) {
-          if (ToSeconds(belief_.now - waiting_since_) > Input<double>("wait_timeout")) {
-            Note("the door did not open in time");
-            return NodeStatus::kFailure;
-          }
-          return NodeStatus::kRunning;
-        }
-        if (const NodeStatus s = StartLineUp(); s != NodeStatus::kRunning) return s;
-        if (phase_ != Phase::kToEntry) return OnRunning();
-        return NodeStatus::kRunning;
-      }
       case Phase::kToEntry: {
         const NodeStatus s = DriveStatus(task_, note, true);
         if (s != NodeStatus::kSuccess) return s;
@@ -430,18 +408,6 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
  private:
   RelocalizeGate gate_;
 
-  // Whoever waited beyond the door the robot itself operated has had their turn: an operator
-  // takes kOperatorMinOpeningTime to open, then right_of_way_time for them to come through.
-  // (A door someone else opened or holds, or one the press found already open, has stood open
-  // for them: nobody is kept waiting, and the hold window has less left.)
-  bool RightOfWayOver() const {
-    const DoorVisit visit = Visit();
-    if (task_.config.right_of_way_time <= 0 || !visit.operated_at || visit.window_restarted_at)
-      return true;
-    return ToSeconds(belief_.now - *visit.operated_at) >=
-           kOperatorMinOpeningTime + task_.config.right_of_way_time;
-  }
-
   // Drives to the entry pose on the door's axis (phase kToEntry).
   NodeStatus StartLineUp() {
     const Eigen::Vector2d entry = pass_.centre + pass_.n_M * entry_distance_;
@@ -483,7 +449,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     return door.p_MHinge + along * (clear_from + w) / 2;
   }
 
-  enum class Phase { kGivingWay, kToEntry, kWaiting, kThrough };
+  enum class Phase { kToEntry, kWaiting, kThrough };
   std::string door_;
   DoorPass pass_;
   double entry_distance_{0.0};

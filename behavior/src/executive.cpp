@@ -594,7 +594,7 @@ bool Executive::Step(RobotPort& port) {
   }
   port.SendBaseVelocity(V_B);
   const GazeReason gaze_before = m.gaze.reason();
-  if (auto head = m.gaze.Update(belief_, m.map, pan_now)) {
+  if (auto head = m.gaze.Update(belief_, pan_now)) {
     port.SendHeadCommand(*head);
     if (m.gaze.reason() != gaze_before) {
       static constexpr const char* kWhy[] = {"ahead", "through the door", "at a person coming"};

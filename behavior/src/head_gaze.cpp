@@ -36,8 +36,7 @@ double HeadGaze::PanTowards(const Pose2& X_MB, const Eigen::Vector2d& p_M) const
   return std::clamp(bearing, -limit, limit);
 }
 
-std::optional<HeadCommand> HeadGaze::Update(const Belief& belief, const MissionMap& /*map*/,
-                                            std::optional<double> pan_now) {
+std::optional<HeadCommand> HeadGaze::Update(const Belief& belief, std::optional<double> pan_now) {
   if (!config_.enabled) return std::nullopt;
   const Pose2& X_MB = belief.X_MB;
   const Eigen::Vector2d at = X_MB.translation();

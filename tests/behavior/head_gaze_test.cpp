@@ -40,9 +40,8 @@ class HeadGazeTest : public ::testing::Test {
     belief_.X_MB = {1.15, 2.4, M_PI / 2};  // at the button's standoff, facing the wall
     belief_.now = At(1.0);
   }
-  std::optional<HeadCommand> Update(double pan_now) { return gaze_.Update(belief_, map_, pan_now); }
+  std::optional<HeadCommand> Update(double pan_now) { return gaze_.Update(belief_, pan_now); }
   Belief belief_;
-  MissionMap map_;
   HeadGaze gaze_;
 };
 
@@ -125,7 +124,7 @@ TEST_F(HeadGazeTest, PanStaysWithinItsLimit) {
   config.max_pan_deg = 90.0;
   HeadGaze gaze(config);
   belief_.world.people = {Walker(4, {1.15, 0.9}, {0.0, 1.0})};  // straight behind
-  const auto look = gaze.Update(belief_, map_, 0.0);
+  const auto look = gaze.Update(belief_, 0.0);
   ASSERT_TRUE(look.has_value());
   EXPECT_NEAR(std::abs(look->pan), M_PI / 2, 1e-9);
 }
@@ -134,7 +133,7 @@ TEST_F(HeadGazeTest, DisabledSendsNothingAndBadConfigsAreRefused) {
   HeadGazeConfig config;
   config.enabled = false;
   HeadGaze off(config);
-  EXPECT_FALSE(off.Update(belief_, map_, 0.0).has_value());
+  EXPECT_FALSE(off.Update(belief_, 0.0).has_value());
   for (auto bad : {&HeadGazeConfig::camera_hfov_deg, &HeadGazeConfig::glance_range,
                    &HeadGazeConfig::door_open_fraction, &HeadGazeConfig::max_pan_deg}) {
     HeadGazeConfig c;

@@ -17,7 +17,6 @@
 #include <optional>
 
 #include "egress/behavior/belief.h"
-#include "egress/behavior/mission_map.h"
 #include "egress/hsr_interface/command_types.h"
 
 namespace egress::behavior {
@@ -48,8 +47,7 @@ class HeadGaze {
 
   /// The head command to send this step, if the target changed (nullopt: keep the last one, or
   /// disabled). `pan_now` is the measured head_pan_joint angle [rad], if known.
-  std::optional<HeadCommand> Update(const Belief& belief, const MissionMap& map,
-                                    std::optional<double> pan_now);
+  std::optional<HeadCommand> Update(const Belief& belief, std::optional<double> pan_now);
   GazeReason reason() const { return reason_; }
   /// The pan last commanded [rad] (0 before any).
   double commanded_pan() const { return commanded_pan_; }

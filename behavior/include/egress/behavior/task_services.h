@@ -44,12 +44,11 @@ struct TaskConfig {
   /// doorway's centre, not walking away, was waiting for it and comes through first [m] ...
   double right_of_way_radius{2.5};
   /// ... while the opening is younger than this; someone still standing there after it is
-  /// not coming, and the robot goes. After operating a door itself, the robot waits beside it
-  /// (not lining up across the doorway) this long after the operator's shortest opening time,
-  /// for people it cannot see from there [s]. 0 (the default): no right of way — the wait eats
-  /// into the operator's hold window, and a robot re-pressing a door it cannot see open from
-  /// the actuator then finds too little of the window left (S2 seeds 2000-2003: 4/4 -> 0/4 with 2
-  /// s).
+  /// not coming, and the robot goes [s]. 0 (the default): no right of way. (Also tried: after
+  /// its own press, the robot waiting beside the door this long past the operator's opening
+  /// time, for people it cannot see from there; the wait ate the hold window, and a re-press on
+  /// a door the robot could not see open from the actuator left too little of it: S2 seeds
+  /// 2000-2003, 4/4 -> 0/4 with 2 s. Removed.)
   double right_of_way_time{0.0};
   /// The gap the robot keeps from people where it can (surface to surface; personal space is
   /// 0.45-1.2 m): a standby retreat goes where people will stay at least this far [m].
