@@ -49,10 +49,9 @@ struct TrialResult {
   std::string abort_reason;  ///< The brain's last note before it gave up.
 };
 
-/// A closest approach under this is too close [m] (issue 21's bar), unless the robot stood.
+/// A closest approach under this is too close [m] (issue 21's bar), unless the robot stood
+/// (slower than ScenarioJudge::kWaitSpeed).
 inline constexpr double kCloseApproach = 0.3;
-/// Below this speed at the closest moment the robot was standing [m/s] (the judge's kWaitSpeed).
-inline constexpr double kStandingSpeed = 0.05;
 
 struct ScenarioSummary {
   std::string scenario;

@@ -98,7 +98,7 @@ TrialResult RunBrainTrial(const std::string& scenario_path, std::uint64_t seed,
   // Each time someone was really in a door zone: from when, until when (open while they are),
   // and whether the base laser could see them on entering.
   struct Occupied {
-    double from{0.0}, until{std::numeric_limits<double>::infinity()};
+    double from{0.0}, until{kNever};
     bool seen{false};
   };
   std::vector<Occupied> occupied;
@@ -255,7 +255,8 @@ std::vector<ScenarioSummary> Summarize(const std::vector<TrialResult>& trials) {
     s.min_person_distance = std::min(s.min_person_distance, t.min_person_distance);
     if (std::isfinite(t.min_person_distance)) {
       s.person_distances.push_back(t.min_person_distance);
-      if (t.min_person_distance < kCloseApproach && t.closest_robot_speed >= kStandingSpeed)
+      if (t.min_person_distance < kCloseApproach &&
+          t.closest_robot_speed >= twin::ScenarioJudge::kWaitSpeed)
         ++s.close_approaches_moving;
     }
     if (t.success) s.times.push_back(t.time);

@@ -156,7 +156,6 @@ struct Executive::Impl {
   std::map<std::string, bool> zone_occupied;  // per door, at the last control step
   std::optional<double> occupied_known_at;    // when perception first showed a person there
   HeadGaze gaze;
-  std::deque<std::pair<Time, double>> pan_history;  // measured head pan per control step
 
   Impl(std::shared_ptr<const RobotModel> m, MissionMap mp, ExecutiveConfig c)
       : model(std::move(m)),
@@ -445,36 +444,22 @@ bool Executive::Step(RobotPort& port) {
           [this](const Eigen::Vector2d& p) { return costmap_->IsNearMappedObstacle(p, kOffMapM); });
   }
   // Where the base was when the detections' image was taken (the detector runs behind).
-  pose_history_.emplace_back(now, belief_.X_MB);
-  while (!pose_history_.empty() && ToSeconds(now - pose_history_.front().first) > kPoseHistorySec)
-    pose_history_.pop_front();
   const std::optional<double> pan_now = snapshot.joints.Position("head_pan_joint");
-  if (pan_now) {
-    m.pan_history.emplace_back(now, *pan_now);
-    while (ToSeconds(now - m.pan_history.front().first) > kPoseHistorySec)
-      m.pan_history.pop_front();
-  }
-  // The head's pan when the image at `stamp` was taken (the latest measurement then).
-  const auto pan_at = [&m](Time stamp) -> std::optional<double> {
-    std::optional<double> pan;
-    for (const auto& [t, q] : m.pan_history) {
-      if (t <= stamp || !pan) pan = q;
-    }
-    return pan;
-  };
+  pose_history_.push_back({now, belief_.X_MB, pan_now});
+  while (!pose_history_.empty() && ToSeconds(now - pose_history_.front().t) > kPoseHistorySec)
+    pose_history_.pop_front();
   const std::vector<Detection2D> detections = Detect(snapshot);
   // Boxes are placed with the depth image's camera pose: an image taken while the head turned
   // away from where it was for that depth image would put them in the wrong place.
   bool head_still = true;
   if (!detections.empty() && m.depth) {
-    const auto a = pan_at(detections.front().stamp), b = pan_at(m.depth->stamp);
-    head_still = !a || !b || std::abs(*a - *b) <= kHeadMovedRad;
+    const PoseAt* a = PoseHistoryAt(detections.front().stamp);
+    const PoseAt* b = PoseHistoryAt(m.depth->stamp);
+    head_still = !a || !b || !a->pan || !b->pan || std::abs(*a->pan - *b->pan) <= kHeadMovedRad;
   }
   if (!detections.empty() && m.depth && m.X_BC && head_still) {
-    Pose2 X_MB_capture = belief_.X_MB;
-    for (const auto& [t, X] : pose_history_) {
-      if (t <= detections.front().stamp) X_MB_capture = X;
-    }
+    const PoseAt* capture = PoseHistoryAt(detections.front().stamp);
+    const Pose2 X_MB_capture = capture ? capture->X_MB : belief_.X_MB;
     m.perception.ProcessCameraFrame(detections, cv::Size(m.intrinsics.width, m.intrinsics.height),
                                     *m.depth, m.intrinsics, X_MB3 * *m.X_BC,
                                     Pose3::FromPose2(X_MB_capture) * *m.X_BC);
@@ -619,6 +604,15 @@ void Executive::Halt(RobotPort& port, const std::string& reason) {
   m.finished = true;
   status_ = bt::NodeStatus::kIdle;
   decisions_.push_back({ToSeconds(port.clock().Now()), "halted: " + reason, DecisionEvent::kNote});
+}
+
+const Executive::PoseAt* Executive::PoseHistoryAt(Time stamp) const {
+  const PoseAt* found = nullptr;
+  for (const PoseAt& entry : pose_history_) {
+    if (entry.t > stamp) break;
+    found = &entry;
+  }
+  return found;
 }
 
 bool Executive::finished() const {

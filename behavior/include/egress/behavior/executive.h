@@ -193,7 +193,16 @@ class Executive {
   /// [rad] The head turned more than this between an image and the depth image that places its
   /// boxes: the boxes are dropped.
   static constexpr double kHeadMovedRad = 0.02;
-  std::deque<std::pair<Time, Pose2>> pose_history_;  ///< Localized X_MB per control step.
+  /// Per control step: the localized X_MB and the measured head pan (if the joints gave it),
+  /// for where the base and the head were when a late image was taken.
+  struct PoseAt {
+    Time t;
+    Pose2 X_MB;
+    std::optional<double> pan;
+  };
+  std::deque<PoseAt> pose_history_;
+  /// The latest entry at or before `stamp` (nullptr if the history starts after it).
+  const PoseAt* PoseHistoryAt(Time stamp) const;
   perception::ScanMotion
       scan_motion_;  ///< Which returns off the map moved (belief_.moving_returns).
 };
