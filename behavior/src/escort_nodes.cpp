@@ -262,8 +262,8 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // kRoomHorizonSec (someone walking at the robot is too near before they arrive, and a step
     // that keeps clear of them for only the tracker's 0.8 s forecast is a step along their path
     // — clinic seed 4, a resident pushed along the wall by the crowd caught up with the robot
-    // stepping ahead of them), each centre pulled in to their edge towards the robot.
-    const std::vector<Eigen::Vector2d> near =
+    // stepping ahead of them).
+    const std::vector<Occupant> near =
         PeopleAround(task_, at, kRoomLookM, kRoomHorizonSec, kRoomHorizonStepSec);
     const auto room_at = [&](const Eigen::Vector2d& q) { return RoomAt(near, q); };
     const double now = room_at(at);

@@ -1,3 +1,4 @@
+#include "egress/behavior/proxemics.h"
 #include "task_node_support.h"
 
 #include <algorithm>
@@ -11,7 +12,8 @@ namespace {
 // does not show), it plans again on the updated costmap; when the costmap has no way to the
 // goal, it detours with the Bug2 local planner (round the obstacle's boundary by the laser).
 // A goal someone stands on, or a detour that gives up, is planned again every `replan_period`
-// for up to `patience` before the node fails.
+// for up to `patience` before the node fails. Someone coming towards the robot who would pass
+// too near stops the drive: the robot makes way (TaskConfig::give_way), then plans again.
 class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
  public:
   using TaskNode::TaskNode;
@@ -23,11 +25,22 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
   }
   NodeStatus OnStart() override {
     blocked_since_.reset();
+    give_way_.reset();
     detour_tried_ = false;
     goal_.reset();  // a place without a heading is resolved once, from where the robot starts
     return Start();
   }
   NodeStatus OnRunning() override {
+    if (give_way_) return GiveWay();
+    if (const auto coming = task_.config.give_way && !task_.motion->bug_active()
+                                ? PeopleComing()
+                                : decltype(PeopleComing()){};
+        !coming.empty()) {
+      task_.motion->StopBase();
+      give_way_ = GiveWayState{belief_.now, belief_.now, false};
+      Note(StrCat("making way: ", Describe(*coming.front().first), " is coming"));
+      return GiveWay();
+    }
     if (blocked_since_) {
       if (ToSeconds(belief_.now - last_try_) < kReplanPeriod) return NodeStatus::kRunning;
       return Start();
@@ -40,10 +53,84 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
     const NodeStatus s = BaseMotionStatus(task_, [this](const std::string& t) { Note(t); });
     return s == NodeStatus::kFailure ? Blocked() : s;
   }
-  void OnHalted() override { task_.motion->StopBase(); }
+  void OnHalted() override {
+    task_.motion->StopBase();
+    give_way_.reset();
+  }
 
  private:
   static constexpr double kReplanPeriod = 0.5;  // [s]
+  // [m/s] People slower than this are standing, not coming (a laser-tracked person standing
+  // still reads 0.3-0.4 m/s now and then: the legs' midpoint jitters; the slowest walkers with
+  // a frame go 0.6); the base slower than kStoppedMps has stopped (it is given kStopWithinSec).
+  static constexpr double kWalkingMps = 0.5;
+  static constexpr double kStoppedMps = 0.05;
+  static constexpr double kStopWithinSec = 1.5;
+  // [m] Someone this near the goal is whom the robot goes to (as ProxemicsConfig::goal_radius).
+  static constexpr double kGoalPersonRadiusM = 1.5;
+  // [m] A spot aside must give this much more room than standing where the robot is.
+  static constexpr double kMinGainM = 0.1;
+  // [s] A slow walker far off is not waited for longer than this.
+  static constexpr double kMaxPassSec = 15.0;
+
+  struct GiveWayState {
+    Time since{};
+    Time until{};        // when the last person seen coming will have passed
+    bool chosen{false};  // the spot is chosen (once the base has stopped)
+  };
+
+  // The people coming (see TaskConfig::give_way) and when each passes nearest [s from now].
+  std::vector<std::pair<const perception::TrackedPerson*, double>> PeopleComing() const {
+    const Eigen::Vector2d at = belief_.X_MB.translation();
+    std::vector<std::pair<const perception::TrackedPerson*, double>> coming;
+    for (const auto& entry : belief_.world.people) {
+      if (goal_ && (entry.person.p_MP - goal_->translation()).norm() < kGoalPersonRadiusM) continue;
+      if (const auto t_pass = OncomingPassTime(
+              entry.person, at, task_.config.footprint_radius, task_.config.person_radius,
+              task_.config.comfort_distance, task_.config.give_way_horizon, kWalkingMps))
+        coming.emplace_back(&entry.person, *t_pass);
+    }
+    return coming;
+  }
+  static std::string Describe(const perception::TrackedPerson& p) {
+    return StrCat("person ", p.id, " at (", std::round(p.p_MP.x() * 100) / 100, ", ",
+                  std::round(p.p_MP.y() * 100) / 100, "), ", std::round(p.v_MP.norm() * 10) / 10,
+                  " m/s");
+  }
+
+  // Making way: once stopped, to the spot round the robot where the people coming will leave it
+  // the most room (or stand still if none is better); on give_way_clear_for after the last one
+  // seen coming has passed, or after `patience`.
+  NodeStatus GiveWay() {
+    GiveWayState& g = *give_way_;
+    const double speed = std::hypot(belief_.V_B.vx, belief_.V_B.vy);
+    const bool stopped = speed <= kStoppedMps || ToSeconds(belief_.now - g.since) >= kStopWithinSec;
+    if (stopped && !g.chosen) {
+      g.chosen = true;
+      // Their ways predicted twice the horizon: on past the robot (to the horizon alone they may
+      // stop short of it, and every spot would look as good as standing in their way).
+      const PeopleRoom room(task_, 2.0 * task_.config.give_way_horizon);
+      const Eigen::Vector2d at = belief_.X_MB.translation();
+      if (const auto spot = room.BestSpotAround({belief_.X_MB}, room.Score(at) + kMinGainM)) {
+        task_.motion->FollowPath({belief_.X_MB, *spot}, {false}, task_.motion->arm_target(),
+                                 belief_.now, task_.config.retreat_speed);
+        Note(StrCat("stepping aside to (", PoseText(*spot), ")"));
+      } else {
+        Note("standing still: no spot aside leaves more room");
+      }
+    }
+    if (task_.motion->base_failed()) task_.motion->StopBase();  // blocked: stay where it is
+    // Until everyone seen coming has passed (by their last prediction: a person the camera
+    // loses behind another is still coming) and give_way_clear_for after.
+    for (const auto& [person, t_pass] : PeopleComing())
+      g.until = std::max(g.until, belief_.now + SecondsToDuration(std::min(t_pass, kMaxPassSec)));
+    const bool clear = ToSeconds(belief_.now - g.until) >= task_.config.give_way_clear_for;
+    const bool waited = ToSeconds(belief_.now - g.since) > Input<double>("patience");
+    if (!clear && !waited) return NodeStatus::kRunning;
+    give_way_.reset();
+    Note(clear ? "nobody is coming any more: going on" : "made way long enough: going on");
+    return Start();
+  }
 
   NodeStatus Start() {
     last_try_ = belief_.now;
@@ -90,6 +177,7 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
     return NodeStatus::kRunning;
   }
   std::optional<Time> blocked_since_;
+  std::optional<GiveWayState> give_way_;
   std::optional<Pose2> goal_;
   Time last_try_{};
   bool detour_tried_{false};
@@ -149,20 +237,8 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
   // [m/s] The base slower than this has stopped; [s] it is given this long to stop.
   static constexpr double kStoppedMps = 0.05;
   static constexpr double kStopWithinSec = 1.5;
-  // Candidate spots round the robot [m] and headings; how far ahead people's paths are
-  // predicted [s] and sampled [s]; how far round people count [m].
-  static constexpr double kSpotRadiiM[] = {0.6, 1.0, 1.5};
-  static constexpr int kSpotHeadings = 16;
+  // How far ahead people's paths are predicted [s].
   static constexpr double kPeopleHorizonSec = 3.0;
-  static constexpr double kPeopleStepSec = 0.2;
-  static constexpr double kPeopleLookM = 5.0;
-  // [m] Each metre of extra way costs this much room: a nearer spot wins a tie.
-  static constexpr double kWayCostPerM = 0.2;
-  // [m] A retreat passes people's edges no nearer than the footprint and this; checked every
-  // kPathSampleM along its way.
-  static constexpr double kPassMarginM = 0.1;
-  static constexpr double kPathSampleM = 0.05;
-  static constexpr double kSweepMarginRad = 10.0 * M_PI / 180.0;
 
   void StartRetreatOnceStopped() {
     const double speed = std::hypot(belief_.V_B.vx, belief_.V_B.vy);
@@ -210,65 +286,19 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
   // every way does. Second: whether it is a spot aside.
   std::optional<std::pair<Pose2, bool>> ChooseSpot(const std::vector<Pose2>& way) const {
     const Pose2 safe = *belief_.last_safe;
-    const Eigen::Vector2d at = belief_.X_MB.translation();
-    const std::vector<Eigen::Vector2d> people =
-        PeopleAround(task_, at, kPeopleLookM, kPeopleHorizonSec, kPeopleStepSec);
-    const std::vector<Eigen::Vector2d> people_now = PeopleAround(task_, at, kPeopleLookM, 0.0, 0.0);
+    const PeopleRoom room(task_, kPeopleHorizonSec);
     const double comfortable = task_.config.footprint_radius + task_.config.comfort_distance;
-    const double passable = task_.config.footprint_radius + kPassMarginM;
-    // Where the base laser looks (its latest scan's sweep, in B; a margin inside its edges):
-    // behind the robot, in its blind sector, nobody is seen (P1 seed 2000: a person waiting
-    // right behind it was backed into).
-    const Pose2 X_ML = belief_.X_MB * belief_.X_BL;
-    const auto seen = [&](const Eigen::Vector2d& p) {
-      if (!belief_.scan || (p - at).norm() <= task_.config.footprint_radius) return true;
-      const Eigen::Vector2d p_L = X_ML.Inverse() * p;
-      const double bearing = std::atan2(p_L.y(), p_L.x());
-      return bearing >= belief_.scan->angle_min + kSweepMarginRad &&
-             bearing <= belief_.scan->angle_max() - kSweepMarginRad;
-    };
-    // The straight lines of `way` and on to q keep clear of everyone now, within the laser's view.
-    const auto clear_way = [&](const Eigen::Vector2d& q) {
-      std::vector<Eigen::Vector2d> corners;
-      for (const Pose2& p : way)
-        corners.push_back(p.translation());
-      corners.push_back(q);
-      for (std::size_t i = 0; i + 1 < corners.size(); ++i) {
-        const double length = (corners[i + 1] - corners[i]).norm();
-        const int steps = std::max(1, int(std::ceil(length / kPathSampleM)));
-        for (int k = 1; k <= steps; ++k) {
-          const Eigen::Vector2d p =
-              corners[i] + (corners[i + 1] - corners[i]) * (double(k) / steps);
-          if (RoomAt(people_now, p) < passable || !seen(p)) return false;
-        }
-      }
-      return true;
-    };
-    const auto score = [&](const Eigen::Vector2d& q) {
-      return std::min(RoomAt(people, q), comfortable) - kWayCostPerM * (q - at).norm();
-    };
-    const bool safe_ok = clear_way(safe.translation());
-    if (safe_ok && RoomAt(people, safe.translation()) >= comfortable) return std::pair{safe, false};
-    std::optional<std::pair<Pose2, bool>> best;
-    double best_score = -std::numeric_limits<double>::infinity();
-    if (safe_ok) {
-      best = std::pair{safe, false};
-      best_score = score(safe.translation());
-    }
-    const Pose2& from = way.back();
-    for (const double radius : kSpotRadiiM) {
-      for (int k = 0; k < kSpotHeadings; ++k) {
-        const double a = 2 * M_PI * k / kSpotHeadings;
-        const Eigen::Vector2d q = at + radius * Eigen::Vector2d(std::cos(a), std::sin(a));
-        const double s = score(q);
-        if (s <= best_score || IsInAnyDoorZone(task_, q) || !clear_way(q)) continue;
-        const Pose2 candidate{q.x(), q.y(), belief_.X_MB.yaw};
-        if (!task_.planner->IsPathValid({from, candidate})) continue;
-        best = std::pair{candidate, true};
-        best_score = s;
-      }
-    }
-    return best;
+    std::vector<Eigen::Vector2d> corners;
+    for (const Pose2& p : way)
+      corners.push_back(p.translation());
+    corners.push_back(safe.translation());
+    const bool safe_ok = room.IsWayClear(corners);
+    if (safe_ok && room.Predicted(safe.translation()) >= comfortable) return std::pair{safe, false};
+    const double beat =
+        safe_ok ? room.Score(safe.translation()) : -std::numeric_limits<double>::infinity();
+    if (const auto aside = room.BestSpotAround(way, beat)) return std::pair{*aside, true};
+    if (safe_ok) return std::pair{safe, false};
+    return std::nullopt;
   }
 
   bool pending_{false};

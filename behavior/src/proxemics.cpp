@@ -47,4 +47,20 @@ double ApproachSpeedScale(const Pose2& X_MB, const Eigen::Vector2d& v_M,
   return scale;
 }
 
+std::optional<double> OncomingPassTime(const perception::TrackedPerson& person,
+                                       const Eigen::Vector2d& p_MB, double robot_radius,
+                                       double person_radius, double gap, double horizon,
+                                       double walking_speed) {
+  const Eigen::Vector2d& v = person.v_MP;
+  const double speed = v.norm();
+  const Eigen::Vector2d to_robot = p_MB - person.p_MP;
+  if (!(speed > walking_speed) || to_robot.dot(v) <= 0.0) return std::nullopt;
+  // Their nearest point to the robot on their straight way, and within the horizon.
+  const double t_pass = to_robot.dot(v) / (speed * speed);
+  const double t = std::min(t_pass, horizon);
+  if ((person.p_MP + v * t - p_MB).norm() - robot_radius - person_radius >= gap)
+    return std::nullopt;
+  return t_pass;
+}
+
 }  // namespace egress::behavior

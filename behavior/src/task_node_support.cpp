@@ -215,29 +215,111 @@ std::optional<std::vector<ArmPose>> SolveArmLine(const TaskServices& task, const
   return knots;
 }
 
-std::vector<Eigen::Vector2d> PeopleAround(const TaskServices& task, const Eigen::Vector2d& at,
-                                          double look, double horizon, double step) {
-  std::vector<Eigen::Vector2d> near;
+namespace {
+// A predicted way meeting a wall turns along it in steps of kWallTurnRad, up to kMaxWallTurns.
+constexpr double kWallTurnRad = 15.0 * M_PI / 180.0;
+constexpr int kMaxWallTurns = 6;
+}  // namespace
+
+std::vector<Occupant> PeopleAround(const TaskServices& task, const Eigen::Vector2d& at, double look,
+                                   double horizon, double step) {
+  std::vector<Occupant> near;
   for (const Eigen::Vector2d& p : task.belief->off_map_returns)
-    if ((p - at).norm() < look) near.push_back(p);
+    if ((p - at).norm() < look) near.push_back({p, 0.0});
+  const perception::Costmap2D* costmap = task.belief->world.costmap;
+  const double wall_gap = 0.5 * task.config.person_radius;
+  const auto walkable = [&](const Eigen::Vector2d& p) {
+    return !costmap || !costmap->IsNearMappedObstacle(p, wall_gap);
+  };
   for (const auto& entry : task.belief->world.people) {
-    const auto& person = entry.person;
+    Eigen::Vector2d p_MP = entry.person.p_MP, v_MP = entry.person.v_MP;
     for (int k = 0; step > 0 ? k * step <= horizon + 1e-9 : k == 0; ++k) {
-      const Eigen::Vector2d p_MP = person.p_MP + person.v_MP * (k * step);
-      const Eigen::Vector2d d = p_MP - at;
-      if (d.norm() < look && d.norm() > 1e-6)
-        near.push_back(p_MP - d.normalized() * task.config.person_radius);
+      if (k > 0) {
+        // Nobody walks through a wall: a way predicted into one (a velocity a few degrees askew
+        // along a corridor, over seconds) turns along it, by the least turn that is free.
+        bool free = walkable(p_MP + v_MP * step);
+        for (int turn = 1; !free && turn <= kMaxWallTurns; ++turn) {
+          for (const double sign : {1.0, -1.0}) {
+            const Eigen::Vector2d v = Eigen::Rotation2Dd(sign * turn * kWallTurnRad) * v_MP;
+            if (walkable(p_MP + v * step)) {
+              v_MP = v;
+              free = true;
+              break;
+            }
+          }
+        }
+        if (!free) break;
+        p_MP += v_MP * step;
+      }
+      if ((p_MP - at).norm() < look) near.push_back({p_MP, task.config.person_radius});
       if (step <= 0) break;
     }
   }
   return near;
 }
 
-double RoomAt(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector2d& q) {
+double RoomAt(const std::vector<Occupant>& near, const Eigen::Vector2d& q) {
   double room = std::numeric_limits<double>::infinity();
-  for (const Eigen::Vector2d& p : points)
-    room = std::min(room, (p - q).norm());
+  for (const Occupant& o : near)
+    room = std::min(room, (o.p_M - q).norm() - o.radius);
   return room;
+}
+
+PeopleRoom::PeopleRoom(const TaskServices& task, double horizon)
+    : task_(task),
+      at_(task.belief->X_MB.translation()),
+      predicted_(PeopleAround(task, at_, kPeopleLookM, horizon, kPeopleStepSec)),
+      now_(PeopleAround(task, at_, kPeopleLookM, 0.0, 0.0)) {}
+
+double PeopleRoom::Score(const Eigen::Vector2d& q) const {
+  const double comfortable = task_.config.footprint_radius + task_.config.comfort_distance;
+  return std::min(Predicted(q), comfortable) - kWayCostPerM * (q - at_).norm();
+}
+
+bool PeopleRoom::IsSeen(const Eigen::Vector2d& p) const {
+  const Belief& belief = *task_.belief;
+  if (!belief.scan || (p - at_).norm() <= task_.config.footprint_radius) return true;
+  const Eigen::Vector2d p_L = (belief.X_MB * belief.X_BL).Inverse() * p;
+  const double bearing = std::atan2(p_L.y(), p_L.x());
+  return bearing >= belief.scan->angle_min + kSweepMarginRad &&
+         bearing <= belief.scan->angle_max() - kSweepMarginRad;
+}
+
+bool PeopleRoom::IsWayClear(const std::vector<Eigen::Vector2d>& corners) const {
+  const double passable = task_.config.footprint_radius + kPassMarginM;
+  for (std::size_t i = 0; i + 1 < corners.size(); ++i) {
+    const double length = (corners[i + 1] - corners[i]).norm();
+    const int steps = std::max(1, int(std::ceil(length / kPathSampleM)));
+    for (int k = 1; k <= steps; ++k) {
+      const Eigen::Vector2d p = corners[i] + (corners[i + 1] - corners[i]) * (double(k) / steps);
+      if (RoomAt(now_, p) < passable || !IsSeen(p)) return false;
+    }
+  }
+  return true;
+}
+
+std::optional<Pose2> PeopleRoom::BestSpotAround(const std::vector<Pose2>& way, double beat) const {
+  std::vector<Eigen::Vector2d> corners;
+  for (const Pose2& p : way)
+    corners.push_back(p.translation());
+  corners.push_back(Eigen::Vector2d::Zero());
+  const double yaw = task_.belief->X_MB.yaw;
+  std::optional<Pose2> best;
+  for (const double radius : kSpotRadiiM) {
+    for (int k = 0; k < kSpotHeadings; ++k) {
+      const double a = 2 * M_PI * k / kSpotHeadings;
+      const Eigen::Vector2d q = at_ + radius * Eigen::Vector2d(std::cos(a), std::sin(a));
+      const double s = Score(q);
+      if (s <= beat || IsInAnyDoorZone(task_, q)) continue;
+      corners.back() = q;
+      if (!IsWayClear(corners)) continue;
+      const Pose2 candidate{q.x(), q.y(), yaw};
+      if (!task_.planner->IsPathValid({way.back(), candidate})) continue;
+      best = candidate;
+      beat = s;
+    }
+  }
+  return best;
 }
 
 double PositionSigma(const TaskServices& task) {

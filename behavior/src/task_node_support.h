@@ -148,13 +148,55 @@ double ExitDistance(const TaskServices& task, const std::string& door);
 /// How far before the door line the robot lines up and waits [m].
 double EntryDistance(const TaskServices& task, const std::string& door, const DoorPass& pass);
 
-/// Where the people near `at` (within `look` [m]) are and will be: each tracked person's centre
-/// now and at their velocity every `step` [s] up to `horizon` [s], pulled in by the person
-/// radius towards `at` (their edge), and the latest scan's returns off the map. In M.
-std::vector<Eigen::Vector2d> PeopleAround(const TaskServices& task, const Eigen::Vector2d& at,
-                                          double look, double horizon, double step);
-/// The distance from `q` to the nearest of `points` (infinity for none) [m].
-double RoomAt(const std::vector<Eigen::Vector2d>& points, const Eigen::Vector2d& q);
+/// A person's body (centre and radius) or a scan return off the map (radius 0), in M.
+struct Occupant {
+  Eigen::Vector2d p_M{Eigen::Vector2d::Zero()};
+  double radius{0.0};  ///< [m]
+};
+/// Where the people near `at` (within `look` [m]) are and will be: each tracked person now and
+/// at their velocity every `step` [s] up to `horizon` [s] (a way predicted into a wall ends
+/// there), and the latest scan's returns off the map.
+std::vector<Occupant> PeopleAround(const TaskServices& task, const Eigen::Vector2d& at, double look,
+                                   double horizon, double step);
+/// The distance from `q` to the nearest edge among `near` (infinity for none) [m].
+double RoomAt(const std::vector<Occupant>& near, const Eigen::Vector2d& q);
+
+/// People's room round the robot, for choosing where to stand out of their way (a standby's
+/// retreat, a give-way in a corridor): where the tracked people (and the latest scan's returns
+/// off the map) are now and will be over `horizon` [s], and which straight ways pass them.
+class PeopleRoom {
+ public:
+  PeopleRoom(const TaskServices& task, double horizon);
+  /// The distance from `q` to the nearest person's edge, now or predicted [m].
+  double Predicted(const Eigen::Vector2d& q) const { return RoomAt(predicted_, q); }
+  /// A spot's worth [m]: its predicted room, capped at the footprint plus the comfort distance
+  /// (beyond that all spots are as good), less kWayCostPerM per metre from the robot.
+  double Score(const Eigen::Vector2d& q) const;
+  /// The straight lines through `corners` pass nobody (where they stand now) nearer than the
+  /// footprint and kPassMarginM, and stay inside the base laser's sweep (behind the robot, in
+  /// its blind sector, nobody is seen: P1 seed 2000 backed into someone waiting there).
+  bool IsWayClear(const std::vector<Eigen::Vector2d>& corners) const;
+  /// Of the spots round the robot (kSpotRadiiM x kSpotHeadings, at its heading) outside every
+  /// door's zone, reachable from `way` (the robot's pose first) by a clear straight line the
+  /// planner finds valid: the best-scoring one, if it scores above `beat`.
+  std::optional<Pose2> BestSpotAround(const std::vector<Pose2>& way, double beat) const;
+
+  static constexpr double kSpotRadiiM[] = {0.6, 1.0, 1.5};
+  static constexpr int kSpotHeadings = 16;
+  static constexpr double kPeopleStepSec = 0.2;  ///< predictions sampled every [s]
+  static constexpr double kPeopleLookM = 5.0;    ///< people this far round count [m]
+  static constexpr double kWayCostPerM = 0.2;    ///< a nearer spot wins a tie [m of room per m]
+  static constexpr double kPassMarginM = 0.1;    ///< beyond the footprint [m]
+  static constexpr double kPathSampleM = 0.05;   ///< ways checked this often [m]
+  static constexpr double kSweepMarginRad = 10.0 * M_PI / 180.0;
+
+ private:
+  bool IsSeen(const Eigen::Vector2d& p) const;
+  const TaskServices& task_;
+  Eigen::Vector2d at_;
+  std::vector<Occupant> predicted_;
+  std::vector<Occupant> now_;
+};
 
 /// The localizer's position standard deviation: the square root of the largest eigenvalue of
 /// the xy block of the belief's covariance [m].

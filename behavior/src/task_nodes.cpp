@@ -19,6 +19,9 @@ void TaskConfig::Validate() const {
               "TaskConfig: comfort_distance must be >= 0 (m)");
   ThrowUnless(std::isfinite(retreat_speed) && retreat_speed > 0,
               "TaskConfig: retreat_speed must be > 0 (m/s)");
+  ThrowUnless(std::isfinite(give_way_horizon) && give_way_horizon >= 0 &&
+                  std::isfinite(give_way_clear_for) && give_way_clear_for >= 0,
+              "TaskConfig: give_way_horizon and give_way_clear_for must be >= 0 (s)");
   ThrowUnless(precise_pose_sigma > 0 && relocalize_timeout >= 0,
               "TaskConfig: precise_pose_sigma must be > 0 and relocalize_timeout >= 0");
   ik.Validate();

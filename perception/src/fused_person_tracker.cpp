@@ -20,6 +20,7 @@ void FusedPersonTrackerConfig::Validate() const {
   positive(max_latency_s, "max_latency_s");
   positive(min_velocity_dt, "min_velocity_dt");
   positive(forecast_dt, "forecast_dt");
+  positive(confirm_window_s, "confirm_window_s");
   ThrowUnless(std::isfinite(confirm_motion) && confirm_motion >= 0.0,
               "FusedPersonTrackerConfig: confirm_motion must be finite and >= 0");
   ThrowUnless(confirm_laser_hits >= 1 && forecast_steps >= 0,
@@ -83,9 +84,13 @@ void FusedPersonTracker::Update(const std::vector<PersonObservation>& observatio
     } else {
       ++track.laser_hits;
     }
+    const bool moved = (track.person.p_MP - track.p_MBirth).norm() >= config_.confirm_motion;
     track.confirmed = track.confirmed || track.camera_hits > 0 ||
-                      (track.laser_hits >= config_.confirm_laser_hits &&
-                       (track.person.p_MP - track.p_MBirth).norm() >= config_.confirm_motion);
+                      (track.laser_hits >= config_.confirm_laser_hits && moved);
+    if (!track.confirmed && ToSeconds(stamp - track.birth) > config_.confirm_window_s) {
+      track.p_MBirth = track.person.p_MP;  // a new window from here
+      track.birth = stamp;
+    }
   }
 
   // Drop tracks this sensor should have seen and has not for drop_after_s, and tracks no sensor
@@ -115,6 +120,7 @@ void FusedPersonTracker::Update(const std::vector<PersonObservation>& observatio
     track.person.hits = 1;
     track.person.last_seen = stamp;
     track.p_MBirth = observations[k].p_MP;
+    track.birth = stamp;
     track.last_measured = stamp;
     track.last_by_source[std::size_t(observations[k].source)] =
         std::make_pair(stamp, observations[k].p_MP);

@@ -18,6 +18,7 @@ constexpr double kArcCentroidOffset = 0.64;
 struct Circle {
   Eigen::Vector2d centre;
   double radius;
+  double residual;  // RMS distance of the points from it [m]
 };
 
 // Algebraic (Kasa) least-squares circle through the points, or nullopt when they are
@@ -41,7 +42,13 @@ std::optional<Circle> FitCircle(const std::vector<Eigen::Vector2d>& points) {
   const Eigen::Vector2d centre(-s.x() / 2, -s.y() / 2);
   const double r2 = centre.squaredNorm() - s.z();
   if (!std::isfinite(r2) || r2 <= 0.0) return std::nullopt;
-  return Circle{centre + mean, std::sqrt(r2)};
+  const double radius = std::sqrt(r2);
+  double squares = 0.0;
+  for (const auto& p : points) {
+    const double off = (p - mean - centre).norm() - radius;
+    squares += off * off;
+  }
+  return Circle{centre + mean, radius, std::sqrt(squares / double(points.size()))};
 }
 
 }  // namespace
@@ -55,6 +62,7 @@ void LaserPersonDetectorConfig::Validate() const {
   positive(leg_min_width, "leg_min_width");
   positive(leg_pair_max_gap, "leg_pair_max_gap");
   positive(body_min_radius, "body_min_radius");
+  positive(body_max_residual, "body_max_residual");
   positive(max_range, "max_range");
   ThrowUnless(min_points >= 2, "LaserPersonDetectorConfig: min_points must be >= 2");
   ThrowUnless(leg_min_width < leg_max_width && leg_max_width < body_max_width,
@@ -116,18 +124,15 @@ std::vector<LaserPersonDetection> LaserPersonDetector::Detect(
           {centroid + away * kArcCentroidOffset * radius, radius, 1, int(points.size())});
       continue;
     }
-    // A body section: its circle's centre lies beyond the arc, seen from the laser.
-    LaserPersonDetection body{Eigen::Vector2d::Zero(), 0.0, 0, int(points.size())};
+    // A body section: an arc whose circle's centre lies beyond it, seen from the laser. A
+    // straight run of returns (a cabinet's face) or a box's corner (S7's phantom person beside
+    // the robot, "entering" the door zone) fits no such circle and is not a person.
     const std::optional<Circle> circle = points.size() >= 5 ? FitCircle(points) : std::nullopt;
-    if (circle && circle->radius >= config_.body_min_radius &&
-        circle->radius <= config_.body_max_radius && (circle->centre - centroid).dot(away) > 0.0) {
-      body.p_MP = circle->centre;
-      body.radius = circle->radius;
-    } else {
-      body.radius = std::clamp(width / 2, config_.body_min_radius, config_.body_max_radius);
-      body.p_MP = centroid + away * kArcCentroidOffset * body.radius;
-    }
-    people.push_back(body);
+    if (!circle || circle->radius < config_.body_min_radius ||
+        circle->radius > config_.body_max_radius || circle->residual > config_.body_max_residual ||
+        (circle->centre - centroid).dot(away) <= 0.0)
+      continue;
+    people.push_back({circle->centre, circle->radius, 0, int(points.size())});
   }
 
   // Legs a stride apart at most are one person's: closest pairs first.

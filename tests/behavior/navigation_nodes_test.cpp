@@ -39,6 +39,73 @@ TEST_F(NavigationNodesTest, NavigateToAnUnreachableGoalWaitsItsPatienceThenFails
   EXPECT_NE(log_.pending().back().text.find("gave up"), std::string::npos);
 }
 
+// Someone walking at the robot stops the drive; once the base has stopped it steps out of
+// their way, and goes on (a new plan to the goal) after they have passed.
+TEST_F(NavigationNodesTest, NavigateToMakesWayForSomeoneComingAndGoesOnAfterThey) {
+  bt::Tree tree = Tree(R"(<NavigateTo goal="2.5;0.5;0.0"/>)");
+  belief_.X_MB = {-2.0, 0.5, 0.0};
+  belief_.now = At(1.0);
+  ASSERT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  ASSERT_TRUE(motion_.base_moving());
+  auto walker = Person({0.4, 0.7}, perception::PersonIntent::kUnknown);
+  walker.person.v_MP = {-1.2, 0.0};
+  belief_.world.people = {walker};
+  belief_.V_B = {0.2, 0.0, 0.0};
+  belief_.now = At(1.1);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_FALSE(motion_.base_moving()) << "stops first";
+  EXPECT_TRUE(NotedText("making way"));
+  belief_.V_B = {};
+  belief_.now = At(1.2);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  ASSERT_TRUE(motion_.base_moving());
+  const Eigen::Vector2d spot = motion_.path().back().translation();
+  EXPECT_LT(spot.y(), 0.5 - 0.3) << "away from their way (y = 0.7), to the side";
+  // Gone past (walking away): on once their pass time and give_way_clear_for are over.
+  motion_.StopBase();
+  belief_.X_MB = {spot.x(), spot.y(), 0.0};
+  walker.person.p_MP = {-2.9, 0.7};
+  belief_.world.people = {walker};
+  belief_.now = At(2.5);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_FALSE(motion_.base_moving()) << "they were to pass at 3.2 s: still waiting";
+  belief_.now = At(4.3);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  ASSERT_TRUE(motion_.base_moving());
+  EXPECT_LT((motion_.path().back().translation() - Eigen::Vector2d(2.5, 0.5)).norm(), 1e-6);
+  EXPECT_TRUE(NotedText("going on"));
+}
+
+// Standing people, people walking elsewhere and whoever waits at the goal are not made way for;
+// nor is anyone when give_way is off.
+TEST_F(NavigationNodesTest, NavigateToMakesWayOnlyForPeopleComingAtTheRobot) {
+  // Whether the robot made way for `person` (the log keeps every note: none before the last).
+  auto makes_way_for = [&](const perception::TrackedPersonWithIntent& person, bool give_way) {
+    services_.config.give_way = give_way;
+    bt::Tree tree = Tree(R"(<NavigateTo goal="2.5;0.5;0.0"/>)");
+    belief_.X_MB = {-2.5, 0.5, 0.0};
+    belief_.world.people.clear();
+    belief_.now = At(1.0);
+    tree.TickOnce();
+    belief_.world.people = {person};
+    belief_.now = At(1.1);
+    tree.TickOnce();
+    return NotedText("making way");
+  };
+  auto standing = Person({-1.3, 0.5}, perception::PersonIntent::kStationary);
+  EXPECT_FALSE(makes_way_for(standing, true));
+  auto elsewhere = Person({-1.0, 2.5}, perception::PersonIntent::kUnknown);
+  elsewhere.person.v_MP = {-1.2, 0.0};
+  EXPECT_FALSE(makes_way_for(elsewhere, true));
+  auto at_goal = Person({2.2, 0.6}, perception::PersonIntent::kUnknown);
+  at_goal.person.v_MP = {-1.0, 0.0};
+  EXPECT_FALSE(makes_way_for(at_goal, true)) << "whom the robot goes to";
+  auto coming = Person({0.5, 0.6}, perception::PersonIntent::kUnknown);
+  coming.person.v_MP = {-1.0, 0.0};
+  EXPECT_FALSE(makes_way_for(coming, false));
+  EXPECT_TRUE(makes_way_for(coming, true));
+}
+
 TEST_F(NavigationNodesTest, RetractToSafeBacksOffToTheLastSafeWaypoint) {
   auto blackboard = bt::Blackboard::Create();
   bt::Tree tree = Tree(R"(<RetractToSafe/>)", blackboard);

@@ -56,6 +56,27 @@ TEST(ProxemicsTest, SomeoneWhereThePathEndsIsWhomTheRobotGoesTo) {
                    0.0);
 }
 
+// Oncoming: walking towards the robot and passing within the gap (0.8 m) within the horizon.
+TEST(ProxemicsTest, SomeoneWalkingAtTheRobotIsOncomingUntilTheyPass) {
+  const auto pass = [](const Eigen::Vector2d& p, const Eigen::Vector2d& v) {
+    return OncomingPassTime(At(p, v).person, {0.0, 0.0}, kRobotRadius, kPersonRadius, 0.8, 4.0,
+                            0.3);
+  };
+  // Head-on from 3 m at 1 m/s: nearest in 3 s.
+  ASSERT_TRUE(pass({3.0, 0.2}, {-1.0, 0.0}).has_value());
+  EXPECT_NEAR(*pass({3.0, 0.2}, {-1.0, 0.0}), 3.0, 1e-9);
+  // Still coming from 6 m: 4 s on they are 2 m off, within the gap of the robot's edge? No:
+  // 2 - 0.515 > 0.8. From 5 m: 1 m off, 0.485 m from its edge: coming (passing in 5 s).
+  EXPECT_FALSE(pass({6.0, 0.0}, {-1.0, 0.0}).has_value());
+  ASSERT_TRUE(pass({5.0, 0.0}, {-1.0, 0.0}).has_value());
+  EXPECT_NEAR(*pass({5.0, 0.0}, {-1.0, 0.0}), 5.0, 1e-9);
+  // Passing 1.5 m to the side (edge gap 0.985 m), walking away, or standing: not coming.
+  EXPECT_FALSE(pass({3.0, 1.5}, {-1.0, 0.0}).has_value());
+  EXPECT_FALSE(pass({-1.0, 0.2}, {-1.0, 0.0}).has_value());
+  EXPECT_FALSE(pass({1.0, 0.0}, {-0.2, 0.0}).has_value());
+  EXPECT_FALSE(pass({1.0, 0.0}, {std::nan(""), 0.0}).has_value());
+}
+
 TEST(ProxemicsTest, BadConfigsAreRefusedNamingTheField) {
   ProxemicsConfig c;
   c.stop_gap = 2.0;  // beyond slow_gap

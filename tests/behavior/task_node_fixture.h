@@ -115,6 +115,13 @@ class TaskNodeFixture : public ::testing::Test {
     return false;
   }
 
+  // Whether any note so far contains `text`.
+  bool NotedText(std::string_view text) const {
+    for (const auto& note : log_.pending())
+      if (note.text.find(text) != std::string::npos) return true;
+    return false;
+  }
+
   MissionMap map_ = LabDoor();
   RobotModel model_;
   MotionExecutor motion_;

@@ -59,6 +59,23 @@ TEST(FusedPersonTrackerTest, ALaserOnlyTrackConfirmsOnlyWhenItMoves) {
   EXPECT_GT(people[0].p_MP.y(), 2.5);
 }
 
+// The returns of a door jamb creeping 1 cm/s as the robot's viewpoint changes: 0.3 m from
+// where they were first seen after 30 s, never 0.3 m within 2 s — not a person. A slow walker
+// (0.3 m/s) is.
+TEST(FusedPersonTrackerTest, ALaserOnlyTrackCreepingSlowlyNeverConfirms) {
+  FusedPersonTracker tracker;
+  for (int i = 0; i <= 400; ++i) {
+    const double t = 0.1 * i;
+    tracker.Update({{Eigen::Vector2d(2.0 + 0.001 * i, 0.0), PersonSource::kLaser},
+                    {Eigen::Vector2d(-3.0, -5.0 + 0.03 * i), PersonSource::kLaser}},
+                   At(t));
+    if (t < 1.5) continue;
+    const auto people = tracker.ConfirmedPeople();
+    ASSERT_EQ(people.size(), 1u) << "at " << t << " s";
+    EXPECT_NEAR(people[0].p_MP.x(), -3.0, 0.05);
+  }
+}
+
 TEST(FusedPersonTrackerTest, APersonTheCameraCannotSeeIsKeptByTheLaser) {
   FusedPersonTracker tracker;
   // Behind the robot: the camera (looking along +x) covers x > 0 only.

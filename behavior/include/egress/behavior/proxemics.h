@@ -37,4 +37,13 @@ double ApproachSpeedScale(const Pose2& X_MB, const Eigen::Vector2d& v_M,
                           const std::vector<perception::TrackedPersonWithIntent>& people,
                           double robot_radius, double person_radius, const ProxemicsConfig& config);
 
+/// Whether `person` walks (faster than `walking_speed` [m/s]) towards a robot standing at
+/// p_MB and, going straight on at their velocity, will pass within `gap` of its edge (surface
+/// to surface) within `horizon` [s]: someone the robot should make way for. Then the time from
+/// now at which they pass nearest [s] (may exceed the horizon); else nullopt. Radii [m].
+std::optional<double> OncomingPassTime(const perception::TrackedPerson& person,
+                                       const Eigen::Vector2d& p_MB, double robot_radius,
+                                       double person_radius, double gap, double horizon,
+                                       double walking_speed);
+
 }  // namespace egress::behavior

@@ -56,6 +56,14 @@ struct TaskConfig {
   /// A standby retreat's speed: a quintic from rest at the paper's 0.2 m/s covers 4 cm in its
   /// first second [m/s].
   double retreat_speed{0.4};
+  /// Making way on the move (NavigateTo): someone walking towards the robot who would pass
+  /// within comfort_distance of it within give_way_horizon [s] stops the drive; the robot steps
+  /// to where they will leave it the most room (out of their way, e.g. to a corridor's wall)
+  /// or stands still, and goes on once nobody has been coming for give_way_clear_for [s]. A
+  /// robot that stops in the middle of a 2 m corridor is walked into (P2).
+  bool give_way{true};
+  double give_way_horizon{4.0};
+  double give_way_clear_for{1.0};
   double arm_tuck_time{1.5};     ///< [s]
   double press_reach_time{2.0};  ///< Tucked → pre-press [s].
   double press_time{1.0};        ///< Pre-press → press → pre-press, each way [s].

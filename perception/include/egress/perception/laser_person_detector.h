@@ -8,7 +8,11 @@
 /// within a stride of each other are paired into one person, and a body section's centre is
 /// found by a circle fit (the laser sees only its near side). Points in M (the map frame).
 ///
-/// What it cannot tell: a table leg from a person's leg, or a round bin from a body. The tracker
+/// Straight runs of returns (a box's face) and box corners of faces 0.4 m or more are not
+/// bodies: their circle fits leave more than `body_max_residual`.
+///
+/// What it cannot tell: a table leg from a person's leg, a round bin from a body, or a smaller
+/// box corner (faces under ~0.4 m fit a circle within the range noise) from a body. The tracker
 /// that consumes these detections (with the camera's) confirms people over several scans and by
 /// motion.
 
@@ -31,7 +35,10 @@ struct LaserPersonDetectorConfig {
   double leg_pair_max_gap{0.50};  ///< Two legs of one person: centres at most this apart [m].
   double body_min_radius{0.10};   ///< Body sections fit circles of this radius ... [m]
   double body_max_radius{0.45};   ///< ... to this.
-  double max_range{10.0};         ///< Returns farther than this are left out [m].
+  /// ... within this RMS distance of their returns [m]: a box's corner (two straight faces)
+  /// fits a circle of a body's radius too, 2-3 cm off; an arc fits to the range noise (1 cm).
+  double body_max_residual{0.02};
+  double max_range{10.0};  ///< Returns farther than this are left out [m].
   /// @throws InvalidArgument naming the field that is non-finite or out of order.
   void Validate() const;
 };
