@@ -364,7 +364,7 @@ nlohmann::json PlanJson(const std::vector<std::pair<std::string, int>>& scenario
     list.push_back({{"scenario", file}, {"trials", trials}});
   nlohmann::json plan = {
       {"scenarios", list}, {"seed_base", seed_base}, {"shard", {shard.first, shard.second}}};
-  if (laser_people) plan["brain"] = {{"laser_people", true}};
+  plan["brain"] = {{"laser_people", laser_people}};
   return plan;
 }
 
@@ -676,8 +676,9 @@ void AddSimBatchCommand(CLI::App& sim_group) {
                   "continue the interrupted batch in --out: run only trials not in its journal");
   batch->add_flag("--overwrite", o->overwrite, "replace existing result files");
   batch->add_flag("-q,--quiet", o->quiet, "no progress bar");
-  batch->add_flag("--laser-people", o->laser_people,
-                  "people from the base laser too, fused with the camera's (as sim run's)");
+  batch->add_flag("--laser-people,!--camera-people-only", o->laser_people,
+                  "people from the base laser too, or the head camera's alone (the "
+                  "default; as sim run's)");
   batch->callback([o] { RunBatch(*o); });
 
   auto m = std::make_shared<MergeOptions>();

@@ -358,9 +358,9 @@ void AddSimCommand(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   sim->add_flag("--overwrite", o->overwrite, "replace existing output files");
   sim->add_flag("-q,--quiet", o->quiet, "print only the verdict");
-  sim->add_flag("--laser-people", o->laser_people,
-                "experimental (issue 21): people from the base laser too, fused with the "
-                "camera's");
+  sim->add_flag("--laser-people,!--camera-people-only", o->laser_people,
+                "people from the base laser too, fused with the camera's; "
+                "--camera-people-only (the default): the head camera's alone");
   sim->add_flag("--no-octomap", o->no_octomap,
                 "disconnect the brain's 3D obstacle map (the base laser alone), for comparison");
   sim->callback([o] { RunSim(*o); });

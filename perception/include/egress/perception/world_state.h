@@ -70,8 +70,10 @@ struct PerceptionConfig {
   double person_mask_radius{0.5};
   LineFitConfig glass_line;
   /// People from the base laser too (LaserPersonDetector), fused with the camera's in a
-  /// FusedPersonTracker whose confirmed tracks are the snapshot's people (issue 21). Off: the
-  /// camera's PersonTracker alone, as before.
+  /// FusedPersonTracker whose confirmed tracks are the snapshot's people (issue 21): people
+  /// beside and behind the robot are known. Off (the default): the camera's PersonTracker alone
+  /// (58 deg; the paper's brain). Still off because the standby retreat, started earlier and
+  /// elsewhere with it, meets people coming through a door (H12: 5 contacts in 100 trials).
   bool laser_people{false};
   LaserPersonDetectorConfig laser_detector;
   FusedPersonTrackerConfig fused_people;
