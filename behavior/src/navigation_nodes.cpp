@@ -8,6 +8,12 @@
 namespace egress::behavior::detail {
 namespace {
 
+// [m/s] The base slower than this has stopped; [s] it is given this long to stop before a
+// step aside or a retreat starts anyway (a path begun at speed the other way leaves the
+// reference behind and trips the watchdog).
+constexpr double kStoppedMps = 0.05;
+constexpr double kStopWithinSec = 1.5;
+
 // Plans and follows a path to `goal`. When the path ahead becomes blocked (an obstacle the map
 // does not show), it plans again on the updated costmap; when the costmap has no way to the
 // goal, it detours with the Bug2 local planner (round the obstacle's boundary by the laser).
@@ -62,10 +68,8 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
   static constexpr double kReplanPeriod = 0.5;  // [s]
   // [m/s] People slower than this are standing, not coming (a laser-tracked person standing
   // still reads 0.3-0.4 m/s now and then: the legs' midpoint jitters; the slowest walkers with
-  // a frame go 0.6); the base slower than kStoppedMps has stopped (it is given kStopWithinSec).
+  // a frame go 0.6).
   static constexpr double kWalkingMps = 0.5;
-  static constexpr double kStoppedMps = 0.05;
-  static constexpr double kStopWithinSec = 1.5;
   // [m] Someone this near the goal is whom the robot goes to (as ProxemicsConfig::goal_radius).
   static constexpr double kGoalPersonRadiusM = 1.5;
   // [m] A spot aside must give this much more room than standing where the robot is.
@@ -234,9 +238,6 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
   }
 
  private:
-  // [m/s] The base slower than this has stopped; [s] it is given this long to stop.
-  static constexpr double kStoppedMps = 0.05;
-  static constexpr double kStopWithinSec = 1.5;
   // How far ahead people's paths are predicted [s].
   static constexpr double kPeopleHorizonSec = 3.0;
 
