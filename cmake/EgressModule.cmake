@@ -20,13 +20,18 @@ function(egress_module name)
 endfunction()
 
 # egress_add_test(<name> SOURCES ... DEPS ...): one GoogleTest executable, registered with ctest.
+# RESOURCE_LOCK: ctest runs no two tests holding the same lock at once.
 function(egress_add_test name)
-  cmake_parse_arguments(_t "" "" "SOURCES;DEPS" ${ARGN})
+  cmake_parse_arguments(_t "" "RESOURCE_LOCK" "SOURCES;DEPS" ${ARGN})
   add_executable(${name} ${_t_SOURCES})
   target_link_libraries(${name} PRIVATE ${_t_DEPS} GTest::gtest GTest::gmock GTest::gtest_main
                         egress_warnings)
   target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR}/tests)
   target_compile_definitions(${name} PRIVATE EGRESS_OFFICE_MAP="${EGRESS_OFFICE_MAP}")
+  set(_lock)
+  if(_t_RESOURCE_LOCK)
+    set(_lock RESOURCE_LOCK ${_t_RESOURCE_LOCK})
+  endif()
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60
-    PROPERTIES ENVIRONMENT "EGRESS_REFERENCE_DIR=${EGRESS_REFERENCE_DIR}")
+    PROPERTIES ENVIRONMENT "EGRESS_REFERENCE_DIR=${EGRESS_REFERENCE_DIR}" ${_lock})
 endfunction()
