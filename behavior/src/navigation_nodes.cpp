@@ -38,14 +38,15 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
   }
   NodeStatus OnRunning() override {
     if (give_way_) return GiveWay();
-    if (const auto coming = task_.config.give_way && !task_.motion->bug_active()
-                                ? PeopleComing()
-                                : decltype(PeopleComing()){};
-        !coming.empty()) {
-      task_.motion->StopBase();
-      give_way_ = GiveWayState{belief_.now, belief_.now, false};
-      Note(StrCat("making way: ", Describe(*coming.front().first), " is coming"));
-      return GiveWay();
+    if (task_.config.give_way && !task_.motion->bug_active()) {
+      if (const auto coming = PeopleComing(); !coming.empty()) {
+        const perception::TrackedPerson& p = *coming.front().first;
+        task_.motion->StopBase();
+        give_way_ = GiveWayState{belief_.now, belief_.now, false};
+        Note(StrCat("making way: person ", p.id, " at (", PoseText({p.p_MP.x(), p.p_MP.y(), 0.0}),
+                    "), ", std::round(p.v_MP.norm() * 10) / 10, " m/s is coming"));
+        return GiveWay();
+      }
     }
     if (blocked_since_) {
       if (ToSeconds(belief_.now - last_try_) < kReplanPeriod) return NodeStatus::kRunning;
@@ -96,12 +97,6 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
     }
     return coming;
   }
-  static std::string Describe(const perception::TrackedPerson& p) {
-    return StrCat("person ", p.id, " at (", std::round(p.p_MP.x() * 100) / 100, ", ",
-                  std::round(p.p_MP.y() * 100) / 100, "), ", std::round(p.v_MP.norm() * 10) / 10,
-                  " m/s");
-  }
-
   // Making way: once stopped, to the spot round the robot where the people coming will leave it
   // the most room (or stand still if none is better); on give_way_clear_for after the last one
   // seen coming has passed, or after `patience`.
