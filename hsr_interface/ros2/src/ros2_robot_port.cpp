@@ -451,6 +451,12 @@ bool Ros2RobotPort::GripperConnected() const {
   return impl_->grasp_goals->ServerMatched() && impl_->apply_force_goals->ServerMatched();
 }
 
+bool Ros2RobotPort::CommandsConnected() const {
+  const Impl& m = *impl_;
+  return m.cmd_vel->MatchedSubscriptions() > 0 && m.arm->MatchedSubscriptions() > 0 &&
+         m.head->MatchedSubscriptions() > 0;
+}
+
 std::pair<int, int> Ros2RobotPort::gripper_goals() const {
   const std::lock_guard<std::mutex> lock(impl_->mutex);
   return {impl_->gripper_goals_accepted, impl_->gripper_goals_refused};

@@ -71,7 +71,7 @@ struct Bridge {
   void Deliver(const SensorSnapshot& s) {
     // The brain's command writers matched too: a command sent before its reader is matched is
     // lost (volatile topics), and the tests send commands right after delivering.
-    ASSERT_TRUE(Eventually([&] { return server.BrainConnected(); }));
+    ASSERT_TRUE(Eventually([&] { return server.BrainConnected() && brain.CommandsConnected(); }));
     Duration later{0};
     ASSERT_TRUE(Eventually([&] {
       SensorSnapshot copy = s;
@@ -169,6 +169,23 @@ TEST(Ros2RobotPortTest, SensorsAndCommandsCrossTheBridge) {
   EXPECT_EQ(grasp.mode, GripperCommand::Mode::kGrasp);
   EXPECT_DOUBLE_EQ(grasp.effort, 8.0);
   EXPECT_EQ(b.robot.gripper[grasp_first ? 1 : 0].mode, GripperCommand::Mode::kOpen);
+}
+
+// The brain's command writers report connected only once they see the robot's readers
+// themselves, and no longer once the robot has gone.
+TEST(Ros2RobotPortTest, CommandsAreConnectedOnlyWhileTheRobotsReadersAreThere) {
+  const egress::testing::DdsDomain claim;
+  Ros2RobotPortConfig c;
+  c.domain_id = claim.id();
+  c.use_sim_time = true;
+  Ros2RobotPort brain(c);
+  EXPECT_FALSE(brain.CommandsConnected());
+  {
+    ScriptedRobot robot;
+    RobotPortServer server(robot, Ros2Topics{}, claim.id());
+    EXPECT_TRUE(Eventually([&] { return brain.CommandsConnected(); }));
+  }
+  EXPECT_TRUE(Eventually([&] { return !brain.CommandsConnected(); }));
 }
 
 // A laser that goes quiet while the clock runs on: within its 0.3 s the port says so, and from

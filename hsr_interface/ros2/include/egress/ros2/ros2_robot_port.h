@@ -90,6 +90,10 @@ class Ros2RobotPort final : public RobotPort {
   /// Whether the gripper controller's action servers are matched (a goal waits up to 2 s for
   /// them, then fails with an error naming the action).
   bool GripperConnected() const;
+  /// Whether the base, arm and head command writers each see a reader. A reader matched on
+  /// its side is not enough: the writer sends only to readers it has discovered itself, and a
+  /// command written before that is lost (volatile topics).
+  bool CommandsConnected() const;
   /// Gripper goals the controller accepted and refused so far.
   std::pair<int, int> gripper_goals() const;
 
