@@ -36,7 +36,8 @@ namespace {
 
 constexpr double kCostmapSnapshotPeriodSec = 1.0;
 
-// The costmap's inflated and lethal cells for the trace.
+// The costmap's inflated and lethal cells, and the free cells deep in someone's personal space,
+// for the trace.
 twin::TraceAnnotation::Grid CostmapLayer(const perception::Costmap2D& costmap) {
   twin::TraceAnnotation::Grid grid;
   const auto& g = costmap.geometry();
@@ -45,8 +46,12 @@ twin::TraceAnnotation::Grid CostmapLayer(const perception::Costmap2D& costmap) {
   grid.width = g.width;
   grid.height = g.height;
   const auto& costs = costmap.costs();
+  const auto& personal = costmap.personal_space_costs();
   for (std::size_t i = 0; i < costs.size(); ++i) {
     if (costs[i] == perception::kUnknownCost) continue;
+    if (costs[i] < perception::kInscribedCost &&
+        personal[i] >= perception::kPersonalSpacePeakCost / 2)
+      grid.personal.push_back(std::uint32_t(i));
     if (costs[i] >= perception::kLethalCost) {
       grid.lethal.push_back(std::uint32_t(i));
     } else if (costs[i] >= perception::kInscribedCost) {

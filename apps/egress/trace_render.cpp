@@ -87,8 +87,9 @@ TraceFile ParseTrace(std::istream& in, const std::string& source) {
 cv::Mat RenderTraceFrame(const TraceFile& trace, std::size_t index, double pixels_per_metre) {
   const View v = MakeView(trace, pixels_per_metre);
   cv::Mat image(v.height, v.width, CV_8UC3, cv::Scalar(250, 250, 250));
-  // Under everything, the driver's latest costmap snapshot: inflation light orange, lethal
-  // cells (walls, leaves, people and obstacles as the laser sees them) red.
+  // Under everything, the driver's latest costmap snapshot: people's personal space light
+  // violet, inflation light orange, lethal cells (walls, leaves, people and obstacles as the
+  // laser sees them) red.
   for (std::size_t k = index + 1; k-- > 0;) {
     const auto& s = trace.samples[k];
     if (!s.contains("costmap")) continue;
@@ -103,6 +104,7 @@ cv::Mat RenderTraceFrame(const TraceFile& trace, std::size_t index, double pixel
         cv::rectangle(image, v(x, y), v(x + res, y + res), colour, cv::FILLED);
       }
     };
+    draw("personal", cv::Scalar(245, 215, 225));
     draw("inflated", cv::Scalar(200, 228, 255));
     draw("lethal", cv::Scalar(110, 120, 235));
     break;

@@ -358,6 +358,24 @@ void Executive::UpdateDoorLeaves() {
   }
 }
 
+void Executive::UpdatePersonalSpaces() {
+  const ProxemicsConfig& proxemics = impl_->config.proxemics;
+  const TaskConfig& tasks = services_.config;
+  std::vector<perception::PersonalSpace> spaces;
+  if (proxemics.personal_space_layer) {
+    const double bodies = tasks.footprint_radius + tasks.person_radius;
+    // Every tracked person, however far: a path may be planned a long way.
+    for (const detail::Occupant& o : detail::PeopleAround(
+             services_, belief_.X_MB.translation(), std::numeric_limits<double>::infinity(),
+             proxemics.space_horizon, proxemics.space_step)) {
+      if (o.radius <= 0.0) continue;  // a scan return off the map: the laser marks it already
+      spaces.push_back({o.p_M, bodies + proxemics.stop_gap, bodies + proxemics.slow_gap,
+                        1.0 - o.t / (proxemics.space_horizon + proxemics.space_step)});
+    }
+  }
+  costmap_->SetPersonalSpaces(spaces);
+}
+
 bt::Tree& Executive::tree() {
   return *impl_->tree;
 }
@@ -516,6 +534,7 @@ bool Executive::Step(RobotPort& port) {
   // Decide.
   if (!m.finished && (!m.next_tick || now >= *m.next_tick)) {
     m.next_tick = now + SecondsToDuration(1.0 / m.config.tick_rate_hz);
+    UpdatePersonalSpaces();  // at the tree's rate: only its nodes plan paths
     status_ = m.tree->TickOnce();
     bool preempted = false;
     for (NodeNote& note : log_.Take()) {

@@ -18,6 +18,9 @@ void ProxemicsConfig::Validate() const {
   ThrowUnless(cone_deg > 0 && cone_deg <= 180, "ProxemicsConfig: cone_deg must be in (0, 180]");
   ThrowUnless(std::isfinite(goal_radius) && goal_radius >= 0,
               "ProxemicsConfig: goal_radius must be >= 0");
+  ThrowUnless(std::isfinite(space_horizon) && space_horizon >= 0 && std::isfinite(space_step) &&
+                  space_step > 0,
+              "ProxemicsConfig: space_horizon must be >= 0 and space_step > 0 (s)");
 }
 
 double ApproachSpeedScale(const Pose2& X_MB, const Eigen::Vector2d& v_M,

@@ -251,7 +251,7 @@ std::vector<Occupant> PeopleAround(const TaskServices& task, const Eigen::Vector
         if (!free) break;
         p_MP += v_MP * step;
       }
-      if ((p_MP - at).norm() < look) near.push_back({p_MP, task.config.person_radius});
+      if ((p_MP - at).norm() < look) near.push_back({p_MP, task.config.person_radius, k * step});
       if (step <= 0) break;
     }
   }

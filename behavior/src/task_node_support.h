@@ -148,10 +148,12 @@ double ExitDistance(const TaskServices& task, const std::string& door);
 /// How far before the door line the robot lines up and waits [m].
 double EntryDistance(const TaskServices& task, const std::string& door, const DoorPass& pass);
 
-/// A person's body (centre and radius) or a scan return off the map (radius 0), in M.
+/// A person's body (centre and radius) or a scan return off the map (radius 0), in M, now or
+/// predicted `t` seconds ahead.
 struct Occupant {
   Eigen::Vector2d p_M{Eigen::Vector2d::Zero()};
   double radius{0.0};  ///< [m]
+  double t{0.0};       ///< how far ahead [s]; 0: now (scan returns are always now)
 };
 /// Where the people near `at` (within `look` [m]) are and will be: each tracked person now and
 /// at their velocity every `step` [s] up to `horizon` [s] (a way predicted into a wall ends

@@ -41,6 +41,7 @@ Costmap2D::Costmap2D(const OccupancyGrid& static_map, CostmapConfig config)
   projection_.assign(geometry_.size(), kFreeCost);
   leaves_.assign(geometry_.size(), kFreeCost);
   doorway_zone_.assign(geometry_.size(), 0);
+  personal_space_.assign(geometry_.size(), kFreeCost);
   master_.assign(geometry_.size(), kFreeCost);
   const int max_cells =
       static_cast<int>(std::ceil(config_.inflation_radius / geometry_.resolution)) + 2;
@@ -144,6 +145,57 @@ void Costmap2D::SetProjectedObstacles(const std::vector<Eigen::Vector2d>& p_MObs
     }
   }
   if (x1 >= x0) RecomputeWindow(x0, y0, x1, y1);
+}
+
+void Costmap2D::SetPersonalSpaces(const std::vector<PersonalSpace>& spaces) {
+  for (std::size_t k = 0; k < spaces.size(); ++k) {
+    const PersonalSpace& s = spaces[k];
+    const auto bad = [&](const char* what) {
+      return StrCat("Invalid personal space ", k, ": ", what, " (centre ", s.p_MP.x(), ", ",
+                    s.p_MP.y(), ", inner ", s.inner, ", outer ", s.outer, ", weight ", s.weight,
+                    ").");
+    };
+    ThrowUnless(s.p_MP.allFinite(), bad("the centre must be finite"));
+    ThrowUnless(std::isfinite(s.inner) && s.inner >= 0.0, bad("inner must be >= 0"));
+    ThrowUnless(std::isfinite(s.outer) && s.outer > s.inner, bad("outer must exceed inner"));
+    ThrowUnless(s.outer <= kMaxPersonalSpaceM, bad("outer is beyond kMaxPersonalSpaceM (5 m)"));
+    ThrowUnless(s.weight > 0.0 && s.weight <= 1.0, bad("the weight must be in (0, 1]"));
+  }
+  for (const std::size_t i : personal_space_cells_)
+    personal_space_[i] = kFreeCost;
+  personal_space_cells_.clear();
+  const double res = geometry_.resolution;
+  for (const PersonalSpace& s : spaces) {
+    const int n = int(std::ceil(s.outer / res));
+    // A person just off the map still reaches into it: cells from the unclamped position.
+    const Eigen::Vector2d local = (s.p_MP - geometry_.origin) / res;
+    if (local.x() < -n - 1 || local.y() < -n - 1 || local.x() > geometry_.width + n + 1 ||
+        local.y() > geometry_.height + n + 1)
+      continue;
+    const int cx = int(std::floor(local.x())), cy = int(std::floor(local.y()));
+    const double inner2 = s.inner * s.inner, outer2 = s.outer * s.outer;
+    const double peak = kPersonalSpacePeakCost * s.weight;
+    for (int iy = std::max(0, cy - n); iy <= std::min(geometry_.height - 1, cy + n); ++iy) {
+      const double dy = (iy + 0.5) * res + geometry_.origin.y() - s.p_MP.y();
+      for (int ix = std::max(0, cx - n); ix <= std::min(geometry_.width - 1, cx + n); ++ix) {
+        const double dx = (ix + 0.5) * res + geometry_.origin.x() - s.p_MP.x();
+        const double d2 = dx * dx + dy * dy;
+        if (d2 >= outer2) continue;
+        // The square root only in the fading ring.
+        const double f = d2 <= inner2 ? 1.0 : (s.outer - std::sqrt(d2)) / (s.outer - s.inner);
+        const auto cost = static_cast<std::uint8_t>(peak * f + 0.5);
+        if (cost == kFreeCost) continue;
+        std::uint8_t& cell = personal_space_[geometry_.Index(ix, iy)];
+        if (cell == kFreeCost) personal_space_cells_.push_back(geometry_.Index(ix, iy));
+        cell = std::max(cell, cost);
+      }
+    }
+  }
+}
+
+std::uint8_t Costmap2D::PersonalSpaceCostAt(const Eigen::Vector2d& p_MQ) const {
+  const auto cell = geometry_.CellOf(p_MQ);
+  return cell ? personal_space_[geometry_.Index(cell->x(), cell->y())] : kFreeCost;
 }
 
 bool Costmap2D::IsNearSensedObstacle(const Eigen::Vector2d& p_MQ, double radius) const {
@@ -322,7 +374,9 @@ cv::Mat Costmap2D::ToImage() const {
   cv::Mat image(geometry_.height, geometry_.width, CV_8UC1);
   for (int iy = 0; iy < geometry_.height; ++iy) {
     for (int ix = 0; ix < geometry_.width; ++ix) {
-      image.at<std::uint8_t>(geometry_.height - 1 - iy, ix) = master_[geometry_.Index(ix, iy)];
+      const std::size_t i = geometry_.Index(ix, iy);
+      image.at<std::uint8_t>(geometry_.height - 1 - iy, ix) =
+          master_[i] < kInscribedCost ? std::max(master_[i], personal_space_[i]) : master_[i];
     }
   }
   return image;

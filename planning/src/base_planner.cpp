@@ -49,6 +49,9 @@ void BasePlannerConfig::Validate() const {
                   std::isfinite(clearance_margin) && clearance_margin >= 0.0,
               "Invalid BasePlannerConfig: clearance_weight and clearance_margin must be finite ",
               "and >= 0, got ", clearance_weight, " and ", clearance_margin, ".");
+  ThrowUnless(std::isfinite(personal_space_weight) && personal_space_weight >= 0.0,
+              "Invalid BasePlannerConfig: personal_space_weight must be finite and >= 0, got ",
+              personal_space_weight, ".");
 }
 
 std::string_view ToString(PlanStatus status) {
@@ -197,16 +200,23 @@ class FootprintValidityChecker final : public ob::StateValidityChecker {
 // Costmap cost as a state cost, for the optional clearance term of the objective.
 class CostmapObjective final : public ob::StateCostIntegralObjective {
  public:
-  CostmapObjective(const ob::SpaceInformationPtr& si, const perception::Costmap2D& costmap)
-      : ob::StateCostIntegralObjective(si, true), costmap_(costmap) {}
+  CostmapObjective(const ob::SpaceInformationPtr& si, const perception::Costmap2D& costmap,
+                   double personal_space_weight)
+      : ob::StateCostIntegralObjective(si, true),
+        costmap_(costmap),
+        personal_space_weight_(personal_space_weight) {}
   ob::Cost stateCost(const ob::State* state) const override {
     const auto* s = state->as<ob::SE2StateSpace::StateType>();
-    const std::uint8_t c = costmap_.CostAt({s->getX(), s->getY()});
-    return ob::Cost(c >= kInscribedCost ? 1.0 : double(c) / double(kInscribedCost));
+    const Eigen::Vector2d p(s->getX(), s->getY());
+    const std::uint8_t c = costmap_.CostAt(p);
+    const double personal = personal_space_weight_ * costmap_.PersonalSpaceCostAt(p) /
+                            double(perception::kPersonalSpacePeakCost);
+    return ob::Cost((c >= kInscribedCost ? 1.0 : double(c) / double(kInscribedCost)) + personal);
   }
 
  private:
   const perception::Costmap2D& costmap_;
+  double personal_space_weight_;
 };
 
 double PathLength(const std::vector<Pose2>& path) {
@@ -303,26 +313,34 @@ struct BasePlanner::Impl {
 
   // With `keep_clearance`, a shortcut must also keep clearance_margin from obstacles unless the
   // stretch of path it replaces came closer (its highest costmap cost bounds the shortcut's).
-  og::PathGeometric StringPull(const og::PathGeometric& dense, bool keep_clearance) const {
+  // With `keep_personal_space`, likewise it may go no deeper into anyone's personal space.
+  og::PathGeometric StringPull(const og::PathGeometric& dense, bool keep_clearance,
+                               bool keep_personal_space) const {
     og::PathGeometric pulled(si);
     const std::size_t n = dense.getStateCount();
     const auto xy = [&](std::size_t i) {
       const auto* st = dense.getState(i)->as<ob::SE2StateSpace::StateType>();
       return Eigen::Vector2d(st->getX(), st->getY());
     };
-    std::vector<std::uint8_t> cost(n);
-    for (std::size_t i = 0; i < n; ++i)
+    std::vector<std::uint8_t> cost(n), personal(n);
+    for (std::size_t i = 0; i < n; ++i) {
       cost[i] = costmap.CostAt(xy(i));
+      personal[i] = costmap.PersonalSpaceCostAt(xy(i));
+    }
     const double step_length = 0.25 * costmap.geometry().resolution;
     const auto shortcut_ok = [&](std::size_t from, std::size_t to) {
       if (!si->checkMotion(dense.getState(from), dense.getState(to))) return false;
-      if (!keep_clearance) return true;
-      const std::uint8_t bound =
-          *std::max_element(cost.begin() + long(from), cost.begin() + long(to) + 1);
+      if (!keep_clearance && !keep_personal_space) return true;
+      const auto highest = [&](const std::vector<std::uint8_t>& along) {
+        return *std::max_element(along.begin() + long(from), along.begin() + long(to) + 1);
+      };
+      const std::uint8_t bound = highest(cost), personal_bound = highest(personal);
       const Eigen::Vector2d a = xy(from), b = xy(to);
       const int steps = int(std::ceil((b - a).norm() / step_length));
       for (int k = 1; k < steps; ++k) {
-        if (costmap.CostAt(a + (b - a) * (double(k) / steps)) > bound) return false;
+        const Eigen::Vector2d p = a + (b - a) * (double(k) / steps);
+        if (keep_clearance && costmap.CostAt(p) > bound) return false;
+        if (keep_personal_space && costmap.PersonalSpaceCostAt(p) > personal_bound) return false;
       }
       return true;
     };
@@ -352,8 +370,9 @@ struct BasePlanner::Impl {
   // The grid's shortest path from start to goal, string-pulled; nullopt without one.
   std::optional<og::PathGeometric> GridSeed(const Pose2& start, const Pose2& goal,
                                             const ob::State* s, const ob::State* g) const {
-    const auto cells = GridCheapestPath(costmap, start.translation(), goal.translation(),
-                                        CloseCost(), config.clearance_weight, config.allow_unknown);
+    const auto cells = GridCheapestPath(
+        costmap, start.translation(), goal.translation(),
+        {CloseCost(), config.clearance_weight, config.personal_space_weight}, config.allow_unknown);
     if (!cells) return std::nullopt;
     og::PathGeometric dense(si);
     ob::ScopedState<ob::SE2StateSpace> state(space);
@@ -364,7 +383,7 @@ struct BasePlanner::Impl {
       dense.append(state.get());
     }
     dense.append(g);
-    return StringPull(dense, config.clearance_weight > 0.0);
+    return StringPull(dense, config.clearance_weight > 0.0, config.personal_space_weight > 0.0);
   }
 
   // One OMPL query between two valid poses.
@@ -381,8 +400,9 @@ struct BasePlanner::Impl {
     if (config.costmap_cost_weight > 0.0) {
       auto multi = std::make_shared<ob::MultiOptimizationObjective>(si);
       multi->addObjective(length, 1.0);
-      multi->addObjective(std::make_shared<CostmapObjective>(si, costmap),
-                          config.costmap_cost_weight);
+      multi->addObjective(
+          std::make_shared<CostmapObjective>(si, costmap, config.personal_space_weight),
+          config.costmap_cost_weight);
       setup.setOptimizationObjective(multi);
     } else {
       setup.setOptimizationObjective(length);

@@ -29,15 +29,23 @@ std::optional<std::vector<Eigen::Vector2d>> GridShortestPath(const perception::C
                                                              const Eigen::Vector2d& start,
                                                              const Eigen::Vector2d& goal,
                                                              bool allow_unknown) {
-  return GridCheapestPath(costmap, start, goal, kInscribedCost, 0.0, allow_unknown);
+  return GridCheapestPath(costmap, start, goal, GridStepCosts{}, allow_unknown);
 }
 
-std::optional<std::vector<Eigen::Vector2d>> GridCheapestPath(
-    const perception::Costmap2D& costmap, const Eigen::Vector2d& start, const Eigen::Vector2d& goal,
-    std::uint8_t close_cost, double close_weight, bool allow_unknown) {
-  ThrowUnless(std::isfinite(close_weight) && close_weight >= 0.0,
-              "GridCheapestPath: close_weight must be finite and >= 0, got ", close_weight);
-  const float penalty = 1.0f + float(close_weight);
+std::optional<std::vector<Eigen::Vector2d>> GridCheapestPath(const perception::Costmap2D& costmap,
+                                                             const Eigen::Vector2d& start,
+                                                             const Eigen::Vector2d& goal,
+                                                             const GridStepCosts& costs,
+                                                             bool allow_unknown) {
+  ThrowUnless(std::isfinite(costs.close_weight) && costs.close_weight >= 0.0,
+              "GridCheapestPath: close_weight must be finite and >= 0, got ", costs.close_weight);
+  ThrowUnless(std::isfinite(costs.personal_space_weight) && costs.personal_space_weight >= 0.0,
+              "GridCheapestPath: personal_space_weight must be finite and >= 0, got ",
+              costs.personal_space_weight);
+  const float penalty = 1.0f + float(costs.close_weight);
+  const float per_personal =
+      float(costs.personal_space_weight) / float(perception::kPersonalSpacePeakCost);
+  const auto& personal = costmap.personal_space_costs();
   const auto& g = costmap.geometry();
   const auto s = g.CellOf(start), t = g.CellOf(goal);
   if (!s || !t) return std::nullopt;
@@ -70,7 +78,8 @@ std::optional<std::vector<Eigen::Vector2d>> GridCheapestPath(
             (!passable(g.Index(ix + dx, iy)) || !passable(g.Index(ix, iy + dy))))
           continue;
         const std::uint8_t c = costmap.costs()[next];
-        const float factor = c != kUnknownCost && c >= close_cost ? penalty : 1.0f;
+        const float factor = (c != kUnknownCost && c >= costs.close_cost ? penalty : 1.0f) +
+                             per_personal * float(personal[next]);
         const float nd = d + ((dx != 0 && dy != 0) ? kDiagonal : 1.0f) * factor;
         if (nd < distance[next]) {
           distance[next] = nd;

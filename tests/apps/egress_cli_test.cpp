@@ -400,6 +400,8 @@ TEST(EgressCliTest, SimRunWithTheBrainPrintsDecisionsAndTracesTheRunningAction) 
   const std::string trace((std::istreambuf_iterator<char>(in)), {});
   EXPECT_THAT(trace, HasSubstr("\"label\":\"traverse_open\""));
   EXPECT_THAT(trace, HasSubstr("\"path\":[["));
+  // The person holding the door, in the costmap snapshots' proxemic layer.
+  EXPECT_THAT(trace, HasSubstr("\"personal\":["));
   std::filesystem::remove_all(dir);
 }
 

@@ -152,6 +152,64 @@ TEST(CostmapTest, MappedObstaclesAreTheMapAndLeavesNotWhatTheLaserSaw) {
   EXPECT_TRUE(costmap.IsNearMappedObstacle({5.05, 5.0}, 0.1));
 }
 
+// The proxemic layer: full within inner, fading linearly to nothing at outer, scaled by the
+// weight; beside the master grid, never in it; each call replaces the last.
+TEST(CostmapTest, PersonalSpaceIsGradedBesideTheMasterGridAndReplacedEachTime) {
+  Costmap2D costmap(EmptyMap());
+  const std::vector<std::uint8_t> master = costmap.costs();
+  costmap.SetPersonalSpaces({{{5.0, 5.0}, 0.9, 1.7, 1.0}, {{2.0, 2.0}, 0.9, 1.7, 0.5}});
+  EXPECT_EQ(costmap.PersonalSpaceCostAt({5.02, 5.02}), kPersonalSpacePeakCost);
+  EXPECT_EQ(costmap.PersonalSpaceCostAt({5.0 + 0.85, 5.02}), kPersonalSpacePeakCost);
+  // Halfway between inner and outer: half the peak (one cell's rounding).
+  EXPECT_NEAR(costmap.PersonalSpaceCostAt({5.0 + 1.3, 5.02}), kPersonalSpacePeakCost / 2.0,
+              kPersonalSpacePeakCost * 0.05 / 0.8 + 1);
+  EXPECT_EQ(costmap.PersonalSpaceCostAt({5.0 + 1.75, 5.02}), kFreeCost);
+  // A prediction at half weight: half the peak at its centre.
+  EXPECT_NEAR(costmap.PersonalSpaceCostAt({2.02, 2.02}), kPersonalSpacePeakCost / 2.0, 1.0);
+  // Where both overlap, the higher counts; the master grid is untouched (nothing is blocked).
+  EXPECT_EQ(costmap.costs(), master);
+  EXPECT_TRUE(costmap.IsFree({5.0, 5.0}));
+  // The image shows it on free cells.
+  EXPECT_EQ(costmap.ToImage().at<std::uint8_t>(costmap.geometry().height - 1 - 100, 100),
+            kPersonalSpacePeakCost);
+  costmap.SetPersonalSpaces({{{8.0, 8.0}, 0.5, 1.0, 1.0}});
+  EXPECT_EQ(costmap.PersonalSpaceCostAt({5.02, 5.02}), kFreeCost);
+  EXPECT_EQ(costmap.PersonalSpaceCostAt({2.02, 2.02}), kFreeCost);
+  EXPECT_EQ(costmap.PersonalSpaceCostAt({8.02, 8.02}), kPersonalSpacePeakCost);
+  costmap.SetPersonalSpaces({});
+  EXPECT_EQ(costmap.personal_space_costs(), std::vector<std::uint8_t>(master.size(), kFreeCost));
+}
+
+TEST(CostmapTest, APersonJustOffTheMapStillReachesIntoIt) {
+  Costmap2D costmap(EmptyMap());
+  costmap.SetPersonalSpaces({{{-0.5, 5.0}, 0.9, 1.7, 1.0}, {{1e12, -1e12}, 0.9, 1.7, 1.0}});
+  EXPECT_EQ(costmap.PersonalSpaceCostAt({0.3, 5.02}), kPersonalSpacePeakCost);
+  EXPECT_EQ(costmap.PersonalSpaceCostAt({1.3, 5.02}), kFreeCost);
+}
+
+TEST(CostmapTest, AMalformedPersonalSpaceIsRefusedNamingWhatIsWrong) {
+  Costmap2D costmap(EmptyMap());
+  const auto refused = [&](PersonalSpace space, const std::string& what) {
+    EXPECT_THAT(
+        [&] {
+          costmap.SetPersonalSpaces({{{1, 1}, 0.5, 1.0, 1.0}, space});
+        },
+        ::testing::ThrowsMessage<InvalidArgument>(::testing::AllOf(
+            ::testing::HasSubstr("personal space 1"), ::testing::HasSubstr(what))));
+  };
+  refused({{kInf, 1.0}, 0.5, 1.0, 1.0}, "centre");
+  refused({{1.0, std::nan("")}, 0.5, 1.0, 1.0}, "centre");
+  refused({{1.0, 1.0}, -0.1, 1.0, 1.0}, "inner");
+  refused({{1.0, 1.0}, 1.0, 1.0, 1.0}, "outer");
+  refused({{1.0, 1.0}, 0.5, 50.0, 1.0}, "outer");
+  refused({{1.0, 1.0}, 0.5, 1.0, 0.0}, "weight");
+  refused({{1.0, 1.0}, 0.5, 1.0, 1.5}, "weight");
+  // A refused call leaves the layer as it was.
+  costmap.SetPersonalSpaces({{{5.0, 5.0}, 0.5, 1.0, 1.0}});
+  EXPECT_THROW(costmap.SetPersonalSpaces({{{5.0, 5.0}, 0.5, 0.2, 1.0}}), InvalidArgument);
+  EXPECT_EQ(costmap.PersonalSpaceCostAt({5.02, 5.02}), kPersonalSpacePeakCost);
+}
+
 TEST(CostmapTest, MalformedInputIsRejectedWithoutCrashing) {
   Costmap2D costmap(EmptyMap());
   LaserScan empty = testing::MakeScan(2);

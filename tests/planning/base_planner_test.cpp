@@ -254,6 +254,67 @@ TEST(BasePlannerClearanceTest, APassageNarrowerThanTheMarginIsStillPassed) {
   EXPECT_GT(ClosestToBox(result.path, 2.45), config.footprint_radius - 0.05);
 }
 
+// Closest distance of the path (sampled at 1 cm) to p [m].
+double ClosestTo(const std::vector<Pose2>& path, const Eigen::Vector2d& p) {
+  double closest = 1e9;
+  for (std::size_t i = 1; i < path.size(); ++i) {
+    const Eigen::Vector2d a = path[i - 1].translation(), b = path[i].translation();
+    const int steps = std::max(1, int((b - a).norm() / 0.01));
+    for (int k = 0; k <= steps; ++k)
+      closest = std::min(closest, (a + (b - a) * (double(k) / steps) - p).norm());
+  }
+  return closest;
+}
+
+// Someone standing in an open room on the straight line between start and goal: the path goes
+// round their personal space where there is room, and straight past them without the layer.
+TEST(BasePlannerPersonalSpaceTest, ThePathGoesRoundSomeonesPersonalSpaceWhereThereIsRoom) {
+  Costmap2D costmap(OccupancyGrid::FromBoxes({}, {0, 0}, {8, 6}, 0.05));
+  const Eigen::Vector2d p_MP(4.0, 3.0);
+  // The person's body is not in the master grid here (the laser would mark it): the layer alone.
+  costmap.SetPersonalSpaces({{p_MP, 0.9, 1.7, 1.0}});
+  BasePlannerConfig config;
+  config.deterministic = true;
+  const Pose2 start{1.0, 3.0, 0.0}, goal{7.0, 3.0, 0.0};
+  const PlanResult round = BasePlanner(costmap, nullptr, config).Plan(start, goal);
+  ASSERT_TRUE(round.ok()) << round.message;
+  // Outside the full-cost disc (less a cell), and shortcutting did not cut back in.
+  EXPECT_GE(ClosestTo(round.path, p_MP), 0.9 - 0.05);
+  config.personal_space_weight = 0.0;
+  const PlanResult straight = BasePlanner(costmap, nullptr, config).Plan(start, goal);
+  ASSERT_TRUE(straight.ok()) << straight.message;
+  EXPECT_LT(ClosestTo(straight.path, p_MP), 0.05);
+  EXPECT_LT(straight.length, round.length);
+}
+
+// Personal space steers, it never blocks: someone standing in the only passage is passed.
+TEST(BasePlannerPersonalSpaceTest, SomeoneInTheOnlyPassageDoesNotBlockIt) {
+  const Costmap2D room = RoomWithBox(0.8);
+  Costmap2D costmap = room;
+  costmap.SetPersonalSpaces({{{3.0, 2.6}, 0.9, 1.7, 1.0}});
+  BasePlannerConfig config;
+  config.deterministic = true;
+  const PlanResult result =
+      BasePlanner(costmap, nullptr, config).Plan({1.0, 2.6, 0.0}, {5.0, 2.6, 0.0});
+  ASSERT_TRUE(result.ok()) << result.message;
+  EXPECT_GT(ClosestToBox(result.path, 2.2), config.footprint_radius - 0.05);
+}
+
+TEST(BasePlannerPersonalSpaceTest, ABadWeightIsRefused) {
+  BasePlannerConfig config;
+  config.personal_space_weight = -1.0;
+  EXPECT_THAT([&] { config.Validate(); },
+              ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("personal_space_weight")));
+  config.personal_space_weight = std::nan("");
+  EXPECT_THROW(config.Validate(), InvalidArgument);
+  Costmap2D costmap(OccupancyGrid::FromBoxes({}, {0, 0}, {2, 2}, 0.05));
+  EXPECT_THAT(
+      [&] {
+        GridCheapestPath(costmap, {0.5, 0.5}, {1.5, 1.5}, {.personal_space_weight = -1});
+      },
+      ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("personal_space_weight")));
+}
+
 TEST(BasePlannerClearanceTest, ABadMarginIsRefused) {
   BasePlannerConfig config;
   config.clearance_margin = -0.1;

@@ -223,6 +223,7 @@ void TraceRecorder::Observe(const TwinWorld& world, const TraceAnnotation* annot
       };
       cells("inflated", g->inflated);
       cells("lethal", g->lethal);
+      if (!g->personal.empty()) cells("personal", g->personal);
       s += '}';
     }
   }

@@ -176,6 +176,8 @@ class Executive {
   void InsertDepth(const DepthImage& depth, const Pose3& X_MC);
   // The estimated door leaves into the costmap.
   void UpdateDoorLeaves();
+  // The tracked people's personal space, now and predicted, into the costmap's proxemic layer.
+  void UpdatePersonalSpaces();
   // The port's detections, plus the detector stage's on a colour image when there is one.
   std::vector<Detection2D> Detect(const SensorSnapshot& snapshot);
 

@@ -25,6 +25,13 @@ struct ProxemicsConfig {
   /// Someone this near where the path ends is whom the robot goes to (a hand-over, a
   /// responder): not slowed for [m].
   double goal_radius{1.5};
+  /// The costmap's proxemic layer, which the base planner weighs (paths round people): each
+  /// tracked person's personal space, full from stop_gap beyond both bodies and fading out at
+  /// slow_gap, where they are and where they are predicted every space_step up to
+  /// space_horizon, a prediction counting less the further ahead it is. False: no layer.
+  bool personal_space_layer{true};
+  double space_horizon{2.0};  ///< [s]
+  double space_step{0.5};     ///< [s]
   /// @throws InvalidArgument naming the field.
   void Validate() const;
 };

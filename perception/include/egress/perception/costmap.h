@@ -9,7 +9,11 @@
 ///    lethal at 0, kInscribedCost within the robot radius, 252·exp(−k·(d − r)) beyond);
 ///  - doorways: inside a known doorway's threshold the decaying part of the inflation is dropped
 ///    (only lethal and inscribed remain), so inflation never seals a door the robot fits through
-///    — the paper's S7 failure.
+///    — the paper's S7 failure;
+///  - personal space (proxemics): a graded cost round each tracked person, now and where they
+///    are predicted to walk. It is kept beside the master grid, not in it: it steers the
+///    planner's paths (a cost per step) but never makes a pose invalid — the robot may still
+///    pass someone standing in a doorway, only not by choice.
 /// Updates are local: a scan recomputes only the window it touched plus the inflation margin.
 
 #include <cstdint>
@@ -48,6 +52,19 @@ struct Doorway {
   double width() const { return (p_MLatch - p_MHinge).norm(); }
 };
 
+/// One person's personal space for the proxemic layer, seen from the robot's centre: the cost
+/// is the layer's peak (times `weight`) within `inner` of the person's centre, falls linearly to
+/// 0 at `outer`. A prediction counts less (weight < 1) the further ahead it is.
+struct PersonalSpace {
+  Eigen::Vector2d p_MP{Eigen::Vector2d::Zero()};  ///< The person's centre in M [m].
+  double inner{0.9};                              ///< [m], >= 0
+  double outer{1.7};                              ///< [m], > inner
+  double weight{1.0};                             ///< in (0, 1]
+};
+
+/// The proxemic layer's highest cost: one below inscribed, so it never reads as a collision.
+inline constexpr std::uint8_t kPersonalSpacePeakCost = kInscribedCost - 1;
+
 class Costmap2D {
  public:
   /// A costmap the size of `static_map`. @throws InvalidArgument for a bad config.
@@ -65,6 +82,16 @@ class Costmap2D {
   /// Whether a lethal cell of the static map or of a door leaf is within `radius` of p_MQ: what
   /// the building explains (a laser return beyond it is someone or something not on the map).
   bool IsNearMappedObstacle(const Eigen::Vector2d& p_MQ, double radius) const;
+  /// Replaces the proxemic layer with `spaces` (overlapping spaces keep the higher cost).
+  /// @throws InvalidArgument naming the space and field: a non-finite centre, inner < 0,
+  /// outer <= inner, a weight outside (0, 1], or an outer radius over kMaxPersonalSpaceM.
+  void SetPersonalSpaces(const std::vector<PersonalSpace>& spaces);
+  /// The proxemic layer's cost of the cell holding p_MQ (0 outside every space or the map).
+  std::uint8_t PersonalSpaceCostAt(const Eigen::Vector2d& p_MQ) const;
+  /// The proxemic layer, row-major like costs().
+  const std::vector<std::uint8_t>& personal_space_costs() const { return personal_space_; }
+  static constexpr double kMaxPersonalSpaceM = 5.0;
+
   /// Clears the obstacle layer (e.g. after relocalization).
   void ClearObstacles();
 
@@ -90,7 +117,8 @@ class Costmap2D {
   /// kInscribedCost within the robot radius, the exponential decay beyond, free past
   /// inflation_radius): what a cell that far from an obstacle costs.
   std::uint8_t InflatedCost(double distance) const;
-  /// The master grid as an 8-bit image, row 0 = highest y (for PNG output).
+  /// The master grid as an 8-bit image, row 0 = highest y (for PNG output); a free cell in
+  /// someone's personal space shows the proxemic layer's cost.
   cv::Mat ToImage() const;
 
  private:
@@ -109,6 +137,8 @@ class Costmap2D {
   std::vector<std::uint8_t> doorway_zone_;  ///< 1 inside a doorway threshold.
   std::vector<std::uint8_t> master_;
   std::vector<Eigen::Vector2i> projected_cells_;
+  std::vector<std::uint8_t> personal_space_;
+  std::vector<std::size_t> personal_space_cells_;  ///< cells set in personal_space_
   std::map<std::string, Doorway> doorways_;
   std::map<std::string, double> leaf_angles_;
   std::vector<std::uint8_t> inflation_lookup_;  // cost by distance in 1/8 cells

@@ -70,6 +70,12 @@ struct BasePlannerConfig {
   /// and pressed its button in 51 of 100 trials (issue 16's note).
   double clearance_margin{0.1};  ///< [m] beyond the footprint radius
   double clearance_weight{0.0};
+  /// Proxemics: a grid step through a person's personal space (the costmap's proxemic layer)
+  /// costs this much more per metre at the layer's peak (linearly less where the cost is lower),
+  /// and shortcutting never takes the path deeper into anyone's space than the grid path went.
+  /// The sampling planners' costmap objective (costmap_cost_weight > 0) weighs it the same way.
+  /// 0: paths ignore personal space (they still never touch anyone: the laser marks people).
+  double personal_space_weight{2.0};
   void Validate() const;
 };
 
@@ -152,12 +158,23 @@ std::optional<std::vector<Eigen::Vector2d>> GridShortestPath(const perception::C
                                                              const Eigen::Vector2d& start,
                                                              const Eigen::Vector2d& goal,
                                                              bool allow_unknown = false);
+/// What a step of a grid path costs beyond its length.
+struct GridStepCosts {
+  /// A step into a cell of master cost >= close_cost costs (1 + close_weight) times its length.
+  std::uint8_t close_cost{perception::kInscribedCost};
+  double close_weight{0.0};
+  /// ... plus personal_space_weight times its length times the cell's proxemic cost over
+  /// kPersonalSpacePeakCost (0: people's personal space is not weighed).
+  double personal_space_weight{0.0};
+};
 /// The cheapest 8-connected grid path (cell centres, no corner cutting) over cells below
-/// kInscribedCost, a step into a cell of cost >= `close_cost` costing (1 + close_weight) times
-/// its length (close_weight 0: the shortest path); nullopt if there is none.
-std::optional<std::vector<Eigen::Vector2d>> GridCheapestPath(
-    const perception::Costmap2D& costmap, const Eigen::Vector2d& start, const Eigen::Vector2d& goal,
-    std::uint8_t close_cost, double close_weight, bool allow_unknown = false);
+/// kInscribedCost, each step weighted by `costs` (all weights 0: the shortest path); nullopt if
+/// there is none. @throws InvalidArgument for a negative or non-finite weight.
+std::optional<std::vector<Eigen::Vector2d>> GridCheapestPath(const perception::Costmap2D& costmap,
+                                                             const Eigen::Vector2d& start,
+                                                             const Eigen::Vector2d& goal,
+                                                             const GridStepCosts& costs,
+                                                             bool allow_unknown = false);
 /// Length [m] of the shortest 8-connected grid path between two points over cells below
 /// kInscribedCost (the reference for path quality); nullopt if there is none.
 std::optional<double> GridShortestPathLength(const perception::Costmap2D& costmap,

@@ -28,7 +28,8 @@ struct TraceAnnotation {
   std::string label;                  ///< e.g. the behavior tree's running action
   std::vector<Eigen::Vector2d> path;  ///< planned base path in W [m]
   /// The driver's costmap (a snapshot now and then: it is large), as the row-major indices of
-  /// its inflated and lethal cells; cell (0, 0) has its corner at `origin` in W.
+  /// its inflated and lethal cells, and of the free cells deep in someone's personal space
+  /// (the proxemic layer at half its peak or more); cell (0, 0) has its corner at `origin` in W.
   struct Grid {
     Eigen::Vector2d origin{Eigen::Vector2d::Zero()};  ///< [m]
     double resolution{0.05};                          ///< [m]
@@ -36,6 +37,7 @@ struct TraceAnnotation {
     int height{0};
     std::vector<std::uint32_t> inflated;
     std::vector<std::uint32_t> lethal;
+    std::vector<std::uint32_t> personal;
   };
   std::optional<Grid> costmap;
 };
