@@ -110,7 +110,7 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
       // stop short of it, and every spot would look as good as standing in their way).
       const PeopleRoom room(task_, 2.0 * task_.config.give_way_horizon);
       const Eigen::Vector2d at = belief_.X_MB.translation();
-      if (const auto spot = room.BestSpotAround({belief_.X_MB}, room.Score(at) + kMinGainM)) {
+      if (const auto spot = room.BestSpotAround({belief_.X_MB}, room.Score({at}) + kMinGainM)) {
         task_.motion->FollowPath({belief_.X_MB, *spot}, {false}, task_.motion->arm_target(),
                                  belief_.now, task_.config.retreat_speed);
         Note(StrCat("stepping aside to (", PoseText(*spot), ")"));
@@ -290,8 +290,7 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
     corners.push_back(safe.translation());
     const bool safe_ok = room.IsWayClear(corners);
     if (safe_ok && room.Predicted(safe.translation()) >= comfortable) return std::pair{safe, false};
-    const double beat =
-        safe_ok ? room.Score(safe.translation()) : -std::numeric_limits<double>::infinity();
+    const double beat = safe_ok ? room.Score(corners) : -std::numeric_limits<double>::infinity();
     if (const auto aside = room.BestSpotAround(way, beat)) return std::pair{*aside, true};
     if (safe_ok) return std::pair{safe, false};
     return std::nullopt;

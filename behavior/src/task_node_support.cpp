@@ -8,6 +8,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "egress/planning/trajectory.h"
+
 namespace egress::behavior::detail {
 
 bool ArmAt(const ArmPose& a, const ArmPose& b) {
@@ -271,9 +273,39 @@ PeopleRoom::PeopleRoom(const TaskServices& task, double horizon)
       predicted_(PeopleAround(task, at_, kPeopleLookM, horizon, kPeopleStepSec)),
       now_(PeopleAround(task, at_, kPeopleLookM, 0.0, 0.0)) {}
 
-double PeopleRoom::Score(const Eigen::Vector2d& q) const {
+double PeopleRoom::RoomOnTheWay(const std::vector<Eigen::Vector2d>& corners) const {
+  planning::TrajectoryConfig timing = task_.motion->trajectory_config();
+  timing.nominal_speed = task_.config.retreat_speed;
+  // Each leg's start time and its quintic progress 0 -> 1.
+  std::vector<double> starts{0.0};
+  std::vector<planning::QuinticPolynomial> legs;
+  for (std::size_t i = 0; i + 1 < corners.size(); ++i) {
+    const double length = (corners[i + 1] - corners[i]).norm();
+    legs.emplace_back(0.0, 0.0, 0.0, 1.0, 0.0, 0.0,
+                      planning::SegmentDuration(length, false, timing));
+    starts.push_back(starts.back() + legs.back().duration());
+  }
+  const auto base_at = [&](double t) -> Eigen::Vector2d {
+    for (std::size_t i = 0; i < legs.size(); ++i)
+      if (t < starts[i + 1])
+        return corners[i] + (corners[i + 1] - corners[i]) * legs[i].Position(t - starts[i]);
+    return corners.back();
+  };
+  double room = std::numeric_limits<double>::infinity();
+  for (const Occupant& o : predicted_) {
+    // A scan return off the map stands where it is: compared with the spot.
+    const Eigen::Vector2d p_MB = o.radius > 0.0 ? base_at(o.t) : corners.back();
+    room = std::min(room, (o.p_M - p_MB).norm() - o.radius);
+  }
+  return room;
+}
+
+double PeopleRoom::Score(const std::vector<Eigen::Vector2d>& corners) const {
   const double comfortable = task_.config.footprint_radius + task_.config.comfort_distance;
-  return std::min(Predicted(q), comfortable) - kWayCostPerM * (q - at_).norm();
+  const Eigen::Vector2d& q = corners.back();
+  const double at_spot = std::min(Predicted(q), comfortable);
+  return std::min(at_spot, RoomOnTheWay(corners)) + kSpotRoomTieBreak * at_spot -
+         kWayCostPerM * (q - at_).norm();
 }
 
 bool PeopleRoom::IsSeen(const Eigen::Vector2d& p) const {
@@ -309,10 +341,9 @@ std::optional<Pose2> PeopleRoom::BestSpotAround(const std::vector<Pose2>& way, d
     for (int k = 0; k < kSpotHeadings; ++k) {
       const double a = 2 * M_PI * k / kSpotHeadings;
       const Eigen::Vector2d q = at_ + radius * Eigen::Vector2d(std::cos(a), std::sin(a));
-      const double s = Score(q);
-      if (s <= beat || IsInAnyDoorZone(task_, q)) continue;
       corners.back() = q;
-      if (!IsWayClear(corners)) continue;
+      const double s = Score(corners);
+      if (s <= beat || IsInAnyDoorZone(task_, q) || !IsWayClear(corners)) continue;
       const Pose2 candidate{q.x(), q.y(), yaw};
       if (!task_.planner->IsPathValid({way.back(), candidate})) continue;
       best = candidate;

@@ -169,11 +169,22 @@ double RoomAt(const std::vector<Occupant>& near, const Eigen::Vector2d& q);
 class PeopleRoom {
  public:
   PeopleRoom(const TaskServices& task, double horizon);
-  /// The distance from `q` to the nearest person's edge, now or predicted [m].
+  /// The distance from `q` to the nearest person's edge, now or predicted at any time [m].
   double Predicted(const Eigen::Vector2d& q) const { return RoomAt(predicted_, q); }
-  /// A spot's worth [m]: its predicted room, capped at the footprint plus the comfort distance
-  /// (beyond that all spots are as good), less kWayCostPerM per metre from the robot.
-  double Score(const Eigen::Vector2d& q) const;
+  /// The least room people's predicted bodies leave the base while it drives `corners` (the
+  /// robot's position first) as the motion executor would at retreat_speed: a quintic from rest
+  /// to rest on each leg, then standing at the last corner; each predicted position of a person
+  /// is compared with where the base is at that time, a scan return off the map with the spot
+  /// [m]. A far spot reached too late for a fast walker scores as the place the robot still is
+  /// when they pass (a 1.5 m retreat is a 3.75 s quintic, 7 % of its way after 0.8 s).
+  double RoomOnTheWay(const std::vector<Eigen::Vector2d>& corners) const;
+  /// The worth of the way through `corners` to the spot it ends at [m]: the least of the spot's
+  /// predicted room (at any time: the robot will stand there) and RoomOnTheWay, capped at the
+  /// footprint plus the comfort distance (beyond that all spots are as good), plus
+  /// kSpotRoomTieBreak times the spot's room (ways that share a pass no way avoids — the walker
+  /// is on the robot before it has moved — differ in where they end), less kWayCostPerM per
+  /// metre from the robot to the spot.
+  double Score(const std::vector<Eigen::Vector2d>& corners) const;
   /// The straight lines through `corners` pass nobody (where they stand now) nearer than the
   /// footprint and kPassMarginM, and stay inside the base laser's sweep (behind the robot, in
   /// its blind sector, nobody is seen: P1 seed 2000 backed into someone waiting there).
@@ -185,11 +196,12 @@ class PeopleRoom {
 
   static constexpr double kSpotRadiiM[] = {0.6, 1.0, 1.5};
   static constexpr int kSpotHeadings = 16;
-  static constexpr double kPeopleStepSec = 0.2;  ///< predictions sampled every [s]
-  static constexpr double kPeopleLookM = 5.0;    ///< people this far round count [m]
-  static constexpr double kWayCostPerM = 0.2;    ///< a nearer spot wins a tie [m of room per m]
-  static constexpr double kPassMarginM = 0.1;    ///< beyond the footprint [m]
-  static constexpr double kPathSampleM = 0.05;   ///< ways checked this often [m]
+  static constexpr double kPeopleStepSec = 0.2;      ///< predictions sampled every [s]
+  static constexpr double kPeopleLookM = 5.0;        ///< people this far round count [m]
+  static constexpr double kWayCostPerM = 0.2;        ///< a nearer spot wins a tie [m of room per m]
+  static constexpr double kSpotRoomTieBreak = 0.05;  ///< see Score
+  static constexpr double kPassMarginM = 0.1;        ///< beyond the footprint [m]
+  static constexpr double kPathSampleM = 0.05;       ///< ways checked this often [m]
   static constexpr double kSweepMarginRad = 10.0 * M_PI / 180.0;
 
  private:
