@@ -89,6 +89,7 @@ class PlanHandOver final : public TaskNode<bt::SyncActionNode> {
     ReleasePlan plan;
     plan.p_MC = {p.x(), p.y(), Input<double>("hand_height")};
     plan.approach_M = HorizontalApproach(belief_.X_MB, plan.p_MC);
+    plan.give = kOfferGive;
     Note(StrCat("holding it out to the responder at ", PoseText({p_MP.x(), p_MP.y(), 0.0})));
     this->SetOutput("release", std::move(plan));
     return NodeStatus::kSuccess;
@@ -97,6 +98,9 @@ class PlanHandOver final : public TaskNode<bt::SyncActionNode> {
  private:
   static constexpr double kOfferDistance =
       0.3;  // [m] payload from the person (as tracked: its near side)
+  // [m] ... or up to this much farther, where the base's pose for the nearer point is not free
+  // (still within WaitForRecipient's 0.8 m reach of them).
+  static constexpr double kOfferGive = 0.3;
 };
 
 using ReleaseLeaf = PlannedLeaf<ReleasePlan>;
@@ -110,7 +114,21 @@ class DriveToRelease final : public ReleaseLeaf {
   NodeStatus OnStart() override {
     std::optional<ReleasePlan> plan = Plan();
     if (!plan) return NodeStatus::kFailure;
-    const auto reach = SolveHandReach(task_, plan->p_MC, plan->approach_M, plan->approach_M);
+    auto reach = SolveHandReach(task_, plan->p_MC, plan->approach_M, plan->approach_M);
+    // Where the base's pose for the point is not free, the point comes back towards the robot
+    // in kGiveStepM steps, as far as the plan's give allows.
+    for (double back = kGiveStepM;
+         reach && !task_.planner->IsValid(reach->X_MB) && back <= plan->give + 1e-9;
+         back += kGiveStepM) {
+      const Eigen::Vector3d p = plan->p_MC - plan->approach_M * back;
+      auto nearer = SolveHandReach(task_, p, plan->approach_M, plan->approach_M);
+      if (nearer && task_.planner->IsValid(nearer->X_MB)) {
+        Note(StrCat("the base's pose for the release point is not free: holding it out ",
+                    std::round(back * 100), " cm nearer the robot"));
+        plan->p_MC = p;
+        reach = nearer;
+      }
+    }
     if (!reach) {
       Note("no whole-body reach for the release point");
       return NodeStatus::kFailure;
@@ -122,6 +140,9 @@ class DriveToRelease final : public ReleaseLeaf {
   }
   NodeStatus OnRunning() override { return BaseMotionStatus(task_, Noter()); }
   void OnHalted() override { task_.motion->StopBase(); }
+
+ private:
+  static constexpr double kGiveStepM = 0.05;
 };
 
 // Carries the payload in from 12 cm short and 5 cm higher to the release point (arm-only IK

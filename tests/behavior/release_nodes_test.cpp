@@ -90,6 +90,43 @@ TEST_F(ReleaseNodesTest, DriveThenReachCarryThePayloadToTheReleasePoint) {
   EXPECT_GT(X_MPre.translation().z(), X_MG.translation().z() + 0.02);
 }
 
+// The responder's own returns, inflated, can cover the base's pose for the offer point: the
+// point comes back towards the robot until the pose is free. A placement's point does not move.
+TEST_F(ReleaseNodesTest, AHandOverHoldsItOutNearerWhenTheBasePoseForItIsNotFree) {
+  See({Person({0.0, 3.0}, perception::PersonIntent::kStationary)});
+  ASSERT_EQ(TickOnce(R"(<PlanHandOver pose="0.0;3.0"/>)"), NodeStatus::kSuccess);
+  const Eigen::Vector3d offered = Plan()->p_MC;
+  Pose2 free_stop;
+  {
+    bt::Tree drive = Tree("<DriveToRelease/>", blackboard_);  // a halt clears the path
+    ASSERT_EQ(drive.TickOnce(), NodeStatus::kRunning);
+    free_stop = motion_.path().back();
+  }
+  // Something 0.15 m ahead of that pose: the base there would touch it.
+  costmap_.SetProjectedObstacles({free_stop.translation() + Eigen::Vector2d(0.0, 0.15)});
+  ASSERT_FALSE(planner_.IsValid(free_stop));
+  ASSERT_EQ(TickOnce(R"(<PlanHandOver pose="0.0;3.0"/>)"), NodeStatus::kSuccess);
+  {
+    bt::Tree drive = Tree("<DriveToRelease/>", blackboard_);
+    ASSERT_EQ(drive.TickOnce(), NodeStatus::kRunning);
+    ASSERT_FALSE(motion_.path().empty());
+    EXPECT_TRUE(planner_.IsValid(motion_.path().back()));
+  }
+  const Eigen::Vector3d nearer = Plan()->p_MC;
+  EXPECT_LT(nearer.y(), offered.y() - 0.04);
+  EXPECT_LE(offered.y() - nearer.y(), 0.3 + 1e-9);
+  EXPECT_TRUE(NotedText("cm nearer the robot"));
+  // A placement at the first offer point keeps its point: the drive fails, saying why.
+  ASSERT_EQ(TickOnce(StrCat(R"(<PlanPlacement pose=")", offered.x(), ";", offered.y(), ";",
+                            offered.z(), R"("/>)")),
+            NodeStatus::kSuccess);
+  const Eigen::Vector3d placed = Plan()->p_MC;
+  bt::Tree drive = Tree("<DriveToRelease/>", blackboard_);
+  EXPECT_EQ(drive.TickOnce(), NodeStatus::kFailure);
+  EXPECT_EQ(Plan()->p_MC, placed);
+  EXPECT_TRUE(NotedText("in collision"));
+}
+
 TEST_F(ReleaseNodesTest, WaitForRecipientLetsGoWhenTheyStandWithinReach) {
   ASSERT_EQ(TickOnce(R"(<PlanPlacement pose="0.0;2.5;0.9"/>)"), NodeStatus::kSuccess);
   See({Person({0.0, 4.0}, perception::PersonIntent::kStationary)});

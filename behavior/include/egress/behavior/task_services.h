@@ -169,6 +169,10 @@ struct ReleasePlan {
   Eigen::Vector3d approach_M{Eigen::Vector3d::UnitX()};  ///< Unit horizontal approach in M.
   ArmPose arm{};      ///< The arm at the release (whole-body IK; DriveToRelease).
   ArmPose pre_arm{};  ///< The arm short of it, which the hand withdraws through (ReachToRelease).
+  /// How far the release point may come back along approach_M when the base pose whole-body IK
+  /// gives for it is not free (a hand-over: the responder's own laser returns, inflated, can
+  /// cover it); 0 for a placement, whose point is where the payload must land [m].
+  double give{0.0};
 };
 
 /// What the task nodes act through, handed to each at construction. The executive owns every
