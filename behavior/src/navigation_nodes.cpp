@@ -108,7 +108,7 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
       g.chosen = true;
       // Their ways predicted twice the horizon: on past the robot (to the horizon alone they may
       // stop short of it, and every spot would look as good as standing in their way).
-      const PeopleRoom room(task_, 2.0 * task_.config.give_way_horizon);
+      const PeopleRoom room(task_, 2.0 * task_.config.give_way_horizon, /*sidestep=*/true);
       const Eigen::Vector2d at = belief_.X_MB.translation();
       if (const auto spot = room.BestSpotAround({belief_.X_MB}, room.Score({at}) + kMinGainM)) {
         task_.motion->FollowPath({belief_.X_MB, *spot}, {false}, task_.motion->arm_target(),

@@ -235,25 +235,30 @@ std::vector<Occupant> PeopleAround(const TaskServices& task, const Eigen::Vector
   };
   for (const auto& entry : task.belief->world.people) {
     Eigen::Vector2d p_MP = entry.person.p_MP, v_MP = entry.person.v_MP;
+    const Eigen::Vector2d v_MStart = v_MP;
     for (int k = 0; step > 0 ? k * step <= horizon + 1e-9 : k == 0; ++k) {
       if (k > 0) {
         // Nobody walks through a wall: a way predicted into one (a velocity a few degrees askew
-        // along a corridor, over seconds) turns along it, by the least turn that is free.
+        // along a corridor, over seconds) turns along it, by the least turn that is free. Never
+        // back the way they came (more than kMaxWallTurns from where they walk now): at a dead
+        // end, or a wall straight ahead, they stop there (P2's group, walking to the corridor's
+        // end, was predicted back along the wall onto the robot's spot aside).
         bool free = walkable(p_MP + v_MP * step);
         for (int turn = 1; !free && turn <= kMaxWallTurns; ++turn) {
           for (const double sign : {1.0, -1.0}) {
             const Eigen::Vector2d v = Eigen::Rotation2Dd(sign * turn * kWallTurnRad) * v_MP;
-            if (walkable(p_MP + v * step)) {
+            if (v.dot(v_MStart) >= -1e-9 && walkable(p_MP + v * step)) {
               v_MP = v;
               free = true;
               break;
             }
           }
         }
-        if (!free) break;
+        if (!free) v_MP.setZero();
         p_MP += v_MP * step;
       }
-      if ((p_MP - at).norm() < look) near.push_back({p_MP, task.config.person_radius, k * step});
+      if ((p_MP - at).norm() < look)
+        near.push_back({p_MP, task.config.person_radius, k * step, v_MP});
       if (step <= 0) break;
     }
   }
@@ -267,11 +272,48 @@ double RoomAt(const std::vector<Occupant>& near, const Eigen::Vector2d& q) {
   return room;
 }
 
-PeopleRoom::PeopleRoom(const TaskServices& task, double horizon)
+PeopleRoom::PeopleRoom(const TaskServices& task, double horizon, bool sidestep)
     : task_(task),
       at_(task.belief->X_MB.translation()),
       predicted_(PeopleAround(task, at_, kPeopleLookM, horizon, kPeopleStepSec)),
-      now_(PeopleAround(task, at_, kPeopleLookM, 0.0, 0.0)) {}
+      now_(PeopleAround(task, at_, kPeopleLookM, 0.0, 0.0)) {
+  const perception::Costmap2D* costmap = task.belief->world.costmap;
+  const double body = task.config.person_radius;
+  for (const Occupant& o : predicted_) {
+    std::pair<Eigen::Vector2d, Eigen::Vector2d> ends{o.p_M, o.p_M};
+    const double speed = o.v_M.norm();
+    const double reach =
+        std::min(task.config.person_sidestep, task.config.person_sidestep_speed * o.t);
+    if (sidestep && o.radius > 0.0 && speed >= kSidestepMinMps && reach > 0.0) {
+      const Eigen::Vector2d across = Eigen::Vector2d(-o.v_M.y(), o.v_M.x()) / speed;
+      // As far to each side as the walls leave the body room.
+      const auto side = [&](double sign) {
+        Eigen::Vector2d end = o.p_M;
+        for (double s = kSidestepSampleM; s <= reach + 1e-9; s += kSidestepSampleM) {
+          const Eigen::Vector2d p = o.p_M + sign * s * across;
+          if (costmap && costmap->IsNearMappedObstacle(p, body)) break;
+          end = p;
+        }
+        return end;
+      };
+      ends = {side(1.0), side(-1.0)};
+    }
+    sidesteps_.push_back(ends);
+  }
+}
+
+double PeopleRoom::RoomFrom(std::size_t i, const Eigen::Vector2d& p_MB) const {
+  // The farthest point of the sidestep segment from the base is one of its ends.
+  const auto& [a, b] = sidesteps_[i];
+  return std::max((a - p_MB).norm(), (b - p_MB).norm()) - predicted_[i].radius;
+}
+
+double PeopleRoom::Predicted(const Eigen::Vector2d& q) const {
+  double room = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < predicted_.size(); ++i)
+    room = std::min(room, RoomFrom(i, q));
+  return room;
+}
 
 double PeopleRoom::RoomOnTheWay(const std::vector<Eigen::Vector2d>& corners) const {
   planning::TrajectoryConfig timing = task_.motion->trajectory_config();
@@ -292,10 +334,11 @@ double PeopleRoom::RoomOnTheWay(const std::vector<Eigen::Vector2d>& corners) con
     return corners.back();
   };
   double room = std::numeric_limits<double>::infinity();
-  for (const Occupant& o : predicted_) {
+  for (std::size_t i = 0; i < predicted_.size(); ++i) {
+    const Occupant& o = predicted_[i];
     // A scan return off the map stands where it is: compared with the spot.
     const Eigen::Vector2d p_MB = o.radius > 0.0 ? base_at(o.t) : corners.back();
-    room = std::min(room, (o.p_M - p_MB).norm() - o.radius);
+    room = std::min(room, RoomFrom(i, p_MB));
   }
   return room;
 }

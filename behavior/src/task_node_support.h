@@ -154,6 +154,7 @@ struct Occupant {
   Eigen::Vector2d p_M{Eigen::Vector2d::Zero()};
   double radius{0.0};  ///< [m]
   double t{0.0};       ///< how far ahead [s]; 0: now (scan returns are always now)
+  Eigen::Vector2d v_M{Eigen::Vector2d::Zero()};  ///< a person's predicted velocity [m/s]
 };
 /// Where the people near `at` (within `look` [m]) are and will be: each tracked person now and
 /// at their velocity every `step` [s] up to `horizon` [s] (a way predicted into a wall ends
@@ -168,9 +169,12 @@ double RoomAt(const std::vector<Occupant>& near, const Eigen::Vector2d& q);
 /// off the map) are now and will be over `horizon` [s], and which straight ways pass them.
 class PeopleRoom {
  public:
-  PeopleRoom(const TaskServices& task, double horizon);
+  /// With `sidestep`, people walking past step round the robot (TaskConfig::person_sidestep):
+  /// each predicted position is a short segment across the walk, and the room a spot leaves a
+  /// person is from its far end.
+  PeopleRoom(const TaskServices& task, double horizon, bool sidestep = false);
   /// The distance from `q` to the nearest person's edge, now or predicted at any time [m].
-  double Predicted(const Eigen::Vector2d& q) const { return RoomAt(predicted_, q); }
+  double Predicted(const Eigen::Vector2d& q) const;
   /// The least room people's predicted bodies leave the base while it drives `corners` (the
   /// robot's position first) as the motion executor would at retreat_speed: a quintic from rest
   /// to rest on each leg, then standing at the last corner; each predicted position of a person
@@ -203,12 +207,19 @@ class PeopleRoom {
   static constexpr double kPassMarginM = 0.1;        ///< beyond the footprint [m]
   static constexpr double kPathSampleM = 0.05;       ///< ways checked this often [m]
   static constexpr double kSweepMarginRad = 10.0 * M_PI / 180.0;
+  static constexpr double kSidestepSampleM = 0.05;  ///< sidesteps checked against walls this often
+  static constexpr double kSidestepMinMps = 0.3;    ///< slower people are standing, not passing
 
  private:
   bool IsSeen(const Eigen::Vector2d& p) const;
+  /// The room predicted_[i] leaves the base at p_MB [m].
+  double RoomFrom(std::size_t i, const Eigen::Vector2d& p_MB) const;
   const TaskServices& task_;
   Eigen::Vector2d at_;
   std::vector<Occupant> predicted_;
+  /// predicted_[i]'s sidestep: the two ends of the segment it may step across (both p_M
+  /// without sidestep).
+  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> sidesteps_;
   std::vector<Occupant> now_;
 };
 

@@ -22,6 +22,9 @@ void TaskConfig::Validate() const {
   ThrowUnless(std::isfinite(give_way_horizon) && give_way_horizon >= 0 &&
                   std::isfinite(give_way_clear_for) && give_way_clear_for >= 0,
               "TaskConfig: give_way_horizon and give_way_clear_for must be >= 0 (s)");
+  ThrowUnless(std::isfinite(person_sidestep) && person_sidestep >= 0 &&
+                  std::isfinite(person_sidestep_speed) && person_sidestep_speed >= 0,
+              "TaskConfig: person_sidestep (m) and person_sidestep_speed (m/s) must be >= 0");
   ThrowUnless(precise_pose_sigma > 0 && relocalize_timeout >= 0,
               "TaskConfig: precise_pose_sigma must be > 0 and relocalize_timeout >= 0");
   ik.Validate();

@@ -59,9 +59,17 @@ void PersonTracker::Update(const std::vector<Eigen::Vector2d>& p_MDetections, Ti
   for (const auto& [t, k] : match.pairs) {
     TrackedPerson& person = people_[t];
     const Eigen::Vector2d previous = person.p_MP;
-    // The paper's filter: exponential smoothing of position and of velocity (alpha = 0.3).
+    // The paper's filter: exponential smoothing of position and of velocity (alpha = 0.3). The
+    // velocity smooths what the detections say (this one against the track's last one), not the
+    // smoothed positions: differencing those smooths twice (gain alpha² on the velocity's
+    // error), and a person who has just set off read as a third of their speed for a second.
     person.p_MP = a * p_MDetections[k] + (1.0 - a) * (previous + person.v_MP * dt);
-    if (dt > 0.0) person.v_MP = a * (person.p_MP - previous) / dt + (1.0 - a) * person.v_MP;
+    const double measured_dt = ToSeconds(stamp - person.last_seen);
+    if (measured_dt > 0.0) {
+      person.v_MP =
+          a * (p_MDetections[k] - person.p_MMeasured) / measured_dt + (1.0 - a) * person.v_MP;
+    }
+    person.p_MMeasured = p_MDetections[k];
     ++person.hits;
     person.misses = 0;
     person.last_seen = stamp;
@@ -77,6 +85,7 @@ void PersonTracker::Update(const std::vector<Eigen::Vector2d>& p_MDetections, Ti
     TrackedPerson person;
     person.id = next_id_++;
     person.p_MP = p_MDetections[k];
+    person.p_MMeasured = p_MDetections[k];
     person.hits = 1;
     person.last_seen = stamp;
     people_.push_back(person);

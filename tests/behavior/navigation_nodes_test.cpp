@@ -60,7 +60,8 @@ TEST_F(NavigationNodesTest, NavigateToMakesWayForSomeoneComingAndGoesOnAfterThey
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
   ASSERT_TRUE(motion_.base_moving());
   const Eigen::Vector2d spot = motion_.path().back().translation();
-  EXPECT_LT(spot.y(), 0.5 - 0.3) << "away from their way (y = 0.7), to the side";
+  // Away from their way (y = 0.7), to the side (they step round it too: not a full metre).
+  EXPECT_LT(spot.y(), 0.5 - 0.2) << "away from their way (y = 0.7), to the side";
   // Gone past (walking away): on once their pass time and give_way_clear_for are over.
   motion_.StopBase();
   belief_.X_MB = {spot.x(), spot.y(), 0.0};

@@ -37,6 +37,44 @@ TEST(PersonTrackerTest, SmoothedVelocityAndForecast) {
   EXPECT_NEAR(person.forecast[3].y() - person.p_MP.y(), 1.2 * 0.8, 0.06);
 }
 
+// H2's fast person stands, then sets off at 1.6 m/s: within half a second (4 frames at 8 Hz) the
+// track must say most of that speed, or nothing downstream sees them coming in time. Smoothing
+// the smoothed positions' differences read a third of it.
+TEST(PersonTrackerTest, APersonWhoSetsOffReadsMostOfTheirSpeedWithinHalfASecond) {
+  PersonTracker tracker;
+  const Eigen::Vector2d p_MStart(0.45, -3.0);
+  int ms = 0;
+  for (int i = 0; i < 8; ++i, ms += 125)
+    tracker.Update({p_MStart}, milliseconds(ms));
+  ASSERT_EQ(tracker.people().size(), 1u);
+  EXPECT_LT(tracker.people()[0].v_MP.norm(), 1e-9);
+  const int set_off_ms = ms - 125;
+  for (int i = 0; i < 4; ++i, ms += 125) {
+    const double walked = 1.6 * (ms - set_off_ms) / 1000.0;
+    tracker.Update({p_MStart + Eigen::Vector2d(0.0, walked)}, milliseconds(ms));
+  }
+  ASSERT_EQ(tracker.people().size(), 1u);
+  EXPECT_GT(tracker.people()[0].v_MP.y(), 0.7 * 1.6);
+  EXPECT_LT(tracker.people()[0].v_MP.y(), 1.6);  // still smoothed, not the raw difference
+}
+
+// A missed frame: the velocity divides by the time between the two detections, not by the
+// frame interval (a walker does not read twice their speed after a miss).
+TEST(PersonTrackerTest, VelocitySpansTheMissedFrames) {
+  PersonTracker tracker;
+  for (int i = 0; i < 20; ++i) {
+    if (i == 10 || i == 11) {
+      tracker.Update({}, milliseconds(100 * i));
+      continue;
+    }
+    tracker.Update({Eigen::Vector2d(0.1 * i, 0.0)}, milliseconds(100 * i));
+    if (i == 12) {
+      ASSERT_EQ(tracker.people().size(), 1u);
+      EXPECT_NEAR(tracker.people()[0].v_MP.x(), 1.0, 0.05);
+    }
+  }
+}
+
 TEST(PersonTrackerTest, IntentOnScriptedTracks) {
   const DoorZone zone = LabZone();
   DoorState closed;

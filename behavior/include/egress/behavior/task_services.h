@@ -64,6 +64,14 @@ struct TaskConfig {
   bool give_way{true};
   double give_way_horizon{4.0};
   double give_way_clear_for{1.0};
+  /// Where the robot stands aside for people walking past (a give-way), they step round it
+  /// too: a predicted position may move sideways (across the walk) by up to
+  /// person_sidestep_speed [m/s] times how far ahead it is, at most person_sidestep [m], as far
+  /// as the walls leave room. A spot at a corridor's wall then leaves the group the corridor; a
+  /// spot in its middle leaves a squeeze on each side (P2: every spot aside read as worse than
+  /// the middle on the straight lines, and the group walked into the robot). 0: straight lines.
+  double person_sidestep{1.0};
+  double person_sidestep_speed{0.4};
   double arm_tuck_time{1.5};     ///< [s]
   double press_reach_time{2.0};  ///< Tucked → pre-press [s].
   double press_time{1.0};        ///< Pre-press → press → pre-press, each way [s].

@@ -36,9 +36,10 @@ struct PersonTrackerConfig {
 
 struct TrackedPerson {
   int id{0};
-  Eigen::Vector2d p_MP{Eigen::Vector2d::Zero()};  ///< Smoothed position [m].
-  Eigen::Vector2d v_MP{Eigen::Vector2d::Zero()};  ///< Smoothed velocity [m/s].
-  std::vector<Eigen::Vector2d> forecast;          ///< Positions at k·forecast_dt, k = 1..steps.
+  Eigen::Vector2d p_MP{Eigen::Vector2d::Zero()};         ///< Smoothed position [m].
+  Eigen::Vector2d v_MP{Eigen::Vector2d::Zero()};         ///< Smoothed velocity [m/s].
+  Eigen::Vector2d p_MMeasured{Eigen::Vector2d::Zero()};  ///< The last detection, unsmoothed [m].
+  std::vector<Eigen::Vector2d> forecast;  ///< Positions at k·forecast_dt, k = 1..steps.
   int hits{0};
   int misses{0};
   Time last_seen{};

@@ -1,0 +1,124 @@
+// People's predicted ways (PeopleAround) and the room they leave a spot (PeopleRoom), from
+// behavior/src/task_node_support.h: walls turn a way along them but never back, and people walking
+// past may step round the robot as far as the walls let them.
+
+#include <algorithm>
+#include <optional>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "task_node_support.h"
+
+namespace egress::behavior::detail {
+namespace {
+
+// A corridor along x, its walls' faces at y = 0 and y = 2, closed at x = 0 (a dead end).
+perception::OccupancyGrid DeadEndCorridor() {
+  using perception::Box2;
+  return perception::OccupancyGrid::FromBoxes(
+      {Box2{{5.0, -0.1, 0.0}, {12.0, 0.2}}, Box2{{5.0, 2.1, 0.0}, {12.0, 0.2}},
+       Box2{{-0.1, 1.0, 0.0}, {0.2, 2.4}}},
+      {-1.0, -1.0}, {11.0, 3.0}, 0.05);
+}
+
+perception::TrackedPersonWithIntent Walker(const Eigen::Vector2d& p_MP,
+                                           const Eigen::Vector2d& v_MP) {
+  perception::TrackedPersonWithIntent entry;
+  entry.person.p_MP = p_MP;
+  entry.person.v_MP = v_MP;
+  return entry;
+}
+
+class PeopleRoomTest : public ::testing::Test {
+ protected:
+  PeopleRoomTest() : costmap_(DeadEndCorridor()) {
+    belief_.world.costmap = &costmap_;
+    task_.belief = &belief_;
+  }
+  perception::Costmap2D costmap_;
+  Belief belief_;
+  TaskServices task_;
+};
+
+// Walking to the corridor's dead end: the way stops at the end wall; it neither goes through it
+// nor turns back along the walls (a group walking to the end was predicted back onto the robot).
+TEST_F(PeopleRoomTest, AWayIntoADeadEndStopsThereAndNeverTurnsBack) {
+  belief_.world.people = {Walker({3.0, 1.0}, {-1.2, 0.0})};
+  const std::vector<Occupant> way = PeopleAround(task_, {3.0, 1.0}, 10.0, 8.0, 0.2);
+  ASSERT_EQ(way.size(), 41u) << "every step of the horizon: they are still there";
+  double x_before = 3.0 + 1e-9;
+  for (const Occupant& o : way) {
+    EXPECT_LE(o.p_M.x(), x_before) << "at t = " << o.t;
+    EXPECT_GT(o.p_M.x(), 0.05) << "into the wall (its face at x = 0)";
+    x_before = o.p_M.x();
+  }
+  EXPECT_LT(way.back().p_M.x(), 0.6);
+  EXPECT_LT(way.back().v_M.norm(), 1e-9) << "standing at the end";
+}
+
+// A way a few degrees askew along the corridor turns along the wall and walks on.
+TEST_F(PeopleRoomTest, AWayAskewIntoAWallTurnsAlongIt) {
+  belief_.world.people = {Walker({9.0, 0.4}, {-1.0, -0.15})};
+  const std::vector<Occupant> way = PeopleAround(task_, {9.0, 1.0}, 10.0, 4.0, 0.2);
+  ASSERT_FALSE(way.empty());
+  for (const Occupant& o : way)
+    EXPECT_GT(o.p_M.y(), 0.05) << "into the wall (its face at y = 0)";
+  EXPECT_LT(way.back().p_M.x(), 9.0 - 3.0) << "on along the wall, not stopped at it";
+}
+
+// Someone walking down the middle: a spot in the middle leaves them only a sidestep's room, a
+// spot at the wall the corridor's other side. Without sidestep both are on their straight line's
+// distance; with it, near-term predictions (no time to step aside) stay straight.
+TEST_F(PeopleRoomTest, PeopleWalkingPastStepRoundTheRobotAsFarAsTheWallsLet) {
+  belief_.world.people = {Walker({9.0, 1.0}, {-1.0, 0.0})};
+  belief_.X_MB = {5.0, 1.0, 0.0};
+  task_.config.person_sidestep = 0.6;
+  const PeopleRoom straight(task_, 8.0, /*sidestep=*/false);
+  const PeopleRoom sidestep(task_, 8.0, /*sidestep=*/true);
+  const double body = task_.config.person_radius;
+  const Eigen::Vector2d middle(5.0, 1.0), at_wall(5.0, 0.3);
+  EXPECT_LT(straight.Predicted(middle), 0.0) << "on their line";
+  EXPECT_NEAR(straight.Predicted(at_wall), 0.7 - body, 0.02);
+  // Sidestep 0.6 m at most: from the middle, its far end is 0.6 m off (either side is free).
+  EXPECT_NEAR(sidestep.Predicted(middle), 0.6 - body, 0.03);
+  // At the wall they step to y = 1.6: 1.3 m from the spot.
+  EXPECT_NEAR(sidestep.Predicted(at_wall), 1.3 - body, 0.03);
+  EXPECT_GT(sidestep.Predicted(at_wall), sidestep.Predicted(middle) + 0.5);
+  // Next to the walker now, 0.1 s ahead of them: no time to step round.
+  EXPECT_NEAR(sidestep.Predicted({8.9, 1.0}), straight.Predicted({8.9, 1.0}), 1e-9);
+
+  // Squeezed between a wall and the far side: a sidestep stops where the body meets the wall.
+  task_.config.person_sidestep = 2.0;
+  task_.config.person_sidestep_speed = 10.0;
+  const PeopleRoom far(task_, 8.0, /*sidestep=*/true);
+  EXPECT_NEAR(far.Predicted({5.0, 0.3}), (2.0 - body - 0.3) - body, 0.06);
+}
+
+// Two walking abreast down the corridor at a robot standing in its middle (P2): the best spot is
+// at a wall, leaving them the rest of the corridor. On straight lines every spot aside is in one
+// of their lanes, and the robot stood where they squeezed past it on both sides.
+TEST_F(PeopleRoomTest, TwoAbreastAreLeftTheCorridorBySteppingToAWall) {
+  const RobotModel model = RobotModel::LoadDefault();
+  MotionExecutor motion(model);
+  const planning::BasePlanner planner(costmap_, nullptr);
+  MissionMap map;  // no doors
+  task_.motion = &motion;
+  task_.planner = &planner;
+  task_.map = &map;
+  belief_.X_MB = {3.0, 0.95, 0.0};
+  belief_.world.people = {Walker({8.0, 0.6}, {-1.1, 0.0}), Walker({8.0, 1.35}, {-1.1, 0.0})};
+  const auto spot_for = [&](bool sidestep) {
+    const PeopleRoom room(task_, 8.0, sidestep);
+    const Eigen::Vector2d at = belief_.X_MB.translation();
+    return room.BestSpotAround({belief_.X_MB}, room.Score({at}) + 0.1);
+  };
+  const std::optional<Pose2> spot = spot_for(true);
+  ASSERT_TRUE(spot.has_value());
+  const double wall_gap = std::min(spot->y, 2.0 - spot->y);
+  EXPECT_LT(wall_gap, task_.config.footprint_radius + 0.25) << "at a wall: y = " << spot->y;
+  EXPECT_TRUE(planner.IsValid(*spot));
+}
+
+}  // namespace
+}  // namespace egress::behavior::detail
