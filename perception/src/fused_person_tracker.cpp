@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "egress/hsr_interface/error.h"
 #include "nearest_first_association.h"
@@ -21,6 +22,11 @@ void FusedPersonTrackerConfig::Validate() const {
   positive(min_velocity_dt, "min_velocity_dt");
   positive(forecast_dt, "forecast_dt");
   positive(confirm_window_s, "confirm_window_s");
+  positive(static_radius, "static_radius");
+  positive(max_person_speed, "max_person_speed");
+  positive(static_after_s, "static_after_s");
+  positive(static_gap_s, "static_gap_s");
+  positive(static_forget_s, "static_forget_s");
   ThrowUnless(std::isfinite(confirm_motion) && confirm_motion >= 0.0,
               "FusedPersonTrackerConfig: confirm_motion must be finite and >= 0");
   ThrowUnless(confirm_laser_hits >= 1 && forecast_steps >= 0,
@@ -37,6 +43,43 @@ void FusedPersonTracker::Predict(Time stamp) {
   for (FusedTrack& track : tracks_)
     track.person.p_MP += track.person.v_MP * dt;
   now_ = stamp;
+}
+
+std::vector<bool> FusedPersonTracker::UpdateSpots(
+    const std::vector<PersonObservation>& observations, Time stamp) {
+  std::erase_if(spots_, [&](const StaticSpot& spot) {
+    return ToSeconds(stamp - spot.last_seen) > config_.static_forget_s;
+  });
+  std::vector<bool> at_static(observations.size(), false);
+  for (std::size_t k = 0; k < observations.size(); ++k) {
+    const PersonObservation& o = observations[k];
+    if (o.source != PersonSource::kLaser) continue;
+    StaticSpot* nearest = nullptr;
+    double nearest_distance = config_.static_radius;
+    for (StaticSpot& spot : spots_) {
+      const double d = (spot.p_M - o.p_MP).norm();
+      if (d <= nearest_distance) {
+        nearest = &spot;
+        nearest_distance = d;
+      }
+    }
+    if (!nearest) {
+      spots_.push_back({o.p_MP, stamp, stamp, false});
+      continue;
+    }
+    StaticSpot& spot = *nearest;
+    if (ToSeconds(stamp - spot.last_seen) > config_.static_gap_s) {
+      // Seen again after a gap: where it is now, counted from now (a spot that drifted with
+      // someone walking slowly never piles up time).
+      spot.p_M = o.p_MP;
+      spot.first_seen = stamp;
+    }
+    spot.last_seen = std::max(spot.last_seen, stamp);
+    spot.is_static =
+        spot.is_static || ToSeconds(spot.last_seen - spot.first_seen) >= config_.static_after_s;
+    at_static[k] = spot.is_static;
+  }
+  return at_static;
 }
 
 void FusedPersonTracker::Update(const std::vector<PersonObservation>& observations, Time stamp,
@@ -56,9 +99,15 @@ void FusedPersonTracker::Update(const std::vector<PersonObservation>& observatio
   std::vector<Eigen::Vector2d> then(tracks_.size());
   for (std::size_t t = 0; t < tracks_.size(); ++t)
     then[t] = tracks_[t].person.p_MP - tracks_[t].person.v_MP * lag;
-  const internal::Association match = internal::AssociateNearestFirst(
-      tracks_.size(), observations.size(), config_.gate_distance,
-      [&](std::size_t t, std::size_t k) { return (observations[k].p_MP - then[t]).norm(); });
+  // A static spot's observation joins only people already confirmed.
+  const std::vector<bool> at_static = UpdateSpots(observations, stamp);
+  const double kNever = std::numeric_limits<double>::infinity();
+  const internal::Association match =
+      internal::AssociateNearestFirst(tracks_.size(), observations.size(), config_.gate_distance,
+                                      [&](std::size_t t, std::size_t k) {
+                                        if (at_static[k] && !tracks_[t].confirmed) return kNever;
+                                        return (observations[k].p_MP - then[t]).norm();
+                                      });
   const std::vector<bool>& used_t = match.track_matched;
   const std::vector<bool>& used_k = match.detection_matched;
   const double a = config_.alpha;
@@ -66,6 +115,11 @@ void FusedPersonTracker::Update(const std::vector<PersonObservation>& observatio
     FusedTrack& track = tracks_[t];
     const PersonObservation& o = observations[k];
     auto& last = track.last_by_source[std::size_t(o.source)];
+    // Faster than anyone walks since its last laser measurement: the track took something else
+    // (the next table leg while the first was hidden), not a step; the jump is no motion.
+    const bool jumped =
+        o.source == PersonSource::kLaser && last && stamp > last->first &&
+        (o.p_MP - last->second).norm() > config_.max_person_speed * ToSeconds(stamp - last->first);
     if (last && stamp > last->first) {
       const double dt = ToSeconds(stamp - last->first);
       if (dt >= config_.min_velocity_dt) {
@@ -83,6 +137,12 @@ void FusedPersonTracker::Update(const std::vector<PersonObservation>& observatio
       ++track.camera_hits;
     } else {
       ++track.laser_hits;
+    }
+    if (jumped && !track.confirmed) {
+      track.person.p_MP = o.p_MP;
+      track.person.v_MP.setZero();
+      track.p_MBirth = o.p_MP;
+      track.birth = stamp;
     }
     const bool moved = (track.person.p_MP - track.p_MBirth).norm() >= config_.confirm_motion;
     track.confirmed = track.confirmed || track.camera_hits > 0 ||
@@ -113,7 +173,7 @@ void FusedPersonTracker::Update(const std::vector<PersonObservation>& observatio
   tracks_ = std::move(kept);
 
   for (std::size_t k = 0; k < observations.size(); ++k) {
-    if (used_k[k]) continue;
+    if (used_k[k] || at_static[k]) continue;
     FusedTrack track;
     track.person.id = next_id_++;
     track.person.p_MP = observations[k].p_MP;

@@ -3,6 +3,7 @@
 #include "egress/perception/fused_person_tracker.h"
 
 #include <cmath>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -80,9 +81,10 @@ TEST(FusedPersonTrackerTest, APersonTheCameraCannotSeeIsKeptByTheLaser) {
   FusedPersonTracker tracker;
   // Behind the robot: the camera (looking along +x) covers x > 0 only.
   const auto camera_covers = [](const Eigen::Vector2d& p) { return p.x() > 0.0; };
+  // Walking slowly (0.4 m/s) across behind it.
   for (int i = 0; i < 30; ++i) {
     const double t = 0.1 * i;
-    tracker.Update({{Eigen::Vector2d(-1.5, 0.2), PersonSource::kLaser}}, At(t));
+    tracker.Update({{Eigen::Vector2d(-1.5, 0.2 + 0.4 * t), PersonSource::kLaser}}, At(t));
     tracker.Update({}, At(t + 0.05), camera_covers);  // the camera sees nobody ahead
   }
   EXPECT_EQ(tracker.tracks().size(), 1u);
@@ -90,6 +92,71 @@ TEST(FusedPersonTrackerTest, APersonTheCameraCannotSeeIsKeptByTheLaser) {
   for (int i = 30; i < 45; ++i)
     tracker.Update({}, At(0.1 * i));
   EXPECT_TRUE(tracker.tracks().empty());
+}
+
+// A table's four legs (O2: 2 cm posts 0.52 m apart in y) seen by a laser on a robot driving
+// past: each leg is hidden behind its neighbour now and then. A track born on one leg must not
+// take the other, 0.52 m off, and confirm as someone walking.
+TEST(FusedPersonTrackerTest, TableLegsSeenInTurnNeverConfirmAsAPerson) {
+  FusedPersonTracker tracker;
+  const Eigen::Vector2d near_leg(-0.26, 4.74), far_leg(-0.26, 5.26);
+  for (int i = 0; i <= 200; ++i) {
+    const double t = 0.1 * i;
+    std::vector<PersonObservation> frame;
+    // Both for 2 s, then in turns of 0.5 s each: the far leg hidden, then the near one.
+    const int phase = i < 20 ? 0 : ((i - 20) / 5) % 2 + 1;
+    if (phase != 2) frame.push_back({near_leg, PersonSource::kLaser});
+    if (phase != 1) frame.push_back({far_leg, PersonSource::kLaser});
+    tracker.Update(frame, At(t));
+    ASSERT_TRUE(tracker.ConfirmedPeople().empty()) << "at " << t << " s";
+  }
+  // Both legs are static spots now; nothing is tracked on them.
+  int static_spots = 0;
+  for (const StaticSpot& spot : tracker.spots())
+    static_spots += spot.is_static;
+  EXPECT_EQ(static_spots, 2);
+  EXPECT_TRUE(tracker.tracks().empty());
+}
+
+// The first leg hidden a scan after the track was born on it: the track takes the other leg,
+// 0.52 m off in 0.1 s (faster than anyone walks), before either is a static spot. That jump is
+// not motion; a walker stepping 0.1 m per scan confirms.
+TEST(FusedPersonTrackerTest, AJumpFasterThanAnyoneWalksIsNoMotion) {
+  FusedPersonTracker tracker;
+  const Eigen::Vector2d near_leg(-0.26, 4.74), far_leg(-0.26, 5.26);
+  for (int i = 0; i < 7; ++i) {
+    tracker.Update({{i < 3 ? near_leg : far_leg, PersonSource::kLaser}}, At(0.1 * i));
+    ASSERT_TRUE(tracker.ConfirmedPeople().empty()) << "at " << 0.1 * i << " s";
+  }
+  FusedPersonTracker walker;
+  for (int i = 0; i < 7; ++i)
+    walker.Update({{near_leg + Eigen::Vector2d(0.0, 0.1 * i), PersonSource::kLaser}}, At(0.1 * i));
+  EXPECT_EQ(walker.ConfirmedPeople().size(), 1u);
+}
+
+// Someone standing where only the laser sees them is a static spot after static_after_s; when
+// they walk off, the laser confirms them as soon as they have moved. A person the camera has
+// confirmed keeps their laser measurements while they stand.
+TEST(FusedPersonTrackerTest, StandingPeopleAreNotLostToTheStaticSpots) {
+  FusedPersonTracker laser_only;
+  FusedPersonTracker with_camera;
+  const Eigen::Vector2d stand(1.0, -2.0);
+  for (int i = 0; i <= 60; ++i) {  // 6 s standing
+    laser_only.Update({{stand, PersonSource::kLaser}}, At(0.1 * i));
+    if (i == 0) with_camera.Update({{stand, PersonSource::kCamera}}, At(0.0));
+    with_camera.Update({{stand, PersonSource::kLaser}}, At(0.1 * i + 0.01));
+  }
+  ASSERT_EQ(with_camera.tracks().size(), 1u);
+  EXPECT_GE(with_camera.tracks()[0].laser_hits, 60) << "kept by the laser, standing";
+  EXPECT_TRUE(laser_only.ConfirmedPeople().empty());
+  // Walking off at 1 m/s.
+  bool confirmed = false;
+  for (int i = 1; i <= 15 && !confirmed; ++i) {
+    laser_only.Update({{stand + Eigen::Vector2d(0.1 * i, 0.0), PersonSource::kLaser}},
+                      At(6.0 + 0.1 * i));
+    confirmed = !laser_only.ConfirmedPeople().empty();
+  }
+  EXPECT_TRUE(confirmed);
 }
 
 TEST(FusedPersonTrackerTest, TwoPeoplePassingStayTwoTracks) {
@@ -116,6 +183,9 @@ TEST(FusedPersonTrackerTest, BadInputIsRefusedNamingIt) {
       tracker.Update({{Eigen::Vector2d(std::nan(""), 0.0), PersonSource::kCamera}}, At(1.1)),
       InvalidArgument);
   FusedPersonTrackerConfig config;
+  config.static_after_s = 0.0;
+  EXPECT_THROW(FusedPersonTracker{config}, InvalidArgument);
+  config = {};
   config.alpha = 0.0;
   EXPECT_THROW(FusedPersonTracker{config}, InvalidArgument);
 }

@@ -18,7 +18,19 @@
 /// dropped when a sensor that covers its position has not measured it for `drop_after_s`, or when
 /// nothing has for `drop_unseen_s`.
 ///
-/// Issue 21's second piece: not yet what the brain reads (PersonTracker still is).
+/// Static spots: a place where the laser has kept finding a "person" within `static_radius` for
+/// `static_after_s` (with no gap over `static_gap_s`) is a thing, not a person — a table's leg, a
+/// bin. A person's legs do not stay put that long while they walk (a stance lasts ~0.6 s), and
+/// one standing still never confirmed on the laser alone anyway. Laser observations at a static
+/// spot neither start a track nor join an unconfirmed one (a confirmed person standing by a table
+/// keeps them). Without this, a track born on one of O2's table legs took the next leg, 0.52 m
+/// off, when the first was occluded, and that jump confirmed a person walking into the doorway.
+/// A spot unseen for `static_forget_s` is forgotten. Before a spot is static, an unconfirmed
+/// track's laser observation that jumped faster than `max_person_speed` from its last one took
+/// something else: its confirm window starts again there.
+///
+/// The brain reads it with PerceptionConfig::laser_people (`--laser-people`); by default the
+/// camera's PersonTracker alone.
 
 #include <array>
 #include <functional>
@@ -52,8 +64,23 @@ struct FusedPersonTrackerConfig {
   double min_velocity_dt{0.05};  ///< Measurements closer in time than this update no velocity [s].
   int forecast_steps{4};
   double forecast_dt{0.2};  ///< [s]
+  /// An unconfirmed track whose laser observation jumped faster than this since the last one
+  /// took something else (a neighbouring table leg): it starts its confirm window there [m/s].
+  double max_person_speed{4.0};
+  double static_radius{0.08};    ///< Laser observations this near are the same spot [m].
+  double static_after_s{0.8};    ///< Seen at one spot this long: a thing, not a person [s].
+  double static_gap_s{1.0};      ///< A spot unseen longer than this starts its count again [s].
+  double static_forget_s{30.0};  ///< A spot unseen this long is forgotten [s].
   /// @throws InvalidArgument naming the field that is out of range.
   void Validate() const;
+};
+
+/// A place where the laser keeps finding a "person" (FusedPersonTracker's static spots).
+struct StaticSpot {
+  Eigen::Vector2d p_M{Eigen::Vector2d::Zero()};  ///< [m]
+  Time first_seen{};                             ///< Since when without a gap over static_gap_s.
+  Time last_seen{};
+  bool is_static{false};  ///< Seen static_after_s on end, once; until forgotten.
 };
 
 struct FusedTrack {
@@ -81,6 +108,8 @@ class FusedPersonTracker {
               const std::function<bool(const Eigen::Vector2d&)>& covers = {});
 
   const std::vector<FusedTrack>& tracks() const { return tracks_; }
+  /// The places the laser keeps finding something (static ones are things, not people).
+  const std::vector<StaticSpot>& spots() const { return spots_; }
   /// The confirmed tracks, as the rest of perception reads people.
   std::vector<TrackedPerson> ConfirmedPeople() const;
   /// The tracks' time: the latest stamp seen.
@@ -89,9 +118,12 @@ class FusedPersonTracker {
  private:
   void Predict(Time stamp);
   void Forecast();
+  /// Records the frame's laser observations in spots_; which of them lie at a static spot.
+  std::vector<bool> UpdateSpots(const std::vector<PersonObservation>& observations, Time stamp);
 
   FusedPersonTrackerConfig config_;
   std::vector<FusedTrack> tracks_;
+  std::vector<StaticSpot> spots_;
   int next_id_{1};
   Time now_{};
   bool started_{false};
