@@ -332,7 +332,7 @@ struct BatchOptions {
   bool resume{false};
   bool overwrite{false};
   bool quiet{false};
-  bool laser_people{false};
+  bool laser_people{egress::perception::PerceptionConfig{}.laser_people};  // the brain's default
 };
 
 // "I/N" with 1 <= I <= N.
@@ -677,8 +677,8 @@ void AddSimBatchCommand(CLI::App& sim_group) {
   batch->add_flag("--overwrite", o->overwrite, "replace existing result files");
   batch->add_flag("-q,--quiet", o->quiet, "no progress bar");
   batch->add_flag("--laser-people,!--camera-people-only", o->laser_people,
-                  "people from the base laser too, or the head camera's alone (the "
-                  "default; as sim run's)");
+                  "people from the base laser too (the default), or the head camera's alone "
+                  "(as sim run's)");
   batch->callback([o] { RunBatch(*o); });
 
   auto m = std::make_shared<MergeOptions>();

@@ -77,7 +77,7 @@ struct SimOptions {
   bool overwrite{false};
   bool quiet{false};
   bool no_octomap{false};
-  bool laser_people{false};
+  bool laser_people{egress::perception::PerceptionConfig{}.laser_people};  // the brain's default
   std::string bag;
   std::string btlog;
   std::optional<std::uint16_t> groot2_port;
@@ -364,8 +364,8 @@ void AddSimCommand(CLI::App& app) {
   sim->add_flag("--overwrite", o->overwrite, "replace existing output files");
   sim->add_flag("-q,--quiet", o->quiet, "print only the verdict");
   sim->add_flag("--laser-people,!--camera-people-only", o->laser_people,
-                "people from the base laser too, fused with the camera's; "
-                "--camera-people-only (the default): the head camera's alone");
+                "people from the base laser too, fused with the camera's (the default); "
+                "--camera-people-only: the head camera's alone (the paper's brain)");
   sim->add_flag("--no-octomap", o->no_octomap,
                 "disconnect the brain's 3D obstacle map (the base laser alone), for comparison");
   sim->callback([o] { RunSim(*o); });

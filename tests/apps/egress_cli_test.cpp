@@ -471,14 +471,15 @@ TEST(EgressCliTest, EvacStudyComparesTheThreeConditionsOnTheSameSeeds) {
 TEST(EgressCliTest, SimBatchReportsClosestApproachesAndTheLaserPeopleSetting) {
   const auto dir = egress::testing::TestTempPath("batch_people");
   const std::string scenario = kWorldsDir + "/scenarios/s2_person_crosses.yaml";
-  Result run = RunEgress("sim batch " + scenario + " --trials 2 --jobs 2 -q --laser-people --out " +
-                         (dir / "lp").string());
+  // Laser people are the default.
+  Result run =
+      RunEgress("sim batch " + scenario + " --trials 2 --jobs 2 -q --out " + (dir / "lp").string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_THAT(run.output, HasSubstr("closest med/worst"));
   EXPECT_THAT(run.output, HasSubstr("the person in the base laser's view on entering"));
   const auto j = nlohmann::json::parse(std::ifstream(dir / "lp" / "batch.json"));
   EXPECT_EQ(j.at("batch").at("brain").at("laser_people"), true);
-  // The camera-only brain (the default) is recorded as such too (a resume must not mix them).
+  // The camera-only brain (the paper's) is recorded as such too (a resume must not mix them).
   Result camera = RunEgress("sim batch " + scenario + " --trials 1 -q --camera-people-only --out " +
                             (dir / "cam").string());
   ASSERT_EQ(camera.exit_code, 0) << camera.output;
