@@ -48,7 +48,8 @@ void FusedPersonTracker::Predict(Time stamp) {
 std::vector<bool> FusedPersonTracker::UpdateSpots(
     const std::vector<PersonObservation>& observations, Time stamp) {
   std::erase_if(spots_, [&](const StaticSpot& spot) {
-    return ToSeconds(stamp - spot.last_seen) > config_.static_forget_s;
+    return ToSeconds(stamp - spot.last_seen) >
+           (spot.is_static ? config_.static_forget_s : config_.static_gap_s);
   });
   std::vector<bool> at_static(observations.size(), false);
   for (std::size_t k = 0; k < observations.size(); ++k) {

@@ -25,12 +25,13 @@
 /// spot neither start a track nor join an unconfirmed one (a confirmed person standing by a table
 /// keeps them). Without this, a track born on one of O2's table legs took the next leg, 0.52 m
 /// off, when the first was occluded, and that jump confirmed a person walking into the doorway.
-/// A spot unseen for `static_forget_s` is forgotten. Before a spot is static, an unconfirmed
-/// track's laser observation that jumped faster than `max_person_speed` from its last one took
-/// something else: its confirm window starts again there.
+/// A static spot unseen for `static_forget_s` is forgotten, any other once unseen for
+/// `static_gap_s` (a walker leaves one every few centimetres). Before a spot is static, an
+/// unconfirmed track's laser observation that jumped faster than `max_person_speed` from its last
+/// one took something else: its confirm window starts again there.
 ///
-/// The brain reads it with PerceptionConfig::laser_people (`--laser-people`); by default the
-/// camera's PersonTracker alone.
+/// The brain reads it with PerceptionConfig::laser_people (on by default); with
+/// `--camera-people-only`, the camera's PersonTracker alone.
 
 #include <array>
 #include <functional>
