@@ -68,13 +68,9 @@ std::vector<bool> FusedPersonTracker::UpdateSpots(
       spots_.push_back({o.p_MP, stamp, stamp, false});
       continue;
     }
+    // A spot still here was seen within static_gap_s, or is static (UpdateSpots forgets the
+    // others once unseen that long): its time since first_seen runs on.
     StaticSpot& spot = *nearest;
-    if (ToSeconds(stamp - spot.last_seen) > config_.static_gap_s) {
-      // Seen again after a gap: where it is now, counted from now (a spot that drifted with
-      // someone walking slowly never piles up time).
-      spot.p_M = o.p_MP;
-      spot.first_seen = stamp;
-    }
     spot.last_seen = std::max(spot.last_seen, stamp);
     spot.is_static =
         spot.is_static || ToSeconds(spot.last_seen - spot.first_seen) >= config_.static_after_s;

@@ -79,7 +79,7 @@ struct FusedPersonTrackerConfig {
 /// A place where the laser keeps finding a "person" (FusedPersonTracker's static spots).
 struct StaticSpot {
   Eigen::Vector2d p_M{Eigen::Vector2d::Zero()};  ///< [m]
-  Time first_seen{};                             ///< Since when without a gap over static_gap_s.
+  Time first_seen{};                             ///< Since when, without a gap over static_gap_s.
   Time last_seen{};
   bool is_static{false};  ///< Seen static_after_s on end, once; until forgotten.
 };
