@@ -78,6 +78,39 @@ class IsPersonHoldingDoor final : public TaskNode<bt::ConditionNode> {
   }
 };
 
+// A traversal the robot yielded in after crossing the door line ends past it: the retry must
+// not take it back to the side it came from to press again (clinic family, seed 2007: a
+// resident made the robot yield 0.9 m past door_b; the retry waved from the far side, drove
+// back through and was struck by the closing leaf). Through means its footprint is past the
+// line by the leaf clearance, in front of the opening, and out of the leaf's sweep. Like
+// TraverseDoor's success it ends the visit (a later traversal may come the other way).
+class IsThroughDoor final : public TaskNode<bt::ConditionNode> {
+ public:
+  using TaskNode::TaskNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>(
+                "door", "door id: the robot is on the far side of the one it approached from"),
+            VisitPort(bt::PortDirection::kInOut)};
+  }
+  NodeStatus Tick() override {
+    DoorVisit visit = Visit();
+    if (!visit.approach_side) return NodeStatus::kFailure;
+    const perception::DoorModel& model = *task_.map->FindDoor(visit.door);
+    const DoorPass pass = CalcKnownPass(task_, visit.door, &visit);
+    const Eigen::Vector2d offset = belief_.X_MB.translation() - pass.centre;
+    const double past = -offset.dot(pass.n_M);
+    const double lateral = std::abs(offset.dot(Eigen::Vector2d(-pass.n_M.y(), pass.n_M.x())));
+    const double body = task_.config.footprint_radius + kLeafClearance;
+    if (past < body || lateral > pass.width / 2 + past ||
+        model.InSweep(belief_.X_MB.translation(), body))
+      return NodeStatus::kFailure;
+    Note(StrCat("already through the door (", past, " m past its line)"));
+    visit.approach_side.reset();
+    Remember(visit);
+    return NodeStatus::kSuccess;
+  }
+};
+
 class IsHoldingPayload final : public TaskNode<bt::ConditionNode> {
  public:
   using TaskNode::TaskNode;
@@ -98,6 +131,7 @@ void RegisterConditionNodes(bt::BehaviorTreeFactory& factory, const TaskServices
   Register<IsPathClear>(factory, "IsPathClear", services);
   Register<IsDoorOpen>(factory, "IsDoorOpen", services);
   Register<IsPersonHoldingDoor>(factory, "IsPersonHoldingDoor", services);
+  Register<IsThroughDoor>(factory, "IsThroughDoor", services);
   Register<IsHoldingPayload>(factory, "IsHoldingPayload", services);
 }
 

@@ -104,6 +104,38 @@ TEST_F(ConditionNodesTest, IsPersonHoldingDoorWantsAStillHolderBesideAnOpenLeaf)
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
 }
 
+TEST_F(ConditionNodesTest, IsThroughDoorOnlyPastTheLineOutOfTheSweepAndEndsTheVisit) {
+  auto blackboard = bt::Blackboard::Create();
+  bt::Tree tree = Tree(R"(<IsThroughDoor door="lab_door"/>)", blackboard);
+  // No visit yet (the robot has not approached this door): not through, wherever it stands.
+  belief_.X_MB = {0.0, 4.6, M_PI / 2};
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
+  DoorVisit visit;
+  visit.door = "lab_door";
+  visit.approach_side = Eigen::Vector2d(0.0, -1.0);  // came from the south
+  const auto with_visit = [&] { blackboard->Set("door_visit", bt::Any(visit)); };
+  // Before the line; in the doorway; past the line but where the leaf (opening north) sweeps;
+  // far beside the opening: not through.
+  for (const Eigen::Vector2d& p : {Eigen::Vector2d(0.0, 2.0), Eigen::Vector2d(0.0, 3.2),
+                                   Eigen::Vector2d(0.0, 3.7), Eigen::Vector2d(3.0, 3.7)}) {
+    with_visit();
+    belief_.X_MB = {p.x(), p.y(), M_PI / 2};
+    EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure) << p.transpose();
+  }
+  // Past the sweep in front of the opening: through, and the visit's side is forgotten (a later
+  // traversal may come back the other way).
+  with_visit();
+  belief_.X_MB = {0.0, 4.6, M_PI / 2};
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);
+  ASSERT_TRUE(blackboard->Get<DoorVisit>("door_visit").has_value());
+  EXPECT_FALSE(blackboard->Get<DoorVisit>("door_visit")->approach_side.has_value());
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
+  // Coming from the north, the same spot is before the door.
+  visit.approach_side = Eigen::Vector2d(0.0, 1.0);
+  with_visit();
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
+}
+
 TEST_F(ConditionNodesTest, IsHoldingPayloadReadsTheGripsBelief) {
   bt::Tree tree = Tree(R"(<IsHoldingPayload payload="bottle"/>)");
   belief_.holding_object = false;

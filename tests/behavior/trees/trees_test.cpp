@@ -88,7 +88,8 @@ TEST(DoorTraversalTreeTest, AClosedPushButtonDoorIsPressedThenTraversed) {
   ScriptedRun run(
       "door_traversal.xml", "DoorTraversal",
       [](int, const TreeNode& n) {
-        if (Is(n, "IsDoorOpen") || Is(n, "IsPersonHoldingDoor")) return NodeStatus::kFailure;
+        if (Is(n, "IsDoorOpen") || Is(n, "IsPersonHoldingDoor") || Is(n, "IsThroughDoor"))
+          return NodeStatus::kFailure;
         if (Is(n, "ButtonType")) {
           n.config().blackboard->Set("button_type", Any(std::string("push_button")));
         }
@@ -106,7 +107,8 @@ TEST(DoorTraversalTreeTest, AProximityPlateIsWavedAtNotPressed) {
   ScriptedRun run(
       "door_traversal.xml", "DoorTraversal",
       [](int, const TreeNode& n) {
-        if (Is(n, "IsDoorOpen") || Is(n, "IsPersonHoldingDoor")) return NodeStatus::kFailure;
+        if (Is(n, "IsDoorOpen") || Is(n, "IsPersonHoldingDoor") || Is(n, "IsThroughDoor"))
+          return NodeStatus::kFailure;
         if (Is(n, "ButtonType")) {
           n.config().blackboard->Set("button_type", Any(std::string("proximity_plate")));
         }
@@ -122,6 +124,7 @@ TEST(DoorTraversalTreeTest, AHeldDoorIsPassedWithoutPressing) {
   ScriptedRun run(
       "door_traversal.xml", "DoorTraversal",
       [](int, const TreeNode& n) {
+        if (Is(n, "IsThroughDoor")) return NodeStatus::kFailure;
         if (Is(n, "IsDoorOpen")) return NodeStatus::kFailure;  // half open: too narrow by itself
         return NodeStatus::kSuccess;                           // but a person holds it
       },
@@ -144,7 +147,7 @@ TEST(DoorTraversalTreeTest, APersonEnteringPreemptsThePressInTheSameTickThenItRe
         if (Is(n, "IsPathClear"))
           return tick == 2 || tick == 3 ? NodeStatus::kFailure : NodeStatus::kSuccess;
         if (Is(n, "IsDoorOpen")) return tick >= 4 ? NodeStatus::kSuccess : NodeStatus::kFailure;
-        if (Is(n, "IsPersonHoldingDoor")) return NodeStatus::kFailure;
+        if (Is(n, "IsPersonHoldingDoor") || Is(n, "IsThroughDoor")) return NodeStatus::kFailure;
         if (Is(n, "ButtonType")) {
           n.config().blackboard->Set("button_type", Any(std::string("push_button")));
           return NodeStatus::kSuccess;
@@ -170,6 +173,29 @@ TEST(DoorTraversalTreeTest, APersonEnteringPreemptsThePressInTheSameTickThenItRe
   EXPECT_EQ(tick4.back(), "traverse_open");
 }
 
+TEST(DoorTraversalTreeTest, ARetryThatFindsTheRobotPastTheDoorEndsTheTraversal) {
+  // Tick 1: driving through (RUNNING). Tick 2: a person enters the zone: the standby starts.
+  // Tick 3: the standby ends and the retry finds the robot already through: SUCCESS, without
+  // pressing or driving back.
+  ScriptedRun run(
+      "door_traversal.xml", "DoorTraversal",
+      [](int tick, const TreeNode& n) {
+        if (Is(n, "IsThroughDoor")) return tick >= 3 ? NodeStatus::kSuccess : NodeStatus::kFailure;
+        if (Is(n, "IsPathClear")) return tick == 2 ? NodeStatus::kFailure : NodeStatus::kSuccess;
+        if (Is(n, "RetractToSafe")) return tick == 2 ? NodeStatus::kRunning : NodeStatus::kSuccess;
+        if (n.name() == "traverse_open") return NodeStatus::kRunning;
+        return NodeStatus::kSuccess;
+      },
+      kDoorA);
+  EXPECT_EQ(run.Tick(), NodeStatus::kRunning);
+  EXPECT_EQ(run.Ticked(1).back(), "traverse_open");
+  EXPECT_EQ(run.Tick(), NodeStatus::kRunning);
+  EXPECT_EQ(run.Ticked(2).back(), "retract");
+  EXPECT_EQ(run.Tick(), NodeStatus::kSuccess);
+  EXPECT_EQ(run.Ticked(3).back(), "IsThroughDoor");
+  EXPECT_FALSE(run.EverTicked("ApproachButton"));
+}
+
 TEST(DoorTraversalTreeTest, AnApproachThatKeepsFailingUsesUpTheAttemptsInsteadOfLooping) {
   // The path is clear but the actuator's standoff cannot be reached: each approach starts
   // (RUNNING), then fails; the standby's retract takes a tick. Each failure costs one of the
@@ -177,22 +203,23 @@ TEST(DoorTraversalTreeTest, AnApproachThatKeepsFailingUsesUpTheAttemptsInsteadOf
   // the standby, the approach re-started every tick and halted the standby, forever.)
   int approaches = 0;
   bool approach_running = false, retract_running = false;
-  ScriptedRun run("door_traversal.xml", "DoorTraversal",
-                  [&](int, const TreeNode& n) {
-                    if (Is(n, "IsDoorOpen") || Is(n, "IsPersonHoldingDoor"))
-                      return NodeStatus::kFailure;
-                    if (Is(n, "ApproachButton")) {
-                      if (!approach_running) ++approaches;
-                      approach_running = !approach_running;
-                      return approach_running ? NodeStatus::kRunning : NodeStatus::kFailure;
-                    }
-                    if (Is(n, "RetractToSafe")) {
-                      retract_running = !retract_running;
-                      return retract_running ? NodeStatus::kRunning : NodeStatus::kSuccess;
-                    }
-                    return NodeStatus::kSuccess;
-                  },
-                  {{"door", "door_a"}, {"max_yields", "3"}});
+  ScriptedRun run(
+      "door_traversal.xml", "DoorTraversal",
+      [&](int, const TreeNode& n) {
+        if (Is(n, "IsDoorOpen") || Is(n, "IsPersonHoldingDoor") || Is(n, "IsThroughDoor"))
+          return NodeStatus::kFailure;
+        if (Is(n, "ApproachButton")) {
+          if (!approach_running) ++approaches;
+          approach_running = !approach_running;
+          return approach_running ? NodeStatus::kRunning : NodeStatus::kFailure;
+        }
+        if (Is(n, "RetractToSafe")) {
+          retract_running = !retract_running;
+          return retract_running ? NodeStatus::kRunning : NodeStatus::kSuccess;
+        }
+        return NodeStatus::kSuccess;
+      },
+      {{"door", "door_a"}, {"max_yields", "3"}});
   NodeStatus status = NodeStatus::kRunning;
   int ticks = 0;
   while (status == NodeStatus::kRunning && ticks < 100) {
@@ -207,7 +234,7 @@ TEST(DoorTraversalTreeTest, AnApproachThatKeepsFailingUsesUpTheAttemptsInsteadOf
 TEST(DoorTraversalTreeTest, GivesUpAfterMaxYields) {
   ScriptedRun run("door_traversal.xml", "DoorTraversal",
                   [](int, const TreeNode& n) {
-                    if (Is(n, "IsPathClear"))
+                    if (Is(n, "IsPathClear") || Is(n, "IsThroughDoor"))
                       return NodeStatus::kFailure;  // someone always in the way
                     return NodeStatus::kSuccess;    // standby completes at once
                   },
@@ -242,7 +269,8 @@ std::vector<std::string> RunGoTo(const std::vector<std::vector<std::string>>& ro
                       }
                       return NodeStatus::kFailure;
                     }
-                    if (Is(n, "IsBeforeDoor") || Is(n, "IsDoorOpen")) return NodeStatus::kFailure;
+                    if (Is(n, "IsBeforeDoor") || Is(n, "IsDoorOpen") || Is(n, "IsThroughDoor"))
+                      return NodeStatus::kFailure;
                     if (Is(n, "IsPersonHoldingDoor")) return NodeStatus::kFailure;
                     if (Is(n, "ButtonType")) {
                       bb->Set("button_type", Any(std::string("push_button")));
