@@ -169,7 +169,9 @@ TrialResult RunBrainTrial(const std::string& scenario_path, std::uint64_t seed,
     for (auto it = brain->decisions().rbegin(); it != brain->decisions().rend(); ++it) {
       const std::string& text = it->text;
       const bool halted = text.size() > 7 && text.compare(text.size() - 7, 7, " halted") == 0;
-      if (text != "mission failed" && !halted) {
+      // Where the head looks is no reason for giving up (it turns back ahead once the tree stops).
+      const bool gaze = text.rfind("head: ", 0) == 0;
+      if (text != "mission failed" && !halted && !gaze) {
         r.abort_reason = text;
         break;
       }

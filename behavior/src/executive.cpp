@@ -208,6 +208,7 @@ Executive::Executive(std::shared_ptr<const RobotModel> model, MissionMap map, Mi
   services_.motion = &m.motion;
   services_.planner = m.planner.get();
   services_.log = &log_;
+  services_.gaze = &m.gaze;
   services_.belief = &belief_;
   belief_.X_BL = m.model->laser_pose().ToPose2();
   belief_.X_MB = X_MB_initial;
@@ -463,7 +464,8 @@ bool Executive::Step(RobotPort& port) {
   }
   // Where the base was when the detections' image was taken (the detector runs behind).
   const std::optional<double> pan_now = snapshot.joints.Position("head_pan_joint");
-  pose_history_.push_back({now, belief_.X_MB, pan_now});
+  pose_history_.push_back(
+      {now, belief_.X_MB, pan_now, snapshot.joints.Position("head_tilt_joint")});
   while (!pose_history_.empty() && ToSeconds(now - pose_history_.front().t) > kPoseHistorySec)
     pose_history_.pop_front();
   const std::vector<Detection2D> detections = Detect(snapshot);
@@ -473,7 +475,10 @@ bool Executive::Step(RobotPort& port) {
   if (!detections.empty() && m.depth) {
     const PoseAt* a = PoseHistoryAt(detections.front().stamp);
     const PoseAt* b = PoseHistoryAt(m.depth->stamp);
-    head_still = !a || !b || !a->pan || !b->pan || std::abs(*a->pan - *b->pan) <= kHeadMovedRad;
+    const auto same = [](const std::optional<double>& x, const std::optional<double>& y) {
+      return !x || !y || std::abs(*x - *y) <= kHeadMovedRad;
+    };
+    head_still = !a || !b || (same(a->pan, b->pan) && same(a->tilt, b->tilt));
   }
   if (!detections.empty() && m.depth && m.X_BC && head_still) {
     const PoseAt* capture = PoseHistoryAt(detections.front().stamp);
@@ -601,7 +606,8 @@ bool Executive::Step(RobotPort& port) {
   if (auto head = m.gaze.Update(belief_, pan_now)) {
     port.SendHeadCommand(*head);
     if (m.gaze.reason() != gaze_before) {
-      static constexpr const char* kWhy[] = {"ahead", "through the door", "at a person coming"};
+      static constexpr const char* kWhy[] = {"ahead", "through the door", "at a person coming",
+                                             "at what the task needs"};
       decisions_.push_back({ToSeconds(now), StrCat("head: looking ", kWhy[int(m.gaze.reason())]),
                             DecisionEvent::kNote});
     }

@@ -79,10 +79,13 @@ class DriveToGrasp final : public GraspLeaf {
     GripperCommand open;
     open.mode = GripperCommand::Mode::kOpen;
     task_.motion->SetGripper(open);
+    p_MC_ = plan->p_MC;
+    LookAt(p_MC_);  // the payload in view on the way, so that the reach finds it seen afresh
     const NodeStatus s = StartPath(task_, plan->X_MB, "the grasp pose", Noter());
     return s == NodeStatus::kSuccess ? OnRunning() : s;
   }
   NodeStatus OnRunning() override {
+    LookAt(p_MC_);
     const NodeStatus s = BaseMotionStatus(task_, Noter());
     if (s != NodeStatus::kSuccess) return s;
     return gate_.Check(task_, "grasping", EventNoter());
@@ -91,6 +94,7 @@ class DriveToGrasp final : public GraspLeaf {
 
  private:
   RelocalizeGate gate_;
+  Eigen::Vector3d p_MC_{Eigen::Vector3d::Zero()};
 };
 
 // Swings the arm from where the base stopped to a pre-grasp 12 cm short of the payload, then to
@@ -134,11 +138,16 @@ class ReachForPayload final : public GraspLeaf {
     knots.emplace_back(t + 3.5, *grasp);
     task_.motion->MoveArm(knots, belief_.now);
     plan->arm = *grasp;
+    p_MC_ = plan->p_MC;
     this->SetOutput("grasp", *plan);
     Note("reaching for the payload");
+    LookAt(p_MC_);
     return NodeStatus::kRunning;
   }
-  NodeStatus OnRunning() override { return ArmMotionStatus(task_, Noter()); }
+  NodeStatus OnRunning() override {
+    LookAt(p_MC_);
+    return ArmMotionStatus(task_, Noter());
+  }
   void OnHalted() override {}
 
  private:
@@ -165,6 +174,7 @@ class ReachForPayload final : public GraspLeaf {
     }
     plan->p_MC = centre;
   }
+  Eigen::Vector3d p_MC_{Eigen::Vector3d::Zero()};
   static constexpr double kRefreshRadius = 0.15;     // [m] the same payload, seen again
   static constexpr double kLowPayloadSearch = 0.08;  // [m] around the estimate, from above
   static constexpr double kRaiseFirstAbove = 0.05;   // [m] a smaller rise goes with the reach

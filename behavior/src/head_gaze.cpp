@@ -23,6 +23,9 @@ void HeadGazeConfig::Validate() const {
               "HeadGazeConfig: door_open_fraction must be in [0, 1]");
   ThrowUnless(max_pan_deg >= 0 && max_pan_deg <= 180 && min_change_deg >= 0,
               "HeadGazeConfig: max_pan_deg must be in [0, 180], min_change_deg >= 0");
+  ThrowUnless(max_tilt_down_deg >= 0 && max_tilt_down_deg <= 90 && max_tilt_up_deg >= 0 &&
+                  max_tilt_up_deg <= 90,
+              "HeadGazeConfig: max_tilt_down_deg and max_tilt_up_deg must be in [0, 90]");
 }
 
 HeadGaze::HeadGaze(HeadGazeConfig config) : config_(config) {
@@ -36,6 +39,19 @@ double HeadGaze::PanTowards(const Pose2& X_MB, const Eigen::Vector2d& p_M) const
   return std::clamp(bearing, -limit, limit);
 }
 
+double HeadGaze::TiltTowards(const Pose3& X_MC, const Eigen::Vector3d& p_M) const {
+  const Eigen::Vector3d d = p_M - X_MC.translation();
+  const double tilt = std::atan2(d.z(), std::max(d.head<2>().norm(), 1e-3));
+  return std::clamp(tilt, -config_.max_tilt_down_deg * kDegToRad,
+                    config_.max_tilt_up_deg * kDegToRad);
+}
+
+void HeadGaze::RequestLook(const Eigen::Vector3d& p_M, Time until) {
+  ThrowUnless(p_M.allFinite(), "HeadGaze::RequestLook: the point must be finite");
+  requested_ = p_M;
+  requested_until_ = until;
+}
+
 std::optional<HeadCommand> HeadGaze::Update(const Belief& belief, std::optional<double> pan_now) {
   if (!config_.enabled) return std::nullopt;
   const Pose2& X_MB = belief.X_MB;
@@ -44,6 +60,7 @@ std::optional<HeadCommand> HeadGaze::Update(const Belief& belief, std::optional<
   const double looking = pan_now.value_or(commanded_pan_);
 
   std::optional<double> pan;
+  double tilt = 0.0;
   GazeReason reason = GazeReason::kAhead;
   // 1. A glance under way goes on while its person is still tracked.
   if (glance_id_ >= 0 && belief.now < glance_until_) {
@@ -81,7 +98,13 @@ std::optional<HeadCommand> HeadGaze::Update(const Belief& belief, std::optional<
       glance_until_ = belief.now + SecondsToDuration(config_.glance_time);
     }
   }
-  // 2. Through the nearest door that is open or opening.
+  // 2. What the task asked for.
+  if (!pan && requested_ && belief.now < requested_until_) {
+    pan = PanTowards(X_MB, requested_->head<2>());
+    tilt = TiltTowards(belief.X_MC, *requested_);
+    reason = GazeReason::kTask;
+  }
+  // 3. Through the nearest door that is open or opening.
   if (!pan) {
     double nearest = config_.door_look_range;
     for (const auto& door : belief.world.doors) {
@@ -109,11 +132,14 @@ std::optional<HeadCommand> HeadGaze::Update(const Belief& belief, std::optional<
         ToSeconds(belief.now - it->second) > config_.glance_time + config_.glance_cooldown;
     it = stale ? glanced_at_.erase(it) : std::next(it);
   }
-  if (sent_ && std::abs(*pan - commanded_pan_) < config_.min_change_deg * kDegToRad)
+  const double min_change = config_.min_change_deg * kDegToRad;
+  if (sent_ && std::abs(*pan - commanded_pan_) < min_change &&
+      std::abs(tilt - commanded_tilt_) < min_change)
     return std::nullopt;
   sent_ = true;
   commanded_pan_ = *pan;
-  return HeadCommand{*pan, 0.0};
+  commanded_tilt_ = tilt;
+  return HeadCommand{*pan, tilt};
 }
 
 }  // namespace egress::behavior

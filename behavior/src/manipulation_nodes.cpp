@@ -1,5 +1,6 @@
 #include "manipulation_support.h"
 
+#include <array>
 #include <cmath>
 
 namespace egress::behavior::detail {
@@ -36,15 +37,31 @@ class DetectPayload final : public TaskNode<bt::StatefulActionNode> {
                   std::round(best->p_MO.z() * 100) / 100, ")"));
       return NodeStatus::kSuccess;
     }
-    if (ToSeconds(belief_.now - started_) > Input<double>("timeout")) {
+    const double timeout = Input<double>("timeout");
+    const double looking = ToSeconds(belief_.now - started_);
+    if (looking > timeout) {
       Note(StrCat("no ", kind, " in sight"));
       return NodeStatus::kFailure;
+    }
+    // Not in the level view ahead: look lower, ahead and to either side (a payload on a low
+    // table or the floor near the robot is below a level camera's view).
+    if (const double searching = looking - timeout * kLevelShare; searching >= 0.0) {
+      const int k = std::min(2, int(searching / (timeout * (1.0 - kLevelShare) / 3.0)));
+      const double bearing = belief_.X_MB.yaw + std::array{0.0, kSearchPanRad, -kSearchPanRad}[k];
+      const Eigen::Vector2d p =
+          belief_.X_MB.translation() +
+          kSearchRange * Eigen::Vector2d(std::cos(bearing), std::sin(bearing));
+      LookAt({p.x(), p.y(), kSearchHeight});
     }
     return NodeStatus::kRunning;
   }
   void OnHalted() override {}
 
  private:
+  static constexpr double kLevelShare = 0.25;   // of the timeout, looking level ahead first
+  static constexpr double kSearchRange = 1.2;   // [m] from the base, the points looked at
+  static constexpr double kSearchHeight = 0.4;  // [m] above the floor
+  static constexpr double kSearchPanRad = 0.6;  // to either side
   Time started_{};
 };
 

@@ -28,6 +28,8 @@ using EventNoteFn = std::function<void(const std::string&, DecisionEvent)>;
 inline constexpr double kArmTolerance = 0.02;        ///< [rad or m] the arm counts as at a pose
 inline constexpr double kPathLookahead = 1.5;        ///< [m] of the path ahead checked for blockage
 inline constexpr double kDoorSeenRecentlySec = 0.5;  // [s] a door estimate this fresh is "now"
+// [s] A node's look request lasts this long: the node renews it each tick while it needs the view.
+inline constexpr double kLookRequestSec = 0.5;
 inline constexpr double kLeafClearance = 0.15;  // [m] kept between the footprint and a leaf's sweep
 // [s] A low-energy ADA operator takes at least this long to open (ANSI A156.19: >= 3 s to the
 // back check), and at most about the second: the hold window starts in between.
@@ -72,6 +74,11 @@ class TaskNode : public Base {
     return Input<T>(port);
   }
   std::string Door() const { return Input<std::string>("door"); }
+  /// Asks the head to look at p_M (in M) for the next kLookRequestSec (HeadGaze::RequestLook).
+  void LookAt(const Eigen::Vector3d& p_M) const {
+    if (task_.gaze != nullptr)
+      task_.gaze->RequestLook(p_M, belief_.now + SecondsToDuration(kLookRequestSec));
+  }
   /// The visit to this node's door on the `visit` port; a new one if there is none yet or the
   /// port holds a visit to another door.
   DoorVisit Visit() const {

@@ -71,6 +71,34 @@ TEST_F(GraspNodesTest, DriveToGraspOpensTheGripperAndDrivesToThePlannedPose) {
   EXPECT_EQ(gripper->mode, GripperCommand::Mode::kOpen);
 }
 
+TEST_F(GraspNodesTest, TheDriveAndTheReachKeepThePayloadInTheCamerasView) {
+  HeadGaze gaze;
+  services_.gaze = &gaze;
+  belief_.X_MB = {0.0, 1.0, M_PI / 2};
+  belief_.X_MC = Pose3(Eigen::Vector3d(0.0, 1.0, 1.0));
+  belief_.now = At(1.0);
+  const auto plan = PlanFor("0.0;3.8;0.8");
+  ASSERT_TRUE(plan);
+  bt::Tree drive = Tree("<DriveToGrasp/>", blackboard_);
+  EXPECT_EQ(drive.TickOnce(), NodeStatus::kRunning);
+  auto look = gaze.Update(belief_, 0.0);
+  ASSERT_TRUE(look.has_value());
+  EXPECT_EQ(gaze.reason(), GazeReason::kTask);
+  EXPECT_NEAR(look->pan, 0.0, 0.05);  // ahead, where the payload is
+  EXPECT_LT(look->tilt, 0.0);         // below the camera
+  // At the grasp pose, close to it, the reach looks further down.
+  belief_.X_MB = plan->X_MB;
+  belief_.X_MC =
+      Pose3(Eigen::Vector3d(plan->X_MB.translation().x(), plan->X_MB.translation().y(), 1.0));
+  bt::Tree reach = Tree("<ReachForPayload/>", blackboard_);
+  belief_.now = At(2.0);
+  EXPECT_EQ(reach.TickOnce(), NodeStatus::kRunning);
+  const auto closer = gaze.Update(belief_, 0.0);
+  ASSERT_TRUE(closer.has_value());
+  EXPECT_EQ(gaze.reason(), GazeReason::kTask);
+  EXPECT_LT(closer->tilt, look->tilt);
+}
+
 TEST_F(GraspNodesTest, ReachForPayloadSwingsTheArmToTheGraspAndRecordsIt) {
   belief_.X_MB = {0.0, 1.0, M_PI / 2};
   belief_.now = At(1.0);

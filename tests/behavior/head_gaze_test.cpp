@@ -119,6 +119,47 @@ TEST_F(HeadGazeTest, NoGlanceAtSomeoneInViewStandingOrWalkingAway) {
   EXPECT_EQ(gaze_.reason(), GazeReason::kAhead);
 }
 
+TEST_F(HeadGazeTest, LooksAtATasksTargetWithPanAndTiltWhileTheRequestLasts) {
+  belief_.X_MC = Pose3(Eigen::Vector3d(1.15, 2.4, 1.0));
+  // A payload 1 m ahead, half a metre below the camera; the door open beside: the task wins.
+  belief_.world.doors = {LabDoor(1.0)};
+  gaze_.RequestLook({1.15, 3.4, 0.5}, At(1.5));
+  auto look = Update(0.0);
+  ASSERT_TRUE(look.has_value());
+  EXPECT_EQ(gaze_.reason(), GazeReason::kTask);
+  EXPECT_NEAR(look->pan, 0.0, 1e-9);
+  EXPECT_NEAR(look->tilt, std::atan2(-0.5, 1.0), 1e-9);
+  // Renewed at a point to the left at the camera's height: pan only.
+  belief_.now = At(1.2);
+  gaze_.RequestLook({0.15, 2.4, 1.0}, At(1.7));
+  look = Update(0.0);
+  ASSERT_TRUE(look.has_value());
+  EXPECT_NEAR(look->pan, M_PI / 2, 1e-9);
+  EXPECT_NEAR(look->tilt, 0.0, 1e-9);
+  // Nearly straight below: the tilt stops at its limit.
+  gaze_.RequestLook({1.2, 2.4, 0.0}, At(1.7));
+  look = Update(0.0);
+  ASSERT_TRUE(look.has_value());
+  EXPECT_NEAR(look->tilt, -gaze_.config().max_tilt_down_deg * M_PI / 180.0, 1e-9);
+  // The request lapsed: back to the door, level.
+  belief_.now = At(1.8);
+  look = Update(0.0);
+  ASSERT_TRUE(look.has_value());
+  EXPECT_EQ(gaze_.reason(), GazeReason::kDoor);
+  EXPECT_DOUBLE_EQ(look->tilt, 0.0);
+  EXPECT_THROW(gaze_.RequestLook({NAN, 0.0, 0.0}, At(2.0)), InvalidArgument);
+}
+
+TEST_F(HeadGazeTest, SomeoneComingOutranksTheTasksTarget) {
+  belief_.X_MC = Pose3(Eigen::Vector3d(1.15, 2.4, 1.0));
+  gaze_.RequestLook({1.15, 3.4, 0.5}, At(2.0));
+  belief_.world.people = {Walker(7, {1.15, 0.4}, {0.0, 1.2})};  // behind, coming
+  const auto look = Update(0.0);
+  ASSERT_TRUE(look.has_value());
+  EXPECT_EQ(gaze_.reason(), GazeReason::kPerson);
+  EXPECT_DOUBLE_EQ(look->tilt, 0.0);
+}
+
 TEST_F(HeadGazeTest, PanStaysWithinItsLimit) {
   HeadGazeConfig config;
   config.max_pan_deg = 90.0;
@@ -135,7 +176,8 @@ TEST_F(HeadGazeTest, DisabledSendsNothingAndBadConfigsAreRefused) {
   HeadGaze off(config);
   EXPECT_FALSE(off.Update(belief_, 0.0).has_value());
   for (auto bad : {&HeadGazeConfig::camera_hfov_deg, &HeadGazeConfig::glance_range,
-                   &HeadGazeConfig::door_open_fraction, &HeadGazeConfig::max_pan_deg}) {
+                   &HeadGazeConfig::door_open_fraction, &HeadGazeConfig::max_pan_deg,
+                   &HeadGazeConfig::max_tilt_down_deg, &HeadGazeConfig::max_tilt_up_deg}) {
     HeadGazeConfig c;
     c.*bad = -1.0;
     EXPECT_THROW(HeadGaze{c}, InvalidArgument);

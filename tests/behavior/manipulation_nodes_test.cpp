@@ -42,5 +42,38 @@ TEST_F(ManipulationNodesTest, DetectPayloadLooksUntilItsTimeout) {
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
 }
 
+TEST_F(ManipulationNodesTest, DetectPayloadLooksLowerAheadThenToEitherSide) {
+  HeadGaze gaze;
+  services_.gaze = &gaze;
+  belief_.X_MC = Pose3(Eigen::Vector3d(0.0, 2.0, 1.0));
+  bt::Tree tree = Tree(R"(<DetectPayload kind="bottle" pose="{where}" timeout="4.0"/>)");
+  // The first second: level ahead, no request.
+  belief_.now = At(1.0);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  gaze.Update(belief_, 0.0);
+  EXPECT_EQ(gaze.reason(), GazeReason::kAhead);
+  // Then lower, ahead; then to the left; then to the right.
+  std::vector<std::pair<double, double>> looks;
+  for (double t : {2.2, 3.2, 4.2}) {
+    belief_.now = At(t);
+    EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+    const auto look = gaze.Update(belief_, 0.0);
+    ASSERT_TRUE(look.has_value()) << t;
+    EXPECT_EQ(gaze.reason(), GazeReason::kTask);
+    EXPECT_LT(look->tilt, -0.2) << t;
+    looks.emplace_back(look->pan, look->tilt);
+  }
+  EXPECT_NEAR(looks[0].first, 0.0, 1e-9);
+  EXPECT_GT(looks[1].first, 0.3);
+  EXPECT_LT(looks[2].first, -0.3);
+  // Found: done, and no more requests.
+  belief_.world.payloads = {Seen("bottle", {0.8, 2.8, 0.4})};
+  belief_.now = At(4.3);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);
+  belief_.now = At(4.9);
+  gaze.Update(belief_, 0.0);
+  EXPECT_EQ(gaze.reason(), GazeReason::kAhead);
+}
+
 }  // namespace
 }  // namespace egress::behavior

@@ -195,12 +195,14 @@ class Executive {
   /// [rad] The head turned more than this between an image and the depth image that places its
   /// boxes: the boxes are dropped.
   static constexpr double kHeadMovedRad = 0.02;
-  /// Per control step: the localized X_MB and the measured head pan (if the joints gave it),
+  /// Per control step: the localized X_MB and the measured head pan and tilt (if the joints
+  /// gave them),
   /// for where the base and the head were when a late image was taken.
   struct PoseAt {
     Time t;
     Pose2 X_MB;
     std::optional<double> pan;
+    std::optional<double> tilt;
   };
   std::deque<PoseAt> pose_history_;
   /// The latest entry at or before `stamp` (nullptr if the history starts after it).

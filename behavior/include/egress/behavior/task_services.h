@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "egress/behavior/belief.h"
+#include "egress/behavior/head_gaze.h"
 #include "egress/behavior/mission_map.h"
 #include "egress/behavior/motion_executor.h"
 #include "egress/hsr_interface/robot_model.h"
@@ -192,6 +193,9 @@ struct TaskServices {
   MotionExecutor* motion{nullptr};
   const planning::BasePlanner* planner{nullptr};
   DecisionLog* log{nullptr};
+  /// Where the head looks; nodes ask it for a view they need (RequestLook). May be null (no
+  /// head control, e.g. in node tests).
+  HeadGaze* gaze{nullptr};
   /// The robot's belief, refreshed by the executive before every tick; read-only to the nodes.
   const Belief* belief{nullptr};
 };
