@@ -181,6 +181,11 @@ bool DoorPassable(const TaskServices& task, const std::string& door, double marg
       open_for = std::max(open_for, since_press - kOperatorMinOpeningTime);
     }
     if (!ours && !witnessed) open_for = std::max(open_for, window);
+    // A press that found the door open restarted the window then, however late the opening was
+    // first seen (from beside the actuator the leaf is often out of view until the robot lines
+    // up): the window is at least that old.
+    if (visit != nullptr && visit->window_restarted_at)
+      open_for = std::max(open_for, ToSeconds(task.belief->now - *visit->window_restarted_at));
     const DoorPass pass = CalcKnownPass(task, door, visit);
     // From here to beyond the leaf's sweep on the far side (less if already past the line); a
     // leaf that opens towards the robot closes away from it: just past the line is clear.

@@ -91,6 +91,26 @@ TEST_F(ConditionNodesTest, IsDoorOpenNeedsTheClearanceAndTimeLeftInTheWindow) {
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
 }
 
+TEST_F(ConditionNodesTest, AWindowRestartedByAPressIsTimedFromThePressNotFromFirstSight) {
+  // The robot pressed the open door 6 s ago (restarting its hold window) but, beside the
+  // actuator, saw the leaf open only 1 s ago: 6 s of the window are gone, and the 5.8 s drive
+  // clear of the leaf does not fit in the 4 left.
+  auto blackboard = bt::Blackboard::Create();
+  bt::Tree tree = Tree(R"(<IsDoorOpen door="lab_door" margin="0.1"/>)", blackboard);
+  belief_.now = At(50.0);
+  DoorSeenOpen(85.0, 1.0);
+  DoorVisit visit;
+  visit.door = "lab_door";
+  visit.operated_at = At(44.0);
+  blackboard->Set("door_visit", bt::Any(visit));
+  // Without the restart the same press is read as the door's own opening (at the earliest 3 s
+  // after it): passable.
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);
+  visit.window_restarted_at = visit.operated_at;
+  blackboard->Set("door_visit", bt::Any(visit));
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
+}
+
 TEST_F(ConditionNodesTest, IsPersonHoldingDoorWantsAStillHolderBesideAnOpenLeaf) {
   bt::Tree tree = Tree(R"(<IsPersonHoldingDoor door="lab_door"/>)");
   belief_.now = At(50.0);
