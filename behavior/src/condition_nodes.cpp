@@ -95,8 +95,8 @@ class IsThroughDoor final : public TaskNode<bt::ConditionNode> {
   NodeStatus Tick() override {
     DoorVisit visit = Visit();
     if (!visit.approach_side) return NodeStatus::kFailure;
+    const DoorPass pass = CalcKnownPass(task_, visit.door, &visit);  // throws for an unknown door
     const perception::DoorModel& model = *task_.map->FindDoor(visit.door);
-    const DoorPass pass = CalcKnownPass(task_, visit.door, &visit);
     const Eigen::Vector2d offset = belief_.X_MB.translation() - pass.centre;
     const double past = -offset.dot(pass.n_M);
     const double lateral = std::abs(offset.dot(Eigen::Vector2d(-pass.n_M.y(), pass.n_M.x())));

@@ -167,6 +167,15 @@ TEST_F(ConditionNodesTest, IsHoldingPayloadReadsTheGripsBelief) {
 TEST_F(ConditionNodesTest, AnUnknownDoorIsAClearError) {
   bt::Tree tree = Tree(R"(<IsPathClear door="door_z"/>)");
   EXPECT_THROW(tree.TickOnce(), InvalidArgument);
+  // A visit to a door the map does not have (a mistyped id in a tree) is an error too, not a
+  // crash.
+  auto blackboard = bt::Blackboard::Create();
+  DoorVisit visit;
+  visit.door = "door_z";
+  visit.approach_side = Eigen::Vector2d(0.0, -1.0);
+  blackboard->Set("door_visit", bt::Any(visit));
+  bt::Tree through = Tree(R"(<IsThroughDoor door="door_z"/>)", blackboard);
+  EXPECT_THROW(through.TickOnce(), InvalidArgument);
 }
 
 }  // namespace
