@@ -172,6 +172,14 @@ Pose2 WallAlignedPose(const TaskServices& task, const MapActuator& actuator,
   return corrected;
 }
 
+// The actuator nodes' `to_pass` port (ActuatorAction::PressWaitsUntil).
+std::pair<std::string, bt::PortInfo> ToPassPort() {
+  return InputPort<bool>("to_pass", true,
+                         "the robot operates the door to pass it itself: a press that would only "
+                         "restart a hold window too short to line up and pass waits for the door "
+                         "to close; false to hold it open for others (EvacuationEscort)");
+}
+
 // Presses (push button) or waves (proximity plate): one arm motion, RUNNING until it ends.
 class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
  public:
@@ -187,6 +195,7 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
     plan_ = *visit.button_plan;
     alignments_ = 0;
     arm_started_ = false;
+    waiting_out_ = false;
     gate_.Reset();
     return AlignOrOperate();
   }
@@ -206,7 +215,12 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
     // A press (or wave) restarts the operator's hold window of an open door — from the moment
     // the hand reached the actuator, not from now: the stroke and the way back take another
     // second or more, and a window timed from here would end that much before the robot thinks.
-    if (DoorVisit visit = Visit(); belief_.door_open_since.count(Door()) > 0 && visit.operated_at) {
+    // Unless the door was last seen closed when the arm set off, it is taken to have been open:
+    // from the actuator the leaf is often out of view, and a restarted window is the shorter one
+    // (a door held open when the estimate last read it opening closed 10 s after a second press,
+    // not 14).
+    if (DoorVisit visit = Visit();
+        (belief_.door_open_since.count(Door()) > 0 || !closed_before_press_) && visit.operated_at) {
       visit.window_restarted_at = visit.operated_at;
       Remember(visit);
     }
@@ -222,6 +236,16 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
   // The base squares up to the planned standoff (by the laser's wall distance) first, then the
   // arm presses or waves.
   NodeStatus AlignOrOperate() {
+    if (const auto until = PressWaitsUntil(); until && belief_.now < *until) {
+      if (!waiting_out_) {
+        Note(
+            StrCat("the door may still stand open from the last press, and a press now would "
+                   "restart a hold window too short to line up and pass: waiting ",
+                   std::round(ToSeconds(*until - belief_.now) * 10) / 10, " s for it to close"));
+      }
+      waiting_out_ = true;
+      return NodeStatus::kRunning;
+    }
     if (gate_.Check(task_, "operating the actuator", EventNoter()) == NodeStatus::kRunning)
       return NodeStatus::kRunning;
     const ButtonPlan& plan = plan_;
@@ -249,6 +273,9 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
     visit.operated_at = belief_.now + SecondsToDuration(task_.config.press_reach_time);
     visit.window_restarted_at.reset();  // an earlier press's restart says nothing of this one
     Remember(visit);
+    const perception::TrackedDoor* door = FindTrackedDoor(belief_.world, Door());
+    closed_before_press_ = waiting_out_ || door == nullptr || !door->state.observed ||
+                           door->state.motion == perception::DoorMotion::kClosed;
     const auto approach = SolveArm(task_, X_MB, plan.targets.approach, plan.approach_arm, push);
     if (!approach) {
       Note("the actuator is out of the arm's reach from here");
@@ -283,10 +310,45 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
     return NodeStatus::kRunning;
   }
 
+  // A press restarts an open door's hold window (it ends a window after the press), where a press
+  // on a shut door has the opening time as well. When the opening of the robot's own last press
+  // may not be over (the door not seen shut since) and a restarted window would not leave time to
+  // finish the stroke, line up and drive clear of the leaf, the press waits until that opening
+  // has surely ended; nullopt: no need to wait.
+  std::optional<Time> PressWaitsUntil() const {
+    const DoorVisit visit = Visit();
+    if (!visit.operated_at || !Input<bool>("to_pass")) return std::nullopt;
+    const perception::TrackedDoor* door = FindTrackedDoor(belief_.world, Door());
+    if (door != nullptr && door->state.motion == perception::DoorMotion::kClosed &&
+        door->state.stamp > *visit.operated_at) {
+      return std::nullopt;
+    }
+    const TaskConfig& c = task_.config;
+    const auto& trajectory = task_.motion->trajectory_config();
+    const DoorPass pass = CalcKnownPass(task_, Door(), &visit);
+    const double entry_distance = EntryDistance(task_, Door(), pass);
+    const Eigen::Vector2d entry = pass.centre + pass.n_M * entry_distance;
+    constexpr double kSettleSec = 1.0;  // the line-up's stop before the pass, with a margin
+    const double after_hand =
+        type_ == planning::ButtonType::kPushButton ? 2 * c.press_time : c.wave_hold_time;
+    const double needed =
+        after_hand +
+        planning::SegmentDuration((entry - plan_.X_MB_standoff.translation()).norm(), true,
+                                  trajectory) +
+        kSettleSec + (entry_distance + ExitDistance(task_, Door())) / trajectory.door_speed;
+    if (needed <= c.door_hold_window) return std::nullopt;
+    const Time window_from = visit.window_restarted_at
+                                 ? *visit.window_restarted_at
+                                 : *visit.operated_at + SecondsToDuration(kOperatorOpeningTime);
+    return window_from + SecondsToDuration(c.door_hold_window + kOperatorClosingTime);
+  }
+
   planning::ButtonType type_;
   ButtonPlan plan_;  // from the visit, at the start
   int alignments_{0};
   bool arm_started_{false};
+  bool closed_before_press_{true};  // the door read closed when the arm set off (Operate)
+  bool waiting_out_{false};         // waited for the last press's opening to end (PressWaitsUntil)
 };
 
 class PressButton final : public ActuatorAction {
@@ -296,7 +358,7 @@ class PressButton final : public ActuatorAction {
   static PortsList ProvidedPorts() {
     return {InputPort<std::string>(
                 "door", "door whose push button to press (fingertip past the face by the stroke)"),
-            VisitPort(bt::PortDirection::kInOut)};
+            ToPassPort(), VisitPort(bt::PortDirection::kInOut)};
   }
 };
 
@@ -308,14 +370,17 @@ class WaveAtPlate final : public ActuatorAction {
     return {
         InputPort<std::string>(
             "door", "door whose proximity plate to wave at (palm within its range, no contact)"),
-        VisitPort(bt::PortDirection::kInOut)};
+        ToPassPort(), VisitPort(bt::PortDirection::kInOut)};
   }
 };
 
 // Drives through a door in two legs: to the entry pose on the door's axis (the arm tucking on
 // the way), where the laser sees through the opening; then, once the leaf leaves room for the
 // footprint, through the doorway to the exit pose. Both legs run at the door speed: the ADA
-// hold window is short.
+// hold window is short. Coming from beside the lane to a door that opens away, the first leg
+// stops at the lane's edge until the leaf is open and the robot has looked through the opening
+// (TaskConfig::door_peek_time): whoever waited on the far side is seen setting off before the
+// robot stands in their way.
 class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
  public:
   using TaskNode::TaskNode;
@@ -349,6 +414,36 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
   NodeStatus OnRunning() override {
     const auto note = [this](const std::string& t) { Note(t); };
     switch (phase_) {
+      case Phase::kToPeek: {
+        const NodeStatus s = DriveStatus(task_, note, true);
+        if (s != NodeStatus::kSuccess) return s;
+        phase_ = Phase::kPeeking;
+        waiting_since_ = belief_.now;
+        [[fallthrough]];
+      }
+      case Phase::kPeeking: {
+        if (const NodeStatus arm = ArmMotionStatus(task_, note); arm != NodeStatus::kSuccess)
+          return arm;
+        const Eigen::Vector2d entry = pass_.centre + pass_.n_M * entry_distance_;
+        const double slide_time = planning::SegmentDuration(
+            (entry - belief_.X_MB.translation()).norm(), true, task_.motion->trajectory_config());
+        const double looked = ToSeconds(belief_.now - waiting_since_);
+        // From beside the lane the leaf is often behind the jamb: its clearance is checked
+        // again on the axis, where it is in view.
+        const DoorVisit visit = Visit();
+        const bool window_leaves_time =
+            LeafSeenNow() ? DoorPassable(task_, door_, 0.0, &visit, slide_time)
+                          : DoorWindowLeavesTime(task_, door_, &visit, slide_time);
+        if (looked < task_.config.door_peek_time || LeafOpening() || !window_leaves_time) {
+          if (looked > Input<double>("wait_timeout")) {
+            Note("the door did not open in time");
+            return NodeStatus::kFailure;
+          }
+          return NodeStatus::kRunning;
+        }
+        if (const NodeStatus s = StartLineUp(); s != NodeStatus::kRunning) return s;
+        return NodeStatus::kRunning;
+      }
       case Phase::kToEntry: {
         const NodeStatus s = DriveStatus(task_, note, true);
         if (s != NodeStatus::kSuccess) return s;
@@ -408,8 +503,28 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
  private:
   RelocalizeGate gate_;
 
-  // Drives to the entry pose on the door's axis (phase kToEntry).
+  // Drives to the entry pose on the door's axis (phase kToEntry), or first to the lane's edge
+  // (phase kToPeek, PeekPose).
   NodeStatus StartLineUp() {
+    if (const auto peek = PeekPose()) {
+      // Only when the hold window leaves time for the stop as well (a press that restarted the
+      // window of an open door leaves 10 s, about what the direct line-up and the pass take).
+      const auto& trajectory = task_.motion->trajectory_config();
+      const Eigen::Vector2d entry = pass_.centre + pass_.n_M * entry_distance_;
+      const double lead =
+          planning::SegmentDuration((peek->translation() - belief_.X_MB.translation()).norm(), true,
+                                    trajectory) +
+          task_.config.door_peek_time +
+          planning::SegmentDuration((entry - peek->translation()).norm(), true, trajectory);
+      const std::vector<Pose2> path{belief_.X_MB, *peek};
+      if (const DoorVisit visit = Visit();
+          DoorWindowLeavesTime(task_, door_, &visit, lead) && task_.planner->IsPathValid(path)) {
+        task_.motion->FollowPath(path, {true}, TuckedArm(*task_.model), belief_.now);
+        Note("to the lane's edge, to look through the door before lining up");
+        phase_ = Phase::kToPeek;
+        return NodeStatus::kRunning;
+      }
+    }
     const Eigen::Vector2d entry = pass_.centre + pass_.n_M * entry_distance_;
     const Eigen::Vector2d offset = belief_.X_MB.translation() - pass_.centre;
     // Straight when the costmap allows (the usual case), else round what is in the way.
@@ -436,6 +551,44 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     return NodeStatus::kRunning;
   }
 
+  // Where the robot stops to look through the door before lining up: on the entry line, just
+  // clear of the lane through the opening on the robot's side. Only for a door that opens away
+  // (one that opens towards the robot stands its leaf between the lane's edge and the far
+  // side) and a robot beside the lane, farther out than that.
+  std::optional<Pose2> PeekPose() const {
+    if (task_.config.door_peek_time <= 0.0) return std::nullopt;
+    const perception::DoorModel& door = *task_.map->FindDoor(door_);
+    if (pass_.n_M.dot(door.SwingSide()) > 0.0) return std::nullopt;
+    constexpr double kEdgeClearance = 0.05;  // [m] between the footprint and the lane
+    constexpr double kMinSlide = 0.15;       // [m] nearer than this, straight onto the axis
+    const Eigen::Vector2d along(-pass_.n_M.y(), pass_.n_M.x());
+    const double lateral = (belief_.X_MB.translation() - pass_.centre).dot(along);
+    const double edge = door.width() / 2 + task_.config.footprint_radius + kEdgeClearance;
+    if (std::abs(lateral) < edge + kMinSlide) return std::nullopt;
+    const Eigen::Vector2d p =
+        pass_.centre + pass_.n_M * entry_distance_ + along * std::copysign(edge, lateral);
+    return Pose2{p.x(), p.y(), yaw_};
+  }
+
+  const perception::TrackedDoor* Estimate() const { return FindTrackedDoor(belief_.world, door_); }
+  bool LeafSeenNow() const {
+    const auto* d = Estimate();
+    return d != nullptr && ToSeconds(belief_.now - d->state.stamp) <= kDoorSeenRecentlySec;
+  }
+  // The leaf may still be swinging open: it hides part of the far side, and people there wait for
+  // it. Out of view, it had the operator's opening time since the robot's own press (or since it
+  // was last seen opening).
+  bool LeafOpening() const {
+    const auto* d = Estimate();
+    if (d == nullptr) return false;
+    const DoorVisit visit = Visit();
+    if (LeafSeenNow()) return d->state.motion == perception::DoorMotion::kOpening;
+    if (visit.operated_at)
+      return ToSeconds(belief_.now - *visit.operated_at) < kOperatorOpeningTime;
+    return d->state.motion == perception::DoorMotion::kOpening &&
+           ToSeconds(belief_.now - d->state.stamp) < kOperatorOpeningTime;
+  }
+
   Eigen::Vector2d ClearOpeningCentre() const {
     const perception::DoorModel& door = *task_.map->FindDoor(door_);
     double angle = M_PI / 2;
@@ -449,7 +602,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     return door.p_MHinge + along * (clear_from + w) / 2;
   }
 
-  enum class Phase { kToEntry, kWaiting, kThrough };
+  enum class Phase { kToPeek, kPeeking, kToEntry, kWaiting, kThrough };
   std::string door_;
   DoorPass pass_;
   double entry_distance_{0.0};

@@ -116,6 +116,14 @@ std::optional<double> DoorClearance(const TaskServices& task, const std::string&
 
 namespace detail {
 
+const perception::TrackedDoor* FindTrackedDoor(const perception::WorldState& world,
+                                               const std::string& door) {
+  for (const auto& d : world.doors) {
+    if (d.model.id == door) return &d;
+  }
+  return nullptr;
+}
+
 // Far enough past the door line that the closing leaf cannot reach the footprint.
 double ExitDistance(const TaskServices& task, const std::string& door) {
   const double w = task.map->FindDoor(door)->width();
@@ -135,11 +143,9 @@ double EntryDistance(const TaskServices& task, const std::string& door, const Do
 
 using namespace detail;
 
-bool DoorPassable(const TaskServices& task, const std::string& door, double margin,
-                  const DoorVisit* visit) {
+bool DoorWindowLeavesTime(const TaskServices& task, const std::string& door, const DoorVisit* visit,
+                          double lead_time) {
   if (visit != nullptr && visit->door != door) visit = nullptr;
-  const auto clearance = DoorClearance(task, door);
-  if (!clearance || *clearance < 2 * task.config.footprint_radius + margin) return false;
   bool held_by_person = false;
   for (const auto& entry : task.belief->world.people) {
     held_by_person = held_by_person || IsHoldingDoorAside(task, entry, door);
@@ -207,9 +213,16 @@ bool DoorPassable(const TaskServices& task, const std::string& door, double marg
           std::atan2(task.config.footprint_radius + kLeafClearance, std::max(lane_edge, 1e-3));
       grace = std::max(0.0, d.state.angle - hit_angle) / kOperatorMaxClosingRate;
     }
-    if (open_for + needed > window + grace) return false;
+    if (open_for + lead_time + needed > window + grace) return false;
   }
   return true;
+}
+
+bool DoorPassable(const TaskServices& task, const std::string& door, double margin,
+                  const DoorVisit* visit, double lead_time) {
+  const auto clearance = DoorClearance(task, door);
+  if (!clearance || *clearance < 2 * task.config.footprint_radius + margin) return false;
+  return DoorWindowLeavesTime(task, door, visit, lead_time);
 }
 
 }  // namespace egress::behavior

@@ -38,6 +38,9 @@ inline constexpr double kOperatorOpeningTime = 4.0;
 // [rad/s] The fastest a low-energy operator may close its door (A156.19: no less than 3 s from
 // 90° to 10°).
 inline constexpr double kOperatorMaxClosingRate = (80.0 * M_PI / 180.0) / 3.0;
+// [s] From the end of its hold to latched, about: A156.19 allows no less than 3 s from 90° to 10°,
+// then the latch check (the twin's operator: 3.5 s + 1.5 s).
+inline constexpr double kOperatorClosingTime = 5.0;
 
 bool ArmAt(const ArmPose& a, const ArmPose& b);
 /// "x, y" rounded to centimetres: for notes people read.
@@ -150,6 +153,9 @@ std::optional<std::vector<ArmPose>> SolveArmLine(const TaskServices& task, const
                                                  const planning::IkTarget& from_target,
                                                  const planning::IkTarget& to_target,
                                                  const ArmPose& from, bool fingertip, int steps);
+/// The belief's estimate of `door`, or nullptr if the world model has none.
+const perception::TrackedDoor* FindTrackedDoor(const perception::WorldState& world,
+                                               const std::string& door);
 /// Far enough past the door line that the closing leaf cannot reach the footprint [m].
 double ExitDistance(const TaskServices& task, const std::string& door);
 /// How far before the door line the robot lines up and waits [m].

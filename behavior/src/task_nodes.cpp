@@ -13,6 +13,8 @@ void TaskConfig::Validate() const {
               "TaskConfig: distances must be positive");
   ThrowUnless(arm_tuck_time > 0 && press_reach_time > 0 && press_time > 0 && wave_hold_time >= 0,
               "TaskConfig: motion times must be positive");
+  ThrowUnless(std::isfinite(door_peek_time) && door_peek_time >= 0,
+              "TaskConfig: door_peek_time must be >= 0 (s)");
   ThrowUnless(right_of_way_radius >= 0 && right_of_way_time >= 0,
               "TaskConfig: right_of_way_radius and right_of_way_time must be >= 0");
   ThrowUnless(std::isfinite(comfort_distance) && comfort_distance >= 0,

@@ -39,9 +39,22 @@ void PerceptionPipeline::ProcessCameraFrame(const std::vector<Detection2D>& dete
     }
     auto p_MO =
         PlaceDetection(detection, detection_image, depth, intrinsics, X_MC, config_.placement);
-    // No depth under a person (seen through glass): by the box's height instead.
-    if (!p_MO && detection.label == labels::kPerson)
-      p_MO = PlacePersonBySize(detection, detection_image, intrinsics, X_MC, kPersonHeightM);
+    // No depth under a person (seen through glass): by the box's height instead. Depth far
+    // nearer than the box's height says is something in front of them (a door leaf they stand
+    // behind, seen past its edge): by the height too. The margins keep a seated person (a
+    // wheelchair user is ~1.3 m tall: 1.3x farther by height) placed by depth.
+    if (detection.label == labels::kPerson) {
+      const auto by_size =
+          PlacePersonBySize(detection, detection_image, intrinsics, X_MC, kPersonHeightM);
+      constexpr double kOccluderRatio = 1.5, kOccluderGapM = 0.75;
+      const auto range = [&](const Eigen::Vector3d& p) {
+        return (p - X_MC.translation()).head<2>().norm();
+      };
+      if (!p_MO || (by_size && range(*by_size) > kOccluderRatio * range(*p_MO) &&
+                    range(*by_size) - range(*p_MO) > kOccluderGapM)) {
+        p_MO = by_size;
+      }
+    }
     if (!p_MO) continue;
     if (detection.label == labels::kPerson) {
       people.push_back(p_MO->head<2>());

@@ -7,7 +7,33 @@ namespace {
 
 using bt::NodeStatus;
 using node_testing::At;
-using DoorNodesTest = node_testing::TaskNodeFixture;
+
+class DoorNodesTest : public node_testing::TaskNodeFixture {
+ protected:
+  // ApproachButton from (0, 1) puts its plan in the visit on `blackboard` (with `operated_at`, an
+  // earlier press, if given); the leaf is last seen at `seen_at` [s], at `angle_deg` and
+  // `motion`, and not since (from beside the actuator it is behind the jamb); then the robot
+  // stands at the standoff. Returns the visit.
+  DoorVisit StandAtTheStandoff(const bt::Blackboard::Ptr& blackboard,
+                               std::optional<Time> operated_at, double seen_at, double angle_deg,
+                               perception::DoorMotion motion) {
+    bt::Tree approach = Tree(R"(<ApproachButton door="lab_door"/>)", blackboard);
+    belief_.X_MB = {0.0, 1.0, M_PI / 2};
+    belief_.now = At(1.0);
+    belief_.door_open_since.clear();
+    EXPECT_EQ(approach.TickOnce(), NodeStatus::kRunning);
+    DoorVisit visit = *blackboard->Get<DoorVisit>("door_visit");
+    visit.operated_at = operated_at;
+    blackboard->Set("door_visit", bt::Any(visit));
+    belief_.now = At(seen_at);
+    DoorSeenOpen(angle_deg, 0.0);
+    belief_.door_open_since.clear();
+    belief_.world.doors[0].state.motion = motion;
+    belief_.X_MB = visit.button_plan->X_MB_standoff;
+    motion_.StopBase();
+    return visit;
+  }
+};
 
 TEST_F(DoorNodesTest, ButtonTypeWritesTheActuatorKindOfThisSide) {
   auto blackboard = bt::Blackboard::Create();
@@ -76,7 +102,159 @@ TEST_F(DoorNodesTest, APressRecordsWhenTheHandReachesTheButtonAndForgetsAnEarlie
   EXPECT_TRUE(after.button_plan.has_value());  // the plan stays with the visit
 }
 
+TEST_F(DoorNodesTest, APressOnADoorNotSeenClosedRestartsItsWindowFromTheHandsArrival) {
+  for (const bool closed : {true, false}) {
+    auto blackboard = bt::Blackboard::Create();
+    // The leaf last seen closed, or still opening after someone's press.
+    StandAtTheStandoff(blackboard, std::nullopt, 1.0, closed ? 0.0 : 55.0,
+                       closed ? perception::DoorMotion::kClosed : perception::DoorMotion::kOpening);
+    belief_.now = At(20.0);
+    bt::Tree press = Tree(R"(<PressButton door="lab_door"/>)", blackboard);
+    ASSERT_EQ(press.TickOnce(), NodeStatus::kRunning);
+    // The arm's stroke ends long after (the clock: no joint measurements here).
+    belief_.now = At(40.0);
+    ASSERT_EQ(press.TickOnce(), NodeStatus::kSuccess);
+    const DoorVisit after = *blackboard->Get<DoorVisit>("door_visit");
+    ASSERT_TRUE(after.operated_at.has_value());
+    if (closed) {
+      EXPECT_FALSE(after.window_restarted_at.has_value()) << "a fresh opening: its own timing";
+    } else {
+      ASSERT_TRUE(after.window_restarted_at.has_value()) << "an open door's window restarts";
+      EXPECT_EQ(*after.window_restarted_at, *after.operated_at);
+    }
+  }
+}
+
+TEST_F(DoorNodesTest, APressWaitsOutItsOwnLastOpeningWhenARestartedWindowIsTooShort) {
+  enum class Case { kToPass, kSeenShut, kHoldingForOthers };
+  for (const Case c : {Case::kToPass, Case::kSeenShut, Case::kHoldingForOthers}) {
+    const bool seen_shut = c == Case::kSeenShut;
+    auto blackboard = bt::Blackboard::Create();
+    // The robot's first press (hand at the button at 1 s); the leaf last seen opening at 3 s,
+    // or seen shut again at 18 s.
+    StandAtTheStandoff(
+        blackboard, At(1.0), seen_shut ? 18.0 : 3.0, seen_shut ? 0.0 : 50.0,
+        seen_shut ? perception::DoorMotion::kClosed : perception::DoorMotion::kOpening);
+    belief_.now = At(19.0);
+    bt::Tree press =
+        Tree(c == Case::kHoldingForOthers ? R"(<PressButton door="lab_door" to_pass="false"/>)"
+                                          : R"(<PressButton door="lab_door"/>)",
+             blackboard);
+    EXPECT_EQ(press.TickOnce(), NodeStatus::kRunning);
+    if (c != Case::kToPass) {
+      // Seen shut since, or pressing to keep the door open for others: at once.
+      EXPECT_TRUE(motion_.arm_moving(belief_.now));
+      continue;
+    }
+    // Lab door: 2 s of stroke, 2.9 s of line-up, 1 s to settle and 5 s to drive clear of the
+    // leaf do not fit a restarted 10 s window: it waits until the first opening's window (from
+    // 1 + 4 s) and the close (5 s) are over, at 20 s.
+    EXPECT_FALSE(motion_.arm_moving(belief_.now));
+    EXPECT_TRUE(NotedText("waiting"));
+    belief_.now = At(19.9);
+    EXPECT_EQ(press.TickOnce(), NodeStatus::kRunning);
+    EXPECT_FALSE(motion_.arm_moving(belief_.now));
+    belief_.now = At(20.1);
+    EXPECT_EQ(press.TickOnce(), NodeStatus::kRunning);
+    ASSERT_TRUE(motion_.arm_moving(belief_.now)) << "the opening is over: pressing";
+    belief_.now = At(40.0);
+    ASSERT_EQ(press.TickOnce(), NodeStatus::kSuccess);
+    // Waited out: a press on a shut door, timed with its opening.
+    EXPECT_FALSE(blackboard->Get<DoorVisit>("door_visit")->window_restarted_at.has_value());
+  }
+}
+
+TEST_F(DoorNodesTest, TraverseDoorFromBesideTheLaneLooksThroughTheOpeningFromItsEdgeFirst) {
+  auto blackboard = bt::Blackboard::Create();
+  DoorVisit visit;
+  visit.door = "lab_door";
+  visit.operated_at = At(0.0);  // the robot's own press: the window leaves time for the stop
+  blackboard->Set("door_visit", bt::Any(visit));
+  bt::Tree tree = Tree(R"(<TraverseDoor door="lab_door"/>)", blackboard);
+  belief_.X_MB = {1.15, 2.43, M_PI / 2};  // the button's standoff, beside the lane
+  DoorSeenOpen(40.0, 0.0);
+  belief_.world.doors[0].state.motion = perception::DoorMotion::kOpening;
+  belief_.door_open_since.clear();
+  belief_.now = At(1.0);
+  ASSERT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  ASSERT_GE(motion_.path().size(), 2u);
+  // First to the lane's edge on the entry line: half the opening, the footprint and 5 cm out.
+  const Pose2 edge = motion_.path().back();
+  EXPECT_NEAR(edge.x, 0.475 + services_.config.footprint_radius + 0.05, 1e-6);
+  EXPECT_NEAR(edge.y, 3.0 - services_.config.door_entry_distance, 1e-6);
+  EXPECT_NEAR(edge.yaw, M_PI / 2, 1e-6);
+  EXPECT_TRUE(NotedText("look through the door"));
+  // There, it waits while the leaf still opens (seen now).
+  motion_.StopBase();
+  belief_.X_MB = edge;
+  belief_.now = At(3.0);
+  DoorSeenOpen(70.0, 0.0);
+  belief_.world.doors[0].state.motion = perception::DoorMotion::kOpening;
+  belief_.door_open_since.clear();
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  belief_.now = At(4.0);
+  belief_.world.doors[0].state.stamp = belief_.now;
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_FALSE(motion_.base_moving()) << "the leaf still opens: looking";
+  // Open and steady: after door_peek_time of looking, onto the axis.
+  belief_.now = At(4.6);
+  DoorSeenOpen(80.0, 0.5);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  ASSERT_TRUE(motion_.base_moving());
+  EXPECT_NEAR(motion_.path().back().x, 0.0, 1e-6);
+  EXPECT_NEAR(motion_.path().back().y, edge.y, 1e-6);
+}
+
+TEST_F(DoorNodesTest, TraverseDoorOutOfViewOfTheLeafGivesItTheOperatorsOpeningTime) {
+  auto blackboard = bt::Blackboard::Create();
+  DoorVisit visit;
+  visit.door = "lab_door";
+  visit.operated_at = At(0.0);
+  blackboard->Set("door_visit", bt::Any(visit));
+  bt::Tree tree = Tree(R"(<TraverseDoor door="lab_door"/>)", blackboard);
+  belief_.X_MB = {1.15, 2.43, M_PI / 2};
+  DoorSeenOpen(40.0, 0.0);  // last seen opening at 1 s, then behind the jamb
+  belief_.world.doors[0].state.motion = perception::DoorMotion::kOpening;
+  belief_.world.doors[0].state.clearance_width = 0.3;  // too narrow when last seen
+  belief_.door_open_since.clear();
+  belief_.now = At(1.0);
+  belief_.world.doors[0].state.stamp = belief_.now;
+  ASSERT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  const Pose2 edge = motion_.path().back();
+  motion_.StopBase();
+  belief_.X_MB = edge;
+  belief_.now = At(3.5);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_FALSE(motion_.base_moving()) << "3.5 s after the press the leaf may still be opening";
+  belief_.now = At(4.5);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  ASSERT_TRUE(motion_.base_moving()) << "the operator's opening time is over: onto the axis";
+  EXPECT_NEAR(motion_.path().back().x, 0.0, 1e-6);
+}
+
+TEST_F(DoorNodesTest, TraverseDoorLinesUpStraightWhenTheWindowLeavesNoTimeToLook) {
+  for (const bool restarted : {false, true}) {
+    auto blackboard = bt::Blackboard::Create();
+    DoorVisit visit;
+    visit.door = "lab_door";
+    visit.operated_at = At(0.0);
+    // A press that found the door open: 10 s from the press, not the opening time more.
+    if (restarted) visit.window_restarted_at = visit.operated_at;
+    blackboard->Set("door_visit", bt::Any(visit));
+    bt::Tree tree = Tree(R"(<TraverseDoor door="lab_door"/>)", blackboard);
+    belief_.X_MB = {1.15, 2.43, M_PI / 2};
+    belief_.now = At(2.0);
+    DoorSeenOpen(80.0, 0.0);
+    belief_.door_open_since.clear();
+    motion_.StopBase();
+    ASSERT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+    ASSERT_GE(motion_.path().size(), 2u);
+    EXPECT_NEAR(motion_.path().back().x, restarted ? 0.0 : 0.74, 1e-6) << restarted;
+  }
+}
+
 TEST_F(DoorNodesTest, TraverseDoorLinesUpOnTheDoorsAxisBeforeGoing) {
+  services_.config.door_peek_time = 0.0;  // no stop at the lane's edge
   bt::Tree tree = Tree(R"(<TraverseDoor door="lab_door"/>)");
   belief_.X_MB = {1.0, 2.2, M_PI / 2};  // beside the axis, before the door
   belief_.now = At(1.0);

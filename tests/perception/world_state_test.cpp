@@ -56,6 +56,36 @@ TEST(PerceptionPipelineTest, BuildsTheWorldState) {
   EXPECT_EQ(world.door_zone_forecast.at("lab").size(), 5u);
 }
 
+// A person's box whose depth is far nearer than its height says (they stand behind a door leaf,
+// seen past its edge: the depth under the box is the leaf's) is placed by its height; where the
+// depth agrees with the height, or is only as much nearer as a seated person's box, by depth.
+TEST(PerceptionPipelineTest, APersonSeenPastSomethingNearerIsPlacedByTheBoxsHeight) {
+  const CameraIntrinsics K = CameraIntrinsics::FromHorizontalFov(80, 60, 1.047);
+  // At (0, 0), 1 m up, looking along +x.
+  const Pose3 X_MC =
+      Pose3::FromXyzRpy({0.0, 0.0, 1.0}, {-std::numbers::pi / 2, 0.0, -std::numbers::pi / 2});
+  // A 1.7 m person 4 m away, feet on the floor: rows 143-379 of a 640 x 480 detection image.
+  const double fy = K.fy * 8;  // detection pixels
+  const double v_top = 240 - fy * 0.7 / 4.0, v_bottom = 240 + fy * 1.0 / 4.0;
+  for (const auto& [depth_m, expected_x] :
+       std::vector<std::pair<float, double>>{{1.5f, 4.0}, {3.9f, 3.9}, {3.1f, 3.1}}) {
+    PerceptionPipeline pipeline({});
+    DepthImage depth;
+    depth.width = 80;
+    depth.height = 60;
+    depth.depth.assign(80 * 60, depth_m);
+    for (int frame = 0; frame < 4; ++frame) {
+      depth.stamp = milliseconds(125 * frame);
+      pipeline.ProcessCameraFrame({{"person", 0.9, {300, v_top, 340, v_bottom}, depth.stamp}},
+                                  {640, 480}, depth, K, X_MC);
+    }
+    const WorldState world =
+        pipeline.Snapshot(milliseconds(375), {-1.0, 0.0, 0.0}, Eigen::Matrix3d::Identity() * 1e-4);
+    ASSERT_EQ(world.people.size(), 1u) << depth_m;
+    EXPECT_NEAR(world.people[0].person.p_MP.x(), expected_x, 0.1) << depth_m;
+  }
+}
+
 // With laser_people, someone beside the robot (where the camera is not looking) walking across
 // the room becomes one of the snapshot's people, and is forecast into the doorway it heads for;
 // without it, the camera-only pipeline does not know of them.

@@ -49,9 +49,16 @@ bool IsDoorZoneClearFor(const TaskServices& task, const std::string& door, doubl
 /// it was first seen open; `visit` holds the robot's own press) leaves time to drive clear of the
 /// leaf: past the line for a leaf that opens towards the robot (which then still has the time the
 /// closing leaf takes to reach its lane), beyond the sweep on the far side otherwise. Needs
-/// `task.motion` (door speed).
+/// `task.motion` (door speed). `lead_time` [s]: how long before the robot can start driving clear
+/// (a line-up still to come); it is spent out of the same window.
 bool DoorPassable(const TaskServices& task, const std::string& door, double margin,
-                  const DoorVisit* visit);
+                  const DoorVisit* visit, double lead_time = 0.0);
+/// DoorPassable without the clearance check: only whether the hold window (and the leaf not
+/// closing) leaves time to drive clear after `lead_time` [s]. For a robot that cannot see the
+/// leaf from where it waits (beside the lane, behind the jamb), which checks the clearance once it
+/// can.
+bool DoorWindowLeavesTime(const TaskServices& task, const std::string& door, const DoorVisit* visit,
+                          double lead_time);
 /// Clearance of the door's opening from the latest estimate, or nullopt if never observed.
 std::optional<double> DoorClearance(const TaskServices& task, const std::string& door);
 

@@ -29,6 +29,13 @@ struct TaskConfig {
   double door_entry_distance{0.7};  ///< Entry pose this far before the door line [m].
   double door_exit_distance{1.0};   ///< Exit pose at least this far past the door line [m]
                                     ///< (and beyond the leaf's sweep).
+  /// Coming to a door that opens away from it from beside its lane (a button's standoff, from
+  /// where the wall and the opening leaf hide the far side), the robot first stops at the lane's
+  /// edge on the entry line, looking through the opening, until the leaf has stopped opening and
+  /// it has looked this long; only then does it slide onto the axis. People waiting for the door
+  /// on the far side set off as it opens, and a robot already in the lane meets them there. 0:
+  /// straight onto the axis [s].
+  double door_peek_time{0.5};
   /// How long an ADA operator holds its door open (the paper's ~10 s auto-close window): a held
   /// door is passed only if the robot can clear the leaf's sweep within it [s].
   double door_hold_window{10.0};
