@@ -424,7 +424,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
       case Phase::kPeeking: {
         if (const NodeStatus arm = ArmMotionStatus(task_, note); arm != NodeStatus::kSuccess)
           return arm;
-        const Eigen::Vector2d entry = pass_.centre + pass_.n_M * entry_distance_;
+        const Eigen::Vector2d entry = EntryPoint();
         const double slide_time = planning::SegmentDuration(
             (entry - belief_.X_MB.translation()).norm(), true, task_.motion->trajectory_config());
         const double looked = ToSeconds(belief_.now - waiting_since_);
@@ -510,7 +510,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
       // Only when the hold window leaves time for the stop as well (a press that restarted the
       // window of an open door leaves 10 s, about what the direct line-up and the pass take).
       const auto& trajectory = task_.motion->trajectory_config();
-      const Eigen::Vector2d entry = pass_.centre + pass_.n_M * entry_distance_;
+      const Eigen::Vector2d entry = EntryPoint();
       const double lead =
           planning::SegmentDuration((peek->translation() - belief_.X_MB.translation()).norm(), true,
                                     trajectory) +
@@ -525,7 +525,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
         return NodeStatus::kRunning;
       }
     }
-    const Eigen::Vector2d entry = pass_.centre + pass_.n_M * entry_distance_;
+    const Eigen::Vector2d entry = EntryPoint();
     const Eigen::Vector2d offset = belief_.X_MB.translation() - pass_.centre;
     // Straight when the costmap allows (the usual case), else round what is in the way.
     const Pose2 X_MB_entry{entry.x(), entry.y(), yaw_};
@@ -565,10 +565,12 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     const double lateral = (belief_.X_MB.translation() - pass_.centre).dot(along);
     const double edge = door.width() / 2 + task_.config.footprint_radius + kEdgeClearance;
     if (std::abs(lateral) < edge + kMinSlide) return std::nullopt;
-    const Eigen::Vector2d p =
-        pass_.centre + pass_.n_M * entry_distance_ + along * std::copysign(edge, lateral);
+    const Eigen::Vector2d p = EntryPoint() + along * std::copysign(edge, lateral);
     return Pose2{p.x(), p.y(), yaw_};
   }
+
+  // The entry pose's position: on the door's axis, entry_distance_ before the door line.
+  Eigen::Vector2d EntryPoint() const { return pass_.centre + pass_.n_M * entry_distance_; }
 
   const perception::TrackedDoor* Estimate() const { return FindTrackedDoor(belief_.world, door_); }
   bool LeafSeenNow() const {
