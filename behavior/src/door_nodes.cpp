@@ -208,6 +208,14 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
       if (task_.motion->base_moving()) return NodeStatus::kRunning;
       return AlignOrOperate();
     }
+    // Seen shut after the arm set off (a closing leaf that closed during the stroke): this press
+    // opens the door afresh, it restarts no window (H1 seed 2006: timed as a restart, the window
+    // ended 0.8 s before the real one, and the robot waited at the open door until it shut).
+    if (const perception::TrackedDoor* door = FindTrackedDoor(belief_.world, Door());
+        door != nullptr && door->state.observed && door->state.stamp >= arm_set_off_ &&
+        door->state.motion == perception::DoorMotion::kClosed) {
+      shut_since_set_off_ = true;
+    }
     if (const NodeStatus arm = ArmMotionStatus(task_, [this](const std::string& t) { Note(t); });
         arm != NodeStatus::kSuccess) {
       return arm;
@@ -220,6 +228,7 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
     // (a door held open when the estimate last read it opening closed 10 s after a second press,
     // not 14).
     if (DoorVisit visit = Visit();
+        !shut_since_set_off_ &&
         (belief_.door_open_since.count(Door()) > 0 || !closed_before_press_) && visit.operated_at) {
       visit.window_restarted_at = visit.operated_at;
       Remember(visit);
@@ -236,6 +245,12 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
   // The base squares up to the planned standoff (by the laser's wall distance) first, then the
   // arm presses or waves.
   NodeStatus AlignOrOperate() {
+    if (OwnOpeningLeavesTimeToPass()) {
+      Note(
+          "the door is opening from the robot's own press, and its window leaves time to line up "
+          "and pass: not pressing again");
+      return NodeStatus::kSuccess;
+    }
     if (const auto until = PressWaitsUntil(); until && belief_.now < *until) {
       if (!waiting_out_) {
         Note(
@@ -276,6 +291,8 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
     const perception::TrackedDoor* door = FindTrackedDoor(belief_.world, Door());
     closed_before_press_ = waiting_out_ || door == nullptr || !door->state.observed ||
                            door->state.motion == perception::DoorMotion::kClosed;
+    arm_set_off_ = belief_.now;
+    shut_since_set_off_ = false;
     const auto approach = SolveArm(task_, X_MB, plan.targets.approach, plan.approach_arm, push);
     if (!approach) {
       Note("the actuator is out of the arm's reach from here");
@@ -324,18 +341,12 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
       return std::nullopt;
     }
     const TaskConfig& c = task_.config;
-    const auto& trajectory = task_.motion->trajectory_config();
     const DoorPass pass = CalcKnownPass(task_, Door(), &visit);
-    const double entry_distance = EntryDistance(task_, Door(), pass);
-    const Eigen::Vector2d entry = pass.centre + pass.n_M * entry_distance;
-    constexpr double kSettleSec = 1.0;  // the line-up's stop before the pass, with a margin
     const double after_hand =
         type_ == planning::ButtonType::kPushButton ? 2 * c.press_time : c.wave_hold_time;
-    const double needed =
-        after_hand +
-        planning::SegmentDuration((entry - plan_.X_MB_standoff.translation()).norm(), true,
-                                  trajectory) +
-        kSettleSec + (entry_distance + ExitDistance(task_, Door())) / trajectory.door_speed;
+    const double needed = after_hand + LineUpTime(visit) +
+                          (EntryDistance(task_, Door(), pass) + ExitDistance(task_, Door())) /
+                              task_.motion->trajectory_config().door_speed;
     if (needed <= c.door_hold_window) return std::nullopt;
     const Time window_from = visit.window_restarted_at
                                  ? *visit.window_restarted_at
@@ -343,11 +354,44 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
     return window_from + SecondsToDuration(c.door_hold_window + kOperatorClosingTime);
   }
 
+  // From the standoff to the entry pose on the door's axis, and the stop there with a margin [s].
+  double LineUpTime(const DoorVisit& visit) const {
+    const DoorPass pass = CalcKnownPass(task_, Door(), &visit);
+    const Eigen::Vector2d entry = pass.centre + pass.n_M * EntryDistance(task_, Door(), pass);
+    constexpr double kSettleSec = 1.0;
+    return planning::SegmentDuration((entry - plan_.X_MB_standoff.translation()).norm(), true,
+                                     task_.motion->trajectory_config()) +
+           kSettleSec;
+  }
+
+  // The robot operated this door moments ago (a hold's last press, before the traversal), the
+  // door has been seen opening or open since, and that opening's window still leaves time to line
+  // up and drive clear: a press now would only restart the window (or, too short, wait it out).
+  bool OwnOpeningLeavesTimeToPass() const {
+    const DoorVisit visit = Visit();
+    if (!visit.operated_at || !Input<bool>("to_pass") ||
+        ToSeconds(belief_.now - *visit.operated_at) >
+            kOperatorOpeningTime + task_.config.door_hold_window) {
+      return false;
+    }
+    const perception::TrackedDoor* door = FindTrackedDoor(belief_.world, Door());
+    if (door == nullptr || !door->state.observed || door->state.stamp <= *visit.operated_at)
+      return false;
+    const auto motion = door->state.motion;
+    if (motion != perception::DoorMotion::kOpening && motion != perception::DoorMotion::kOpen &&
+        motion != perception::DoorMotion::kHeldOpen) {
+      return false;
+    }
+    return DoorWindowLeavesTime(task_, Door(), &visit, LineUpTime(visit));
+  }
+
   planning::ButtonType type_;
   ButtonPlan plan_;  // from the visit, at the start
   int alignments_{0};
   bool arm_started_{false};
   bool closed_before_press_{true};  // the door read closed when the arm set off (Operate)
+  Time arm_set_off_{};              // when the arm set off to press or wave (Operate)
+  bool shut_since_set_off_{false};  // the door read closed (a fresh estimate) since then
   bool waiting_out_{false};         // waited for the last press's opening to end (PressWaitsUntil)
 };
 

@@ -10,6 +10,7 @@
 #include <optional>
 #include <vector>
 
+#include "egress/behavior/head_gaze.h"
 #include "egress/perception/door_estimation.h"
 
 namespace egress::behavior::detail {
@@ -19,12 +20,20 @@ namespace {
 constexpr double kLookOutM = 2.0;
 // [rad] Facing the people's way in within this, the robot does not turn again.
 constexpr double kFacingToleranceRad = 20.0 * M_PI / 180.0;
+// [rad] Waiting, the robot turns only as far as brings the people's way in within this of
+// ahead: the laser (270 deg) sees it with 45 deg to spare and the head turns the camera to it,
+// while the turn from the actuator and back stays short.
+constexpr double kWatchWithinRad = M_PI / 2;
 // [m] A person on the far side of the door line by more than this is through.
 constexpr double kThroughM = 0.3;
 // [m] The robot this near its wait spot is there.
 constexpr double kAtSpotM = 0.15;
+// [s] The head's look at the residents' way in lasts this long unless renewed (each tick).
+constexpr double kLookRequestSec = 0.5;
 // [m/s] A tracked person faster than this is on the move.
 constexpr double kMovingMps = 0.2;
+// [m] A tracked person this far from where they last stood (and on the move) walked off.
+constexpr double kWalkedOffM = 0.3;
 // [s] Still this long after people came, those left near the door are waiting for it.
 constexpr double kStillForSec = 4.0;
 // [m] The robot goes to its wait spot only with nobody this near it (or the way there).
@@ -53,10 +62,10 @@ constexpr double kRoomHorizonStepSec = 0.2;
 constexpr double kRoomGainM = 0.1;
 
 // Who is near a door on the robot's side (or in its doorway), and whether anyone there is on
-// the move: tracked people within `watch_radius` (moving: faster than kMovingMps) and the
-// laser's returns off the map within `near_door` (moving: Belief::moving_returns). The laser
-// sees all round, the camera only ahead. (Furniture off the map near a door counts as someone
-// near: such a door is held until max_hold.)
+// the move: tracked people within `watch_radius` (moving: faster than kMovingMps and kWalkedOffM
+// from where they last stood) and the laser's returns off the map within `near_door` (moving:
+// Belief::moving_returns). The laser sees all round, the camera only ahead. (Furniture off the
+// map near a door counts as someone near: such a door is held until max_hold.)
 struct Surroundings {
   bool near{false};
   bool moving{false};
@@ -71,7 +80,10 @@ Surroundings LookAround(const Belief& belief, const DoorPass& pass, double watch
   for (const auto& entry : belief.world.people) {
     if (!this_side(entry.person.p_MP, watch_radius)) continue;
     s.near = true;
-    s.moving = s.moving || entry.person.v_MP.norm() > kMovingMps;
+    // Walking off, not a tracker's wobble: away from where they stood as well as fast.
+    const auto& person = entry.person;
+    s.moving = s.moving || (person.v_MP.norm() > kMovingMps &&
+                            (person.p_MP - person.p_MRest).norm() > kWalkedOffM);
   }
   for (const Eigen::Vector2d& p : belief.off_map_returns)
     s.near = s.near || this_side(p, near_door);
@@ -230,8 +242,21 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // ahead, and the laser's blind sector is behind (facing the wall at the actuator, it is the
     // room: office seeds 20, 24, 31, 33 — a group it did not see stood behind it, set off and
     // walked into it).
+    // Only as far as brings that way within kWatchWithinRad of ahead: at the actuator the
+    // robot faces the wall and the residents' way in is behind it; a whole turn there and back
+    // took ~5 s each way (lab: back at the button after the door had shut, as the residents set
+    // off). The head looks the rest of the way.
     {
-      const double yaw = LookYaw(pass, belief_.X_MB.translation());
+      const double look = LookYaw(pass, belief_.X_MB.translation());
+      const double off = std::remainder(look - belief_.X_MB.yaw, 2 * M_PI);
+      const double yaw = std::abs(off) <= kWatchWithinRad
+                             ? belief_.X_MB.yaw
+                             : belief_.X_MB.yaw + off - std::copysign(kWatchWithinRad, off);
+      if (task_.gaze != nullptr) {
+        const Eigen::Vector2d p = pass.centre + pass.n_M * kLookOutM;
+        task_.gaze->RequestLook({p.x(), p.y(), belief_.X_MC.translation().z()},
+                                belief_.now + SecondsToDuration(kLookRequestSec));
+      }
       if (std::abs(std::remainder(yaw - belief_.X_MB.yaw, 2 * M_PI)) > kFacingToleranceRad) {
         task_.motion->FollowPath({belief_.X_MB, Pose2{belief_.X_MB.x, belief_.X_MB.y, yaw}},
                                  {false}, task_.motion->arm_target(), belief_.now);

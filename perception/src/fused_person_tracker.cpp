@@ -189,6 +189,8 @@ void FusedPersonTracker::Update(const std::vector<PersonObservation>& observatio
     }
     tracks_.push_back(std::move(track));
   }
+  for (FusedTrack& track : tracks_)
+    UpdateRestPoint(track.person);
   Forecast();
 }
 

@@ -91,6 +91,7 @@ void PersonTracker::Update(const std::vector<Eigen::Vector2d>& p_MDetections, Ti
     people_.push_back(person);
   }
   for (TrackedPerson& person : people_) {
+    UpdateRestPoint(person);
     person.forecast.clear();
     for (int s = 1; s <= config_.forecast_steps; ++s) {
       person.forecast.push_back(person.p_MP + person.v_MP * (s * config_.forecast_dt));
@@ -113,6 +114,10 @@ bool DoorZone::Contains(const Eigen::Vector2d& p_MP) const {
   const double dx = std::max({0.0, -c.x(), c.x() - door.width()});
   const double dy = std::max(0.0, std::abs(c.y()) - depth);
   return std::hypot(dx, dy) <= person_radius;
+}
+
+void UpdateRestPoint(TrackedPerson& person) {
+  if (person.v_MP.norm() < kRestSpeedMps) person.p_MRest = person.p_MP;
 }
 
 PersonIntent ClassifyIntent(const TrackedPerson& person, const DoorZone& zone,

@@ -39,12 +39,25 @@ const std::vector<Eigen::Vector2d>& ScanMotion::Update(Time stamp, const Pose2& 
   if (!history_.empty() && ToSeconds(stamp - history_.front().stamp) >= config_.window &&
       ToSeconds(stamp - history_.front().stamp) <= 3 * config_.window) {
     const std::vector<Eigen::Vector2d>& before = history_.front().p_MR;
+    const double step2 = config_.step * config_.step;
+    const double reach2 = config_.reach * config_.reach;
+    // The earlier returns with no return near them now: where something left.
+    std::vector<Eigen::Vector2d> left;
+    for (const Eigen::Vector2d& q : before) {
+      bool stayed = false;
+      for (const Eigen::Vector2d& p : p_MR)
+        stayed = stayed || (p - q).squaredNorm() <= step2;
+      if (!stayed) left.push_back(q);
+    }
     for (const Eigen::Vector2d& p : p_MR) {
-      double nearest = INFINITY;
+      bool new_here = true;
       for (const Eigen::Vector2d& q : before)
-        nearest = std::min(nearest, (p - q).squaredNorm());
-      if (nearest > config_.step * config_.step && nearest <= config_.reach * config_.reach)
-        moving_.push_back(p);
+        new_here = new_here && (p - q).squaredNorm() > step2;
+      if (!new_here) continue;
+      bool came_from_near = false;
+      for (const Eigen::Vector2d& q : left)
+        came_from_near = came_from_near || (p - q).squaredNorm() <= reach2;
+      if (came_from_near) moving_.push_back(p);
     }
   }
   history_.push_back({stamp, X_ML, std::move(p_MR)});

@@ -3,6 +3,7 @@
 
 #include "task_node_fixture.h"
 
+#include "egress/behavior/head_gaze.h"
 #include "egress/planning/ik_solver.h"
 
 namespace egress::behavior {
@@ -88,9 +89,12 @@ TEST_F(HoldForResidentsTest, ResidentsComingSendTheRobotAsideAndItLetsThemPass) 
   EXPECT_TRUE(NotedText("everyone is through"));
 }
 
-TEST_F(HoldForResidentsTest, WaitingAtTheActuatorItFacesTheWayTheResidentsCome) {
-  // Pressed, with nobody about: it waits at the actuator, but turned from the wall to the room
-  // (the laser's blind sector, behind it, would otherwise be the room).
+TEST_F(HoldForResidentsTest, WaitingAtTheActuatorItTurnsTheWayTheResidentsComeIntoView) {
+  // Pressed, with nobody about: it waits at the actuator, but turned from the wall until the
+  // way the residents come is 90 degrees off ahead (the laser's blind sector, behind it, would
+  // otherwise be the room; a whole turn there and back takes too long between presses).
+  HeadGaze gaze;
+  services_.gaze = &gaze;
   tree_.TickOnce();
   belief_.now = At(2.0);
   OperatedAgo(1.0);  // in this hold: not due again
@@ -98,10 +102,20 @@ TEST_F(HoldForResidentsTest, WaitingAtTheActuatorItFacesTheWayTheResidentsCome) 
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
   ASSERT_GE(motion_.path().size(), 2u);
   const Pose2 to = motion_.path().back();
+  // The head looks the rest of the way: at the way in.
+  const auto head = gaze.Update(belief_, std::nullopt);
+  ASSERT_TRUE(head.has_value());
+  EXPECT_EQ(gaze.reason(), GazeReason::kTask);
   EXPECT_LT((to.translation() - Standoff().translation()).norm(), 1e-6);  // turns in place
-  // Towards 2 m out from the doorway (0, 3) on the robot's side.
+  // 2 m out from the doorway (0, 3) on the robot's side: a right angle off ahead, on the side
+  // the robot turned to (the shorter way round from the wall).
   const Eigen::Vector2d look = (Eigen::Vector2d(0.0, 1.0) - to.translation()).normalized();
-  EXPECT_GT(look.dot(Eigen::Vector2d(std::cos(to.yaw), std::sin(to.yaw))), 0.99);
+  const Eigen::Vector2d ahead(std::cos(to.yaw), std::sin(to.yaw));
+  EXPECT_NEAR(look.dot(ahead), 0.0, 1e-6);
+  const double turned = std::remainder(to.yaw - Standoff().yaw, 2 * M_PI);
+  const double full = std::remainder(std::atan2(look.y(), look.x()) - Standoff().yaw, 2 * M_PI);
+  EXPECT_GT(turned * full, 0.0) << "towards the way in";
+  EXPECT_NEAR(std::abs(full) - std::abs(turned), M_PI / 2, 1e-6);
 }
 
 TEST_F(HoldForResidentsTest, NeverGoesToTheActuatorWithSomeoneStandingByIt) {
@@ -307,7 +321,13 @@ TEST_F(EscortNodesTest, IsNobodyComingFailsWhenSomeoneMovesNearTheDoorOnTheRobot
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
   belief_.moving_returns.clear();
   See({node_testing::Person({-1.0, 0.0}, perception::PersonIntent::kUnknown)});
-  belief_.world.people[0].person.v_MP = {0.5, 1.0};  // tracked, walking to the door
+  auto& person = belief_.world.people[0].person;
+  // Tracked at walking pace, but where they stood: the tracker's wobble, not someone coming.
+  person.v_MP = {0.2, 0.25};
+  person.p_MRest = person.p_MP;
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);
+  person.v_MP = {0.5, 1.0};  // walking to the door, 0.45 m on from where they stood
+  person.p_MRest = person.p_MP - Eigen::Vector2d(0.2, 0.4);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
 }
 

@@ -1,5 +1,6 @@
 #include "egress/perception/person_tracker.h"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -56,6 +57,30 @@ TEST(PersonTrackerTest, APersonWhoSetsOffReadsMostOfTheirSpeedWithinHalfASecond)
   ASSERT_EQ(tracker.people().size(), 1u);
   EXPECT_GT(tracker.people()[0].v_MP.y(), 0.7 * 1.6);
   EXPECT_LT(tracker.people()[0].v_MP.y(), 1.6);  // still smoothed, not the raw difference
+}
+
+// The rest point: where the person stood. A standing person's detections placed a few
+// centimetres off now and then push the smoothed velocity past walking pace for a frame or two;
+// they stay by their rest point. Walking off, they leave it behind.
+TEST(PersonTrackerTest, TheRestPointStaysWhereTheyStoodOnceTheyWalkOff) {
+  PersonTracker tracker;
+  const Eigen::Vector2d p_MStand(1.0, 2.0);
+  int ms = 0;
+  double fastest = 0.0;
+  for (int i = 0; i < 20; ++i, ms += 100) {
+    const Eigen::Vector2d off = i % 5 == 4 ? Eigen::Vector2d(0.1, 0.0) : Eigen::Vector2d::Zero();
+    tracker.Update({p_MStand + off}, milliseconds(ms));
+    ASSERT_EQ(tracker.people().size(), 1u);
+    const TrackedPerson& person = tracker.people()[0];
+    fastest = std::max(fastest, person.v_MP.norm());
+    EXPECT_LT((person.p_MP - person.p_MRest).norm(), 0.1) << "frame " << i;
+  }
+  EXPECT_GT(fastest, kRestSpeedMps) << "the test's wobble reads as walking pace";
+  for (int i = 1; i <= 10; ++i, ms += 100)
+    tracker.Update({p_MStand + Eigen::Vector2d(0.12 * i, 0.0)}, milliseconds(ms));
+  const TrackedPerson& walker = tracker.people()[0];
+  EXPECT_LT((walker.p_MRest - p_MStand).norm(), 0.15);
+  EXPECT_GT((walker.p_MP - walker.p_MRest).norm(), 0.8);
 }
 
 // A missed frame: the velocity divides by the time between the two detections, not by the

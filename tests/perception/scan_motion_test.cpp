@@ -50,6 +50,23 @@ TEST(ScanMotionTest, NothingMovesUntilAScanAWindowOldAndNotFromAMovingLaser) {
   EXPECT_TRUE(motion.Update(At(2.4), {0.2, 0, 0}, {Eigen::Vector2d(-3.0, 4.0)}).empty());
 }
 
+TEST(ScanMotionTest, MoreOfAStandingBodySeenPastAShadowsEdgeIsNotMotion) {
+  ScanMotion motion;
+  const Pose2 X_ML{0.0, 0.0, 0.0};
+  // A person standing at 4 m, half in another's shadow: then a ray that grazed their far leg
+  // hits it, 0.2 m from the returns already seen, all of which are still there.
+  const std::vector<Eigen::Vector2d> half = Legs({4.0, 0.0});
+  std::vector<Eigen::Vector2d> whole = half;
+  whole.emplace_back(4.0, 0.25);
+  EXPECT_TRUE(motion.Update(At(0.0), X_ML, half).empty());
+  EXPECT_TRUE(motion.Update(At(0.5), X_ML, whole).empty());
+  // A leg that leaves its place for one 0.3 m on still moves.
+  std::vector<Eigen::Vector2d> stepped = whole;
+  stepped[0] += Eigen::Vector2d(0.0, -0.3);
+  stepped[1] += Eigen::Vector2d(0.0, -0.3);
+  EXPECT_EQ(motion.Update(At(1.0), X_ML, stepped).size(), 2u);
+}
+
 TEST(ScanMotionTest, BadInputIsRefused) {
   ScanMotionConfig bad;
   bad.step = 2.0;  // beyond reach

@@ -173,6 +173,37 @@ TEST(DoorTraversalTreeTest, APersonEnteringPreemptsThePressInTheSameTickThenItRe
   EXPECT_EQ(tick4.back(), "traverse_open");
 }
 
+TEST(DoorTraversalTreeTest, ADoorSeenOpenOnceThePassAfterThePressBeganDoesNotRestartIt) {
+  // Tick 1: pressed, the pass after it begins (RUNNING). Tick 2: the door now reads open: the
+  // pass goes on (a restart stopped the robot mid-line-up). Tick 3: a person enters: standby.
+  // Tick 4: clear again: the retry re-decides, and the open door is passed as such.
+  ScriptedRun run(
+      "door_traversal.xml", "DoorTraversal",
+      [](int tick, const TreeNode& n) {
+        if (Is(n, "IsThroughDoor") || Is(n, "IsPersonHoldingDoor")) return NodeStatus::kFailure;
+        if (Is(n, "IsPathClear")) return tick == 3 ? NodeStatus::kFailure : NodeStatus::kSuccess;
+        if (Is(n, "IsDoorOpen")) return tick >= 2 ? NodeStatus::kSuccess : NodeStatus::kFailure;
+        if (Is(n, "ButtonType")) {
+          n.config().blackboard->Set("button_type", Any(std::string("push_button")));
+          return NodeStatus::kSuccess;
+        }
+        if (n.name() == "traverse_opened" || n.name() == "traverse_open")
+          return tick == 4 ? NodeStatus::kSuccess : NodeStatus::kRunning;
+        if (Is(n, "RetractToSafe")) return tick == 3 ? NodeStatus::kRunning : NodeStatus::kSuccess;
+        return NodeStatus::kSuccess;
+      },
+      kDoorA);
+  EXPECT_EQ(run.Tick(), NodeStatus::kRunning);
+  EXPECT_EQ(run.Ticked(1).back(), "traverse_opened");
+  EXPECT_EQ(run.Tick(), NodeStatus::kRunning);
+  EXPECT_EQ(run.Ticked(2), (std::vector<std::string>{"reactive_check", "traverse_opened"}));
+  EXPECT_EQ(run.Tick(), NodeStatus::kRunning);
+  EXPECT_EQ(run.Ticked(3).back(), "retract");
+  EXPECT_EQ(run.Tick(), NodeStatus::kSuccess);
+  EXPECT_EQ(run.Ticked(4).back(), "traverse_open");
+  EXPECT_EQ(std::count(run.Ticked(4).begin(), run.Ticked(4).end(), "PressButton"), 0);
+}
+
 TEST(DoorTraversalTreeTest, ARetryThatFindsTheRobotPastTheDoorEndsTheTraversal) {
   // Tick 1: driving through (RUNNING). Tick 2: a person enters the zone: the standby starts.
   // Tick 3: the standby ends and the retry finds the robot already through: SUCCESS, without

@@ -44,7 +44,19 @@ struct TrackedPerson {
   int misses{0};
   Time last_seen{};
   PersonIntent intent{PersonIntent::kUnknown};
+  /// Where the person last stood (UpdateRestPoint) [m].
+  Eigen::Vector2d p_MRest{Eigen::Vector2d::Zero()};
 };
+
+/// A tracked person slower than this [m/s] is standing: their rest point follows them.
+inline constexpr double kRestSpeedMps = 0.2;
+
+/// Moves the person's rest point to where they are while they are slower than kRestSpeedMps,
+/// and leaves it where they last stood once they are faster. How far they are from it tells
+/// someone walking off from a tracker's wobble: a standing person's smoothed velocity goes over
+/// walking pace for a frame or two now and then (a detection placed a little off), but they
+/// stay within centimetres of where they stood.
+void UpdateRestPoint(TrackedPerson& person);
 
 class PersonTracker {
  public:

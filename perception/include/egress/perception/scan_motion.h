@@ -3,9 +3,12 @@
 /// ScanMotion: which of the laser's returns off the map are moving — the legs of someone
 /// walking, as opposed to someone (or something) standing. A return moved when, against the
 /// returns of about `window` seconds earlier, none lies within `step` of it but one lies within
-/// `reach`: a walker's swinging leg travels 0.3-0.6 m in half a second, a standing one only by
-/// the laser's noise (a centimetre or two), and a return with nothing near it earlier is
-/// something that came out from behind an occluder, not motion. Points are in M (the map frame).
+/// `reach` that has itself gone (no return within `step` of it now): a walker's swinging leg
+/// travels 0.3-0.6 m in half a second and leaves where it was, a standing one moves only by the
+/// laser's noise (a centimetre or two). A return with nothing near it earlier came out from
+/// behind an occluder, and one whose earlier neighbours are all still there is more of a standing
+/// body seen past a shadow's edge (a ray that grazed a leg and now hits it): not motion either.
+/// Points are in M (the map frame).
 /// Only scans taken from the same spot are compared: seen from a moving laser, legs standing
 /// still slide in and out of each other's shadows, which looks like motion; while the laser moves
 /// (more than `still_distance` or `still_angle` from where the reference was taken) nothing is
