@@ -34,9 +34,6 @@ constexpr double kLookRequestSec = 0.5;
 constexpr double kMovingMps = 0.2;
 // [m] A tracked person this far from where they last stood (and on the move) walked off.
 constexpr double kWalkedOffM = 0.3;
-// A track measured fewer times than this (laser and camera, ~18 a second) is too young for its
-// velocity to say anyone moves.
-constexpr int kSettledHits = 10;
 // [s] Still this long after people came, those left near the door are waiting for it.
 constexpr double kStillForSec = 4.0;
 // [m] The robot goes to its wait spot only with nobody this near it (or the way there).
@@ -83,12 +80,9 @@ Surroundings LookAround(const Belief& belief, const DoorPass& pass, double watch
   for (const auto& entry : belief.world.people) {
     if (!this_side(entry.person.p_MP, watch_radius)) continue;
     s.near = true;
-    // Walking off, not a tracker's wobble: away from where they stood as well as fast, and
-    // measured often enough that the velocity is not the filter still settling on a first
-    // placement a few decimetres off (lab seed 18: a track 6 measurements old slid 0.3 m from
-    // where it was born onto a resident standing still).
+    // Walking off, not a tracker's wobble: away from where they stood as well as fast.
     const auto& person = entry.person;
-    s.moving = s.moving || (person.hits >= kSettledHits && person.v_MP.norm() > kMovingMps &&
+    s.moving = s.moving || (person.v_MP.norm() > kMovingMps &&
                             (person.p_MP - person.p_MRest).norm() > kWalkedOffM);
   }
   for (const Eigen::Vector2d& p : belief.off_map_returns)
