@@ -1,5 +1,6 @@
 #include "egress/perception/scan_motion.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "egress/hsr_interface/error.h"
@@ -41,24 +42,17 @@ const std::vector<Eigen::Vector2d>& ScanMotion::Update(Time stamp, const Pose2& 
     const std::vector<Eigen::Vector2d>& before = history_.front().p_MR;
     const double step2 = config_.step * config_.step;
     const double reach2 = config_.reach * config_.reach;
+    const auto near = [](const std::vector<Eigen::Vector2d>& points, const Eigen::Vector2d& p,
+                         double r2) {
+      return std::any_of(points.begin(), points.end(),
+                         [&](const Eigen::Vector2d& q) { return (p - q).squaredNorm() <= r2; });
+    };
     // The earlier returns with no return near them now: where something left.
     std::vector<Eigen::Vector2d> left;
-    for (const Eigen::Vector2d& q : before) {
-      bool stayed = false;
-      for (const Eigen::Vector2d& p : p_MR)
-        stayed = stayed || (p - q).squaredNorm() <= step2;
-      if (!stayed) left.push_back(q);
-    }
-    for (const Eigen::Vector2d& p : p_MR) {
-      bool new_here = true;
-      for (const Eigen::Vector2d& q : before)
-        new_here = new_here && (p - q).squaredNorm() > step2;
-      if (!new_here) continue;
-      bool came_from_near = false;
-      for (const Eigen::Vector2d& q : left)
-        came_from_near = came_from_near || (p - q).squaredNorm() <= reach2;
-      if (came_from_near) moving_.push_back(p);
-    }
+    for (const Eigen::Vector2d& q : before)
+      if (!near(p_MR, q, step2)) left.push_back(q);
+    for (const Eigen::Vector2d& p : p_MR)
+      if (!near(before, p, step2) && near(left, p, reach2)) moving_.push_back(p);
   }
   history_.push_back({stamp, X_ML, std::move(p_MR)});
   return moving_;
