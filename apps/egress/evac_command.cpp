@@ -5,8 +5,11 @@
 // every evacuee is out (at the assembly point beyond the exit) or at the time limit. Printed: a
 // table per condition (evacuation time median with its 95 % interval, people left behind,
 // robot-resident contacts and closest approach, time the robot stood in a doorway with a
-// resident within 2 m), per-door flow and queue time; written: DIR/study.json, DIR/trials.csv,
-// DIR/evacuated.png (people out vs time, median and 10-90 % band per condition).
+// resident within 2 m), per-door flow and queue time, and for the robot and the propped doors
+// the paired difference from no robot on the same seeds (median with its 95 % interval, seeds
+// faster and slower: what the condition buys, with the seeds' own spread taken out); written:
+// DIR/study.json, DIR/trials.csv, DIR/evacuated.png (people out vs time, median and 10-90 % band
+// per condition).
 //
 // A trial is a pure function of the scenario file, the condition and the seed, whatever --jobs.
 
@@ -29,6 +32,7 @@
 #include "egress/twin/sdf_world_loader.h"
 #include "egress/twin/twin_robot.h"
 #include "egress/twin/twin_run.h"
+#include "study_stats.h"
 #include "workers.h"
 
 namespace egress::apps {
@@ -39,6 +43,9 @@ constexpr const char* kConditions[] = {"no_robot", "robot", "propped_open"};
 constexpr double kDoorwayBlockRadiusM = 2.0;
 // The robot is in a doorway within this of the door line (and within its jambs) [m].
 constexpr double kInDoorwayM = 0.5;
+// Evacuation times this close under two conditions count as a tie: the same evacuation, seen a
+// control period or so apart [s].
+constexpr double kTieSec = 0.15;
 
 struct StudyOptions {
   std::string scenario;
@@ -191,24 +198,6 @@ nlohmann::json RunStudyTrial(const twin::Scenario& scenario, const twin::WorldDe
           {"time", result.simulated_time}};
 }
 
-// The median of sorted `v` and its 95 % interval from the order statistics (binomial).
-struct MedianCi {
-  double median{0.0}, low{0.0}, high{0.0};
-};
-MedianCi CalcMedianCi(std::vector<double> v) {
-  MedianCi out;
-  if (v.empty()) return out;
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  out.median = n % 2 ? v[n / 2] : (v[n / 2 - 1] + v[n / 2]) / 2;
-  const double half = 1.96 * std::sqrt(double(n)) / 2;
-  const long lo = std::max(0L, long(std::floor(double(n) / 2 - half)) - 1);
-  const long hi = std::min(long(n) - 1, long(std::ceil(double(n) / 2 + half)));
-  out.low = v[std::size_t(lo)];
-  out.high = v[std::size_t(hi)];
-  return out;
-}
-
 // People out vs time, one curve (median) and band (10-90 %) per condition.
 void DrawEvacuated(const std::map<std::string, std::vector<nlohmann::json>>& by_condition,
                    double time_limit, int residents, const std::filesystem::path& png) {
@@ -326,6 +315,13 @@ void RunStudy(const StudyOptions& o) {
   fmt::print("\n{:<14} {:>7} {:>24} {:>12} {:>9} {:>9} {:>12}\n", "condition", "trials",
              "evacuation time [s]", "left behind", "contacts", "closest", "in doorway");
   int residents = 0;
+  // Per condition, each seed's evacuation time; people left behind count at the time limit
+  // (censored, conservative).
+  std::map<std::string, std::map<std::uint64_t, double>> t_by_seed;
+  for (const auto& [c, trials] : by_condition)
+    for (const auto& t : trials)
+      t_by_seed[c][t.at("seed").get<std::uint64_t>()] =
+          t.at("t_evac").is_null() ? base.time_limit : t.at("t_evac").get<double>();
   for (const std::string& c : conditions) {
     const auto& trials = by_condition[c];
     std::vector<double> times;
@@ -334,8 +330,7 @@ void RunStudy(const StudyOptions& o) {
     std::map<std::string, std::vector<double>> flow, queue;
     for (const auto& t : trials) {
       residents = t.at("residents").get<int>();
-      // A trial with people left behind counts at the time limit (censored, conservative).
-      times.push_back(t.at("t_evac").is_null() ? base.time_limit : t.at("t_evac").get<double>());
+      times.push_back(t_by_seed[c].at(t.at("seed").get<std::uint64_t>()));
       left += t.at("left_behind").get<int>();
       contacts += t.at("contacts").get<int>();
       if (!t.at("closest").is_null()) closest = std::min(closest, t.at("closest").get<double>());
@@ -358,8 +353,23 @@ void RunStudy(const StudyOptions& o) {
       fmt::print("    {:<12} flow {:.2f} persons/s, queue {:.1f} s per person (medians)\n", door, f,
                  CalcMedianCi(q).median);
     }
+    nlohmann::json vs = nullptr;
+    if (c != "no_robot" && t_by_seed.count("no_robot")) {
+      const PairedDifference p = CalcPairedDifference(t_by_seed["no_robot"], t_by_seed[c], kTieSec);
+      fmt::print(
+          "    vs no_robot, same seeds: {:+.1f} s [{:+.1f}, {:+.1f}] (median difference, 95 %), "
+          "mean {:+.1f} s; faster in {}, slower in {} of {}\n",
+          p.diff.median, p.diff.low, p.diff.high, p.mean, p.lower, p.higher, p.pairs);
+      vs = {{"pairs", p.pairs},
+            {"t_evac_diff_median_s", p.diff.median},
+            {"t_evac_diff_ci_s", {p.diff.low, p.diff.high}},
+            {"t_evac_diff_mean_s", p.mean},
+            {"faster", p.lower},
+            {"slower", p.higher}};
+    }
     study["conditions"].push_back(
         {{"condition", c},
+         {"vs_no_robot", vs},
          {"t_evac_median_s", ci.median},
          {"t_evac_ci_s", {ci.low, ci.high}},
          {"left_behind", left},

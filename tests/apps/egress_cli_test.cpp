@@ -430,6 +430,19 @@ TEST(EgressCliTest, EvacStudyComparesTheThreeConditionsOnTheSameSeeds) {
   EXPECT_LE(by["propped_open"].at("t_evac_median_s").get<double>(),
             by["no_robot"].at("t_evac_median_s").get<double>());
   EXPECT_EQ(by["robot"].at("contacts").get<int>(), 0);
+  // What each buys over no robot, seed by seed: one seed, one pair, the difference of the times.
+  EXPECT_TRUE(by["no_robot"].at("vs_no_robot").is_null());
+  for (const char* c : {"robot", "propped_open"}) {
+    const auto& vs = by[c].at("vs_no_robot");
+    ASSERT_TRUE(vs.is_object()) << c;
+    EXPECT_EQ(vs.at("pairs").get<int>(), 1) << c;
+    EXPECT_NEAR(vs.at("t_evac_diff_median_s").get<double>(),
+                by[c].at("t_evac_median_s").get<double>() -
+                    by["no_robot"].at("t_evac_median_s").get<double>(),
+                1e-9)
+        << c;
+  }
+  EXPECT_THAT(two.output, HasSubstr("vs no_robot, same seeds"));
   EXPECT_TRUE(std::filesystem::exists(dir / "two" / "evacuated.png"));
   // The same with one worker: the results do not depend on the number of jobs.
   Result one = RunEgress("evac study " + scenario + " --trials 1 --jobs 1 -q --out " +
@@ -455,6 +468,7 @@ TEST(EgressCliTest, EvacStudyComparesTheThreeConditionsOnTheSameSeeds) {
   ASSERT_EQ(robot.exit_code, 0) << robot.output;
   const std::string rows = read("robot");
   EXPECT_THAT(rows, Not(HasSubstr("no_robot,")));
+  EXPECT_THAT(robot.output, Not(HasSubstr("vs no_robot")));  // nothing to pair with
   const std::string full = read("one");
   const std::size_t at = full.find("\nrobot,");
   ASSERT_NE(at, std::string::npos);
