@@ -150,22 +150,43 @@ void Costmap2D::SetProjectedObstacles(const std::vector<Eigen::Vector2d>& p_MObs
 void Costmap2D::SetPersonalSpaces(const std::vector<PersonalSpace>& spaces) {
   for (std::size_t k = 0; k < spaces.size(); ++k) {
     const PersonalSpace& s = spaces[k];
-    const auto bad = [&](const char* what) {
-      return StrCat("Invalid personal space ", k, ": ", what, " (centre ", s.p_MP.x(), ", ",
-                    s.p_MP.y(), ", inner ", s.inner, ", outer ", s.outer, ", weight ", s.weight,
-                    ").");
-    };
-    ThrowUnless(s.p_MP.allFinite(), bad("the centre must be finite"));
-    ThrowUnless(std::isfinite(s.inner) && s.inner >= 0.0, bad("inner must be >= 0"));
-    ThrowUnless(std::isfinite(s.outer) && s.outer > s.inner, bad("outer must exceed inner"));
-    ThrowUnless(s.outer <= kMaxPersonalSpaceM, bad("outer is beyond kMaxPersonalSpaceM (5 m)"));
-    ThrowUnless(s.weight > 0.0 && s.weight <= 1.0, bad("the weight must be in (0, 1]"));
+    // The message only for a bad space: this runs for every space ten times a second.
+    const char* bad = nullptr;
+    if (!s.p_MP.allFinite()) {
+      bad = "the centre must be finite";
+    } else if (!(std::isfinite(s.inner) && s.inner >= 0.0)) {
+      bad = "inner must be >= 0";
+    } else if (!(std::isfinite(s.outer) && s.outer > s.inner)) {
+      bad = "outer must exceed inner";
+    } else if (!(s.outer <= kMaxPersonalSpaceM)) {
+      bad = "outer is beyond kMaxPersonalSpaceM (5 m)";
+    } else if (!(s.weight > 0.0 && s.weight <= 1.0)) {
+      bad = "the weight must be in (0, 1]";
+    }
+    ThrowUnless(bad == nullptr, "Invalid personal space ", k, ": ", bad ? bad : "", " (centre ",
+                s.p_MP.x(), ", ", s.p_MP.y(), ", inner ", s.inner, ", outer ", s.outer, ", weight ",
+                s.weight, ").");
   }
+  personal_spaces_ = spaces;
+  personal_space_painted_ = false;
+}
+
+void Costmap2D::PaintPersonalSpaces() const {
+  if (personal_space_painted_) return;
+  personal_space_painted_ = true;
   for (const std::size_t i : personal_space_cells_)
     personal_space_[i] = kFreeCost;
   personal_space_cells_.clear();
   const double res = geometry_.resolution;
-  for (const PersonalSpace& s : spaces) {
+  const std::vector<PersonalSpace>& spaces = personal_spaces_;
+  for (std::size_t k = 0; k < spaces.size(); ++k) {
+    const PersonalSpace& s = spaces[k];
+    // A space another one covers (the same centre and radii, no lower weight: a standing
+    // person's predicted positions) adds nothing: its cost is no higher in any cell.
+    const bool covered = std::any_of(spaces.begin(), spaces.begin() + long(k), [&](const auto& o) {
+      return o.p_MP == s.p_MP && o.inner == s.inner && o.outer == s.outer && o.weight >= s.weight;
+    });
+    if (covered) continue;
     const int n = int(std::ceil(s.outer / res));
     // A person just off the map still reaches into it: cells from the unclamped position.
     const Eigen::Vector2d local = (s.p_MP - geometry_.origin) / res;
@@ -177,7 +198,13 @@ void Costmap2D::SetPersonalSpaces(const std::vector<PersonalSpace>& spaces) {
     const double peak = kPersonalSpacePeakCost * s.weight;
     for (int iy = std::max(0, cy - n); iy <= std::min(geometry_.height - 1, cy + n); ++iy) {
       const double dy = (iy + 0.5) * res + geometry_.origin.y() - s.p_MP.y();
-      for (int ix = std::max(0, cx - n); ix <= std::min(geometry_.width - 1, cx + n); ++ix) {
+      if (dy * dy >= outer2) continue;
+      // Only the row's cells the circle spans (and one more each side for rounding); the
+      // distance test below decides each.
+      const int half = int(std::ceil(std::sqrt(outer2 - dy * dy) / res)) + 1;
+      const int x0 = std::max({0, cx - n, cx - half});
+      const int x1 = std::min({geometry_.width - 1, cx + n, cx + half});
+      for (int ix = x0; ix <= x1; ++ix) {
         const double dx = (ix + 0.5) * res + geometry_.origin.x() - s.p_MP.x();
         const double d2 = dx * dx + dy * dy;
         if (d2 >= outer2) continue;
@@ -193,7 +220,13 @@ void Costmap2D::SetPersonalSpaces(const std::vector<PersonalSpace>& spaces) {
   }
 }
 
+const std::vector<std::uint8_t>& Costmap2D::personal_space_costs() const {
+  PaintPersonalSpaces();
+  return personal_space_;
+}
+
 std::uint8_t Costmap2D::PersonalSpaceCostAt(const Eigen::Vector2d& p_MQ) const {
+  PaintPersonalSpaces();
   const auto cell = geometry_.CellOf(p_MQ);
   return cell ? personal_space_[geometry_.Index(cell->x(), cell->y())] : kFreeCost;
 }
@@ -371,6 +404,7 @@ std::uint8_t Costmap2D::FootprintCost(const Pose2& X_MB) const {
 }
 
 cv::Mat Costmap2D::ToImage() const {
+  PaintPersonalSpaces();
   cv::Mat image(geometry_.height, geometry_.width, CV_8UC1);
   for (int iy = 0; iy < geometry_.height; ++iy) {
     for (int ix = 0; ix < geometry_.width; ++ix) {

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -185,6 +186,48 @@ TEST(CostmapTest, APersonJustOffTheMapStillReachesIntoIt) {
   costmap.SetPersonalSpaces({{{-0.5, 5.0}, 0.9, 1.7, 1.0}, {{1e12, -1e12}, 0.9, 1.7, 1.0}});
   EXPECT_EQ(costmap.PersonalSpaceCostAt({0.3, 5.02}), kPersonalSpacePeakCost);
   EXPECT_EQ(costmap.PersonalSpaceCostAt({1.3, 5.02}), kFreeCost);
+}
+
+// Every cell as the layer's definition says, whatever shortcuts fill it (the row spans, spaces
+// covered by another at the same centre): random spaces, on and off the map, some repeated at
+// lower weights (a standing person's predictions), against a brute-force pass over every cell.
+TEST(CostmapTest, PersonalSpacesFillExactlyTheCellsTheirDefinitionGives) {
+  Costmap2D costmap(EmptyMap());
+  const GridGeometry& g = costmap.geometry();
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> at(-1.5, 11.5), radius(0.0, 1.5), weight(0.05, 1.0);
+  for (int round = 0; round < 20; ++round) {
+    std::vector<PersonalSpace> spaces;
+    for (int k = 0; k < 12; ++k) {
+      const double inner = radius(rng);
+      PersonalSpace s{{at(rng), at(rng)}, inner, inner + 0.05 + radius(rng), weight(rng)};
+      spaces.push_back(s);
+      if (k % 3 == 0) {
+        s.weight *= 0.5;  // covered by the one before
+        spaces.push_back(s);
+        s.weight = 1.0;  // not covered: heavier
+        spaces.push_back(s);
+      }
+    }
+    costmap.SetPersonalSpaces(spaces);
+    std::vector<std::uint8_t> expected(costmap.personal_space_costs().size(), kFreeCost);
+    for (int iy = 0; iy < g.height; ++iy) {
+      for (int ix = 0; ix < g.width; ++ix) {
+        for (const PersonalSpace& s : spaces) {
+          const double dx = (ix + 0.5) * g.resolution + g.origin.x() - s.p_MP.x();
+          const double dy = (iy + 0.5) * g.resolution + g.origin.y() - s.p_MP.y();
+          const double d2 = dx * dx + dy * dy;
+          if (d2 >= s.outer * s.outer) continue;
+          const double f =
+              d2 <= s.inner * s.inner ? 1.0 : (s.outer - std::sqrt(d2)) / (s.outer - s.inner);
+          const auto cost = static_cast<std::uint8_t>(kPersonalSpacePeakCost * s.weight * f + 0.5);
+          std::uint8_t& cell = expected[g.Index(ix, iy)];
+          cell = std::max(cell, cost);
+        }
+      }
+    }
+    ASSERT_EQ(costmap.personal_space_costs(), expected) << "round " << round;
+  }
 }
 
 TEST(CostmapTest, AMalformedPersonalSpaceIsRefusedNamingWhatIsWrong) {

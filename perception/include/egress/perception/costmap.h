@@ -82,14 +82,16 @@ class Costmap2D {
   /// Whether a lethal cell of the static map or of a door leaf is within `radius` of p_MQ: what
   /// the building explains (a laser return beyond it is someone or something not on the map).
   bool IsNearMappedObstacle(const Eigen::Vector2d& p_MQ, double radius) const;
-  /// Replaces the proxemic layer with `spaces` (overlapping spaces keep the higher cost).
+  /// Replaces the proxemic layer with `spaces` (overlapping spaces keep the higher cost). The
+  /// cells are filled when the layer is next read (a hundred people's spaces take milliseconds
+  /// to paint, and most control ticks plan nothing).
   /// @throws InvalidArgument naming the space and field: a non-finite centre, inner < 0,
   /// outer <= inner, a weight outside (0, 1], or an outer radius over kMaxPersonalSpaceM.
   void SetPersonalSpaces(const std::vector<PersonalSpace>& spaces);
   /// The proxemic layer's cost of the cell holding p_MQ (0 outside every space or the map).
   std::uint8_t PersonalSpaceCostAt(const Eigen::Vector2d& p_MQ) const;
   /// The proxemic layer, row-major like costs().
-  const std::vector<std::uint8_t>& personal_space_costs() const { return personal_space_; }
+  const std::vector<std::uint8_t>& personal_space_costs() const;
   static constexpr double kMaxPersonalSpaceM = 5.0;
 
   /// Clears the obstacle layer (e.g. after relocalization).
@@ -137,8 +139,12 @@ class Costmap2D {
   std::vector<std::uint8_t> doorway_zone_;  ///< 1 inside a doorway threshold.
   std::vector<std::uint8_t> master_;
   std::vector<Eigen::Vector2i> projected_cells_;
-  std::vector<std::uint8_t> personal_space_;
-  std::vector<std::size_t> personal_space_cells_;  ///< cells set in personal_space_
+  // The proxemic layer: the spaces last set, painted into personal_space_ on the first read.
+  void PaintPersonalSpaces() const;
+  std::vector<PersonalSpace> personal_spaces_;
+  mutable bool personal_space_painted_{true};
+  mutable std::vector<std::uint8_t> personal_space_;
+  mutable std::vector<std::size_t> personal_space_cells_;  ///< cells set in personal_space_
   std::map<std::string, Doorway> doorways_;
   std::map<std::string, double> leaf_angles_;
   std::vector<std::uint8_t> inflation_lookup_;  // cost by distance in 1/8 cells
