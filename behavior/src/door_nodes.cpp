@@ -283,9 +283,17 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
 
   NodeStatus Operate(const ButtonPlan& plan, const Pose2& X_MB) {
     const bool push = type_ == planning::ButtonType::kPushButton;
+    const TaskConfig& c = task_.config;
+    // A proximity plate senses a hand coming into its field: a wave from an arm left out (at the
+    // plate since the last wave, while the robot waited out a window) first takes the hand away
+    // (office seed 1: a wave from the hand held at door_b's plate did not open it, and the robot
+    // drove at the shut door).
+    const double withdraw = !push && !ArmAt(task_.motion->arm_target(), TuckedArm(*task_.model))
+                                ? c.arm_tuck_time
+                                : 0.0;
     // The hand reaches the actuator's approach pose then; the press or wave follows.
     DoorVisit visit = Visit();
-    visit.operated_at = belief_.now + SecondsToDuration(task_.config.press_reach_time);
+    visit.operated_at = belief_.now + SecondsToDuration(withdraw + c.press_reach_time);
     visit.window_restarted_at.reset();  // an earlier press's restart says nothing of this one
     Remember(visit);
     const perception::TrackedDoor* door = FindTrackedDoor(belief_.world, Door());
@@ -298,7 +306,6 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
       Note("the actuator is out of the arm's reach from here");
       return NodeStatus::kFailure;
     }
-    const TaskConfig& c = task_.config;
     if (push) {
       planning::IkTarget press = plan.targets.press;
       press.approach_M.reset();  // the arm alone cannot also hold the approach axis exactly
@@ -318,9 +325,11 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
       task_.motion->MoveArm(knots, belief_.now);
       Note("pressing the push button");
     } else {
-      task_.motion->MoveArm(
-          {{c.press_reach_time, *approach}, {c.press_reach_time + c.wave_hold_time, *approach}},
-          belief_.now);
+      std::vector<std::pair<double, ArmPose>> knots;
+      if (withdraw > 0.0) knots.emplace_back(withdraw, TuckedArm(*task_.model));
+      knots.emplace_back(withdraw + c.press_reach_time, *approach);
+      knots.emplace_back(withdraw + c.press_reach_time + c.wave_hold_time, *approach);
+      task_.motion->MoveArm(knots, belief_.now);
       Note("waving at the proximity plate");
     }
     arm_started_ = true;

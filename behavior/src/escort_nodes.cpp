@@ -144,7 +144,12 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
       door_ = door;
       ResetHold();
     }
-    last_tick_.reset();  // the time it was not watching (operating) does not count as clear
+    // Once people came, the time it was not watching (operating) does not count as clear: at
+    // the actuator, facing the wall, someone still coming may be behind it. Before anyone came,
+    // time spent operating between two looks that found nobody about counts as nobody about:
+    // it operates every `every` seconds and watches only in between, and the wait_for clock ran
+    // at a fifth of its speed (office seed 1: door_b held 100 s for a group already out).
+    if (came_ || !nobody_at_last_watch_) last_tick_.reset();
     if (!started_) {
       started_ = belief_.now;
       if (!PlanSpot()) return NodeStatus::kFailure;
@@ -168,6 +173,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
       unseen_ += ToSeconds(belief_.now - *last_tick_);
     }
     last_tick_ = belief_.now;
+    nobody_at_last_watch_ = !around.near;
     if (held > Input<double>("max_hold"))
       return Release(StrCat("held for ", std::round(held), " s"));
     if (!came_ && unseen_ > Input<double>("wait_for")) return Release("nobody about");
@@ -319,6 +325,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   void ResetHold() {
     started_.reset();
     last_tick_.reset();
+    nobody_at_last_watch_ = false;
     came_ = false;
     last_moving_.reset();
     unseen_ = 0.0;
@@ -450,12 +457,13 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   std::string door_;
   Pose2 standoff_;
   Pose2 spot_;
-  std::optional<Time> started_;      // when this hold began
-  std::optional<Time> last_tick_;    // the previous tick of an unbroken watch
-  bool came_{false};                 // someone came during this hold
-  std::optional<Time> last_moving_;  // when someone near was last seen on the move
-  double unseen_{0.0};               // [s] of watching since anyone was near
-  bool making_room_{false};          // stepping away from someone too near
+  std::optional<Time> started_;       // when this hold began
+  std::optional<Time> last_tick_;     // the previous tick of an unbroken watch
+  bool nobody_at_last_watch_{false};  // nobody was near at the last tick of the watch
+  bool came_{false};                  // someone came during this hold
+  std::optional<Time> last_moving_;   // when someone near was last seen on the move
+  double unseen_{0.0};                // [s] of watching since anyone was near
+  bool making_room_{false};           // stepping away from someone too near
   bool stood_open_{false};  // the door stood open kStillForSec in this hold with nobody moving
 };
 

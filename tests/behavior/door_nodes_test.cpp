@@ -102,6 +102,30 @@ TEST_F(DoorNodesTest, APressRecordsWhenTheHandReachesTheButtonAndForgetsAnEarlie
   EXPECT_TRUE(after.button_plan.has_value());  // the plan stays with the visit
 }
 
+// A proximity plate senses a hand coming into its field: a wave with the hand still at the plate
+// from the last one (nobody tucked the arm between: the traversal after a hold's last wave)
+// takes it away first, and the hand reaches the plate that much later.
+TEST_F(DoorNodesTest, AWaveWithTheHandLeftAtThePlateTakesItAwayFirst) {
+  map_.actuators[0].type = planning::ButtonType::kProximityPlate;
+  auto blackboard = bt::Blackboard::Create();
+  bt::Tree approach = Tree(R"(<ApproachButton door="lab_door"/>)", blackboard);
+  belief_.now = At(1.0);
+  ASSERT_EQ(approach.TickOnce(), NodeStatus::kRunning);
+  belief_.X_MB = blackboard->Get<DoorVisit>("door_visit")->button_plan->X_MB_standoff;
+  motion_.StopBase();
+  const auto hand_at_plate_after = [&](double t) {
+    belief_.now = At(t);
+    bt::Tree wave = Tree(R"(<WaveAtPlate door="lab_door"/>)", blackboard);
+    EXPECT_EQ(wave.TickOnce(), NodeStatus::kRunning);
+    EXPECT_TRUE(motion_.arm_moving(belief_.now));
+    return ToSeconds(*blackboard->Get<DoorVisit>("door_visit")->operated_at - At(t));
+  };
+  const TaskConfig& c = services_.config;
+  EXPECT_NEAR(hand_at_plate_after(20.0), c.press_reach_time, 1e-9);  // from the tucked arm
+  EXPECT_NE(motion_.arm_target(), TuckedArm(model_));                // left at the plate
+  EXPECT_NEAR(hand_at_plate_after(60.0), c.arm_tuck_time + c.press_reach_time, 1e-9);
+}
+
 TEST_F(DoorNodesTest, APressOnADoorNotSeenClosedRestartsItsWindowFromTheHandsArrival) {
   for (const bool closed : {true, false}) {
     auto blackboard = bt::Blackboard::Create();

@@ -310,6 +310,51 @@ TEST_F(HoldForResidentsTest, WithNobodyAboutTheHoldEndsAfterWaitFor) {
   EXPECT_TRUE(NotedText("nobody about"));
 }
 
+// Holding a door nobody comes to, the robot operates every `every` (6) s and watches only in
+// between: the time spent operating between two looks that found nobody counts towards
+// wait_for too (it counted only the watching, a fifth of the time, and office door_b was held
+// 100 s for a group long out).
+TEST_F(HoldForResidentsTest, WithNobodyAboutTheTimeSpentOperatingCountsTowardsWaitFor) {
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // operate (t = 1)
+  // Operating until t = 7 (the hand at the button at 3), then watching.
+  belief_.now = At(7.0);
+  OperatedAgo(4.0);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  motion_.StopBase();  // turned to watch
+  belief_.now = At(9.0);
+  OperatedAgo(6.0);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // due again
+  // Back from the next operation at t = 15: 14 s since it last saw anyone, over wait_for (10).
+  belief_.now = At(15.0);
+  OperatedAgo(4.0);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kFailure);
+  EXPECT_TRUE(NotedText("nobody about"));
+}
+
+// ... but an operation that began with someone about does not count as clear (they may come
+// while the robot faces the actuator).
+TEST_F(HoldForResidentsTest, AnOperationBegunWithSomeoneAboutDoesNotCountAsClear) {
+  // Standing 4 m from the doorway, 4.8 m from the standoff: about, and no bar to operating.
+  See({node_testing::Person({-3.5, 1.0}, perception::PersonIntent::kStationary)});
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // operate (t = 1)
+  See({});                                            // gone meanwhile
+  belief_.now = At(7.0);
+  OperatedAgo(4.0);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);  // clear from here: 0 s
+  motion_.StopBase();  // turned to watch
+  belief_.now = At(9.0);
+  OperatedAgo(6.0);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // 2 s
+  belief_.now = At(15.0);
+  OperatedAgo(4.0);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);  // 8 s (this operation began with nobody)
+  motion_.StopBase();
+  belief_.now = At(17.5);
+  OperatedAgo(0.5);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kFailure);  // 10.5 s
+  EXPECT_TRUE(NotedText("nobody about"));
+}
+
 TEST_F(EscortNodesTest, IsNobodyComingFailsWhenSomeoneMovesNearTheDoorOnTheRobotsSide) {
   bt::Tree tree = Tree(R"(<IsNobodyComing door="lab_door"/>)");
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);
