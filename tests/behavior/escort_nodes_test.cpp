@@ -341,7 +341,7 @@ TEST_F(HoldForResidentsTest, AnOperationBegunWithSomeoneAboutDoesNotCountAsClear
   belief_.now = At(7.0);
   OperatedAgo(4.0);
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);  // clear from here: 0 s
-  motion_.StopBase();  // turned to watch
+  motion_.StopBase();                                 // turned to watch
   belief_.now = At(9.0);
   OperatedAgo(6.0);
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // 2 s
