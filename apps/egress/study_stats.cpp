@@ -11,7 +11,8 @@ MedianCi CalcMedianCi(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   const std::size_t n = v.size();
   out.median = n % 2 ? v[n / 2] : (v[n / 2 - 1] + v[n / 2]) / 2;
-  // Ranks n/2 -+ 1.96 sqrt(n)/2 (the normal approximation of the binomial), widened by one.
+  // Ranks n/2 -+ 1.96 sqrt(n)/2 (the normal approximation of the binomial), rounded outwards,
+  // the lower one a rank further out (it errs on the wide side).
   const double half = 1.96 * std::sqrt(double(n)) / 2;
   const long lo = std::max(0L, long(std::floor(double(n) / 2 - half)) - 1);
   const long hi = std::min(long(n) - 1, long(std::ceil(double(n) / 2 + half)));
