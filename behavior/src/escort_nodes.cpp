@@ -51,7 +51,7 @@ constexpr double kStandoffFreeM = 0.5;
 constexpr double kMakeRoomGapM = 0.35;
 // [m] How far it looks round for room, and the steps it considers.
 constexpr double kRoomLookM = 2.5;
-constexpr double kRoomStepsM[] = {0.3, 0.6};
+constexpr double kRoomStepsM[] = {0.3, 0.6, 1.0};
 constexpr int kRoomHeadings = 16;
 // [s] Making room keeps clear of where people will be up to this far ahead (their positions at
 // their velocity every kRoomHorizonStepSec; the tracker's own forecast is the first 0.8 s of
@@ -60,6 +60,11 @@ constexpr double kRoomHorizonSec = 2.0;
 constexpr double kRoomHorizonStepSec = 0.2;
 // [m] A step that gains less room than this is not worth taking.
 constexpr double kRoomGainM = 0.1;
+// [s] A step under way is re-aimed (someone now comes at where it ends) only this long after it
+// began: a step starts from rest, and one re-aimed every tick hardly moves the robot.
+constexpr double kReAimAfterSec = 1.0;
+// [m] A step ends at least this much beyond the footprint from the building's walls.
+constexpr double kRoomWallMarginM = 0.1;
 
 // Who is near a door on the robot's side (or in its doorway), and whether anyone there is on
 // the move: tracked people within `watch_radius` (moving: faster than kMovingMps and kWalkedOffM
@@ -179,17 +184,25 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     if (!came_ && unseen_ > Input<double>("wait_for")) return Release("nobody about");
     if (came_ && unseen_ > Input<double>("clear_for")) return Release("everyone is through");
     // Someone too near: the robot steps away from them first, whatever it was doing (a crowd
-    // funnelling into the doorway spreads along the wall it waits by).
-    if (!making_room_ || !task_.motion->base_moving()) {
-      making_room_ = false;
-      if (const std::optional<Pose2> room = FindRoom(pass)) {
-        // At the door speed (the quickest the trajectories go): a resident walks at 1 m/s.
-        task_.motion->FollowPath({belief_.X_MB, *room}, {true}, task_.motion->arm_target(),
-                                 belief_.now);
-        making_room_ = true;
-        Note(StrCat("making room: stepping to ", PoseText(*room)));
-        return NodeStatus::kRunning;
-      }
+    // funnelling into the doorway spreads along the wall it waits by). A step under way is
+    // re-aimed when someone now comes at where it ends (clinic seed 4: a resident skirting the
+    // crowd walked 2 m at the robot during a 3 s step it took for others, and into it).
+    if (!task_.motion->base_moving()) making_room_ = false;
+    // Not sooner than kReAimAfterSec into a step: each starts from rest, and re-aimed every
+    // tick the robot hardly moved (clinic seed 124).
+    const bool may_re_aim = making_room_ && ToSeconds(belief_.now - room_since_) >= kReAimAfterSec;
+    if (making_room_ && !may_re_aim) {
+      // stepping: on
+    } else if (const std::optional<Pose2> room =
+                   FindRoom(pass, making_room_ ? std::optional(room_to_) : std::nullopt)) {
+      // At the door speed (the quickest the trajectories go): a resident walks at 1 m/s.
+      task_.motion->FollowPath({belief_.X_MB, *room}, {true}, task_.motion->arm_target(),
+                               belief_.now);
+      making_room_ = true;
+      room_to_ = room->translation();
+      room_since_ = belief_.now;
+      Note(StrCat("making room: stepping to ", PoseText(*room)));
+      return NodeStatus::kRunning;
     }
     if (task_.motion->base_moving()) return NodeStatus::kRunning;  // turning, or stepping aside
     // An operation broken off (someone came) leaves the arm out: tucked before the base moves.
@@ -283,11 +296,13 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     return std::atan2(look.y(), look.x());
   }
 
-  // Where to step to make room when someone is within kMakeRoomGapM of the robot's edge: of
-  // the poses a free straight step away (the same heading), not in the residents' way in, the one
-  // farthest from everyone near, if it gains kRoomGainM. nullopt: nobody that near, or no better
-  // place.
-  std::optional<Pose2> FindRoom(const DoorPass& pass) const {
+  // Where to step to make room when someone is within kMakeRoomGapM of the robot's edge (or,
+  // during a step to `stepping_to`, of that step's end): of the poses a free straight step away
+  // (the same heading), not in the residents' way in, the one farthest from everyone near, if
+  // it gains kRoomGainM over staying (over the step's end). nullopt: nobody that near, or no
+  // better place.
+  std::optional<Pose2> FindRoom(const DoorPass& pass,
+                                const std::optional<Eigen::Vector2d>& stepping_to) const {
     const Eigen::Vector2d at = belief_.X_MB.translation();
     // A tracked person where they are and where they will be at their velocity up to
     // kRoomHorizonSec (someone walking at the robot is too near before they arrive, and a step
@@ -297,8 +312,18 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     const std::vector<Occupant> near =
         PeopleAround(task_, at, kRoomLookM, kRoomHorizonSec, kRoomHorizonStepSec);
     const auto room_at = [&](const Eigen::Vector2d& q) { return RoomAt(near, q); };
-    const double now = room_at(at);
-    if (now > task_.config.footprint_radius + kMakeRoomGapM) return std::nullopt;
+    if (room_at(stepping_to.value_or(at)) > task_.config.footprint_radius + kMakeRoomGapM)
+      return std::nullopt;
+    // A step is worth the least room it leaves anyone: where it ends (at any time of the
+    // horizon) and on the way there, the robot where the step has taken it when they are where
+    // they are predicted (clinic seed 62: a step to a spot beyond a resident's way, chosen for
+    // the room there, crossed in front of them).
+    const PeopleRoom people(task_, kRoomHorizonSec);
+    const auto worth = [&](const Eigen::Vector2d& q) {
+      return std::min(room_at(q), people.RoomOnTheWay({at, q}));
+    };
+    const double now = stepping_to ? worth(*stepping_to) : room_at(at);
+    const perception::Costmap2D* costmap = belief_.world.costmap;
     // A step never goes into the residents' way in, nor nearer the doorway (the flow funnels
     // there).
     const auto in_the_way = [&](const Eigen::Vector2d& q) {
@@ -310,8 +335,14 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
       for (int k = 0; k < kRoomHeadings; ++k) {
         const double a = 2 * M_PI * k / kRoomHeadings;
         const Eigen::Vector2d q = at + step * Eigen::Vector2d(std::cos(a), std::sin(a));
-        const double room = room_at(q);
-        if (room <= best_room || in_the_way(q)) continue;
+        if (room_at(q) <= best_room || in_the_way(q)) continue;
+        // Not up to a wall: a step's quintic settles up to a decimetre past its end (clinic
+        // seed 62: a step to 2.5 cm from the corridor's wall touched it).
+        if (costmap != nullptr &&
+            costmap->IsNearMappedObstacle(q, task_.config.footprint_radius + kRoomWallMarginM))
+          continue;
+        const double room = worth(q);
+        if (room <= best_room) continue;
         const Pose2 candidate{q.x(), q.y(), belief_.X_MB.yaw};
         // The straight step, not only where it ends: a free pose may lie beyond a wall.
         if (!task_.planner->IsPathValid({belief_.X_MB, candidate})) continue;
@@ -457,13 +488,15 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   std::string door_;
   Pose2 standoff_;
   Pose2 spot_;
-  std::optional<Time> started_;       // when this hold began
-  std::optional<Time> last_tick_;     // the previous tick of an unbroken watch
-  bool nobody_at_last_watch_{false};  // nobody was near at the last tick of the watch
-  bool came_{false};                  // someone came during this hold
-  std::optional<Time> last_moving_;   // when someone near was last seen on the move
-  double unseen_{0.0};                // [s] of watching since anyone was near
-  bool making_room_{false};           // stepping away from someone too near
+  std::optional<Time> started_;        // when this hold began
+  std::optional<Time> last_tick_;      // the previous tick of an unbroken watch
+  bool nobody_at_last_watch_{false};   // nobody was near at the last tick of the watch
+  bool came_{false};                   // someone came during this hold
+  std::optional<Time> last_moving_;    // when someone near was last seen on the move
+  double unseen_{0.0};                 // [s] of watching since anyone was near
+  bool making_room_{false};            // stepping away from someone too near
+  Eigen::Vector2d room_to_{0.0, 0.0};  // where that step ends
+  Time room_since_{};                  // when it began
   bool stood_open_{false};  // the door stood open kStillForSec in this hold with nobody moving
 };
 

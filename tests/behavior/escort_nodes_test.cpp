@@ -6,6 +6,8 @@
 #include "egress/behavior/head_gaze.h"
 #include "egress/planning/ik_solver.h"
 
+#include <limits>
+
 namespace egress::behavior {
 namespace {
 
@@ -294,6 +296,76 @@ TEST_F(HoldForResidentsTest, MakesRoomToTheSideOfSomeoneWalkingAtIt) {
   const Eigen::Vector2d step = motion_.path().back().translation() - belief_.X_MB.translation();
   EXPECT_GT(std::abs(step.x()), std::abs(step.y())) << "step " << step.transpose();
   EXPECT_GT(std::abs(motion_.path().back().x - -1.8), 0.5) << "off their path";
+}
+
+// A step under way is re-aimed when someone comes at where it ends: taking a 0.6 m step for
+// one person, the robot did not look again for the seconds it took, while another walked 2 m
+// at it (clinic seed 4, a contact).
+TEST_F(HoldForResidentsTest, AStepUnderWayIsReAimedWhenSomeoneComesAtWhereItEnds) {
+  tree_.TickOnce();
+  OperatedAgo(1.0);
+  const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
+  belief_.X_MB = spot;
+  belief_.now = At(2.0);
+  belief_.off_map_returns = {{spot.x - 0.4, spot.y}};
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  ASSERT_TRUE(NotedText("making room"));
+  ASSERT_TRUE(motion_.base_moving());
+  const Eigen::Vector2d first = motion_.path().back().translation();
+  // Still on the way there: nobody new, the step goes on.
+  log_.Take();
+  belief_.now = At(2.2);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_FALSE(NotedText("making room"));
+  // Someone 1.2 m beyond the step's end walking at it at 1 m/s: a new step, away from their way.
+  const Eigen::Vector2d away = (first - spot.translation()).normalized();
+  auto walker = node_testing::Person(first + away * 1.2, perception::PersonIntent::kApproaching);
+  walker.person.v_MP = -away;
+  for (int k = 1; k <= 4; ++k)
+    walker.person.forecast.push_back(walker.person.p_MP + walker.person.v_MP * (0.2 * k));
+  See({walker});
+  // Not at once: a step starts from rest, and one re-aimed every tick would not move the robot.
+  belief_.now = At(2.4);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_FALSE(NotedText("making room"));
+  belief_.now = At(3.1);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  ASSERT_TRUE(NotedText("making room"));
+  const Eigen::Vector2d second = motion_.path().back().translation();
+  // Farther from where they will be over the next 2 s than the first step's end, which they
+  // walk through.
+  const auto nearest_pass = [&](const Eigen::Vector2d& q) {
+    double d = std::numeric_limits<double>::infinity();
+    for (double t = 0.0; t <= 2.0; t += 0.05)
+      d = std::min(d, (walker.person.p_MP + walker.person.v_MP * t - q).norm());
+    return d;
+  };
+  EXPECT_GT(nearest_pass(second), nearest_pass(first) + 0.3)
+      << "first " << first.transpose() << " second " << second.transpose();
+}
+
+// A step to make room ends clear of the building's walls by a margin (a step's quintic settles
+// a little past its end: clinic seed 62, a step ending 2.5 cm from the corridor's wall touched
+// it), even where the most room from people lies along the wall.
+TEST_F(HoldForResidentsTest, AStepToMakeRoomEndsClearOfTheWall) {
+  // The lab wall (y = 3) either side of the doorway, on the map the robot holds (the fixture's
+  // grid has no walls).
+  const perception::Costmap2D walls(perception::OccupancyGrid::FromBoxes(
+      {{{1.75, 3.0, 0.0}, {2.5, 0.1}}, {{-1.75, 3.0, 0.0}, {2.5, 0.1}}}, {-3.0, -1.0}, {3.0, 7.0},
+      0.05));
+  belief_.world.costmap = &walls;
+  tree_.TickOnce();
+  OperatedAgo(1.0);
+  const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
+  belief_.X_MB = spot;
+  belief_.now = At(2.0);
+  belief_.off_map_returns = {{spot.x, spot.y - 0.4}};  // someone just south of it
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  ASSERT_TRUE(NotedText("making room"));
+  const Pose2 to = motion_.path().back();
+  constexpr double kWallFaceY = 2.95;  // the lab wall's south face
+  EXPECT_LE(to.y, kWallFaceY - TaskConfig{}.footprint_radius - 0.1 + 1e-9) << to.x << ", " << to.y;
+  EXPECT_GT((to.translation() - Eigen::Vector2d(spot.x, spot.y - 0.4)).norm(), 0.4 + 0.1);
 }
 
 TEST_F(HoldForResidentsTest, WithNobodyAboutTheHoldEndsAfterWaitFor) {
