@@ -193,11 +193,10 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     if (!task_.motion->base_moving()) making_room_ = false;
     // Not sooner than kReAimAfterSec into a step: each starts from rest, and re-aimed every
     // tick the robot hardly moved (clinic seed 124).
-    const bool may_re_aim = making_room_ && ToSeconds(belief_.now - room_since_) >= kReAimAfterSec;
-    if (making_room_ && !may_re_aim) {
-      // stepping: on
-    } else if (const std::optional<Pose2> room =
-                   FindRoom(pass, making_room_ ? std::optional(room_to_) : std::nullopt)) {
+    const bool may_step = !making_room_ || ToSeconds(belief_.now - room_since_) >= kReAimAfterSec;
+    if (const std::optional<Pose2> room =
+            may_step ? FindRoom(pass, making_room_ ? std::optional(room_to_) : std::nullopt)
+                     : std::nullopt) {
       // At the door speed (the quickest the trajectories go): a resident walks at 1 m/s.
       task_.motion->FollowPath({belief_.X_MB, *room}, {true}, task_.motion->arm_target(),
                                belief_.now);
@@ -363,15 +362,15 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   bool IntoADoorway(const Eigen::Vector2d& at, const Eigen::Vector2d& q) const {
     const double body = task_.config.footprint_radius;
     for (const auto& door : task_.map->doors) {
-      const Eigen::Vector2d c = 0.5 * (door.p_MHinge + door.p_MLatch);
-      const Eigen::Vector2d along = (door.p_MLatch - door.p_MHinge).normalized();
-      const Eigen::Vector2d n(-along.y(), along.x());
-      const double half = 0.5 * (door.p_MLatch - door.p_MHinge).norm() + body;
-      const double from = (at - c).dot(n), to = (q - c).dot(n);
-      if (std::abs(to) < kOffDoorwayM && std::abs((q - c).dot(along)) < half) return true;
-      if ((from < 0.0) != (to < 0.0)) {
+      // The normal towards the robot's side now: a step ending on the other side crosses.
+      const DoorPass pass = CalcDoorPass(*task_.map, door.id, Pose2{at.x(), at.y(), 0.0});
+      const Eigen::Vector2d along(-pass.n_M.y(), pass.n_M.x());
+      const double half = pass.width / 2 + body;
+      const double from = (at - pass.centre).dot(pass.n_M), to = (q - pass.centre).dot(pass.n_M);
+      if (std::abs(to) < kOffDoorwayM && std::abs((q - pass.centre).dot(along)) < half) return true;
+      if (to < 0.0) {
         const Eigen::Vector2d cross = at + (q - at) * (from / (from - to));
-        if (std::abs((cross - c).dot(along)) < half) return true;
+        if (std::abs((cross - pass.centre).dot(along)) < half) return true;
       }
       if (door.InSweep(q, body + detail::kLeafClearance)) return true;
     }

@@ -24,6 +24,14 @@ Pose2 Standoff() {
       .X_MB_standoff;
 }
 
+// The lab wall (y = 3) either side of the doorway, as a costmap: the fixture's grid has no
+// walls (its planner lets steps through them; the making-room rules read the belief's costmap).
+perception::Costmap2D LabWalls() {
+  return perception::Costmap2D(perception::OccupancyGrid::FromBoxes(
+      {{{1.75, 3.0, 0.0}, {2.5, 0.1}}, {{-1.75, 3.0, 0.0}, {2.5, 0.1}}}, {-3.0, -1.0}, {3.0, 7.0},
+      0.05));
+}
+
 class HoldForResidentsTest : public EscortNodesTest {
  protected:
   HoldForResidentsTest() {
@@ -348,11 +356,7 @@ TEST_F(HoldForResidentsTest, AStepUnderWayIsReAimedWhenSomeoneComesAtWhereItEnds
 // a little past its end: clinic seed 62, a step ending 2.5 cm from the corridor's wall touched
 // it), even where the most room from people lies along the wall.
 TEST_F(HoldForResidentsTest, AStepToMakeRoomEndsClearOfTheWall) {
-  // The lab wall (y = 3) either side of the doorway, on the map the robot holds (the fixture's
-  // grid has no walls).
-  const perception::Costmap2D walls(perception::OccupancyGrid::FromBoxes(
-      {{{1.75, 3.0, 0.0}, {2.5, 0.1}}, {{-1.75, 3.0, 0.0}, {2.5, 0.1}}}, {-3.0, -1.0}, {3.0, 7.0},
-      0.05));
+  const perception::Costmap2D walls = LabWalls();
   belief_.world.costmap = &walls;
   tree_.TickOnce();
   OperatedAgo(1.0);
@@ -372,10 +376,7 @@ TEST_F(HoldForResidentsTest, AStepToMakeRoomEndsClearOfTheWall) {
 // the robot stepped back into door_d's doorway, making room for residents walking along the
 // corridor, as door_d closed).
 TEST_F(HoldForResidentsTest, AStepToMakeRoomStaysOutOfEveryDoorway) {
-  // The lab wall north of the robot (as in AStepToMakeRoomEndsClearOfTheWall).
-  const perception::Costmap2D walls(perception::OccupancyGrid::FromBoxes(
-      {{{1.75, 3.0, 0.0}, {2.5, 0.1}}, {{-1.75, 3.0, 0.0}, {2.5, 0.1}}}, {-3.0, -1.0}, {3.0, 7.0},
-      0.05));
+  const perception::Costmap2D walls = LabWalls();  // the lab wall north of the robot
   belief_.world.costmap = &walls;
   tree_.TickOnce();
   OperatedAgo(1.0);
