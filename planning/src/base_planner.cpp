@@ -52,6 +52,9 @@ void BasePlannerConfig::Validate() const {
   ThrowUnless(std::isfinite(personal_space_weight) && personal_space_weight >= 0.0,
               "Invalid BasePlannerConfig: personal_space_weight must be finite and >= 0, got ",
               personal_space_weight, ".");
+  ThrowUnless(std::isfinite(doorway_weight) && doorway_weight >= 0.0,
+              "Invalid BasePlannerConfig: doorway_weight must be finite and >= 0, got ",
+              doorway_weight, ".");
 }
 
 std::string_view ToString(PlanStatus status) {
@@ -201,22 +204,33 @@ class FootprintValidityChecker final : public ob::StateValidityChecker {
 class CostmapObjective final : public ob::StateCostIntegralObjective {
  public:
   CostmapObjective(const ob::SpaceInformationPtr& si, const perception::Costmap2D& costmap,
-                   double personal_space_weight)
+                   double personal_space_weight, const std::vector<std::uint8_t>& doorway,
+                   double doorway_weight)
       : ob::StateCostIntegralObjective(si, true),
         costmap_(costmap),
-        personal_space_weight_(personal_space_weight) {}
+        personal_space_weight_(personal_space_weight),
+        doorway_(doorway),
+        doorway_weight_(doorway_weight) {}
   ob::Cost stateCost(const ob::State* state) const override {
     const auto* s = state->as<ob::SE2StateSpace::StateType>();
     const Eigen::Vector2d p(s->getX(), s->getY());
     const std::uint8_t c = costmap_.CostAt(p);
     const double personal = personal_space_weight_ * costmap_.PersonalSpaceCostAt(p) /
                             double(perception::kPersonalSpacePeakCost);
-    return ob::Cost((c >= kInscribedCost ? 1.0 : double(c) / double(kInscribedCost)) + personal);
+    const auto cell = costmap_.geometry().CellOf(p);
+    const double doorway =
+        !doorway_.empty() && cell && doorway_[costmap_.geometry().Index(cell->x(), cell->y())]
+            ? doorway_weight_
+            : 0.0;
+    return ob::Cost((c >= kInscribedCost ? 1.0 : double(c) / double(kInscribedCost)) + personal +
+                    doorway);
   }
 
  private:
   const perception::Costmap2D& costmap_;
   double personal_space_weight_;
+  const std::vector<std::uint8_t>& doorway_;  // DoorwayCells, or empty
+  double doorway_weight_;
 };
 
 double PathLength(const std::vector<Pose2>& path) {
@@ -246,6 +260,7 @@ struct BasePlanner::Impl {
   BasePlannerConfig config;
   std::shared_ptr<const Clock> clock;
   std::vector<PlannerDoor> doors;
+  std::vector<std::uint8_t> doorway;  // the doors' doorway cells (DoorwayCells), per AddDoor
   std::shared_ptr<ob::SE2StateSpace> space;
   ob::SpaceInformationPtr si;
   std::shared_ptr<FootprintValidityChecker> checker;
@@ -313,34 +328,50 @@ struct BasePlanner::Impl {
 
   // With `keep_clearance`, a shortcut must also keep clearance_margin from obstacles unless the
   // stretch of path it replaces came closer (its highest costmap cost bounds the shortcut's).
-  // With `keep_personal_space`, likewise it may go no deeper into anyone's personal space.
+  // With `keep_personal_space`, likewise it may go no deeper into anyone's personal space, and
+  // with `keep_out_of_doorways` no further through doorways than the stretch it replaces went.
   og::PathGeometric StringPull(const og::PathGeometric& dense, bool keep_clearance,
-                               bool keep_personal_space) const {
+                               bool keep_personal_space, bool keep_out_of_doorways) const {
     og::PathGeometric pulled(si);
     const std::size_t n = dense.getStateCount();
     const auto xy = [&](std::size_t i) {
       const auto* st = dense.getState(i)->as<ob::SE2StateSpace::StateType>();
       return Eigen::Vector2d(st->getX(), st->getY());
     };
-    std::vector<std::uint8_t> cost(n), personal(n);
+    const auto in_doorway = [&](const Eigen::Vector2d& p) -> std::uint8_t {
+      if (doorway.empty()) return 0;
+      const auto cell = costmap.geometry().CellOf(p);
+      return cell ? doorway[costmap.geometry().Index(cell->x(), cell->y())] : 0;
+    };
+    keep_out_of_doorways = keep_out_of_doorways && !doorway.empty();
+    std::vector<std::uint8_t> cost(n), personal(n), doorways(n);
     for (std::size_t i = 0; i < n; ++i) {
       cost[i] = costmap.CostAt(xy(i));
       personal[i] = costmap.PersonalSpaceCostAt(xy(i));
+      doorways[i] = in_doorway(xy(i));
     }
+    // How far the dense path has run in doorways up to each state [m].
+    std::vector<double> doorway_run(n, 0.0);
+    for (std::size_t i = 1; i < n; ++i)
+      doorway_run[i] = doorway_run[i - 1] + (doorways[i] ? (xy(i) - xy(i - 1)).norm() : 0.0);
     const double step_length = 0.25 * costmap.geometry().resolution;
     const auto shortcut_ok = [&](std::size_t from, std::size_t to) {
       if (!si->checkMotion(dense.getState(from), dense.getState(to))) return false;
-      if (!keep_clearance && !keep_personal_space) return true;
+      if (!keep_clearance && !keep_personal_space && !keep_out_of_doorways) return true;
       const auto highest = [&](const std::vector<std::uint8_t>& along) {
         return *std::max_element(along.begin() + long(from), along.begin() + long(to) + 1);
       };
       const std::uint8_t bound = highest(cost), personal_bound = highest(personal);
+      // A cell's worth of slack: the samples and the cell centres see a doorway's edge apart.
+      double doorway_left = doorway_run[to] - doorway_run[from] + costmap.geometry().resolution;
       const Eigen::Vector2d a = xy(from), b = xy(to);
       const int steps = int(std::ceil((b - a).norm() / step_length));
       for (int k = 1; k < steps; ++k) {
         const Eigen::Vector2d p = a + (b - a) * (double(k) / steps);
         if (keep_clearance && costmap.CostAt(p) > bound) return false;
         if (keep_personal_space && costmap.PersonalSpaceCostAt(p) > personal_bound) return false;
+        if (keep_out_of_doorways && in_doorway(p) && (doorway_left -= (b - a).norm() / steps) < 0)
+          return false;
       }
       return true;
     };
@@ -370,9 +401,11 @@ struct BasePlanner::Impl {
   // The grid's shortest path from start to goal, string-pulled; nullopt without one.
   std::optional<og::PathGeometric> GridSeed(const Pose2& start, const Pose2& goal,
                                             const ob::State* s, const ob::State* g) const {
-    const auto cells = GridCheapestPath(
-        costmap, start.translation(), goal.translation(),
-        {CloseCost(), config.clearance_weight, config.personal_space_weight}, config.allow_unknown);
+    const auto cells =
+        GridCheapestPath(costmap, start.translation(), goal.translation(),
+                         {CloseCost(), config.clearance_weight, config.personal_space_weight,
+                          doorway.empty() ? nullptr : &doorway, config.doorway_weight},
+                         config.allow_unknown);
     if (!cells) return std::nullopt;
     og::PathGeometric dense(si);
     ob::ScopedState<ob::SE2StateSpace> state(space);
@@ -383,7 +416,8 @@ struct BasePlanner::Impl {
       dense.append(state.get());
     }
     dense.append(g);
-    return StringPull(dense, config.clearance_weight > 0.0, config.personal_space_weight > 0.0);
+    return StringPull(dense, config.clearance_weight > 0.0, config.personal_space_weight > 0.0,
+                      config.doorway_weight > 0.0);
   }
 
   // One OMPL query between two valid poses.
@@ -401,7 +435,8 @@ struct BasePlanner::Impl {
       auto multi = std::make_shared<ob::MultiOptimizationObjective>(si);
       multi->addObjective(length, 1.0);
       multi->addObjective(
-          std::make_shared<CostmapObjective>(si, costmap, config.personal_space_weight),
+          std::make_shared<CostmapObjective>(si, costmap, config.personal_space_weight, doorway,
+                                             config.doorway_weight),
           config.costmap_cost_weight);
       setup.setOptimizationObjective(multi);
     } else {
@@ -482,6 +517,8 @@ void BasePlanner::AddDoor(const PlannerDoor& door) {
       door.p_MA.allFinite() && door.p_MB.allFinite() && (door.p_MB - door.p_MA).norm() > 0.1,
       "Invalid door '", door.id, "': jambs must be finite and at least 0.1 m apart.");
   impl_->doors.push_back(door);
+  impl_->doorway = DoorwayCells(impl_->costmap.geometry(), impl_->doors,
+                                impl_->config.door_standoff, impl_->config.footprint_radius);
 }
 
 void BasePlanner::SetBodyShapes(std::vector<PlacedShape> shapes) {

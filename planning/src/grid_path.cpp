@@ -32,6 +32,34 @@ std::optional<std::vector<Eigen::Vector2d>> GridShortestPath(const perception::C
   return GridCheapestPath(costmap, start, goal, GridStepCosts{}, allow_unknown);
 }
 
+std::vector<std::uint8_t> DoorwayCells(const perception::GridGeometry& geometry,
+                                       const std::vector<PlannerDoor>& doors, double depth,
+                                       double widen) {
+  std::vector<std::uint8_t> doorway(geometry.size(), 0);
+  for (const auto& door : doors) {
+    const Eigen::Vector2d centre = 0.5 * (door.p_MA + door.p_MB);
+    const Eigen::Vector2d along = (door.p_MB - door.p_MA).normalized();
+    const Eigen::Vector2d normal(-along.y(), along.x());
+    const double half_width = 0.5 * (door.p_MB - door.p_MA).norm() + widen;
+    // The band's bounding box in cells, then each cell centre tested in the door's frame.
+    const Eigen::Vector2d extent = half_width * along.cwiseAbs() + depth * normal.cwiseAbs() +
+                                   Eigen::Vector2d::Constant(geometry.resolution);
+    const Eigen::Vector2d lo = (centre - extent - geometry.origin) / geometry.resolution;
+    const Eigen::Vector2d hi = (centre + extent - geometry.origin) / geometry.resolution;
+    const int x0 = std::max(0, int(std::floor(lo.x()))), y0 = std::max(0, int(std::floor(lo.y())));
+    const int x1 = std::min(geometry.width - 1, int(std::ceil(hi.x())));
+    const int y1 = std::min(geometry.height - 1, int(std::ceil(hi.y())));
+    for (int iy = y0; iy <= y1; ++iy) {
+      for (int ix = x0; ix <= x1; ++ix) {
+        const Eigen::Vector2d rel = geometry.CellCenter(ix, iy) - centre;
+        if (std::abs(rel.dot(along)) <= half_width && std::abs(rel.dot(normal)) <= depth)
+          doorway[geometry.Index(ix, iy)] = 1;
+      }
+    }
+  }
+  return doorway;
+}
+
 std::optional<std::vector<Eigen::Vector2d>> GridCheapestPath(const perception::Costmap2D& costmap,
                                                              const Eigen::Vector2d& start,
                                                              const Eigen::Vector2d& goal,
@@ -42,7 +70,14 @@ std::optional<std::vector<Eigen::Vector2d>> GridCheapestPath(const perception::C
   ThrowUnless(std::isfinite(costs.personal_space_weight) && costs.personal_space_weight >= 0.0,
               "GridCheapestPath: personal_space_weight must be finite and >= 0, got ",
               costs.personal_space_weight);
+  ThrowUnless(std::isfinite(costs.doorway_weight) && costs.doorway_weight >= 0.0,
+              "GridCheapestPath: doorway_weight must be finite and >= 0, got ",
+              costs.doorway_weight);
+  ThrowUnless(costs.doorway == nullptr || costs.doorway->size() == costmap.geometry().size(),
+              "GridCheapestPath: the doorway cells (", costs.doorway ? costs.doorway->size() : 0,
+              ") do not match the costmap (", costmap.geometry().size(), " cells)");
   const float penalty = 1.0f + float(costs.close_weight);
+  const float per_doorway = costs.doorway ? float(costs.doorway_weight) : 0.0f;
   const float per_personal =
       float(costs.personal_space_weight) / float(perception::kPersonalSpacePeakCost);
   const auto& personal = costmap.personal_space_costs();
@@ -79,7 +114,8 @@ std::optional<std::vector<Eigen::Vector2d>> GridCheapestPath(const perception::C
           continue;
         const std::uint8_t c = costmap.costs()[next];
         const float factor = (c != kUnknownCost && c >= costs.close_cost ? penalty : 1.0f) +
-                             per_personal * float(personal[next]);
+                             per_personal * float(personal[next]) +
+                             (per_doorway > 0.0f && (*costs.doorway)[next] ? per_doorway : 0.0f);
         const float nd = d + ((dx != 0 && dy != 0) ? kDiagonal : 1.0f) * factor;
         if (nd < distance[next]) {
           distance[next] = nd;

@@ -315,6 +315,95 @@ TEST(BasePlannerPersonalSpaceTest, ABadWeightIsRefused) {
       ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("personal_space_weight")));
 }
 
+// A corridor (x 0..10, y 0..2) with a room south of it through a doorway in its south wall
+// (x 4.5..5.5 at y = 0).
+Costmap2D CorridorWithSideDoor() {
+  const std::vector<Box2> boxes = {
+      {{10.0 / 2, 2.05, 0.0}, {10.2, 0.1}}, {{2.25, -0.05, 0.0}, {4.5, 0.1}},
+      {{7.75, -0.05, 0.0}, {4.5, 0.1}},     {{-0.05, 0.0, 0.0}, {0.1, 4.2}},
+      {{10.05, 0.0, 0.0}, {0.1, 4.2}},      {{5.0, -2.05, 0.0}, {10.2, 0.1}}};
+  return Costmap2D(OccupancyGrid::FromBoxes(boxes, {-0.5, -2.5}, {11.0, 5.0}, 0.05));
+}
+const PlannerDoor kSideDoor{"side", {4.5, 0.0}, {5.5, 0.0}};
+
+// How far [m] the path (sampled at 1 cm) runs within `depth` of the side door's line across its
+// opening widened by `widen`.
+double LengthInSideDoorway(const std::vector<Pose2>& path, double depth, double widen) {
+  double inside = 0.0;
+  for (std::size_t i = 1; i < path.size(); ++i) {
+    const Eigen::Vector2d a = path[i - 1].translation(), b = path[i].translation();
+    const int steps = std::max(1, int((b - a).norm() / 0.01));
+    for (int k = 1; k <= steps; ++k) {
+      const Eigen::Vector2d p = a + (b - a) * (double(k) / steps);
+      if (std::abs(p.x() - 5.0) <= 0.5 + widen && std::abs(p.y()) <= depth)
+        inside += (b - a).norm() / steps;
+    }
+  }
+  return inside;
+}
+
+// Along a corridor past a door in its wall, from and to spots by that wall: the path leaves the
+// wall to pass the doorway, instead of running through it lengthwise.
+TEST(BasePlannerDoorwayTest, APathAlongTheWallKeepsOutOfADoorwayItDoesNotUse) {
+  const Costmap2D costmap = CorridorWithSideDoor();
+  BasePlannerConfig config;
+  config.deterministic = true;
+  const Pose2 start{1.0, 0.4, 0.0}, goal{9.0, 0.4, 0.0};
+  BasePlanner planner(costmap, nullptr, config);
+  planner.AddDoor(kSideDoor);
+  const PlanResult kept = planner.Plan(start, goal);
+  ASSERT_TRUE(kept.ok()) << kept.message;
+  EXPECT_TRUE(kept.doors_crossed.empty());
+  // Out of the doorway (less a cell of rasterization), shortcutting included.
+  EXPECT_EQ(
+      LengthInSideDoorway(kept.path, config.door_standoff - 0.05, config.footprint_radius - 0.05),
+      0.0);
+  // Without the weight the path runs straight along the wall through the doorway.
+  config.doorway_weight = 0.0;
+  BasePlanner plain(costmap, nullptr, config);
+  plain.AddDoor(kSideDoor);
+  const PlanResult straight = plain.Plan(start, goal);
+  ASSERT_TRUE(straight.ok()) << straight.message;
+  EXPECT_GT(LengthInSideDoorway(straight.path, config.door_standoff, config.footprint_radius), 1.0);
+  EXPECT_LT(straight.length, kept.length);
+}
+
+// The doorway weighs against running along a door, never against using it: through the door
+// from the room, the path crosses it on its centreline, and from a start inside the doorway the
+// path leaves it.
+TEST(BasePlannerDoorwayTest, ADoorOnTheWayIsStillTakenAndADoorwayIsLeftStraight) {
+  const Costmap2D costmap = CorridorWithSideDoor();
+  BasePlannerConfig config;
+  config.deterministic = true;
+  BasePlanner planner(costmap, nullptr, config);
+  planner.AddDoor(kSideDoor);
+  const PlanResult through = planner.Plan({5.0, -1.5, M_PI / 2}, {9.0, 1.0, 0.0});
+  ASSERT_TRUE(through.ok()) << through.message;
+  EXPECT_THAT(through.doors_crossed, ElementsAre("side"));
+  // From inside the doorway (0.3 m past the line) along the corridor: it runs no further in
+  // the doorway than straight out of it would (0.3 m), plus a cell.
+  const PlanResult out = planner.Plan({5.0, 0.3, 0.0}, {9.0, 0.4, 0.0});
+  ASSERT_TRUE(out.ok()) << out.message;
+  EXPECT_LT(LengthInSideDoorway(out.path, config.door_standoff - 0.05, 0.5), 0.3 + 0.1);
+}
+
+TEST(BasePlannerDoorwayTest, ABadWeightIsRefused) {
+  BasePlannerConfig config;
+  config.doorway_weight = -1.0;
+  EXPECT_THAT([&] { config.Validate(); },
+              ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("doorway_weight")));
+  config.doorway_weight = std::nan("");
+  EXPECT_THROW(config.Validate(), InvalidArgument);
+  const Costmap2D costmap(OccupancyGrid::FromBoxes({}, {0, 0}, {2, 2}, 0.05));
+  const std::vector<std::uint8_t> too_few(10, 0);
+  EXPECT_THAT(
+      [&] {
+        GridCheapestPath(costmap, {0.5, 0.5}, {1.5, 1.5},
+                         {.doorway = &too_few, .doorway_weight = 1.0});
+      },
+      ::testing::ThrowsMessage<InvalidArgument>(HasSubstr("doorway cells")));
+}
+
 TEST(BasePlannerClearanceTest, ABadMarginIsRefused) {
   BasePlannerConfig config;
   config.clearance_margin = -0.1;

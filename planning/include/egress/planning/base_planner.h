@@ -76,6 +76,14 @@ struct BasePlannerConfig {
   /// The sampling planners' costmap objective (costmap_cost_weight > 0) weighs it the same way.
   /// 0: paths ignore personal space (they still never touch anyone: the laser marks people).
   double personal_space_weight{2.0};
+  /// Doorways: a grid step into a known door's doorway (within door_standoff of its line, across
+  /// its opening widened by the footprint radius on each side) costs this much more per metre,
+  /// and shortcutting never takes the path into a doorway the grid path kept out of. Why: a
+  /// path along the wall that has a door in it runs the robot through that doorway lengthwise,
+  /// where it blocks everyone using the door (it may stop there for people passing); crossing a
+  /// doorway straight costs the same whatever the path, so a door on the way is still taken.
+  /// 0: doorways cost nothing extra.
+  double doorway_weight{2.0};
   void Validate() const;
 };
 
@@ -166,7 +174,17 @@ struct GridStepCosts {
   /// ... plus personal_space_weight times its length times the cell's proxemic cost over
   /// kPersonalSpacePeakCost (0: people's personal space is not weighed).
   double personal_space_weight{0.0};
+  /// ... plus doorway_weight times its length for a cell `doorway` marks (non-zero; row-major
+  /// like the costmap's costs, or null: no doorways).
+  const std::vector<std::uint8_t>* doorway{nullptr};
+  double doorway_weight{0.0};
 };
+/// The costmap cells in any of `doors`' doorways (1, else 0; row-major like the costmap's
+/// costs): within `depth` of the door line on either side, across its opening widened by
+/// `widen` at each jamb.
+std::vector<std::uint8_t> DoorwayCells(const perception::GridGeometry& geometry,
+                                       const std::vector<PlannerDoor>& doors, double depth,
+                                       double widen);
 /// The cheapest 8-connected grid path (cell centres, no corner cutting) over cells below
 /// kInscribedCost, each step weighted by `costs` (all weights 0: the shortest path); nullopt if
 /// there is none. @throws InvalidArgument for a negative or non-finite weight.
