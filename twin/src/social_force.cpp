@@ -24,13 +24,6 @@ double NegligibleBeyond(double range) {
   return range * std::log(1.0 / kSocialNegligibleFraction);
 }
 
-// The farthest centre distance at which a walker whose step (its velocity over the social
-// horizon) is `step` long exerts a social term that is not dropped: b >= sqrt(r^2 - r |step|)
-// on the HM95 ellipse, so b > b_max wherever r > (|step| + sqrt(|step|^2 + 4 b_max^2)) / 2.
-double SocialReach(double step, double b_max) {
-  return 0.5 * (step + std::sqrt(step * step + 4.0 * b_max * b_max));
-}
-
 // Beyond this distance from its nearest point an obstacle exerts no force [m].
 constexpr double kWallCutoffM = 3.0;
 
@@ -56,12 +49,14 @@ Eigen::Vector2d SocialForceModel::BodyForce(const Walker& w, const Eigen::Vector
   return params_.body_compression * overlap * n + params_.sliding_friction * overlap * dv_t * t;
 }
 
-double SocialForceModel::WalkerReach(const Walker& o) const {
-  // A hair more than the bound, so rounding never drops a term the sum over everyone keeps;
-  // and at least touching distance for the body force (the widest body is under 1 m across).
-  const double social = SocialReach(o.velocity.norm() * params_.social_horizon,
-                                    NegligibleBeyond(params_.social_range));
-  return std::max(social * (1.0 + 1e-9) + 1e-9, kMaxBodyReachM);
+SocialForceModel::Reach SocialForceModel::WalkerReach(const Walker& o) const {
+  // The ellipse of the cutoff, semi-minor axis b_max with foci at o and one step ahead, lies
+  // within sqrt(b_max² + (step / 2)²) of its centre. A hair more than that, so rounding never
+  // drops a term the sum over everyone keeps.
+  const Eigen::Vector2d step = o.velocity * params_.social_horizon;
+  const double b_max = NegligibleBeyond(params_.social_range);
+  const double radius = std::sqrt(b_max * b_max + 0.25 * step.squaredNorm());
+  return {o.position + 0.5 * step, radius * (1.0 + 1e-9) + 1e-9};
 }
 
 Eigen::Vector2d SocialForceModel::CalcAcceleration(std::size_t i,
@@ -120,10 +115,14 @@ Eigen::Vector2d SocialForceModel::CalcAccelerationAmong(
     if (j == i) continue;
     const Walker& o = walkers[j];
     // Beyond its reach (and touching distance) another walker does nothing: no square roots.
-    const double reach = near.reach ? (*near.reach)[j] : WalkerReach(o);
-    if ((w.position - o.position).squaredNorm() > reach * reach) continue;
+    const Reach reach = near.reach ? (*near.reach)[j] : WalkerReach(o);
+    const bool social_near = (w.position - reach.social_centre).squaredNorm() <=
+                             reach.social_radius * reach.social_radius;
+    if (!social_near && (w.position - o.position).squaredNorm() > kMaxBodyReachM * kMaxBodyReachM)
+      continue;
     // Social terms scale with the drive (their balance is what HM95 tuned); walls do not.
-    a += social(o.position, o.velocity, P.drive_factor * P.social_strength, P.social_range);
+    if (social_near)
+      a += social(o.position, o.velocity, P.drive_factor * P.social_strength, P.social_range);
     a += BodyForce(w, o.position, o.velocity, o.radius) / P.mass;
   }
   for (const auto& d : discs) {
@@ -225,11 +224,11 @@ std::vector<Eigen::Vector2d> SocialForceModel::CalcAccelerations(
     const std::vector<Walker>& all, const std::vector<DiscObstacle>& discs, const WallCells& fixed,
     const std::vector<WallSegment>& moving) const {
   // A uniform grid over the walkers: each cell lists, in ascending index, every walker whose
-  // reach (a disc round it) overlaps the cell, so a walker meets only those that may reach it,
-  // in the order of the whole crowd: the sums (and the run) are the same as without the grid,
-  // in O(n) instead of O(n^2).
+  // reach (the box round its social circle and touching distance) overlaps the cell, so a walker
+  // meets only those that may reach it, in the order of the whole crowd: the sums (and the run) are
+  // the same as without the grid, in O(n) instead of O(n^2).
   std::vector<Eigen::Vector2d> accelerations(all.size());
-  std::vector<double> reach(all.size());
+  std::vector<Reach> reach(all.size());
   for (std::size_t j = 0; j < all.size(); ++j)
     reach[j] = WalkerReach(all[j]);
   // The grid spans the walkers' bounding box (a crowd spans tens of metres at most). Walkers that
@@ -241,7 +240,8 @@ std::vector<Eigen::Vector2d> SocialForceModel::CalcAccelerations(
   Eigen::Vector2d hi = -lo;
   bool finite = true;
   for (std::size_t j = 0; j < all.size(); ++j) {
-    finite = finite && all[j].position.allFinite() && std::isfinite(reach[j]);
+    finite = finite && all[j].position.allFinite() && reach[j].social_centre.allFinite() &&
+             std::isfinite(reach[j].social_radius);
     lo = lo.cwiseMin(all[j].position);
     hi = hi.cwiseMax(all[j].position);
   }
@@ -261,8 +261,13 @@ std::vector<Eigen::Vector2d> SocialForceModel::CalcAccelerations(
   start.assign(std::size_t(nx * ny) + 1, 0);
   for (std::size_t j = 0; j < all.size(); ++j) {
     const Eigen::Vector2d& p = all[j].position;
-    blocks[j] = {cell_x(p.x() - reach[j]), cell_x(p.x() + reach[j]), cell_y(p.y() - reach[j]),
-                 cell_y(p.y() + reach[j])};
+    // The box round both: the social circle and touching distance.
+    const Eigen::Vector2d& c = reach[j].social_centre;
+    const double r = reach[j].social_radius;
+    blocks[j] = {cell_x(std::min(c.x() - r, p.x() - kMaxBodyReachM)),
+                 cell_x(std::max(c.x() + r, p.x() + kMaxBodyReachM)),
+                 cell_y(std::min(c.y() - r, p.y() - kMaxBodyReachM)),
+                 cell_y(std::max(c.y() + r, p.y() + kMaxBodyReachM))};
     const auto& [x0, x1, y0, y1] = blocks[j];
     for (long y = y0; y <= y1; ++y)
       for (long x = x0; x <= x1; ++x)

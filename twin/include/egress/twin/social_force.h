@@ -128,16 +128,22 @@ class SocialForceModel {
   const SocialForceParams& params() const { return params_; }
 
  private:
+  // Where walker o's terms can be non-zero: its social term within `social_radius` of
+  // `social_centre` (the circle round the HM95 ellipse at the cutoff: centred half its step
+  // ahead of it), its body within kMaxBodyReachM of its centre [m].
+  struct Reach {
+    Eigen::Vector2d social_centre{Eigen::Vector2d::Zero()};
+    double social_radius{0.0};
+  };
   // Who can reach walker i, from Step's cell lists (nullptr: everyone, everything).
   struct Neighbours {
     const std::vector<std::size_t>* walkers{nullptr};  // indices, ascending
     const std::vector<std::size_t>* walls{nullptr};    // indices, ascending
     // Per wall: the index of the first wall of its obstacle (the order obstacles are summed).
     const std::vector<std::size_t>* wall_rank{nullptr};
-    const std::vector<double>* reach{nullptr};  // per walker: WalkerReach
+    const std::vector<Reach>* reach{nullptr};  // per walker: WalkerReach
   };
-  // How far from its centre walker o's social and body terms reach [m].
-  double WalkerReach(const Walker& o) const;
+  Reach WalkerReach(const Walker& o) const;
   Eigen::Vector2d CalcAccelerationAmong(std::size_t i, const std::vector<Walker>& walkers,
                                         const Neighbours& near,
                                         const std::vector<DiscObstacle>& discs,
