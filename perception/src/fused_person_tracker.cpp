@@ -113,13 +113,11 @@ void FusedPersonTracker::Update(const std::vector<PersonObservation>& observatio
     const PersonObservation& o = observations[k];
     auto& last = track.last_by_source[std::size_t(o.source)];
     // Faster than anyone walks since its last laser measurement: the track took something else
-    // (the next table leg while the first was hidden), not a step; the jump is no motion, for a
-    // confirmed track too (O2 seed 2010: a table's legs, confirmed as someone, read 1.5 m/s
-    // towards the doorway from one such jump and stopped the robot in it as the door shut).
+    // (the next table leg while the first was hidden), not a step; the jump is no motion.
     const bool jumped =
         o.source == PersonSource::kLaser && last && stamp > last->first &&
         (o.p_MP - last->second).norm() > config_.max_person_speed * ToSeconds(stamp - last->first);
-    if (last && stamp > last->first && !jumped) {
+    if (last && stamp > last->first) {
       const double dt = ToSeconds(stamp - last->first);
       if (dt >= config_.min_velocity_dt) {
         track.person.v_MP = a * (o.p_MP - last->second) / dt + (1.0 - a) * track.person.v_MP;

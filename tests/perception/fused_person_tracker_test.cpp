@@ -134,21 +134,6 @@ TEST(FusedPersonTrackerTest, AJumpFasterThanAnyoneWalksIsNoMotion) {
   EXPECT_EQ(walker.ConfirmedPeople().size(), 1u);
 }
 
-// A confirmed track (the camera saw someone standing there) whose laser observation jumps
-// 0.52 m in 0.1 s, from one table leg to the next: its velocity is not taken from the jump.
-TEST(FusedPersonTrackerTest, AJumpIsNoMotionForAConfirmedTrackEither) {
-  FusedPersonTracker tracker;
-  const Eigen::Vector2d near_leg(-0.26, 4.74), far_leg(-0.26, 5.26);
-  for (int i = 0; i < 5; ++i) {
-    tracker.Update({{near_leg, PersonSource::kCamera}}, At(0.1 * i));
-    tracker.Update({{near_leg, PersonSource::kLaser}}, At(0.1 * i + 0.05));
-  }
-  ASSERT_EQ(tracker.ConfirmedPeople().size(), 1u);
-  tracker.Update({{far_leg, PersonSource::kLaser}}, At(0.55));
-  ASSERT_EQ(tracker.tracks().size(), 1u);
-  EXPECT_LT(tracker.tracks().front().person.v_MP.norm(), 0.05);
-}
-
 // Someone standing where only the laser sees them is a static spot after static_after_s; when
 // they walk off, the laser confirms them as soon as they have moved. A person the camera has
 // confirmed keeps their laser measurements while they stand.

@@ -28,8 +28,7 @@
 /// A static spot unseen for `static_forget_s` is forgotten, any other once unseen for
 /// `static_gap_s` (a walker leaves one every few centimetres). Before a spot is static, an
 /// unconfirmed track's laser observation that jumped faster than `max_person_speed` from its last
-/// one took something else: its confirm window starts again there. No track, confirmed or not,
-/// takes its velocity from such a jump.
+/// one took something else: its confirm window starts again there.
 ///
 /// The brain reads it with PerceptionConfig::laser_people (on by default); with
 /// `--camera-people-only`, the camera's PersonTracker alone.
@@ -66,9 +65,8 @@ struct FusedPersonTrackerConfig {
   double min_velocity_dt{0.05};  ///< Measurements closer in time than this update no velocity [s].
   int forecast_steps{4};
   double forecast_dt{0.2};  ///< [s]
-  /// A laser observation that jumped faster than this since the track's last one is something
-  /// else (a neighbouring table leg): no track's velocity is taken from it, and an unconfirmed
-  /// track starts its confirm window there [m/s].
+  /// An unconfirmed track whose laser observation jumped faster than this since the last one
+  /// took something else (a neighbouring table leg): it starts its confirm window there [m/s].
   double max_person_speed{4.0};
   double static_radius{0.08};    ///< Laser observations this near are the same spot [m].
   double static_after_s{0.8};    ///< Seen at one spot this long: a thing, not a person [s].
