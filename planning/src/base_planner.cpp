@@ -200,6 +200,14 @@ class FootprintValidityChecker final : public ob::StateValidityChecker {
   Pose3 X_BBound_;
 };
 
+// Whether p_MQ is in a cell `doorway` (DoorwayCells over `geometry`, or empty: none) marks.
+bool InDoorway(const perception::GridGeometry& geometry, const std::vector<std::uint8_t>& doorway,
+               const Eigen::Vector2d& p_MQ) {
+  if (doorway.empty()) return false;
+  const auto cell = geometry.CellOf(p_MQ);
+  return cell && doorway[geometry.Index(cell->x(), cell->y())] != 0;
+}
+
 // Costmap cost as a state cost, for the optional clearance term of the objective.
 class CostmapObjective final : public ob::StateCostIntegralObjective {
  public:
@@ -217,11 +225,7 @@ class CostmapObjective final : public ob::StateCostIntegralObjective {
     const std::uint8_t c = costmap_.CostAt(p);
     const double personal = personal_space_weight_ * costmap_.PersonalSpaceCostAt(p) /
                             double(perception::kPersonalSpacePeakCost);
-    const auto cell = costmap_.geometry().CellOf(p);
-    const double doorway =
-        !doorway_.empty() && cell && doorway_[costmap_.geometry().Index(cell->x(), cell->y())]
-            ? doorway_weight_
-            : 0.0;
+    const double doorway = InDoorway(costmap_.geometry(), doorway_, p) ? doorway_weight_ : 0.0;
     return ob::Cost((c >= kInscribedCost ? 1.0 : double(c) / double(kInscribedCost)) + personal +
                     doorway);
   }
@@ -338,13 +342,12 @@ struct BasePlanner::Impl {
       const auto* st = dense.getState(i)->as<ob::SE2StateSpace::StateType>();
       return Eigen::Vector2d(st->getX(), st->getY());
     };
-    const auto in_doorway = [&](const Eigen::Vector2d& p) -> std::uint8_t {
-      if (doorway.empty()) return 0;
-      const auto cell = costmap.geometry().CellOf(p);
-      return cell ? doorway[costmap.geometry().Index(cell->x(), cell->y())] : 0;
+    const auto in_doorway = [&](const Eigen::Vector2d& p) {
+      return InDoorway(costmap.geometry(), doorway, p);
     };
     keep_out_of_doorways = keep_out_of_doorways && !doorway.empty();
-    std::vector<std::uint8_t> cost(n), personal(n), doorways(n);
+    std::vector<std::uint8_t> cost(n), personal(n);
+    std::vector<bool> doorways(n);
     for (std::size_t i = 0; i < n; ++i) {
       cost[i] = costmap.CostAt(xy(i));
       personal[i] = costmap.PersonalSpaceCostAt(xy(i));

@@ -78,7 +78,7 @@ struct BasePlannerConfig {
   double personal_space_weight{2.0};
   /// Doorways: a grid step into a known door's doorway (within door_standoff of its line, across
   /// its opening widened by the footprint radius on each side) costs this much more per metre,
-  /// and shortcutting never takes the path into a doorway the grid path kept out of. Why: a
+  /// and a shortcut never runs further through doorways than the grid path it replaces. Why: a
   /// path along the wall that has a door in it runs the robot through that doorway lengthwise,
   /// where it blocks everyone using the door (it may stop there for people passing); crossing a
   /// doorway straight costs the same whatever the path, so a door on the way is still taken.
