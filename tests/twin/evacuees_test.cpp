@@ -164,10 +164,9 @@ TEST(EvacueesTest, AMixedGroupOpensTheClinicsShutDoorsItself) {
       "  - {name: r, behavior: evacuate, route: [door_d, door_e, exit_door], start: [2.8, -3.0],"
       " goal: [21.0, 11.5], count: 20, trigger: {at: 5.0},"
       " mobility: {walker: 10, cane: 3, frame: 3, wheelchair: 2, wheelchair_pushed: 2}}\n";
-  // In seed 17 the crowd pushes someone back into the ward through door_d after they passed
-  // it: they take up their route from before it (they slid along the ward's wall towards the
-  // next waypoint, beyond it, and stood there for ever).
-  int rewinds = 0;
+  // Seed 17 once pushed someone back into the ward through door_d after they passed it (they
+  // now take up their route from before it). Since people carried into a doorway go on through
+  // it, no seed of 1-150 does: that case is no longer exercised here.
   for (const std::uint64_t seed : {5, 9, 17}) {
     auto loaded = LoadText(text, WorldsDir() / "clinic");
     TwinWorld world(loaded.scenario, loaded.world, seed, Hsr());
@@ -176,9 +175,34 @@ TEST(EvacueesTest, AMixedGroupOpensTheClinicsShutDoorsItself) {
     for (const auto& p : world.people())
       out += p.out;
     EXPECT_EQ(out, 20) << "seed " << seed;
-    rewinds += CountEvents(world, "person_rewinds_route");
   }
-  EXPECT_GE(rewinds, 1) << "no one pushed back through a doorway: the case is not exercised";
+}
+
+// door_d held open from the start (as the robot holds it for them), door_e and the exit shut:
+// the group reaches them dense, and the crowd carries people on past their waypoints. Before,
+// with these seeds, 1 to 11 of them stayed at a doorway to the end:
+// - 10, 13: someone carried on past their way round door_e's open leaf walked back to it, into
+//   the doorway against the crowd, and everyone behind waited for the doorway;
+// - 15: someone pushed into door_d's doorway before reaching the spot before it did the same;
+// - 22: a wheelchair aimed at the exit door's centre stood against its open leaf's free edge
+//   and the jamb (it now aims at the middle of what the leaf leaves open).
+TEST(EvacueesTest, NobodyCarriedOnByTheCrowdWalksBackIntoADoorway) {
+  const std::string text =
+      "world: clinic.sdf\n"
+      "robot: {off_scene: true}\n"
+      "doors: [{door: door_d, operator: push, open_at: [0.0], hold_open_s: 1000000}]\n"
+      "people:\n"
+      "  - {name: r, behavior: evacuate, route: [door_d, door_e, exit_door], start: [2.8, -3.0],"
+      " goal: [21.0, 11.5], count: 20, trigger: {at: 5.0},"
+      " mobility: {walker: 10, cane: 3, frame: 3, wheelchair: 2, wheelchair_pushed: 2}}\n";
+  for (const std::uint64_t seed : {10, 13, 15, 22}) {
+    auto loaded = LoadText(text, WorldsDir() / "clinic");
+    TwinWorld world(loaded.scenario, loaded.world, seed, Hsr());
+    world.StepFor(300.0);
+    for (const auto& p : world.people())
+      EXPECT_TRUE(p.out) << "seed " << seed << ": " << p.name << " (" << p.mobility << ") at "
+                         << p.position.transpose() << " phase " << int(p.phase);
+  }
 }
 
 TEST(EvacueesTest, SomeoneWhoCannotOperateTheDoorWaitsAtItAndTheRestGoOn) {

@@ -56,6 +56,21 @@ bool SegmentsCross(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eig
   return d1 * d2 <= 0.0 && d3 * d4 <= 0.0;
 }
 
+// The middle of the way through door d's opening [m, in W]: a leaf standing open fills the
+// opening's hinge end, up to its free edge's reach along the closed leaf (at 80 degrees, a
+// 0.95 m leaf 0.17 m of it), on the side it opens into; whoever passes, either way, passes
+// beside it. Aimed at the doorway's centre, a wide body (a wheelchair) meets the leaf's edge
+// and the far jamb at once and stands there, held by the walls' push (a local minimum).
+Eigen::Vector2d PassageCentre(const Door& d) {
+  const DoorModel& m = *d.fixed;
+  if (d.angle <= AdaDoorOperator::kClosedAngle || m.swing_side == 0.0) return m.centre;
+  const Eigen::Vector2d hinge = m.desc->p_WH.head<2>();
+  const double half = (m.centre - hinge).dot(m.along);
+  const double taken =
+      std::clamp((m.desc->CalcFreeEdge(d.angle).head<2>() - hinge).dot(m.along), 0.0, half);
+  return m.centre + m.along * (taken / 2);
+}
+
 }  // namespace
 
 std::string_view ToString(PersonPhase phase) {
@@ -276,7 +291,8 @@ void TwinWorld::Impl::UpdatePeople() {
                 config.door_crossed_open_angle_deg * kDegToRad &&
             (p.walker.position - d.centre).norm() < kSkipQueueSpotM) {
           const double side = (p.walker.position - d.centre).dot(d.normal) >= 0 ? 1.0 : -1.0;
-          p.route.front() = d.centre + d.normal * side * kLineUpBeforeDoorM;
+          p.route.front() = PassageCentre(doors[std::size_t(next->second)]) +
+                            d.normal * side * kLineUpBeforeDoorM;
         }
       }
     }
@@ -285,6 +301,10 @@ void TwinWorld::Impl::UpdatePeople() {
     p.walker.final_target = p.route.size() == 1;
     p.walker.desired_speed = p.speed;
     const int gate = GateDoor(p);
+    // Through a doorway of the route: by the middle of what its leaf leaves open.
+    if (const auto through = p.doorway_waypoints.find(p.reached);
+        through != p.doorway_waypoints.end() && p.route.size() > 1)
+      p.walker.target = PassageCentre(doors[std::size_t(through->second)]);
     // Someone waiting goes on only once the leaf is a few degrees past the threshold: a leaf
     // held right at it (by someone behind it) would otherwise set them walking into it and
     // stopping again, step after step.
@@ -379,6 +399,19 @@ void TwinWorld::Impl::UpdatePeople() {
         const Eigen::Vector2d round =
             edge + along * kStepRoundLeaf + across * to_next * p.walker.radius;
         if (p.round_leaf == int(k)) {
+          // Carried on past the way round by the crowd behind, towards the doorway: once the
+          // straight way on clears the leaf (by a body's width past its free edge), the detour
+          // is done. Walking back to it would be against the crowd, in the doorway where they
+          // stand (clinic two wards seed 22: 6 residents kept at door_e to the time limit).
+          if (p.route.size() > 1 && !SegmentsCross(p.walker.position, p.route[1], hinge,
+                                                   edge + along * p.walker.radius)) {
+            p.route.erase(p.route.begin());
+            ++p.reached;
+            p.round_leaf = -1;
+            p.walker.target = p.route.front();
+            p.walker.final_target = p.route.size() == 1;
+            continue;
+          }
           p.route.front() = round;  // the leaf moves: so does the way round it
         } else {
           if (!SegmentsCross(p.walker.position, p.route.front(), hinge, edge)) continue;
@@ -489,12 +522,28 @@ void TwinWorld::Impl::AdvancePastDoorways(Person& p) const {
     if (centre < p.reached || beyond >= p.route.size()) continue;
     const DoorModel& d = *doors[std::size_t(it->second)].fixed;
     const Eigen::Vector2d rel = p.walker.position - d.centre;
+    // Pushed into the doorway by the crowd before reaching the waypoints before it (the spot
+    // before the door they head for first), an evacuee goes on through: back to those would be
+    // against the crowd, and standing in the doorway they keep everyone behind waiting for it
+    // (door_d propped open, no robot, seed 15: 7 residents held in the ward for 250 s).
+    if (centre > p.reached && std::abs(rel.dot(d.normal)) < p.walker.radius &&
+        std::abs(rel.dot(d.along)) < d.reach / 2) {
+      p.route.erase(p.route.begin(), p.route.begin() + long(centre - p.reached));
+      p.reached = centre;
+      p.round_leaf = -1;
+      return;
+    }
     const bool past = rel.dot(d.normal) * (p.route[beyond] - d.centre).dot(d.normal) > 0.0 &&
                       std::abs(rel.dot(d.normal)) > p.walker.radius &&
                       rel.norm() < kPastDoorwayReachM;
     if (!past) continue;
     p.route.erase(p.route.begin(), p.route.begin() + long(beyond));
     p.reached = centre + 1;
+    // The way round a leaf (the route's first waypoint, now erased) is behind them too: left
+    // set, it would turn their next waypoint into that way round, back through the doorway
+    // against the crowd, where they would stand and keep everyone waiting for the doorway
+    // (clinic escort seed 54: 11 residents held at door_e for 300 s).
+    p.round_leaf = -1;
     return;
   }
 }

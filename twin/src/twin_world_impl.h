@@ -153,7 +153,7 @@ struct TwinWorld::Impl {
   // point and must not step into a closed door).
   static bool PendingDoorWaypoint(const Person& p) { return p.reached == p.wait_before_waypoint; }
   // An evacuee past a doorway of their route (pushed through by the crowd) resumes their route
-  // beyond it.
+  // beyond it; one pushed into it before reaching the waypoints before it, from its centre.
   void AdvancePastDoorways(Person& p) const;
   // An evacuee stuck with a wall between them and their next waypoint, on the near side of a
   // doorway of their route they had passed (the crowd pushed them back through it), takes up
