@@ -56,21 +56,6 @@ bool SegmentsCross(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eig
   return d1 * d2 <= 0.0 && d3 * d4 <= 0.0;
 }
 
-// The middle of the way through door d's opening [m, in W]: a leaf standing open fills the
-// opening's hinge end, up to its free edge's reach along the closed leaf (at 80 degrees, a
-// 0.95 m leaf 0.17 m of it), on the side it opens into; whoever passes, either way, passes
-// beside it. Aimed at the doorway's centre, a wide body (a wheelchair) meets the leaf's edge
-// and the far jamb at once and stands there, held by the walls' push (a local minimum).
-Eigen::Vector2d PassageCentre(const Door& d) {
-  const DoorModel& m = *d.fixed;
-  if (d.angle <= AdaDoorOperator::kClosedAngle || m.swing_side == 0.0) return m.centre;
-  const Eigen::Vector2d hinge = m.desc->p_WH.head<2>();
-  const double half = (m.centre - hinge).dot(m.along);
-  const double taken =
-      std::clamp((m.desc->CalcFreeEdge(d.angle).head<2>() - hinge).dot(m.along), 0.0, half);
-  return m.centre + m.along * (taken / 2);
-}
-
 }  // namespace
 
 std::string_view ToString(PersonPhase phase) {
@@ -291,8 +276,7 @@ void TwinWorld::Impl::UpdatePeople() {
                 config.door_crossed_open_angle_deg * kDegToRad &&
             (p.walker.position - d.centre).norm() < kSkipQueueSpotM) {
           const double side = (p.walker.position - d.centre).dot(d.normal) >= 0 ? 1.0 : -1.0;
-          p.route.front() = PassageCentre(doors[std::size_t(next->second)]) +
-                            d.normal * side * kLineUpBeforeDoorM;
+          p.route.front() = d.centre + d.normal * side * kLineUpBeforeDoorM;
         }
       }
     }
@@ -301,10 +285,6 @@ void TwinWorld::Impl::UpdatePeople() {
     p.walker.final_target = p.route.size() == 1;
     p.walker.desired_speed = p.speed;
     const int gate = GateDoor(p);
-    // Through a doorway of the route: by the middle of what its leaf leaves open.
-    if (const auto through = p.doorway_waypoints.find(p.reached);
-        through != p.doorway_waypoints.end() && p.route.size() > 1)
-      p.walker.target = PassageCentre(doors[std::size_t(through->second)]);
     // Someone waiting goes on only once the leaf is a few degrees past the threshold: a leaf
     // held right at it (by someone behind it) would otherwise set them walking into it and
     // stopping again, step after step.
