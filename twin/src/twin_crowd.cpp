@@ -360,9 +360,7 @@ void TwinWorld::Impl::UpdatePeople() {
           // The leaf they were going round has shut: the way round it (now likely through the
           // wall beside the doorway) is no way at all.
           if (p.round_leaf == int(k)) {
-            p.route.erase(p.route.begin());
-            ++p.reached;
-            p.round_leaf = -1;
+            SkipRouteTo(p, p.reached + 1);
             p.walker.target = p.route.front();
           }
           continue;
@@ -385,9 +383,7 @@ void TwinWorld::Impl::UpdatePeople() {
           // stand (clinic two wards seed 22: 6 residents kept at door_e to the time limit).
           if (p.route.size() > 1 && !SegmentsCross(p.walker.position, p.route[1], hinge,
                                                    edge + along * p.walker.radius)) {
-            p.route.erase(p.route.begin());
-            ++p.reached;
-            p.round_leaf = -1;
+            SkipRouteTo(p, p.reached + 1);
             p.walker.target = p.route.front();
             p.walker.final_target = p.route.size() == 1;
             continue;
@@ -418,9 +414,7 @@ void TwinWorld::Impl::UpdatePeople() {
                             : kWaypointReachedM;
     if ((p.walker.position - p.route.front()).norm() < reached_radius &&
         p.state.phase != PersonPhase::kWaitingForDoor) {
-      p.route.erase(p.route.begin());
-      ++p.reached;
-      p.round_leaf = -1;
+      SkipRouteTo(p, p.reached + 1);
     }
   }
   // Social forces: the robot is a disc to avoid; door leaves are walls.
@@ -495,6 +489,15 @@ void TwinWorld::Impl::RewindIfPushedBack(Person& p) {
   }
 }
 
+void TwinWorld::Impl::SkipRouteTo(Person& p, int waypoint) {
+  p.route.erase(p.route.begin(), p.route.begin() + long(waypoint - p.reached));
+  p.reached = waypoint;
+  // A way round a leaf is always the route's first waypoint, now dropped: left set, it would
+  // turn the next waypoint into that way round (clinic escort seed 54: past door_e, back
+  // through it against the crowd, 11 residents held there for 300 s).
+  p.round_leaf = -1;
+}
+
 void TwinWorld::Impl::AdvancePastDoorways(Person& p) const {
   for (auto it = p.doorway_waypoints.rbegin(); it != p.doorway_waypoints.rend(); ++it) {
     const int centre = it->first;
@@ -508,22 +511,14 @@ void TwinWorld::Impl::AdvancePastDoorways(Person& p) const {
     // (door_d propped open, no robot, seed 15: 7 residents held in the ward for 250 s).
     if (centre > p.reached && std::abs(rel.dot(d.normal)) < p.walker.radius &&
         std::abs(rel.dot(d.along)) < d.reach / 2) {
-      p.route.erase(p.route.begin(), p.route.begin() + long(centre - p.reached));
-      p.reached = centre;
-      p.round_leaf = -1;
+      SkipRouteTo(p, centre);
       return;
     }
     const bool past = rel.dot(d.normal) * (p.route[beyond] - d.centre).dot(d.normal) > 0.0 &&
                       std::abs(rel.dot(d.normal)) > p.walker.radius &&
                       rel.norm() < kPastDoorwayReachM;
     if (!past) continue;
-    p.route.erase(p.route.begin(), p.route.begin() + long(beyond));
-    p.reached = centre + 1;
-    // The way round a leaf (the route's first waypoint, now erased) is behind them too: left
-    // set, it would turn their next waypoint into that way round, back through the doorway
-    // against the crowd, where they would stand and keep everyone waiting for the doorway
-    // (clinic escort seed 54: 11 residents held at door_e for 300 s).
-    p.round_leaf = -1;
+    SkipRouteTo(p, centre + 1);
     return;
   }
 }

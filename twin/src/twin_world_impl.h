@@ -155,6 +155,9 @@ struct TwinWorld::Impl {
   // An evacuee past a doorway of their route (pushed through by the crowd) resumes their route
   // beyond it; one pushed into it before reaching the waypoints before it, from its centre.
   void AdvancePastDoorways(Person& p) const;
+  // Drops the route's waypoints before index `waypoint` of the whole route (p.reached indexes
+  // the first remaining one), with any way round a leaf: every step on along the route.
+  static void SkipRouteTo(Person& p, int waypoint);
   // An evacuee stuck with a wall between them and their next waypoint, on the near side of a
   // doorway of their route they had passed (the crowd pushed them back through it), takes up
   // their route again from before that doorway.
