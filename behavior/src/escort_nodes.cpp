@@ -28,6 +28,8 @@ constexpr double kWatchWithinRad = M_PI / 2;
 constexpr double kThroughM = 0.3;
 // [m] The robot this near its wait spot is there.
 constexpr double kAtSpotM = 0.15;
+// An operation asked for that did not happen is not asked for again sooner than this [s].
+constexpr double kOperateRetrySec = 3.0;
 // [s] The head's look at the residents' way in lasts this long unless renewed (each tick).
 constexpr double kLookRequestSec = 0.5;
 // [m/s] A tracked person faster than this is on the move.
@@ -175,9 +177,12 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
       came_ = true;
     }
     if (around.moving) last_moving_ = belief_.now;
+    // Clear time counts only while the way in is in the laser's sweep: stepping aside with its
+    // back to the door, the robot sees nobody there (two-wards seed 17: a resident waiting at
+    // door_e, behind it, was "everyone through" after clear_for).
     if (around.near) {
       unseen_ = 0.0;
-    } else if (last_tick_) {
+    } else if (last_tick_ && IsInLaserSweep(task_, belief_.X_MB, pass.centre + pass.n_M)) {
       unseen_ += ToSeconds(belief_.now - *last_tick_);
     }
     last_tick_ = belief_.now;
@@ -245,7 +250,10 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
         !around.moving &&
         (found_waiting || all_waiting ? WayClear(standoff_, kStandoffFreeM, kSpotClearM)
                                       : WayClear(standoff_, Input<double>("keep_clear")));
-    if (OperateDue() && actuator_clear) return NodeStatus::kSuccess;
+    if (OperateDue() && actuator_clear && !OperationJustFailed()) {
+      operate_asked_at_ = belief_.now;
+      return NodeStatus::kSuccess;
+    }
     const Pose2& wait_at = came_ || !actuator_clear ? spot_ : standoff_;
     // Only the spot and the last kSpotClearM of the way there: from far back, the straight line
     // to it passes people it will never meet on its path (clinic: a resident waiting at door_e
@@ -253,10 +261,16 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // navigation yields to people as everywhere.
     if ((wait_at.translation() - belief_.X_MB.translation()).norm() > kAtSpotM &&
         WayClear(wait_at, kSpotClearM, kSpotClearM)) {
+      // Facing the way it drives, turning to watch at the spot (below): from the last door
+      // the way there runs away from where the residents come, and facing them the robot drove
+      // backwards, the laser's blind sector leading, into a resident queued on its way
+      // (two-wards seed 12, 14 m along the corridor).
       Pose2 goal = wait_at;
       goal.yaw = LookYaw(pass, wait_at.translation());
-      if (StartPath(task_, goal, &wait_at == &spot_ ? "the spot beside the door" : "the actuator",
-                    [this](const std::string& t) { Note(t); }) == NodeStatus::kRunning)
+      if (StartPath(
+              task_, goal, &wait_at == &spot_ ? "the spot beside the door" : "the actuator",
+              [this](const std::string& t) { Note(t); }, false,
+              PathHeading::kAlongTravel) == NodeStatus::kRunning)
         return NodeStatus::kRunning;
     }
     // Waiting, at the actuator as aside, face the way the residents come: the camera sees only
@@ -379,6 +393,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
 
   void ResetHold() {
     started_.reset();
+    operate_asked_at_.reset();
     last_tick_.reset();
     nobody_at_last_watch_ = false;
     came_ = false;
@@ -425,6 +440,18 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     if (!found) Note("no free spot beside the actuator: waiting at its standoff");
     this->SetOutput("spot", PosePortText(spot_));
     return true;
+  }
+
+  // The operation asked for less than kOperateRetrySec ago did not happen (the approach found
+  // no free standoff: someone waiting by the actuator, in reach of the arm from nowhere the
+  // base may stand): asked again at once, it failed again every tick for 340 s (two-wards
+  // seed 17).
+  bool OperationJustFailed() const {
+    if (!operate_asked_at_ || ToSeconds(belief_.now - *operate_asked_at_) >= kOperateRetrySec)
+      return false;
+    const std::optional<DoorVisit> visit = Shared<DoorVisit>("visit");
+    return !visit || visit->door != door_ || !visit->operated_at ||
+           *visit->operated_at < *operate_asked_at_;
   }
 
   bool OperateDue() const {
@@ -512,15 +539,16 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   std::string door_;
   Pose2 standoff_;
   Pose2 spot_;
-  std::optional<Time> started_;        // when this hold began
-  std::optional<Time> last_tick_;      // the previous tick of an unbroken watch
-  bool nobody_at_last_watch_{false};   // nobody was near at the last tick of the watch
-  bool came_{false};                   // someone came during this hold
-  std::optional<Time> last_moving_;    // when someone near was last seen on the move
-  double unseen_{0.0};                 // [s] of watching since anyone was near
-  bool making_room_{false};            // stepping away from someone too near
-  Eigen::Vector2d room_to_{0.0, 0.0};  // where that step ends
-  Time room_since_{};                  // when it began
+  std::optional<Time> started_;           // when this hold began
+  std::optional<Time> operate_asked_at_;  // when it last returned SUCCESS: operate now
+  std::optional<Time> last_tick_;         // the previous tick of an unbroken watch
+  bool nobody_at_last_watch_{false};      // nobody was near at the last tick of the watch
+  bool came_{false};                      // someone came during this hold
+  std::optional<Time> last_moving_;       // when someone near was last seen on the move
+  double unseen_{0.0};                    // [s] of watching since anyone was near
+  bool making_room_{false};               // stepping away from someone too near
+  Eigen::Vector2d room_to_{0.0, 0.0};     // where that step ends
+  Time room_since_{};                     // when it began
   bool stood_open_{false};  // the door stood open kStillForSec in this hold with nobody moving
 };
 

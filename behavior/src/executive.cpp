@@ -377,6 +377,26 @@ void Executive::UpdatePersonalSpaces() {
   costmap_->SetPersonalSpaces(spaces);
 }
 
+void Executive::RememberSwept() {
+  auto& swept = belief_.swept_p_MB;
+  const auto old = std::find_if(swept.begin(), swept.end(), [&](const auto& s) {
+    return ToSeconds(belief_.now - s.first) <= kSweptMemorySec;
+  });
+  swept.erase(swept.begin(), old);
+  if (!belief_.scan) return;
+  const double speed = std::hypot(belief_.V_B.vx, belief_.V_B.vy);
+  if (speed < kSweptMinMps) return;
+  // The heading of the base's velocity in the laser's frame.
+  const double bearing =
+      std::remainder(std::atan2(belief_.V_B.vy, belief_.V_B.vx) - belief_.X_BL.yaw, 2 * M_PI);
+  if (bearing < belief_.scan->angle_min + detail::PeopleRoom::kSweepMarginRad ||
+      bearing > belief_.scan->angle_max() - detail::PeopleRoom::kSweepMarginRad)
+    return;
+  const Eigen::Vector2d p = belief_.X_MB.translation();
+  if (swept.empty() || (p - swept.back().second).norm() >= kSweptSampleM)
+    swept.emplace_back(belief_.now, p);
+}
+
 bt::Tree& Executive::tree() {
   return *impl_->tree;
 }
@@ -530,6 +550,7 @@ bool Executive::Step(RobotPort& port) {
     m.zone_occupied[door.id] = occupied;
   }
   if (!in_any_zone && !m.motion.base_failed()) belief_.last_safe = belief_.X_MB;
+  RememberSwept();
   if (newly_occupied && !m.occupied_known_at) m.occupied_known_at = ToSeconds(now);
   bool any_occupied = false;
   for (const auto& entry : m.zone_occupied)

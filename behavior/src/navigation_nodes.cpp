@@ -197,6 +197,8 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
   NodeStatus OnStart() override {
     task_.motion->StopBase();
     failure_noted_ = false;
+    looked_back_ = false;
+    looking_back_until_.reset();
     started_ = belief_.now;
     if (!ArmAt(task_.motion->arm_target(), TuckedArm(*task_.model)) ||
         task_.motion->arm_moving(belief_.now)) {
@@ -239,6 +241,10 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
   void StartRetreatOnceStopped() {
     const double speed = std::hypot(belief_.V_B.vx, belief_.V_B.vy);
     if (speed > kStoppedMps && ToSeconds(belief_.now - started_) < kStopWithinSec) return;
+    if (looking_back_until_) {
+      if (task_.motion->base_moving() || belief_.now < *looking_back_until_) return;
+      looking_back_until_.reset();
+    }
     pending_ = false;
     // Out of a doorway straight back along the door's normal first (a diagonal line would cut
     // the jamb or the leaf), then on.
@@ -258,6 +264,28 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
       }
     }
     const auto chosen = ChooseSpot(path);
+    if (!chosen && !looked_back_) {
+      // The way back may only be unseen: it is behind the robot, in the laser's blind sector
+      // (two-wards seed 12: driving through door_d, halted for residents crossing the doorway's
+      // far side, the robot stood 7 s in the doorway beside them, then the door shut on it).
+      // Turn on the spot until it is inside the laser's sweep (no further: the base turns at
+      // ~0.3 rad/s on average, and a whole turn took 9 s, the door shutting on the robot
+      // meanwhile), and choose again once the laser has seen it.
+      looked_back_ = true;
+      std::vector<Eigen::Vector2d> back;
+      for (const Pose2& p : path)
+        back.push_back(p.translation());
+      back.push_back(belief_.last_safe->translation());
+      const std::optional<double> yaw = PeopleRoom(task_, kPeopleHorizonSec).YawSeeing(back);
+      if (yaw && std::abs(std::remainder(*yaw - belief_.X_MB.yaw, 2 * M_PI)) > 0.0) {
+        task_.motion->FollowPath({belief_.X_MB, {belief_.X_MB.x, belief_.X_MB.y, *yaw}}, {false},
+                                 TuckedArm(*task_.model), belief_.now);
+        looking_back_until_ = belief_.now + SecondsToDuration(kLookBackDwellSec);
+        pending_ = true;
+        Note("turning to see the way back");
+        return;
+      }
+    }
     if (!chosen) {
       Note("nowhere to back off to without passing someone: standing still");
       return;
@@ -296,8 +324,14 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
     return std::nullopt;
   }
 
+  // After turning to see the way back: long enough for the laser's people tracks to confirm
+  // whoever stands there [s].
+  static constexpr double kLookBackDwellSec = 0.5;
+
   bool pending_{false};
   bool failure_noted_{false};
+  bool looked_back_{false};
+  std::optional<Time> looking_back_until_;  ///< turning to see the way back until then, at least
   Time started_{};
 };
 

@@ -33,7 +33,8 @@ std::string PosePortText(const Pose2& X) {
 // Plans from the robot to `goal` on the costmap and starts following the path; `door_speed`
 // runs every segment at the door speed (a door approach inside the hold window).
 NodeStatus StartPath(const TaskServices& task, const Pose2& goal, const std::string& what,
-                     const std::function<void(const std::string&)>& note, bool door_speed) {
+                     const std::function<void(const std::string&)>& note, bool door_speed,
+                     PathHeading heading) {
   planning::PlanResult plan = task.planner->Plan(task.belief->X_MB, goal);
   if (plan.status == planning::PlanStatus::kStartInCollision) {
     // The robot stands where the costmap says it cannot (inflation around a leaf, a person seen
@@ -70,22 +71,46 @@ NodeStatus StartPath(const TaskServices& task, const Pose2& goal, const std::str
     note(StrCat("no path to ", what, " (", PoseText(goal), "): ", plan.message));
     return NodeStatus::kFailure;
   }
-  const std::vector<bool> through(plan.path.size() > 0 ? plan.path.size() - 1 : 0, door_speed);
   if (plan.path.size() < 2 ||
       (plan.path.back().translation() - task.belief->X_MB.translation()).norm() < 0.01) {
     return NodeStatus::kSuccess;  // already there
   }
-  // The base is holonomic: turn from the start yaw to the goal yaw evenly along the path
-  // rather than through the planner's intermediate headings.
   std::vector<Pose2> path = plan.path;
   path.front().yaw = task.belief->X_MB.yaw;
-  const double turn = std::remainder(goal.yaw - task.belief->X_MB.yaw, 2 * M_PI);
-  double travelled = 0.0;
-  for (std::size_t i = 1; i < path.size(); ++i) {
-    travelled += (path[i].translation() - path[i - 1].translation()).norm();
-    const double fraction = plan.length > 0 ? std::min(1.0, travelled / plan.length) : 1.0;
-    path[i].yaw = task.belief->X_MB.yaw + turn * fraction;
+  if (heading == PathHeading::kAlongTravel && plan.length >= kFaceTravelBeyondM) {
+    // Each waypoint faces along the segment that starts there (the last, along the one that
+    // ends there): the robot turns into each segment on the one before.
+    const auto segment_yaw = [&](std::size_t i) {
+      const Eigen::Vector2d d = path[i + 1].translation() - path[i].translation();
+      return std::atan2(d.y(), d.x());
+    };
+    // Segments too short to have a direction (an escape step's end) take the next one's.
+    std::size_t first = 0;
+    while (first + 2 < path.size() &&
+           (path[first + 1].translation() - path[first].translation()).norm() < 0.01)
+      ++first;
+    const double first_yaw = segment_yaw(first);
+    for (std::size_t i = 1; i + 1 < path.size(); ++i)
+      path[i].yaw = i <= first ? first_yaw : segment_yaw(i);
+    path.back().yaw = segment_yaw(path.size() - 2);
+    if (std::abs(std::remainder(first_yaw - task.belief->X_MB.yaw, 2 * M_PI)) >
+        kFaceTravelTurnFirstRad) {
+      Pose2 turned = task.belief->X_MB;
+      turned.yaw = first_yaw;
+      path.insert(path.begin() + 1, turned);
+    }
+  } else {
+    // The base is holonomic: turn from the start yaw to the goal yaw evenly along the path
+    // rather than through the planner's intermediate headings.
+    const double turn = std::remainder(goal.yaw - task.belief->X_MB.yaw, 2 * M_PI);
+    double travelled = 0.0;
+    for (std::size_t i = 1; i < path.size(); ++i) {
+      travelled += (path[i].translation() - path[i - 1].translation()).norm();
+      const double fraction = plan.length > 0 ? std::min(1.0, travelled / plan.length) : 1.0;
+      path[i].yaw = task.belief->X_MB.yaw + turn * fraction;
+    }
   }
+  const std::vector<bool> through(path.size() - 1, door_speed);
   task.motion->FollowPath(path, through, task.motion->arm_target(), task.belief->now);
   note(StrCat("driving to ", what, " (", PoseText(goal), ", ", std::round(plan.length * 100) / 100,
               " m)"));
@@ -351,26 +376,54 @@ double PeopleRoom::Score(const std::vector<Eigen::Vector2d>& corners) const {
          kWayCostPerM * (q - at_).norm();
 }
 
-bool PeopleRoom::IsSeen(const Eigen::Vector2d& p) const {
-  const Belief& belief = *task_.belief;
-  if (!belief.scan || (p - at_).norm() <= task_.config.footprint_radius) return true;
-  const Eigen::Vector2d p_L = (belief.X_MB * belief.X_BL).Inverse() * p;
+bool IsInLaserSweep(const TaskServices& task, const Pose2& X_MB, const Eigen::Vector2d& p_M) {
+  const Belief& belief = *task.belief;
+  if (!belief.scan || (p_M - X_MB.translation()).norm() <= task.config.footprint_radius)
+    return true;
+  const Eigen::Vector2d p_L = (X_MB * belief.X_BL).Inverse() * p_M;
   const double bearing = std::atan2(p_L.y(), p_L.x());
-  return bearing >= belief.scan->angle_min + kSweepMarginRad &&
-         bearing <= belief.scan->angle_max() - kSweepMarginRad;
+  return bearing >= belief.scan->angle_min + PeopleRoom::kSweepMarginRad &&
+         bearing <= belief.scan->angle_max() - PeopleRoom::kSweepMarginRad;
+}
+
+bool PeopleRoom::IsSeenFrom(const Pose2& X_MB, const Eigen::Vector2d& p) const {
+  // Where the base just drove, facing that way: nobody stood there as it passed.
+  for (const auto& [t, p_MB] : task_.belief->swept_p_MB)
+    if ((p - p_MB).norm() <= task_.config.footprint_radius) return true;
+  return IsInLaserSweep(task_, X_MB, p);
+}
+
+bool PeopleRoom::AllAlong(const std::vector<Eigen::Vector2d>& corners,
+                          const std::function<bool(const Eigen::Vector2d&)>& f) const {
+  for (std::size_t i = 0; i + 1 < corners.size(); ++i) {
+    const double length = (corners[i + 1] - corners[i]).norm();
+    const int steps = std::max(1, int(std::ceil(length / kPathSampleM)));
+    for (int k = 1; k <= steps; ++k)
+      if (!f(corners[i] + (corners[i + 1] - corners[i]) * (double(k) / steps))) return false;
+  }
+  return true;
 }
 
 bool PeopleRoom::IsWayClear(const std::vector<Eigen::Vector2d>& corners) const {
   const double passable = task_.config.footprint_radius + kPassMarginM;
-  for (std::size_t i = 0; i + 1 < corners.size(); ++i) {
-    const double length = (corners[i + 1] - corners[i]).norm();
-    const int steps = std::max(1, int(std::ceil(length / kPathSampleM)));
-    for (int k = 1; k <= steps; ++k) {
-      const Eigen::Vector2d p = corners[i] + (corners[i + 1] - corners[i]) * (double(k) / steps);
-      if (RoomAt(now_, p) < passable || !IsSeen(p)) return false;
+  const Pose2& X_MB = task_.belief->X_MB;
+  return AllAlong(corners, [&](const Eigen::Vector2d& p) {
+    return RoomAt(now_, p) >= passable && IsSeenFrom(X_MB, p);
+  });
+}
+
+std::optional<double> PeopleRoom::YawSeeing(const std::vector<Eigen::Vector2d>& corners) const {
+  if (!task_.belief->scan) return std::nullopt;
+  Pose2 X_MB = task_.belief->X_MB;
+  const double yaw = X_MB.yaw;
+  for (double turn = 0.0; turn <= M_PI + 1e-9; turn += kLookTurnStepRad) {
+    for (const double sign : {1.0, -1.0}) {
+      X_MB.yaw = yaw + sign * turn;
+      if (AllAlong(corners, [&](const Eigen::Vector2d& p) { return IsSeenFrom(X_MB, p); }))
+        return X_MB.yaw;
     }
   }
-  return true;
+  return std::nullopt;
 }
 
 std::optional<Pose2> PeopleRoom::BestSpotAround(const std::vector<Pose2>& way, double beat) const {

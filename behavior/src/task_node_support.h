@@ -3,6 +3,7 @@
 // path helpers, arm IK at a fixed base, the door constants — and each family's registration.
 // Not installed; the public face is egress/behavior/task_nodes.h.
 
+#include <cmath>
 #include <functional>
 #include <optional>
 #include <string>
@@ -126,11 +127,30 @@ inline std::pair<std::string, bt::PortInfo> RetreatingPort(bt::PortDirection dir
   return port;
 }
 
+/// How the base's heading goes along a path StartPath starts.
+enum class PathHeading {
+  /// From the start yaw to the goal's evenly along the path (the base is holonomic).
+  kEvenTurn,
+  /// Facing the way it drives on a path longer than kFaceTravelBeyondM (turning on the spot
+  /// first when that way is more than kFaceTravelTurnFirstRad off), ending facing along the
+  /// last segment, not the goal's yaw: the laser's blind sector is behind the robot, and a
+  /// long drive backwards meets whoever stands in its way unseen (two-wards seed 12). Shorter
+  /// paths: as kEvenTurn.
+  kAlongTravel,
+};
+/// Paths at least this long are driven facing the way of travel under PathHeading::kAlongTravel.
+inline constexpr double kFaceTravelBeyondM = 2.0;
+/// Under PathHeading::kAlongTravel, a start heading more than this off the first segment's is
+/// turned on the spot before driving (within it, the turn is spread along the first segment).
+inline constexpr double kFaceTravelTurnFirstRad = M_PI / 3;
+
 /// Plans from the robot to `goal` on the costmap and starts following the path; `door_speed`
-/// runs every segment at the door speed (a door approach inside the hold window). RUNNING while
-/// the base moves, SUCCESS if already there, FAILURE (noted) without a path.
+/// runs every segment at the door speed (a door approach inside the hold window); `heading`:
+/// how the base turns along it. RUNNING while the base moves, SUCCESS if already there, FAILURE
+/// (noted) without a path.
 NodeStatus StartPath(const TaskServices& task, const Pose2& goal, const std::string& what,
-                     const NoteFn& note, bool door_speed = false);
+                     const NoteFn& note, bool door_speed = false,
+                     PathHeading heading = PathHeading::kEvenTurn);
 /// The base motion under way: RUNNING, SUCCESS when it ended, FAILURE (noted) when the
 /// watchdog stopped it.
 NodeStatus BaseMotionStatus(const TaskServices& task, const NoteFn& note);
@@ -177,6 +197,10 @@ std::vector<Occupant> PeopleAround(const TaskServices& task, const Eigen::Vector
 /// The distance from `q` to the nearest edge among `near` (infinity for none) [m].
 double RoomAt(const std::vector<Occupant>& near, const Eigen::Vector2d& q);
 
+/// p_M is inside the base laser's sweep (less PeopleRoom::kSweepMarginRad each side) with the
+/// base at X_MB, or under the robot; true without a scan (nothing to tell).
+bool IsInLaserSweep(const TaskServices& task, const Pose2& X_MB, const Eigen::Vector2d& p_M);
+
 /// People's room round the robot, for choosing where to stand out of their way (a standby's
 /// retreat, a give-way in a corridor): where the tracked people (and the latest scan's returns
 /// off the map) are now and will be over `horizon` [s], and which straight ways pass them.
@@ -204,8 +228,13 @@ class PeopleRoom {
   double Score(const std::vector<Eigen::Vector2d>& corners) const;
   /// The straight lines through `corners` pass nobody (where they stand now) nearer than the
   /// footprint and kPassMarginM, and stay inside the base laser's sweep (behind the robot, in
-  /// its blind sector, nobody is seen: P1 seed 2000 backed into someone waiting there).
+  /// its blind sector, nobody is seen: P1 seed 2000 backed into someone waiting there) or where
+  /// the base has just driven facing that way (Belief::swept_p_MB).
   bool IsWayClear(const std::vector<Eigen::Vector2d>& corners) const;
+  /// The heading nearest the robot's (in kLookTurnStepRad steps) from which the straight lines
+  /// through `corners` are all inside the base laser's sweep: where to turn to see a way that
+  /// is behind it. nullopt without a scan.
+  std::optional<double> YawSeeing(const std::vector<Eigen::Vector2d>& corners) const;
   /// Of the spots round the robot (kSpotRadiiM x kSpotHeadings, at its heading) outside every
   /// door's zone, reachable from `way` (the robot's pose first) by a clear straight line the
   /// planner finds valid: the best-scoring one, if it scores above `beat`.
@@ -220,11 +249,18 @@ class PeopleRoom {
   static constexpr double kPassMarginM = 0.1;        ///< beyond the footprint [m]
   static constexpr double kPathSampleM = 0.05;       ///< ways checked this often [m]
   static constexpr double kSweepMarginRad = 10.0 * M_PI / 180.0;
+  static constexpr double kLookTurnStepRad = 5.0 * M_PI / 180.0;  ///< see YawSeeing
   static constexpr double kSidestepSampleM = 0.05;  ///< sidesteps checked against walls this often
   static constexpr double kSidestepMinMps = 0.3;    ///< slower people are standing, not passing
 
  private:
-  bool IsSeen(const Eigen::Vector2d& p) const;
+  /// p is inside the laser's sweep with the base at X_MB (IsInLaserSweep), or where the base
+  /// has just driven facing that way (Belief::swept_p_MB).
+  bool IsSeenFrom(const Pose2& X_MB, const Eigen::Vector2d& p) const;
+  /// Calls `f` on the points the straight lines through `corners` are checked at, the first
+  /// corner excluded, until it returns false; false then.
+  bool AllAlong(const std::vector<Eigen::Vector2d>& corners,
+                const std::function<bool(const Eigen::Vector2d&)>& f) const;
   /// The room predicted_[i] leaves the base at p_MB [m].
   double RoomFrom(std::size_t i, const Eigen::Vector2d& p_MB) const;
   const TaskServices& task_;

@@ -261,6 +261,48 @@ TEST_F(HoldForResidentsTest, GoesToItsSpotPastSomeoneFarFromItOnTheStraightLine)
   EXPECT_FALSE(NotedText("driving to the spot"));
 }
 
+// From far off, it drives to its spot facing the way it goes (the laser's blind sector is behind
+// it: facing the way the residents come, it drove backwards 14 m into someone queued on its way,
+// two-wards seed 12), turning on the spot first when it faces well away; the watch turns it at
+// the spot.
+TEST_F(HoldForResidentsTest, DrivesToItsSpotFacingTheWayItGoes) {
+  BeginFarFromAShutDoor();
+  OperatedAgo(1.0);                       // not due
+  belief_.X_MB = {2.7, -0.7, -M_PI / 2};  // facing away from the spot, 3.1 m off
+  const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
+  belief_.now = At(2.0);
+  belief_.moving_returns = {{-0.5, 1.5}};  // they come
+  belief_.off_map_returns = belief_.moving_returns;
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(NotedText("driving to the spot beside the door"));
+  const std::vector<Pose2>& path = motion_.path();
+  ASSERT_GE(path.size(), 3u);
+  EXPECT_LT((path.back().translation() - spot.translation()).norm(), 1e-6);
+  // A turn on the spot first, to face the first leg.
+  EXPECT_LT((path[1].translation() - belief_.X_MB.translation()).norm(), 1e-9);
+  for (std::size_t i = 1; i + 1 < path.size(); ++i) {
+    const Eigen::Vector2d leg = path[i + 1].translation() - path[i].translation();
+    if (leg.norm() < 0.01) continue;
+    EXPECT_NEAR(std::remainder(path[i].yaw - std::atan2(leg.y(), leg.x()), 2 * M_PI), 0.0, 1e-9)
+        << "waypoint " << i << " faces along the leg that starts there";
+  }
+  const Eigen::Vector2d last = path.back().translation() - path[path.size() - 2].translation();
+  EXPECT_NEAR(std::remainder(path.back().yaw - std::atan2(last.y(), last.x()), 2 * M_PI), 0.0,
+              1e-9);
+  // A short way (under kFaceTravelBeyondM) turns evenly to the watching yaw, as before.
+  motion_.StopBase();
+  log_.Take();
+  belief_.X_MB = {spot.x, spot.y - 1.0, M_PI};
+  belief_.now = At(3.0);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(NotedText("driving to the spot beside the door"));
+  ASSERT_EQ(motion_.path().size(), 2u);
+  const Eigen::Vector2d look =
+      Eigen::Vector2d(0.0, 1.0) - motion_.path().back().translation();  // 2 m out from the door
+  EXPECT_NEAR(std::remainder(motion_.path().back().yaw - std::atan2(look.y(), look.x()), 2 * M_PI),
+              0.0, 1e-6);
+}
+
 TEST_F(HoldForResidentsTest, MakesRoomForSomeoneWhoComesTooNear) {
   tree_.TickOnce();
   OperatedAgo(1.0);
@@ -406,6 +448,61 @@ TEST_F(HoldForResidentsTest, AStepToMakeRoomStaysOutOfEveryDoorway) {
   EXPECT_LT(to.x, line_x) << "through the side door: " << to.x << ", " << to.y;
   const bool across_opening = std::abs(to.y - spot.y) < 0.5 + TaskConfig{}.footprint_radius;
   EXPECT_FALSE(across_opening && line_x - to.x < 0.6) << "in its doorway: " << to.x << ", " << to.y;
+}
+
+// An operation it asked for that did not happen (the approach found no free standoff) is not
+// asked for again at once: it was, every tick, for 340 s (two-wards seed 17).
+TEST_F(HoldForResidentsTest, AnOperationThatDidNotHappenIsNotAskedForAgainAtOnce) {
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // operate
+  // The approach failed at once: no operation. The hold runs again.
+  belief_.now = At(1.1);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  motion_.StopBase();  // the turn to watch the way in, done
+  belief_.now = At(3.9);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  motion_.StopBase();
+  belief_.now = At(4.1);  // kOperateRetrySec on
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);
+  // Operated this time: due again only `every` seconds after the operation.
+  OperatedAgo(0.0);
+  belief_.now = At(4.2);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+}
+
+// The clear time counts only while the way in is in the laser's sweep: with its back to the
+// door (stepping aside, turning), nobody there is seen (two-wards seed 17).
+TEST_F(HoldForResidentsTest, ClearTimeCountsOnlyWhileTheWayInIsInTheLasersSweep) {
+  belief_.scan = node_testing::SweepScan();
+  tree_.TickOnce();
+  OperatedAgo(1.0);
+  belief_.now = At(2.0);
+  belief_.moving_returns = {{-0.5, 1.5}};  // they come
+  belief_.off_map_returns = belief_.moving_returns;
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  belief_.moving_returns.clear();
+  belief_.off_map_returns.clear();
+  // Aside, facing away from the doorway's way in (x = 0, y = 2 from the spot's east): the
+  // laser's blind sector behind it.
+  const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
+  belief_.X_MB = {spot.x, spot.y, 0.0};
+  for (double t = 2.5; t < 9.0; t += 0.5) {
+    belief_.now = At(t);
+    motion_.StopBase();  // it would turn to watch: held facing away here
+    OperatedAgo(0.5);
+    EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning) << "at " << t << ": nothing seen yet";
+  }
+  // Facing the way in: clear_for (3 s) of watching, then the hold is over.
+  belief_.X_MB.yaw = M_PI;
+  for (double t = 9.0; t < 12.0; t += 0.5) {
+    belief_.now = At(t);
+    motion_.StopBase();
+    OperatedAgo(0.5);
+    EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning) << "at " << t;
+  }
+  belief_.now = At(12.6);
+  OperatedAgo(0.5);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kFailure);
+  EXPECT_TRUE(NotedText("everyone is through"));
 }
 
 TEST_F(HoldForResidentsTest, WithNobodyAboutTheHoldEndsAfterWaitFor) {

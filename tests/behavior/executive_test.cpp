@@ -3,7 +3,9 @@
 
 #include "egress/behavior/executive.h"
 
+#include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -63,18 +65,41 @@ TEST(ExecutiveTest, TheFootprintComesFromTheRobotDescription) {
   EXPECT_EQ(blind.octomap(), nullptr);
 }
 
+// A scripted robot on a simulated clock that ignores every command; subclasses give the
+// sensing.
+class ScriptedRobot : public RobotPort {
+ public:
+  const Clock& clock() const override { return clock_; }
+
+ protected:
+  // A snapshot stamped now, with odometry, joints and gripper stamped too (and nothing else).
+  SensorSnapshot Stamped() const {
+    SensorSnapshot s;
+    s.stamp = clock_.Now();
+    s.odometry.stamp = s.stamp;
+    s.joints.stamp = s.stamp;
+    s.gripper.stamp = s.stamp;
+    return s;
+  }
+  SimClock clock_;
+
+ private:
+  void DoSendBaseVelocity(const Twist2&) override {}
+  void DoSendArmTrajectory(const JointTrajectory&) override {}
+  void DoSendGripperCommand(const GripperCommand&) override {}
+  void DoSendHeadCommand(const HeadCommand&) override {}
+};
+
 // A robot that gives colour images and depth, no detections of its own (a real robot without
 // an on-board detector): a fixed pose, a flat wall 1.5 m ahead of the camera.
-class ImageOnlyRobot final : public RobotPort {
+class ImageOnlyRobot final : public ScriptedRobot {
  public:
   explicit ImageOnlyRobot(const RobotModel& model) : X_BC_(model.CalcHeadCameraPose(0.0, {})) {}
-  const Clock& clock() const override { return clock_; }
   void Advance() { clock_.AdvanceBy(SecondsToDuration(0.1)); }
 
  private:
   SensorSnapshot DoSense() override {
-    SensorSnapshot s;
-    s.stamp = clock_.Now();
+    SensorSnapshot s = Stamped();
     s.depth_intrinsics = CameraIntrinsics::FromHorizontalFov(64, 48, 1.0);
     DepthImage depth;
     depth.stamp = s.stamp;
@@ -90,16 +115,8 @@ class ImageOnlyRobot final : public RobotPort {
     color.bgr.assign(64 * 48 * 3, 0);
     color.bgr[0] = 200;  // a mark the detector checks it sees
     s.color = color;
-    s.odometry.stamp = s.stamp;
-    s.joints.stamp = s.stamp;
-    s.gripper.stamp = s.stamp;
     return s;
   }
-  void DoSendBaseVelocity(const Twist2&) override {}
-  void DoSendArmTrajectory(const JointTrajectory&) override {}
-  void DoSendGripperCommand(const GripperCommand&) override {}
-  void DoSendHeadCommand(const HeadCommand&) override {}
-  SimClock clock_;
   Pose3 X_BC_;
 };
 
@@ -150,6 +167,65 @@ TEST(ExecutiveTest, ColourImagesGoThroughTheDetectorStage) {
     other.Advance();
   }
   EXPECT_TRUE(blind.belief().world.payloads.empty());
+}
+
+// A robot whose base moves at a set velocity (odometry only; its laser sees nothing in range).
+class RollingRobot final : public ScriptedRobot {
+ public:
+  void Advance(double dt) {
+    const Pose2 step{V_B_.vx * dt, V_B_.vy * dt, V_B_.wz * dt};
+    X_OB_ = X_OB_ * step;
+    clock_.AdvanceBy(SecondsToDuration(dt));
+  }
+  void set_velocity(const Twist2& V_B) { V_B_ = V_B; }
+
+ private:
+  SensorSnapshot DoSense() override {
+    SensorSnapshot s = Stamped();
+    LaserScan scan;
+    scan.stamp = s.stamp;
+    scan.angle_min = -0.75 * M_PI;
+    scan.angle_increment = 1.5 * M_PI / 100;
+    scan.range_max = 20.0;
+    scan.ranges.assign(101, std::numeric_limits<float>::infinity());
+    s.scan = scan;
+    s.odometry.X_OB = X_OB_;
+    s.odometry.V_B = V_B_;
+    return s;
+  }
+  Pose2 X_OB_;
+  Twist2 V_B_;
+};
+
+// Where the base drove the way its laser looks is remembered for kSweptMemorySec (a retreat may
+// go back that way unseen); where it backed is not.
+TEST(ExecutiveTest, WhereTheBaseDroveFacingTheWayIsRememberedForAWhile) {
+  const auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
+  RollingRobot robot;
+  Executive brain(model, EmptyRoom(), GoTo(), {2.0, 3.0, 0.0}, Defaults());
+  const auto step_for = [&](double seconds) {
+    for (int i = 0; i < int(std::lround(seconds / 0.1)); ++i) {
+      brain.Step(robot);
+      robot.Advance(0.1);
+    }
+  };
+  robot.set_velocity({0.4, 0.0, 0.0});  // forwards: 0.8 m in 2 s
+  step_for(2.0);
+  const auto& swept = brain.belief().swept_p_MB;
+  ASSERT_GE(swept.size(), 10u);
+  for (std::size_t i = 1; i < swept.size(); ++i) {
+    EXPECT_GE((swept[i].second - swept[i - 1].second).norm(), kSweptSampleM - 1e-9);
+    EXPECT_GT(swept[i].first, swept[i - 1].first);
+  }
+  EXPECT_NEAR(swept.front().second.x(), 2.0, 0.1);
+  EXPECT_GT(swept.back().second.x(), 2.6);
+  const std::size_t forwards = swept.size();
+  robot.set_velocity({-0.4, 0.0, 0.0});  // backwards, the blind sector leading: not kept
+  step_for(2.0);
+  EXPECT_EQ(swept.size(), forwards);
+  robot.set_velocity({});
+  step_for(kSweptMemorySec);  // all of it older than the memory
+  EXPECT_TRUE(swept.empty());
 }
 
 TEST(ExecutiveTest, BadConfigurationsAreRefusedNamingTheField) {

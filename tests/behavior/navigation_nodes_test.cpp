@@ -237,12 +237,7 @@ TEST_F(NavigationNodesTest, RetractToSafeKeepsToWhereTheLaserSeesAndPassesNobody
   bt::Tree tree = Tree(R"(<RetractToSafe/>)", blackboard);
   belief_.X_MB = {0.0, 2.4, M_PI / 2};
   belief_.last_safe = Pose2{0.0, 1.2, M_PI / 2};  // straight behind: the laser's blind sector
-  LaserScan scan;
-  scan.angle_min = -0.75 * M_PI;
-  scan.angle_increment = 1.5 * M_PI / 100;
-  scan.ranges.assign(101, 5.0f);
-  scan.range_max = 20.0;
-  belief_.scan = scan;
+  belief_.scan = node_testing::SweepScan();
   belief_.X_BL = Pose2{};
   belief_.now = At(1.0);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
@@ -263,6 +258,61 @@ TEST_F(NavigationNodesTest, RetractToSafeKeepsToWhereTheLaserSeesAndPassesNobody
   tree.TickOnce();
   for (const Pose2& p : motion_.path())
     EXPECT_LT(p.x, 0.75 - 0.3 - 0.215) << "the way would pass through the person at x = 0.75";
+}
+
+// Halted in a doorway facing away from the way back (two-wards seed 12: it stood 7 s in the
+// doorway beside residents passing, until the door shut on it): where it has just driven,
+// facing that way, counts as seen; beyond that it turns on the spot only until the way back
+// is inside the laser's sweep, then backs off.
+TEST_F(NavigationNodesTest, RetractToSafeTurnsToSeeTheWayBackAndTrustsWhereItJustDrove) {
+  auto blackboard = bt::Blackboard::Create();
+  bt::Tree tree = Tree(R"(<RetractToSafe/>)", blackboard);
+  belief_.X_MB = {0.0, 2.9, M_PI / 2};            // in the doorway, facing through it
+  belief_.last_safe = Pose2{0.0, 1.2, M_PI / 2};  // straight behind: the laser's blind sector
+  belief_.scan = node_testing::SweepScan();
+  belief_.X_BL = Pose2{0.15, 0.0, 0.0};
+  belief_.now = At(1.0);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_FALSE(Noted(DecisionEvent::kRetreating));
+  ASSERT_EQ(motion_.path().size(), 2u);
+  const Pose2 turned = motion_.path().back();
+  EXPECT_LT((turned.translation() - belief_.X_MB.translation()).norm(), 1e-9) << "on the spot";
+  const double turn = std::abs(std::remainder(turned.yaw - belief_.X_MB.yaw, 2 * M_PI));
+  EXPECT_GT(turn, 0.1);
+  EXPECT_LT(turn, M_PI - 0.1) << "only as far as brings the way back into the sweep";
+  // Turned and looked (past the dwell): the way back is seen and clear, so it backs off.
+  motion_.StopBase();
+  belief_.X_MB.yaw = turned.yaw;
+  belief_.now = At(1.2);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_FALSE(Noted(DecisionEvent::kRetreating)) << "still looking";
+  belief_.now = At(2.0);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(Noted(DecisionEvent::kRetreating));
+  EXPECT_LT((motion_.path().back().translation() - Eigen::Vector2d(0.0, 1.2)).norm(), 1e-6);
+
+  // The same, having just driven up that way facing it: it backs off at once, no turn.
+  tree.HaltTree();
+  motion_.StopBase();
+  log_.Take();
+  belief_.X_MB = {0.0, 2.9, M_PI / 2};
+  belief_.now = At(10.0);
+  belief_.swept_p_MB.clear();
+  for (double y = 1.2; y < 2.9; y += kSweptSampleM)
+    belief_.swept_p_MB.emplace_back(At(10.0 - (2.9 - y) / 0.4), Eigen::Vector2d(0.0, y));
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(Noted(DecisionEvent::kRetreating));
+  EXPECT_LT((motion_.path().back().translation() - Eigen::Vector2d(0.0, 1.2)).norm(), 1e-6);
+  // Someone seen standing on that way: never passed, turn or no turn.
+  tree.HaltTree();
+  motion_.StopBase();
+  log_.Take();
+  belief_.world.people = {Person({0.0, 2.0}, perception::PersonIntent::kStationary)};
+  belief_.now = At(11.0);
+  tree.TickOnce();
+  for (const Pose2& p : motion_.path())
+    EXPECT_GT((p.translation() - Eigen::Vector2d(0.0, 2.0)).norm(), 0.3 + 0.215)
+        << "the way would pass through the person";
 }
 
 }  // namespace

@@ -54,6 +54,16 @@ inline perception::TrackedPersonWithIntent Person(const Eigen::Vector2d& p_MP,
   return entry;
 }
 
+// A 270-degree scan (the HSR's base laser) with every return at 5 m: only its sweep matters.
+inline LaserScan SweepScan() {
+  LaserScan scan;
+  scan.angle_min = -0.75 * M_PI;
+  scan.angle_increment = 1.5 * M_PI / 100;
+  scan.ranges.assign(101, 5.0f);
+  scan.range_max = 20.0;
+  return scan;
+}
+
 class TaskNodeFixture : public ::testing::Test {
  protected:
   TaskNodeFixture()

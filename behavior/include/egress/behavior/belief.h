@@ -11,6 +11,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "egress/hsr_interface/geometry.h"
@@ -23,6 +24,10 @@ namespace egress::behavior {
 /// [m] A laser return this far from every wall and door leaf of the costmap is off the map: three
 /// cells, more than the localizer's error at a wall.
 inline constexpr double kOffMapM = 0.15;
+/// [s] How long Belief::swept_p_MB remembers where the base drove.
+inline constexpr double kSweptMemorySec = 5.0;
+/// [m] Belief::swept_p_MB's spacing.
+inline constexpr double kSweptSampleM = 0.05;
 
 struct Belief {
   Time now{};  ///< The robot clock at this step.
@@ -45,6 +50,10 @@ struct Belief {
   Pose2 X_BL;  ///< The laser in the base frame.
   /// The last pose at which the robot stood outside every door zone (where a standby retreats).
   std::optional<Pose2> last_safe;
+  /// Where the base has been over the last kSweptMemorySec while it drove the way its laser
+  /// looked (its velocity inside the sweep), oldest first, every kSweptSampleM: nobody stood
+  /// there as it passed, though the place may now be behind it, in the laser's blind sector.
+  std::vector<std::pair<Time, Eigen::Vector2d>> swept_p_MB;
   /// Per door: since when it has been open enough to pass in its current opening (from the
   /// angle estimate: it starts when the leaf is first seen wide enough, ends when it is seen
   /// closed or closing).

@@ -180,6 +180,8 @@ class Executive {
   void UpdatePersonalSpaces();
   // The port's detections, plus the detector stage's on a colour image when there is one.
   std::vector<Detection2D> Detect(const SensorSnapshot& snapshot);
+  // Belief::swept_p_MB: the base's position, when it drives the way its laser looks.
+  void RememberSwept();
 
   struct Impl;
   std::unique_ptr<Impl> impl_;
@@ -192,6 +194,8 @@ class Executive {
   std::vector<Decision> decisions_;
   std::vector<std::pair<double, double>> preemptions_;
   static constexpr double kPoseHistorySec = 1.0;  ///< Longer than the detector's latency.
+  /// [m/s] Slower, the base is turning or standing: RememberSwept keeps nothing.
+  static constexpr double kSweptMinMps = 0.05;
   /// [rad] The head turned more than this between an image and the depth image that places its
   /// boxes: the boxes are dropped.
   static constexpr double kHeadMovedRad = 0.02;
