@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <map>
+#include <vector>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -133,18 +134,26 @@ std::string ClinicWardEvacuation(const std::string& setting) {
          " mobility: {walker: 10, cane: 3, frame: 3, wheelchair: 2, wheelchair_pushed: 2}}\n";
 }
 
-// Every resident of `text` (ClinicWardEvacuation) is out by `until` [s], for each seed.
-void ExpectAllOut(const std::string& text, std::initializer_list<std::uint64_t> seeds,
-                  double until) {
+// Every resident of `text` (ClinicWardEvacuation) is out by `until` [s], for each seed; with
+// `one_unable_may_wait`, but for one who cannot operate a door, left waiting at it after all
+// the others went (nobody is left to open it for them: what the robot is there for).
+void ExpectAllOut(const std::string& text, std::initializer_list<std::uint64_t> seeds, double until,
+                  bool one_unable_may_wait = false) {
   for (const std::uint64_t seed : seeds) {
     auto loaded = LoadText(text, WorldsDir() / "clinic");
     TwinWorld world(loaded.scenario, loaded.world, seed, Hsr());
     world.StepFor(until);
     EXPECT_EQ(world.people().size(), 20u);
+    std::vector<const PersonState*> left;
     for (const auto& p : world.people())
-      EXPECT_TRUE(p.out) << "seed " << seed << ": " << p.name << " (" << p.mobility << ") at "
-                         << p.position.transpose() << " phase " << int(p.phase) << " operated "
-                         << p.doors_operated;
+      if (!p.out) left.push_back(&p);
+    if (one_unable_may_wait && left.size() == 1 && !left[0]->can_operate &&
+        left[0]->phase == PersonPhase::kWaitingForDoor)
+      continue;
+    for (const PersonState* p : left)
+      ADD_FAILURE() << "seed " << seed << ": " << p->name << " (" << p->mobility << ") at "
+                    << p->position.transpose() << " phase " << int(p->phase) << " operated "
+                    << p->doors_operated << (p->can_operate ? "" : ", cannot operate");
   }
 }
 
@@ -177,13 +186,15 @@ TEST(EvacueesTest, AMixedGroupOpensTheClinicsShutDoorsItself) {
 //   the doorway against the crowd, and everyone behind waited for the doorway;
 // - 15: someone pushed into door_d's doorway before reaching the spot before it did the same.
 // (Seed 22 still leaves 9 at the exit door: wheelchairs converging on its line-up spot squeeze
-// each other short of the doorway — see the README.)
+// each other short of the doorway — see the README.) Since those held up near the spot before a
+// shut door queue for it, seed 13's last wheelchair user, who cannot open the exit, reaches it
+// after the others went and waits there alone.
 TEST(EvacueesTest, NobodyCarriedOnByTheCrowdWalksBackIntoADoorway) {
   ExpectAllOut(
       ClinicWardEvacuation(
           "robot: {off_scene: true}\n"
           "doors: [{door: door_d, operator: push, open_at: [0.0], hold_open_s: 1000000}]\n"),
-      {10, 13, 15}, 300.0);
+      {10, 13, 15}, 300.0, /*one_unable_may_wait=*/true);
 }
 
 TEST(EvacueesTest, SomeoneWhoCannotOperateTheDoorWaitsAtItAndTheRestGoOn) {
@@ -212,6 +223,58 @@ TEST(EvacueesTest, SomeoneWhoCannotOperateTheDoorWaitsAtItAndTheRestGoOn) {
   }
   EXPECT_GT(stuck, 0);
   EXPECT_GT(through, 0);
+}
+
+// Someone who cannot operate a door, waiting at it, keeps the front of its actuator clear for
+// whoever can (a resident, the robot): at door_e, whose button is on the corridor's side wall
+// beside the way in, a wheelchair user held up by those before them waited at the button,
+// where nobody else could stand to press it (two-wards seed 17: the robot found no free
+// standoff, and they waited to the end). Here someone stands where they would wait (the spot
+// before the doorway), and they come from beside the button.
+TEST(EvacueesTest, SomeoneWhoCannotOperateTheDoorKeepsItsActuatorClear) {
+  // Where one stands to press door_e's button (on the east wall at (21.99, 1.9)).
+  const Eigen::Vector2d stand_at = Eigen::Vector2d(21.99, 1.9) + Eigen::Vector2d(-0.45, 0.0);
+  int unable = 0;
+  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
+    auto loaded = LoadText(
+        "world: clinic.sdf\nrobot: {off_scene: true}\npeople:\n"
+        "  - {name: s, behavior: approach_and_wait, start: [20.8, 1.0], goal: [21.1, 1.35]}\n"
+        "  - {name: w, behavior: evacuate, route: [door_e, exit_door], start: [21.55, 1.7],"
+        " goal: [21.0, 11.5], mobility: {wheelchair: 1}}\n",
+        WorldsDir() / "clinic");
+    TwinWorld world(loaded.scenario, loaded.world, seed, Hsr());
+    world.StepFor(30.0);
+    const PersonState& p = world.people().back();
+    if (p.can_operate) continue;
+    ++unable;
+    EXPECT_EQ(p.phase, PersonPhase::kWaitingForDoor) << "seed " << seed;
+    EXPECT_EQ(p.waiting_for, "door_e") << "seed " << seed;
+    // Someone at the button (0.3 m) and a 0.15 m margin between them, less the walk's settling.
+    EXPECT_GT((p.position - stand_at).norm(), 0.3 + 0.15 + p.radius - 0.05)
+        << "seed " << seed << " at " << p.position.transpose();
+    EXPECT_LT((p.position - Eigen::Vector2d(21.0, 2.65)).norm(), 2.5)
+        << "seed " << seed << ": still waiting at the door";
+  }
+  EXPECT_GT(unable, 0);
+}
+
+// Held up short of the spot before a shut door, an evacuee queues for the door where they are,
+// and operates it if they can (clinic seed 21, no robot, the study's clinic escort group:
+// everyone who could press the exit's button stood round the spot before it, held there by
+// someone who could not; none of them was waiting for the door, so nobody pressed it, and 9
+// were left to the end).
+TEST(EvacueesTest, SomeoneHeldUpShortOfTheSpotBeforeAShutDoorQueuesForIt) {
+  auto loaded = LoadText(
+      "world: clinic.sdf\nrobot: {off_scene: true}\npeople:\n"
+      "  - {name: r, behavior: evacuate, route: [door_d, door_e, exit_door], start: [2.8, -3.0],"
+      " goal: [21.0, 11.5], count: 20, trigger: {at: 60.0},"
+      " mobility: {walker: 10, cane: 3, frame: 3, wheelchair: 2, wheelchair_pushed: 2}}\n",
+      WorldsDir() / "clinic");
+  TwinWorld world(loaded.scenario, loaded.world, 21, Hsr());
+  world.StepFor(420.0);
+  for (const auto& p : world.people())
+    EXPECT_TRUE(p.out) << p.name << " (" << p.mobility << ") at " << p.position.transpose()
+                       << " phase " << int(p.phase);
 }
 
 TEST(EvacueesTest, TheMobilityMixIsDrawnBySeedFromTheShares) {

@@ -28,10 +28,17 @@ constexpr double kPersonAtActuatorRadiusM = 0.3;
 constexpr double kOperateReachM = 3.0;
 constexpr double kAtActuatorM = 0.25;
 constexpr double kArmReachM = 0.7;
+// Between whoever stands at an actuator and someone waiting who cannot operate it [m].
+constexpr double kActuatorClearMarginM = 0.15;
 // Kept from the actuator this long, a person gives up operating it (and for as long again) [s].
 constexpr double kOperateGiveUpSec = 12.0;
 // An evacuee this near a doorway's centre, on its far side, is past it [m].
 constexpr double kPastDoorwayReachM = 2.5;
+// An evacuee slower than this for this long within kQueueNearSpotM of the spot before a shut
+// door queues for it (GateDoor) [m/s], [s], [m].
+constexpr double kHeldUpMps = 0.2;
+constexpr double kHeldUpSec = 1.0;
+constexpr double kQueueNearSpotM = 1.5;
 // Where an evacuee lines up before an open door, on its axis [m].
 constexpr double kLineUpBeforeDoorM = 0.6;
 // The pace whose drive every evacuee has (Boyce et al.'s mean without disability) [m/s].
@@ -297,9 +304,25 @@ void TwinWorld::Impl::UpdatePeople() {
       p.state.waiting_for = doors[std::size_t(gate)].fixed->desc->name;
       p.walker.desired_speed = 0.0;
       if (OperateDoor(p, gate)) continue;
+      const Door& d = doors[std::size_t(gate)];
+      // Someone who cannot operate the door keeps the front of its actuator clear for whoever
+      // can (a resident, the robot): pushed there by the queue, a wheelchair user waited for the
+      // door at its button, where nobody else could stand to press it (two-wards seed 17).
+      if (!p.can_operate) {
+        const double side =
+            (p.walker.position - d.fixed->centre).dot(d.fixed->normal) >= 0 ? 1 : -1;
+        if (const auto spot = ActuatorSpot(gate, side, p.walker.position)) {
+          const Eigen::Vector2d away = p.walker.position - *spot;
+          const double keep = kPersonAtActuatorRadiusM + kActuatorClearMarginM + p.walker.radius;
+          if (away.norm() < keep && away.norm() > 1e-6) {
+            p.walker.target = ClearOfWalls(*spot + away.normalized() * keep, p.walker.radius);
+            p.walker.final_target = true;
+            p.walker.desired_speed = p.speed;
+          }
+        }
+      }
       // Waiting in the sweep of a leaf that opens towards them, people step back out of it as
       // it comes (standing there they would hold shut the door they wait for).
-      const Door& d = doors[std::size_t(gate)];
       const Eigen::Vector2d hinge = d.fixed->desc->p_WH.head<2>();
       const Eigen::Vector2d from_hinge = p.walker.position - hinge;
       const double clear = d.fixed->reach + p.walker.radius + kSweepMarginM;
@@ -343,6 +366,7 @@ void TwinWorld::Impl::UpdatePeople() {
     p.blocked_for = p.state.phase == PersonPhase::kWalking && p.walker.velocity.norm() < 0.05
                         ? p.blocked_for + dt
                         : 0.0;
+    p.slow_for = p.walker.velocity.norm() < kHeldUpMps ? p.slow_for + dt : 0.0;
     if (p.blocked_for > kStuckSec) RewindIfPushedBack(p);
     // Held off its last waypoint by the walls round it (a hold spot in a corner: the social
     // forces balance short of it), a walker who is near enough has arrived.
@@ -523,10 +547,23 @@ void TwinWorld::Impl::AdvancePastDoorways(Person& p) const {
   }
 }
 
-int TwinWorld::Impl::GateDoor(const Person& p) {
+int TwinWorld::Impl::GateDoor(const Person& p) const {
   if (p.door >= 0 && p.wait_before_waypoint >= 0 && PendingDoorWaypoint(p)) return p.door;
   const auto it = p.doorway_waypoints.find(p.reached);
-  return it == p.doorway_waypoints.end() ? -1 : it->second;
+  if (it != p.doorway_waypoints.end()) return it->second;
+  // Held up near the spot before a shut door: queueing for it, as those at the spot are (clinic
+  // seed 21, no robot: the group stood round the spot before the exit door, which someone who
+  // could not open it held; none of them waited for the door, so nobody pressed its button).
+  const auto next = p.doorway_waypoints.find(p.reached + 1);
+  if (next == p.doorway_waypoints.end() || p.state.behavior != PersonBehavior::kEvacuate ||
+      p.route.empty())
+    return -1;
+  const Door& d = doors[std::size_t(next->second)];
+  const bool shut = d.angle < config.door_crossed_open_angle_deg * kDegToRad;
+  return shut && p.slow_for >= kHeldUpSec &&
+                 (p.walker.position - p.route.front()).norm() < kQueueNearSpotM
+             ? next->second
+             : -1;
 }
 
 std::optional<Eigen::Vector2d> TwinWorld::Impl::ActuatorSpot(int door, double side,

@@ -52,6 +52,7 @@ struct Person {
   bool stepped_aside{false};     // walked to the side of the corridor at the end of its route
   std::optional<Eigen::Vector2d> aside_spot;  // where it then stands (held against the walls' push)
   double blocked_for{0.0};                    // [s] walking but not moving (any leg of the route)
+  double slow_for{0.0};                       // [s] slower than kHeldUpMps (any phase)
   double hold_angle{0.0};
   double hold_duration{0.0};
   double hold_started{-1.0};
@@ -162,8 +163,10 @@ struct TwinWorld::Impl {
   // doorway of their route they had passed (the crowd pushed them back through it), takes up
   // their route again from before that doorway.
   void RewindIfPushedBack(Person& p);
-  // The door whose doorway centre is the person's next waypoint, or -1.
-  static int GateDoor(const Person& p);
+  // The door whose doorway centre is the person's next waypoint, or -1. Also, for an evacuee
+  // held up (slower than kHeldUpMps for kHeldUpSec) within kQueueNearSpotM of the spot before a
+  // shut door's doorway, that door: they queue for it where the crowd lets them stand.
+  int GateDoor(const Person& p) const;
   // Where a person on `side` (+1/-1 along the door's normal) stands to operate door `door`'s
   // actuator: in front of its free face, on their side of the door; nullopt if none is there.
   std::optional<Eigen::Vector2d> ActuatorSpot(int door, double side,
