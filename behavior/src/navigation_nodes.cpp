@@ -258,6 +258,11 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
       const double entry = EntryDistance(task_, door.id, pass);
       if (along < entry - 0.05 && along > -ExitDistance(task_, door.id) &&
           lateral < pass.width / 2 + 0.3) {
+        // Past the door line, with the last safe pose beyond it too (it left the door's zone
+        // on the far side, then halted back in it): on to that pose, not back through the
+        // doorway (clinic family seed 2007: it backed through door_b as the leaf closed).
+        if (along < 0.0 && (belief_.last_safe->translation() - pass.centre).dot(pass.n_M) < 0.0)
+          break;
         const Eigen::Vector2d out = belief_.X_MB.translation() + pass.n_M * (entry - along);
         path.push_back({out.x(), out.y(), belief_.X_MB.yaw});
         break;

@@ -315,5 +315,35 @@ TEST_F(NavigationNodesTest, RetractToSafeTurnsToSeeTheWayBackAndTrustsWhereItJus
         << "the way would pass through the person";
 }
 
+// Halted just past the door line, having left the door's zone on the far side before (its last
+// safe pose is there): it goes on to that pose, never back through the doorway (clinic family
+// seed 2007: it backed through door_b as the leaf closed on it).
+TEST_F(NavigationNodesTest, RetractToSafePastTheDoorLineNeverBacksThroughTheDoorway) {
+  auto blackboard = bt::Blackboard::Create();
+  DoorVisit visit;
+  visit.door = "lab_door";
+  visit.approach_side = Eigen::Vector2d(0.0, -1.0);  // it came from the south (wall y = 3)
+  blackboard->Set("door_visit", bt::Any(visit));
+  bt::Tree tree = Tree(R"(<RetractToSafe/>)", blackboard);
+  belief_.X_MB = {0.0, 3.3, M_PI / 2};
+  belief_.last_safe = Pose2{0.0, 4.4, M_PI / 2};
+  belief_.now = At(1.0);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(Noted(DecisionEvent::kRetreating));
+  ASSERT_GE(motion_.path().size(), 2u);
+  for (const Pose2& p : motion_.path())
+    EXPECT_GT(p.y, 3.0) << "back through the doorway";
+  EXPECT_LT((motion_.path().back().translation() - Eigen::Vector2d(0.0, 4.4)).norm(), 1e-6);
+  // Still on the near side of the line, it backs out the way it came, as before.
+  tree.HaltTree();
+  motion_.StopBase();
+  belief_.X_MB = {0.0, 2.9, M_PI / 2};
+  belief_.last_safe = Pose2{0.0, 1.5, M_PI / 2};
+  belief_.now = At(3.0);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  ASSERT_GE(motion_.path().size(), 2u);
+  EXPECT_LT((motion_.path().back().translation() - Eigen::Vector2d(0.0, 1.5)).norm(), 1e-6);
+}
+
 }  // namespace
 }  // namespace egress::behavior
