@@ -167,6 +167,10 @@ struct TwinWorld::Impl {
   // held up (slower than kHeldUpMps for kHeldUpSec) within kQueueNearSpotM of the spot before a
   // shut door's doorway, that door: they queue for it where the crowd lets them stand.
   int GateDoor(const Person& p) const;
+  // Where someone waiting at door `gate` who cannot operate it goes to keep the front of its
+  // actuator clear for whoever can (a resident, the robot); nullopt: they are clear of it (or
+  // can operate it).
+  std::optional<Eigen::Vector2d> ClearOfActuator(const Person& p, int gate) const;
   // Where a person on `side` (+1/-1 along the door's normal) stands to operate door `door`'s
   // actuator: in front of its free face, on their side of the door; nullopt if none is there.
   std::optional<Eigen::Vector2d> ActuatorSpot(int door, double side,

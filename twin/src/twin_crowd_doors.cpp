@@ -1,0 +1,162 @@
+// People at doors: which door an evacuee waits for, who operates a shut door's actuator and
+// how, whether a doorway is taken, and where someone who cannot operate it waits.
+#include "twin_world_impl.h"
+
+#include <cmath>
+#include <optional>
+
+namespace egress::twin {
+namespace {
+
+// Operating an actuator: where a person stands (this far in front of its face) [m], how near the
+// doorway they must be to go and operate it [m], near enough to the spot to operate [m], and
+// within arm's reach when the queue keeps them off the spot [m].
+constexpr double kActuatorStandOffM = 0.45;
+constexpr double kPersonAtActuatorRadiusM = 0.3;
+constexpr double kOperateReachM = 3.0;
+constexpr double kAtActuatorM = 0.25;
+constexpr double kArmReachM = 0.7;
+// Between whoever stands at an actuator and someone waiting who cannot operate it [m].
+constexpr double kActuatorClearMarginM = 0.15;
+// Kept from the actuator this long, a person gives up operating it (and for as long again) [s].
+constexpr double kOperateGiveUpSec = 12.0;
+// Held up (Person::slow_for) this long within this of the spot before a shut door, an evacuee
+// queues for it (GateDoor) [s], [m].
+constexpr double kHeldUpSec = 1.0;
+constexpr double kQueueNearSpotM = 1.5;
+
+}  // namespace
+
+int TwinWorld::Impl::GateDoor(const Person& p) const {
+  if (p.door >= 0 && p.wait_before_waypoint >= 0 && PendingDoorWaypoint(p)) return p.door;
+  const auto it = p.doorway_waypoints.find(p.reached);
+  if (it != p.doorway_waypoints.end()) return it->second;
+  // Held up near the spot before a shut door: queueing for it, as those at the spot are (clinic
+  // seed 21, no robot: the group stood round the spot before the exit door, which someone who
+  // could not open it held; none of them waited for the door, so nobody pressed its button).
+  const auto next = p.doorway_waypoints.find(p.reached + 1);
+  if (next == p.doorway_waypoints.end() || p.state.behavior != PersonBehavior::kEvacuate ||
+      p.route.empty())
+    return -1;
+  const Door& d = doors[std::size_t(next->second)];
+  const bool shut = d.angle < config.door_crossed_open_angle_deg * kDegToRad;
+  return shut && p.slow_for >= kHeldUpSec &&
+                 (p.walker.position - p.route.front()).norm() < kQueueNearSpotM
+             ? next->second
+             : -1;
+}
+
+std::optional<Eigen::Vector2d> TwinWorld::Impl::ActuatorSpot(int door, double side,
+                                                             const Eigen::Vector2d& p_W) const {
+  // The building's actuators of this door, each faced from its own box (building.h): the
+  // person stands in front of the face, on their side of the door.
+  const DoorModel& d = *doors[std::size_t(door)].fixed;
+  std::optional<Eigen::Vector2d> best;
+  for (const BuildingActuator& a : twin_model->building().actuators) {
+    if (a.door != d.desc->name) continue;
+    const Eigen::Vector2d n = a.n_W.head<2>();
+    if (n.norm() < 1e-6) continue;
+    Eigen::Vector2d spot = a.p_W.head<2>() + n.normalized() * kActuatorStandOffM;
+    if ((spot - d.centre).dot(d.normal) * side <= 0.0) continue;
+    spot = ClearOfWalls(spot, kPersonAtActuatorRadiusM);
+    if (!best || (spot - p_W).norm() < (*best - p_W).norm()) best = spot;
+  }
+  return best;
+}
+
+bool TwinWorld::Impl::OperateDoor(Person& p, int gate) {
+  Door& d = doors[std::size_t(gate)];
+  if (!d.op) return false;
+  const bool shut = d.op->phase() == DoorPhase::kClosed || d.op->phase() == DoorPhase::kClosing;
+  if (p.operating >= 0 && (p.operating != gate || !shut)) {
+    p.operating = -1;  // someone else opened it meanwhile
+    return false;
+  }
+  if (p.operating < 0) {
+    if (!p.can_operate || !shut || time < p.operate_retry_at) return false;
+    // One operator per door: of the waiting people who can, within reach of the doorway, the
+    // one nearest the actuator.
+    if ((p.walker.position - d.fixed->centre).norm() > kOperateReachM) return false;
+    const double side = (p.walker.position - d.fixed->centre).dot(d.fixed->normal) >= 0 ? 1 : -1;
+    const auto spot = ActuatorSpot(gate, side, p.walker.position);
+    if (!spot) return false;
+    const double mine = (p.walker.position - *spot).norm();
+    for (const auto& other : people) {
+      if (other.operating == gate) return false;
+      // Someone nearer who would go: on this side, within reach (deferring to anyone nearer,
+      // whether or not they could go, left a crowd waiting at a shut door for ever).
+      if (&other != &p && other.can_operate && !other.state.out && GateDoor(other) == gate &&
+          other.state.phase == PersonPhase::kWaitingForDoor && time >= other.operate_retry_at &&
+          (other.walker.position - d.fixed->centre).norm() <= kOperateReachM &&
+          (other.walker.position - d.fixed->centre).dot(d.fixed->normal) * side >= 0.0 &&
+          (other.walker.position - *spot).norm() < mine)
+        return false;
+    }
+    p.operating = gate;
+    p.operate_spot = *spot;
+    p.operate_elapsed = 0.0;
+    p.operate_progress_at = time;
+  }
+  const double away = (p.walker.position - p.operate_spot).norm();
+  // At the actuator (or as near as the queue lets them: within reach and not getting closer).
+  const bool there = away < kAtActuatorM || (away < kArmReachM && p.walker.velocity.norm() < 0.05);
+  // Kept off the actuator by the queue for too long, or pushed off it part-way through: they
+  // give up for a while and someone else (nearer now) may go. (Counting only a wait that never
+  // reached it, someone pushed off after a second at it stayed the door's operator for ever,
+  // and everyone else waited for them.)
+  if (!there && time - p.operate_progress_at > kOperateGiveUpSec) {
+    p.operating = -1;
+    p.operate_elapsed = 0.0;
+    p.operate_retry_at = time + kOperateGiveUpSec;
+    return false;
+  }
+  p.walker.target = p.operate_spot;
+  p.walker.final_target = true;
+  p.walker.desired_speed = there ? 0.0 : p.speed;
+  if (there) {
+    p.operate_elapsed += dt;
+    p.operate_progress_at = time;
+  }
+  if (p.operate_elapsed >= p.operate_time) {
+    d.op->Trigger(time);
+    ++p.state.doors_operated;
+    AddEvent("door_operated", d.fixed->desc->name, p.state.name);
+    p.operating = -1;
+    p.operate_elapsed = 0.0;
+  }
+  return true;
+}
+
+bool TwinWorld::Impl::DoorwayTaken(const Person& me, int door) const {
+  const Door& d = doors[std::size_t(door)];
+  const double my_side = (me.walker.position - d.fixed->centre).dot(d.fixed->normal) >= 0 ? 1 : -1;
+  const Eigen::Vector2d my_heading = -d.fixed->normal * my_side;
+  const bool evacuee = me.state.behavior == PersonBehavior::kEvacuate;
+  for (const auto& other : people) {
+    if (&other == &me || !other.state.started || other.state.out) continue;
+    if ((other.walker.position - d.fixed->centre).norm() >= 0.9) continue;
+    // In an evacuation people go through one behind the other: only someone coming the other
+    // way (from the far side, or walking against them) keeps an evacuee waiting.
+    if (evacuee) {
+      const double side = (other.walker.position - d.fixed->centre).dot(d.fixed->normal);
+      const bool my_way = side * my_side > 0.0 || other.walker.velocity.dot(my_heading) > 0.2;
+      if (my_way) continue;
+    }
+    return true;
+  }
+  return false;
+}
+
+std::optional<Eigen::Vector2d> TwinWorld::Impl::ClearOfActuator(const Person& p, int gate) const {
+  if (p.can_operate) return std::nullopt;
+  const DoorModel& d = *doors[std::size_t(gate)].fixed;
+  const double side = (p.walker.position - d.centre).dot(d.normal) >= 0 ? 1 : -1;
+  const auto spot = ActuatorSpot(gate, side, p.walker.position);
+  if (!spot) return std::nullopt;
+  const Eigen::Vector2d away = p.walker.position - *spot;
+  const double keep = kPersonAtActuatorRadiusM + kActuatorClearMarginM + p.walker.radius;
+  if (away.norm() >= keep || away.norm() <= 1e-6) return std::nullopt;
+  return ClearOfWalls(*spot + away.normalized() * keep, p.walker.radius);
+}
+
+}  // namespace egress::twin
