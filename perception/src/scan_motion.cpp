@@ -15,6 +15,8 @@ void ScanMotionConfig::Validate() const {
   ThrowUnless(std::isfinite(still_distance) && std::isfinite(still_angle) &&
                   still_distance >= 0.0 && still_angle >= 0.0,
               "ScanMotionConfig: still_distance and still_angle must be >= 0");
+  ThrowUnless(std::isfinite(max_range) && max_range > 0.0,
+              "ScanMotionConfig: max_range must be > 0 (got ", max_range, ")");
 }
 
 ScanMotion::ScanMotion(ScanMotionConfig config) : config_(config) {
@@ -51,8 +53,11 @@ const std::vector<Eigen::Vector2d>& ScanMotion::Update(Time stamp, const Pose2& 
     std::vector<Eigen::Vector2d> left;
     for (const Eigen::Vector2d& q : before)
       if (!near(p_MR, q, step2)) left.push_back(q);
+    const double range2 = config_.max_range * config_.max_range;
     for (const Eigen::Vector2d& p : p_MR)
-      if (!near(before, p, step2) && near(left, p, reach2)) moving_.push_back(p);
+      if ((p - X_ML.translation()).squaredNorm() <= range2 && !near(before, p, step2) &&
+          near(left, p, reach2))
+        moving_.push_back(p);
   }
   history_.push_back({stamp, X_ML, std::move(p_MR)});
   return moving_;

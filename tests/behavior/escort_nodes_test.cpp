@@ -179,6 +179,30 @@ TEST_F(HoldForResidentsTest, OpensTheDoorForSomeoneFoundWaitingAtIt) {
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // waiting: the robot goes to open it
 }
 
+TEST_F(HoldForResidentsTest, OpensTheDoorForSomeoneWaitingBesideTheWayToTheActuator) {
+  // As the clinic's 2 m corridor: the robot comes from 6 m along the wall; the one waiting by
+  // the doorway stands 0.7 m short of the standoff, right on the straight line there. Only the
+  // standoff itself must be free: the way is the planner's, round them (asking the line's last
+  // metre to be clear too kept the robot away for good: clinic seeds 13, 60).
+  belief_.X_MB = {-5.0, 2.0, 0.0};
+  tree_.TickOnce();
+  OperatedAgo(12.0);
+  const Eigen::Vector2d standoff = Standoff().translation();
+  const Eigen::Vector2d waiting =
+      standoff + 0.7 * (belief_.X_MB.translation() - standoff).normalized();
+  belief_.off_map_returns = {waiting};
+  belief_.now = At(2.0);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);  // still only a moment: may set off
+  belief_.now = At(6.5);
+  motion_.StopBase();
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // waiting: the robot goes to open it
+  // Someone at the standoff itself: not yet.
+  tree_.HaltTree();
+  belief_.off_map_returns = {waiting, standoff + Eigen::Vector2d(0.3, 0.0)};
+  belief_.now = At(12.0);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+}
+
 TEST_F(HoldForResidentsTest, SomeoneWhoStayedWhileTheDoorStoodOpenIsNotWaitingForIt) {
   // As OpensTheDoorForSomeoneFoundWaitingAtIt, but the door stood open before them for 5 s in
   // this hold and they did not go through: not waiting for the door.

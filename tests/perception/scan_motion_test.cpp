@@ -67,10 +67,32 @@ TEST(ScanMotionTest, MoreOfAStandingBodySeenPastAShadowsEdgeIsNotMotion) {
   EXPECT_EQ(motion.Update(At(1.0), X_ML, stepped).size(), 2u);
 }
 
+TEST(ScanMotionTest, NothingFartherThanMaxRangeIsJudged) {
+  // The same walk 4 m and 9 m from the laser: beyond max_range (6 m) a wall's grazed returns
+  // slide with the pose estimate's heading error, so nothing there is reported moving.
+  for (const double x : {4.0, 9.0}) {
+    ScanMotion motion;
+    std::size_t moved = 0;
+    for (int k = 0; k <= 10; ++k)
+      moved = motion.Update(At(0.1 * k), {0, 0, 0}, Legs({x + 0.1 * k, 0.0})).size();
+    EXPECT_EQ(moved, x < 6.0 ? 4u : 0u) << "at " << x << " m";
+  }
+  ScanMotionConfig far;
+  far.max_range = 20.0;
+  ScanMotion motion(far);
+  std::size_t moved = 0;
+  for (int k = 0; k <= 10; ++k)
+    moved = motion.Update(At(0.1 * k), {0, 0, 0}, Legs({9.0 + 0.1 * k, 0.0})).size();
+  EXPECT_EQ(moved, 4u);
+}
+
 TEST(ScanMotionTest, BadInputIsRefused) {
   ScanMotionConfig bad;
   bad.step = 2.0;  // beyond reach
   EXPECT_THROW(ScanMotion{bad}, InvalidArgument);
+  ScanMotionConfig no_range;
+  no_range.max_range = 0.0;
+  EXPECT_THROW(ScanMotion{no_range}, InvalidArgument);
   ScanMotion motion;
   motion.Update(At(1.0), {0, 0, 0}, {});
   EXPECT_THROW(motion.Update(At(0.5), {0, 0, 0}, {}), InvalidArgument);

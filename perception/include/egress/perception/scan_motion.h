@@ -12,7 +12,7 @@
 /// Only scans taken from the same spot are compared: seen from a moving laser, legs standing
 /// still slide in and out of each other's shadows, which looks like motion; while the laser moves
 /// (more than `still_distance` or `still_angle` from where the reference was taken) nothing is
-/// reported moving.
+/// reported moving; nor is anything farther than `max_range` from the laser.
 
 #include <deque>
 #include <utility>
@@ -31,7 +31,12 @@ struct ScanMotionConfig {
   double reach{1.0};            ///< ... if an earlier one lies within this [m].
   double still_distance{0.03};  ///< The laser counts as still within this of the reference [m].
   double still_angle{0.03};     ///< ... and within this of its heading [rad].
-  /// @throws InvalidArgument unless 0 < step < reach and window > 0 (all finite).
+  /// Returns farther than this from the laser are not judged [m]: there the pose estimate's
+  /// heading error (a hundredth of a radian) shifts a wall's grazed returns by tens of
+  /// centimetres off and along it as the estimate wanders, which looks like motion (clinic
+  /// seeds 13, 46: the corridor's walls 8-14 m off "moved" while the robot stood still).
+  double max_range{6.0};
+  /// @throws InvalidArgument unless 0 < step < reach, window > 0 and max_range > 0 (all finite).
   void Validate() const;
 };
 
