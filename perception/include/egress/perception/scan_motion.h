@@ -33,8 +33,8 @@ struct ScanMotionConfig {
   double still_angle{0.03};     ///< ... and within this of its heading [rad].
   /// Returns farther than this from the laser are not judged [m]: there the pose estimate's
   /// heading error (a hundredth of a radian) shifts a wall's grazed returns by tens of
-  /// centimetres off and along it as the estimate wanders, which looks like motion (clinic
-  /// seeds 13, 46: the corridor's walls 8-14 m off "moved" while the robot stood still).
+  /// centimetres off and along it as the estimate wanders, which looks like motion (in the
+  /// clinic's corridor, its walls 8-14 m off "moved" while the robot stood still).
   double max_range{6.0};
   /// @throws InvalidArgument unless 0 < step < reach, window > 0 and max_range > 0 (all finite).
   void Validate() const;
