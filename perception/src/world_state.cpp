@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "egress/hsr_interface/error.h"
+#include "egress/hsr_interface/geometry.h"
 
 namespace egress::perception {
 
@@ -54,6 +55,11 @@ void PerceptionPipeline::ProcessCameraFrame(const std::vector<Detection2D>& dete
                     range(*by_size) - range(*p_MO) > kOccluderGapM)) {
         p_MO = by_size;
       }
+      // Depth on an open leaf is the leaf's, whatever the box says: the person stands behind
+      // it, and a box cut by the image's edge has no height to place them by (office seed 87:
+      // a resident 2 m past door_a, seen past its open leaf, became a "person" standing on the
+      // leaf's tip, in the door's zone, and the robot stopped in the doorway for good).
+      if (p_MO && IsOnAnOpenLeaf(p_MO->head<2>())) p_MO = by_size;
     }
     if (!p_MO) continue;
     if (detection.label == labels::kPerson) {
@@ -82,6 +88,19 @@ void PerceptionPipeline::ProcessCameraFrame(const std::vector<Detection2D>& dete
       return d.norm() < range && std::abs(WrapAngle(std::atan2(d.y(), d.x()) - yaw)) < half_fov;
     });
   }
+}
+
+bool PerceptionPipeline::IsOnAnOpenLeaf(const Eigen::Vector2d& p_MQ) const {
+  // [m] Half a leaf's thickness and the depth camera's noise at a few metres.
+  constexpr double kOnLeafM = 0.1;
+  for (const auto& tracker : doors_) {
+    const DoorState& state = tracker.state();
+    if (!state.observed || state.angle < config_.door_state.closed_angle) continue;
+    const DoorModel& door = tracker.door();
+    const Eigen::Vector2d q = ClosestPointOnSegment(p_MQ, door.p_MHinge, door.LeafTip(state.angle));
+    if ((p_MQ - q).norm() < kOnLeafM) return true;
+  }
+  return false;
 }
 
 std::vector<TrackedPerson> PerceptionPipeline::CurrentPeople() const {

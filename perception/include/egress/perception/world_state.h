@@ -120,6 +120,9 @@ class PerceptionPipeline {
   const std::vector<DoorStateTracker>& doors() const { return doors_; }
 
  private:
+  // Whether p_MQ lies on the leaf of a door seen open (at its tracked angle).
+  bool IsOnAnOpenLeaf(const Eigen::Vector2d& p_MQ) const;
+
   PerceptionConfig config_;
   std::vector<DoorStateTracker> doors_;
   ObjectTracker objects_;
