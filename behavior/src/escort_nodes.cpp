@@ -46,8 +46,11 @@ constexpr double kAtDoorwayM = 1.5;
 // apart are centimetres apart on it; people in a group stand further apart than this).
 constexpr double kSameBodyM = 0.15;
 // [m] For residents waiting at the door, the robot goes to the actuator with nobody this near
-// its standoff.
-constexpr double kStandoffFreeM = 0.5;
+// its standoff: its footprint (0.215 m) and a hand's breadth. Someone waiting who cannot
+// operate the door leaves a person's room before the actuator for whoever can, not more (clinic
+// seed 13: a wheelchair user's side 0.36 m from the standoff; with 0.5 m the robot watched them
+// wait from its spot aside until the time limit).
+constexpr double kStandoffFreeM = 0.33;
 // [m] Someone (a laser return off the map, a tracked person) this near the robot's edge is too
 // near: it makes room. Inside personal space (0.45-1.2 m), beyond a crowd's elbow room.
 constexpr double kMakeRoomGapM = 0.35;
@@ -130,7 +133,8 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
                               "from the doorway [m]"),
             InputPort<double>("every", 6.0,
                               "operate again this long after the last operation, inside the "
-                              "operator's hold window [s]"),
+                              "operator's hold window (for residents left waiting at the door: "
+                              "once per hold window, waiting aside between) [s]"),
             InputPort<double>("near_door", 5.0,
                               "a laser return off the map this close to the doorway, on the "
                               "robot's side, is someone near (coming, if it moves) [m]"),
@@ -253,17 +257,30 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
         !around.moving &&
         (found_waiting || all_waiting ? WayClear(standoff_, kStandoffFreeM, 0.0)
                                       : WayClear(standoff_, Input<double>("keep_clear")));
-    if (OperateDue() && actuator_clear && !OperationJustFailed()) {
+    // For those waiting, once per hold window, not every `every` seconds: between operations
+    // the robot waits aside, out of their way in (at `every`, the press itself and the tuck
+    // after it kept the robot at the actuator, beside the way in, for good: clinic seed 13).
+    const double every = found_waiting || all_waiting
+                             ? std::max(Input<double>("every"), task_.config.door_hold_window)
+                             : Input<double>("every");
+    if (OperateDue(every) && actuator_clear && !OperationJustFailed()) {
       operate_asked_at_ = belief_.now;
       return NodeStatus::kSuccess;
     }
-    const Pose2& wait_at = came_ || !actuator_clear ? spot_ : standoff_;
+    // Not at the actuator with anyone near, moving or not: its standoff is beside the doorway's
+    // way in, and with the leaf open towards them a wide resident waiting there cannot get
+    // between the leaf and the robot (clinic seed 13: a wheelchair user waited through 80 s of
+    // the robot's presses, the robot at the button between presses, until the time limit).
+    const Pose2& wait_at = came_ || around.near || !actuator_clear ? spot_ : standoff_;
     // Only the spot and the last kSpotClearM of the way there: from far back, the straight line
     // to it passes people it will never meet on its path (clinic: a resident waiting at door_e
     // kept the robot 14 m back from its spot, and the door shut, until max_hold). On the way, the
     // navigation yields to people as everywhere.
+    // Past those waiting (standing still), the robot's room is enough: the planner keeps it
+    // off them (a metre kept it at the actuator beside a wheelchair user it had opened for).
     if ((wait_at.translation() - belief_.X_MB.translation()).norm() > kAtSpotM &&
-        WayClear(wait_at, kSpotClearM, kSpotClearM)) {
+        WayClear(wait_at, found_waiting || all_waiting ? kStandoffFreeM : kSpotClearM,
+                 kSpotClearM)) {
       // Facing the way it drives, turning to watch at the spot (below): from the last door
       // the way there runs away from where the residents come, and facing them the robot drove
       // backwards, the laser's blind sector leading, into a resident queued on its way
@@ -457,7 +474,9 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
            *visit->operated_at < *operate_asked_at_;
   }
 
-  bool OperateDue() const {
+  // Whether to operate the actuator now: not yet in this hold, the door seen shut or shutting,
+  // or `every` seconds since the last operation.
+  bool OperateDue(double every) const {
     const std::optional<DoorVisit> visit = Shared<DoorVisit>("visit");
     if (!visit || visit->door != door_ || !visit->operated_at || *visit->operated_at < *started_)
       return true;  // not operated in this hold yet
@@ -467,7 +486,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
                                d.state.motion == perception::DoorMotion::kClosed))
         return true;
     }
-    return ToSeconds(belief_.now - *visit->operated_at) >= Input<double>("every");
+    return ToSeconds(belief_.now - *visit->operated_at) >= every;
   }
 
   // The residents' way in: the doorway and the lane before it, as wide as the opening plus the

@@ -203,6 +203,53 @@ TEST_F(HoldForResidentsTest, OpensTheDoorForSomeoneWaitingBesideTheWayToTheActua
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
 }
 
+TEST_F(HoldForResidentsTest, BetweenOperationsForSomeoneWaitingItWaitsAsideNotAtTheActuator) {
+  // Operated at the start of the hold; someone waits by the doorway (a wheelchair user who
+  // cannot press), still, for longer than kStillForSec: the robot may go to the actuator for
+  // them, but between operations it waits at the spot aside, not at the standoff beside their
+  // way in (the open leaf and the robot there left a wide resident no way through: clinic
+  // seed 13, 80 s of presses to the time limit).
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // operates first
+  belief_.now = At(1.5);
+  OperatedAgo(0.0);  // in this hold: not due again for `every` seconds
+  belief_.off_map_returns = {{0.5, 2.2}};
+  // Not again after `every` (6 s) but after the operator's hold window (10 s): the press and the
+  // tuck after it take most of 6 s, and the robot would never leave the actuator.
+  for (double t = 2.0; t < 11.5; t += 0.5) {
+    belief_.now = At(t);
+    belief_.X_MB = Standoff();  // back at the standoff after each tick
+    motion_.StopBase();
+    EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning) << "at " << t;
+    ASSERT_GE(motion_.path().size(), 2u) << "at " << t;
+    EXPECT_NEAR(motion_.path().back().x, Standoff().x + 1.5, 1e-6) << "at " << t;
+  }
+  belief_.now = At(11.6);
+  motion_.StopBase();
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);
+}
+
+TEST_F(HoldForResidentsTest, GoesAsideForSomeoneWaitingBesideTheWayThere) {
+  // Someone came, and stopped 0.6 m beside the way from the actuator to the spot, waiting (a
+  // wheelchair user held up there): past someone standing still, the robot's room is enough (a
+  // metre's clearance kept it at the actuator beside them: clinic seed 13).
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);
+  belief_.now = At(1.5);
+  OperatedAgo(0.0);
+  const Eigen::Vector2d beside = Standoff().translation() + Eigen::Vector2d(1.2, -0.6);
+  belief_.moving_returns = {beside + Eigen::Vector2d(0.0, -0.5)};
+  belief_.off_map_returns = belief_.moving_returns;
+  belief_.now = At(2.0);
+  tree_.TickOnce();  // they come
+  belief_.X_MB = Standoff();
+  belief_.moving_returns.clear();
+  belief_.off_map_returns = {beside};
+  belief_.now = At(6.5);
+  motion_.StopBase();
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  ASSERT_GE(motion_.path().size(), 2u);
+  EXPECT_NEAR(motion_.path().back().x, Standoff().x + 1.5, 1e-6);
+}
+
 TEST_F(HoldForResidentsTest, SomeoneWhoStayedWhileTheDoorStoodOpenIsNotWaitingForIt) {
   // As OpensTheDoorForSomeoneFoundWaitingAtIt, but the door stood open before them for 5 s in
   // this hold and they did not go through: not waiting for the door.
