@@ -27,11 +27,21 @@ function(egress_add_test name)
   target_link_libraries(${name} PRIVATE ${_t_DEPS} GTest::gtest GTest::gmock GTest::gtest_main
                         egress_warnings)
   target_include_directories(${name} PRIVATE ${PROJECT_SOURCE_DIR}/tests)
-  target_compile_definitions(${name} PRIVATE EGRESS_OFFICE_MAP="${EGRESS_OFFICE_MAP}")
   set(_lock)
   if(_t_RESOURCE_LOCK)
     set(_lock RESOURCE_LOCK ${_t_RESOURCE_LOCK})
   endif()
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60
     PROPERTIES ENVIRONMENT "EGRESS_REFERENCE_DIR=${EGRESS_REFERENCE_DIR}" ${_lock})
+endfunction()
+
+# egress_path_definitions(<source>... DEFINITIONS <NAME="path">...): definitions that hold this
+# checkout's absolute paths go on the files that use them, never on a whole target. ccache
+# (CCACHE_BASEDIR, set by egress.sh) then shares every other object with a checkout in another
+# folder: CI's clean clone builds from the cache the developer's builds filled, instead of
+# compiling three configurations from nothing.
+function(egress_path_definitions)
+  cmake_parse_arguments(_p "" "" "DEFINITIONS" ${ARGN})
+  set_property(SOURCE ${_p_UNPARSED_ARGUMENTS} APPEND PROPERTY COMPILE_DEFINITIONS
+               ${_p_DEFINITIONS})
 endfunction()

@@ -52,7 +52,7 @@ std::string Corridor(const std::string& actuators, const std::string& frames = "
 }
 
 TEST(BuildingTest, ActuatorsOnTheDoorsWallFaceAwayFromIt) {
-  const WorldDescription world = LoadSdfWorld(EGRESS_WORLDS_DIR "/office/office.sdf");
+  const WorldDescription world = LoadSdfWorld(testing::WorldsDir() / "office" / "office.sdf");
   const BuildingDescription b = DescribeBuilding(world);
   ASSERT_EQ(b.doors.size(), 2u);
   const BuildingDoor* door_a = b.FindDoor("door_a");
@@ -175,7 +175,7 @@ testing::Loaded GoalOnlyOffice(const std::string& extra = "") {
   return testing::LoadText(
       "world: office.sdf\nrobot:\n  start: {place: room_start}\n  goal: {place: room_far}\n" +
           extra,
-      std::filesystem::path(EGRESS_WORLDS_DIR) / "office");
+      testing::WorldsDir() / "office");
 }
 
 TEST(ScenarioBuildingTest, DoorsActuatorsAndPlacesComeFromTheBuilding) {

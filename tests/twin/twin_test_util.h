@@ -15,9 +15,8 @@
 
 namespace egress::twin::testing {
 
-inline std::filesystem::path WorldsDir() {
-  return EGRESS_WORLDS_DIR;
-}
+/// egress's worlds/ folder (defined in twin_test_util.cpp, the one file that holds the path).
+std::filesystem::path WorldsDir();
 
 /// The reference folder (../shared/reference through EGRESS_REFERENCE_DIR), or empty.
 inline std::filesystem::path ReferenceDir() {
