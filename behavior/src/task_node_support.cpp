@@ -77,18 +77,24 @@ NodeStatus StartPath(const TaskServices& task, const Pose2& goal, const std::str
   }
   std::vector<Pose2> path = plan.path;
   path.front().yaw = task.belief->X_MB.yaw;
-  if (heading == PathHeading::kAlongTravel && plan.length >= kFaceTravelBeyondM) {
+  if ((heading == PathHeading::kAlongTravel || heading == PathHeading::kAcrossTravel) &&
+      plan.length >= kFaceTravelBeyondM) {
     // Each waypoint faces along the segment that starts there (the last, along the one that
-    // ends there): the robot turns into each segment on the one before.
+    // ends there), or square to it: the robot turns into each segment on the one before.
+    double offset = 0.0;  // [rad] from the way of travel
     const auto segment_yaw = [&](std::size_t i) {
       const Eigen::Vector2d d = path[i + 1].translation() - path[i].translation();
-      return std::atan2(d.y(), d.x());
+      return std::atan2(d.y(), d.x()) + offset;
     };
     // Segments too short to have a direction (an escape step's end) take the next one's.
     std::size_t first = 0;
     while (first + 2 < path.size() &&
            (path[first + 1].translation() - path[first].translation()).norm() < 0.01)
       ++first;
+    if (heading == PathHeading::kAcrossTravel)
+      offset = std::remainder(task.belief->X_MB.yaw - segment_yaw(first), 2 * M_PI) >= 0.0
+                   ? M_PI / 2
+                   : -M_PI / 2;
     const double first_yaw = segment_yaw(first);
     for (std::size_t i = 1; i + 1 < path.size(); ++i)
       path[i].yaw = i <= first ? first_yaw : segment_yaw(i);

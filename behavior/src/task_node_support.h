@@ -137,10 +137,17 @@ enum class PathHeading {
   /// long drive backwards meets whoever stands in its way unseen (two-wards seed 12). Shorter
   /// paths: as kEvenTurn.
   kAlongTravel,
+  /// As kAlongTravel, but facing square to the way it drives (to the side nearer its heading at
+  /// the start, the same side all the way): the laser's 270 degrees then see ahead along the way
+  /// and back along it, the blind sector facing the side. Driving ahead of people who walk the
+  /// same way faster (residents after the robot along a corridor), one who came up behind it was
+  /// never seen, under kAlongTravel, until they touched it (two wards seed 3).
+  kAcrossTravel,
 };
-/// Paths at least this long are driven facing the way of travel under PathHeading::kAlongTravel.
+/// Paths at least this long are driven facing the way of travel (or square to it) under
+/// PathHeading::kAlongTravel (kAcrossTravel).
 inline constexpr double kFaceTravelBeyondM = 2.0;
-/// Under PathHeading::kAlongTravel, a start heading more than this off the first segment's is
+/// Under those, a start heading more than this off the first segment's is
 /// turned on the spot before driving (within it, the turn is spread along the first segment).
 inline constexpr double kFaceTravelTurnFirstRad = M_PI / 3;
 

@@ -7,6 +7,7 @@
 #include "egress/planning/ik_solver.h"
 
 #include <limits>
+#include <optional>
 
 namespace egress::behavior {
 namespace {
@@ -332,11 +333,13 @@ TEST_F(HoldForResidentsTest, GoesToItsSpotPastSomeoneFarFromItOnTheStraightLine)
   EXPECT_FALSE(NotedText("driving to the spot"));
 }
 
-// From far off, it drives to its spot facing the way it goes (the laser's blind sector is behind
-// it: facing the way the residents come, it drove backwards 14 m into someone queued on its way,
-// two-wards seed 12), turning on the spot first when it faces well away; the watch turns it at
-// the spot.
-TEST_F(HoldForResidentsTest, DrivesToItsSpotFacingTheWayItGoes) {
+// From far off, it drives to its spot square to the way it goes, the same side all the way, so
+// the laser (270 degrees) sees ahead along the way and back along it: its blind sector behind it,
+// facing the way the residents come it drove backwards 14 m into someone queued on its way
+// (two-wards seed 12); facing the way it went, a resident who came up behind it was not seen
+// until they walked into it (two-wards seed 3). It turns on the spot first when it faces well
+// away; the watch turns it at the spot.
+TEST_F(HoldForResidentsTest, DrivesToItsSpotSquareToTheWayItGoes) {
   BeginFarFromAShutDoor();
   OperatedAgo(1.0);                       // not due
   belief_.X_MB = {2.7, -0.7, -M_PI / 2};  // facing away from the spot, 3.1 m off
@@ -349,16 +352,22 @@ TEST_F(HoldForResidentsTest, DrivesToItsSpotFacingTheWayItGoes) {
   const std::vector<Pose2>& path = motion_.path();
   ASSERT_GE(path.size(), 3u);
   EXPECT_LT((path.back().translation() - spot.translation()).norm(), 1e-6);
-  // A turn on the spot first, to face the first leg.
+  // A turn on the spot first, to face square to the first leg.
   EXPECT_LT((path[1].translation() - belief_.X_MB.translation()).norm(), 1e-9);
+  std::optional<double> side;  // +pi/2: facing left of the way, -pi/2: right
   for (std::size_t i = 1; i + 1 < path.size(); ++i) {
     const Eigen::Vector2d leg = path[i + 1].translation() - path[i].translation();
     if (leg.norm() < 0.01) continue;
-    EXPECT_NEAR(std::remainder(path[i].yaw - std::atan2(leg.y(), leg.x()), 2 * M_PI), 0.0, 1e-9)
-        << "waypoint " << i << " faces along the leg that starts there";
+    const double off = std::remainder(path[i].yaw - std::atan2(leg.y(), leg.x()), 2 * M_PI);
+    EXPECT_NEAR(std::abs(off), M_PI / 2, 1e-9) << "waypoint " << i << " square to its leg";
+    if (side) {
+      EXPECT_NEAR(off, *side, 1e-9) << "waypoint " << i << " on the same side";
+    }
+    side = off;
   }
+  ASSERT_TRUE(side.has_value());
   const Eigen::Vector2d last = path.back().translation() - path[path.size() - 2].translation();
-  EXPECT_NEAR(std::remainder(path.back().yaw - std::atan2(last.y(), last.x()), 2 * M_PI), 0.0,
+  EXPECT_NEAR(std::remainder(path.back().yaw - std::atan2(last.y(), last.x()), 2 * M_PI), *side,
               1e-9);
   // A short way (under kFaceTravelBeyondM) turns evenly to the watching yaw, as before.
   motion_.StopBase();
@@ -372,6 +381,91 @@ TEST_F(HoldForResidentsTest, DrivesToItsSpotFacingTheWayItGoes) {
       Eigen::Vector2d(0.0, 1.0) - motion_.path().back().translation();  // 2 m out from the door
   EXPECT_NEAR(std::remainder(motion_.path().back().yaw - std::atan2(look.y(), look.x()), 2 * M_PI),
               0.0, 1e-6);
+}
+
+// Driving to its spot, someone walking up behind it (from there on in the laser's blind sector)
+// makes it stop and stand aside; it drives on once nobody has walked up behind for a while.
+// Someone behind it walking away does not (two wards seed 3: a resident followed the robot along
+// the corridor into the blind sector and walked into its back).
+TEST_F(HoldForResidentsTest, LetsSomeoneWalkingUpBehindItPassBeforeDrivingOn) {
+  BeginFarFromAShutDoor();
+  OperatedAgo(1.0);  // not due
+  const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
+  belief_.X_MB = {spot.x, 1.3, M_PI / 2};  // south of its spot, facing it
+  belief_.now = At(2.0);
+  belief_.moving_returns = {{-0.5, 1.5}};  // they come
+  belief_.off_map_returns = belief_.moving_returns;
+  ASSERT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  ASSERT_TRUE(NotedText("driving to the spot beside the door"));
+  ASSERT_TRUE(motion_.base_moving());
+  const auto walking = [&](const Eigen::Vector2d& p, const Eigen::Vector2d& v) {
+    auto entry = node_testing::Person(p, perception::PersonIntent::kApproaching);
+    entry.person.v_MP = v;
+    return entry;
+  };
+  const Eigen::Vector2d at = belief_.X_MB.translation();
+  // Behind it, walking away: it drives on.
+  log_.Take();
+  belief_.now = At(2.1);
+  See({walking(at + Eigen::Vector2d(0.0, -1.0), {0.0, -1.0})});
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_FALSE(NotedText("walking up behind"));
+  EXPECT_TRUE(motion_.base_moving());
+  // Behind it, walking up: it stops and steps aside, out of their way. (Slow and far enough
+  // that making room, for someone about to touch it, has nothing to do yet.)
+  belief_.now = At(2.2);
+  See({walking(at + Eigen::Vector2d(0.0, -2.2), {0.0, 0.55})});
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(NotedText("someone walking up behind: letting them pass"));
+  ASSERT_TRUE(NotedText("stepping aside"));
+  ASSERT_GE(motion_.path().size(), 2u);
+  const Eigen::Vector2d aside = motion_.path().back().translation() - at;
+  EXPECT_GT(std::abs(aside.x()), 0.3) << "off their way: " << aside.transpose();
+  EXPECT_GE(aside.y(), 0.0) << "not back towards them: " << aside.transpose();
+  // They have passed and the step has ended: it waits out kLetPassClearSec, then drives on.
+  motion_.StopBase();
+  See({});
+  log_.Take();
+  belief_.now = At(3.0);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_FALSE(NotedText("driving to the spot"));
+  belief_.now = At(3.8);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(NotedText("driving on"));
+  EXPECT_TRUE(NotedText("driving to the spot beside the door"));
+}
+
+// Its spot taken while it drives there: it stops short (the drive's slowing near people spares
+// whoever stands at its goal: two wards seed 10, a resident came to wait for door_e beside the
+// spot and the robot crept on into them); someone near the way but not the spot does not stop it.
+TEST_F(HoldForResidentsTest, StopsShortWhenItsSpotIsTakenOnTheWay) {
+  BeginFarFromAShutDoor();
+  OperatedAgo(1.0);  // not due
+  const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
+  belief_.X_MB = {spot.x, spot.y - 2.5, M_PI / 2};
+  belief_.now = At(2.0);
+  belief_.moving_returns = {{-0.5, 1.5}};  // they come
+  belief_.off_map_returns = belief_.moving_returns;
+  ASSERT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  ASSERT_TRUE(NotedText("driving to the spot beside the door"));
+  log_.Take();
+  // Someone 1.5 m beside the spot: it drives on.
+  belief_.now = At(2.5);
+  belief_.off_map_returns = {{-0.5, 1.5}, {spot.x + 1.5, spot.y}};
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(motion_.base_moving());
+  EXPECT_FALSE(NotedText("taken"));
+  // Someone comes to stand 0.5 m from the spot: it stops short.
+  belief_.now = At(3.0);
+  belief_.off_map_returns = {{-0.5, 1.5}, {spot.x + 0.5, spot.y}};
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(NotedText("the spot is taken: stopping short"));
+  EXPECT_FALSE(motion_.base_moving());
+  // ... and does not set off for it again while they stand there.
+  log_.Take();
+  belief_.now = At(3.5);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_FALSE(NotedText("driving to the spot"));
 }
 
 TEST_F(HoldForResidentsTest, MakesRoomForSomeoneWhoComesTooNear) {
