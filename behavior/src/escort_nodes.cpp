@@ -73,22 +73,13 @@ constexpr double kRoomWallMarginM = 0.1;
 // [m] ... and at least this far from every door's line, across its opening: not in a doorway
 // (the study's judge counts the robot within 0.5 m of one with a resident near).
 constexpr double kOffDoorwayM = 0.6;
-// Letting people walking up behind pass (HoldForResidents::LettingFollowersPass): someone behind
-// the robot's way with a gap under kFollowerGapM, walking (kWalkingMps, as NavigateTo's give-way
-// reads walking) and closing on it at kClosingMps or more. The robot drives at 0.2-0.4 m/s, and
-// every resident walks faster.
-constexpr double kFollowerGapM = 2.0;
-constexpr double kWalkingMps = 0.5;
-constexpr double kClosingMps = 0.3;
-// [s] It drives on once nobody has walked up behind for this long, or after kLetPassMaxSec.
-constexpr double kLetPassClearSec = 1.5;
-constexpr double kLetPassMaxSec = 15.0;
-// [m/s] Slower than this the base has stopped; it chooses where to stand aside only then, or
-// kStopWithinSec after the stop was commanded.
-constexpr double kStoppedMps = 0.05;
-constexpr double kStopWithinSec = 1.5;
-// [m] A spot aside must leave this much more room than standing where it stopped.
-constexpr double kAsideGainM = 0.1;
+// Someone walking up behind (LettingFollowersPass): their gap under kFollowerGapM [m], walking
+// (kWalkingMps, as NavigateTo reads walking) and closing at kClosingMps or more [m/s]. It drives
+// on kLetPassClearSec after the last one, or after kLetPassMaxSec [s]; it stands aside once
+// slower than kStoppedMps (or kStopWithinSec after stopping), where kAsideGainM more room is.
+constexpr double kFollowerGapM = 2.0, kWalkingMps = 0.5, kClosingMps = 0.3;
+constexpr double kLetPassClearSec = 1.5, kLetPassMaxSec = 15.0;
+constexpr double kStoppedMps = 0.05, kStopWithinSec = 1.5, kAsideGainM = 0.1;
 
 // Who is near a door on the robot's side (or in its doorway), and whether anyone there is on
 // the move: tracked people within `watch_radius` (moving: faster than kMovingMps and kWalkedOffM
@@ -232,10 +223,8 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
       return NodeStatus::kRunning;
     }
     if (!task_.motion->base_moving() && !letting_pass_since_) driving_to_.reset();
-    // Its spot (or the standoff) taken while it drives there: it stops short and watches from
-    // where it is, as it would not have set off (the drive's slowing near people spares
-    // whoever stands at its goal, whom a drive goes to: two wards seed 10, a resident came to
-    // wait for door_e 0.4 m from the spot, and the robot crept on into them).
+    // Its spot taken on the way: it stops short (the drive's slowing spares whoever stands at
+    // its goal: two wards seed 10, it crept on into a resident waiting beside the spot).
     if (driving_to_ && !letting_pass_since_ && task_.motion->base_moving() &&
         (*driving_to_ - belief_.X_MB.translation()).norm() > kAtSpotM &&
         !WayClear({driving_to_->x(), driving_to_->y(), 0.0}, drive_clear_, 0.0)) {
@@ -425,14 +414,11 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     return best;
   }
 
-  // Someone walking up behind the robot as it drives to its spot or the actuator: it stops, steps
-  // to where the people about will leave it the most room (a corridor's wall: the PeopleRoom a
-  // give-way on the move uses), and drives on once nobody has walked up behind for
-  // kLetPassClearSec (or after kLetPassMaxSec). Every resident walks faster than the robot
-  // drives (two wards seed 3: a resident came out of door_a behind the robot as it drove 17 m
-  // along the 2 m corridor to its spot at door_e, and walked into its back four times; facing
-  // the way it drove, it never saw them — driving square to the way, it sees back along it,
-  // which is what this rule needs). True: letting them pass (the node only watches this tick).
+  // Someone walking up behind the robot as it drives to its spot or the actuator (every resident
+  // walks faster than it drives; two wards seed 3): it stops, stands where people leave it the
+  // most room (PeopleRoom, as NavigateTo's give-way), and drives on once nobody has walked up
+  // behind for kLetPassClearSec. Driving square to its way, it sees back along it. True: letting
+  // them pass.
   bool LettingFollowersPass() {
     const Eigen::Vector2d at = belief_.X_MB.translation();
     if (driving_to_ && (*driving_to_ - at).norm() > kAtSpotM &&
@@ -470,8 +456,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     return true;
   }
 
-  // A tracked person behind the robot's way `way` (a unit vector in M), their surface within
-  // kFollowerGapM of its footprint, walking and closing on it.
+  // A tracked person behind the way `way` (unit, M), within kFollowerGapM, walking up to it.
   bool SomeoneWalkingUpBehind(const Eigen::Vector2d& way) const {
     const Eigen::Vector2d at = belief_.X_MB.translation();
     for (const auto& entry : belief_.world.people) {
