@@ -232,7 +232,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
       driving_to_.reset();
       Note("the spot is taken: stopping short");
     }
-    if (LettingFollowersPass()) return NodeStatus::kRunning;
+    if (LettingFollowersPass(pass)) return NodeStatus::kRunning;
     if (task_.motion->base_moving()) return NodeStatus::kRunning;  // turning, or stepping aside
     // An operation broken off (someone came) leaves the arm out: tucked before the base moves.
     if (!ArmAt(task_.motion->arm_target(), TuckedArm(*task_.model))) {
@@ -385,18 +385,13 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     };
     const double now = stepping_to ? worth(*stepping_to) : room_at(at);
     const perception::Costmap2D* costmap = belief_.world.costmap;
-    // A step never goes into the residents' way in, nor nearer the doorway (the flow funnels
-    // there).
-    const auto in_the_way = [&](const Eigen::Vector2d& q) {
-      return InTheLane(pass, q) || (q - pass.centre).norm() < (at - pass.centre).norm();
-    };
-    std::optional<Pose2> best;
+    std::optional<Pose2> best;  // never in their way (InTheirWay)
     double best_room = now + kRoomGainM;
     for (const double step : kRoomStepsM) {
       for (int k = 0; k < kRoomHeadings; ++k) {
         const double a = 2 * M_PI * k / kRoomHeadings;
         const Eigen::Vector2d q = at + step * Eigen::Vector2d(std::cos(a), std::sin(a));
-        if (room_at(q) <= best_room || in_the_way(q) || IntoADoorway(at, q)) continue;
+        if (room_at(q) <= best_room || InTheirWay(pass, at, q)) continue;
         // Not up to a wall: a step's quintic settles up to a decimetre past its end (clinic
         // seed 62: a step to 2.5 cm from the corridor's wall touched it).
         if (costmap != nullptr &&
@@ -414,12 +409,11 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     return best;
   }
 
-  // Someone walking up behind the robot as it drives to its spot or the actuator (every resident
-  // walks faster than it drives; two wards seed 3): it stops, stands where people leave it the
-  // most room (PeopleRoom, as NavigateTo's give-way), and drives on once nobody has walked up
-  // behind for kLetPassClearSec. Driving square to its way, it sees back along it. True: letting
-  // them pass.
-  bool LettingFollowersPass() {
+  // Someone walking up behind its drive (residents walk faster; two wards seed 3): it stops,
+  // stands where people leave it the most room (PeopleRoom, as NavigateTo's give-way) but never
+  // in the way in, nearer the doorway or in one (lab seed 14), and drives on kLetPassClearSec
+  // after the last. True: letting them pass.
+  bool LettingFollowersPass(const DoorPass& pass) {
     const Eigen::Vector2d at = belief_.X_MB.translation();
     if (driving_to_ && (*driving_to_ - at).norm() > kAtSpotM &&
         SomeoneWalkingUpBehind((*driving_to_ - at).normalized())) {
@@ -443,10 +437,10 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     if (!aside_chosen_ &&
         (speed <= kStoppedMps || ToSeconds(belief_.now - *letting_pass_since_) >= kStopWithinSec)) {
       aside_chosen_ = true;
-      // Their ways predicted twice the give-way horizon, on past the robot (as NavigateTo's
-      // give-way: to the horizon alone they may stop short of it).
+      // Their ways predicted twice the give-way horizon, on past the robot (as NavigateTo's).
       const PeopleRoom room(task_, 2.0 * task_.config.give_way_horizon, /*sidestep=*/true);
-      if (const auto aside = room.BestSpotAround({belief_.X_MB}, room.Score({at}) + kAsideGainM)) {
+      const auto aside = room.BestSpotAround({belief_.X_MB}, room.Score({at}) + kAsideGainM);
+      if (aside && !InTheirWay(pass, at, aside->translation())) {
         task_.motion->FollowPath({belief_.X_MB, *aside}, {false}, task_.motion->arm_target(),
                                  belief_.now, task_.config.retreat_speed);
         Note(StrCat("stepping aside to ", PoseText(*aside)));
@@ -454,6 +448,12 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     }
     if (task_.motion->base_failed()) task_.motion->StopBase();  // blocked: stay where it is
     return true;
+  }
+
+  // A step from `at` to `q` into the residents' way in, nearer the doorway, or into a doorway.
+  bool InTheirWay(const DoorPass& pass, const Eigen::Vector2d& at, const Eigen::Vector2d& q) const {
+    return InTheLane(pass, q) || (q - pass.centre).norm() < (at - pass.centre).norm() ||
+           IntoADoorway(at, q);
   }
 
   // A tracked person behind the way `way` (unit, M), within kFollowerGapM, walking up to it.
