@@ -74,12 +74,12 @@ constexpr double kRoomWallMarginM = 0.1;
 // (the study's judge counts the robot within 0.5 m of one with a resident near).
 constexpr double kOffDoorwayM = 0.6;
 // Someone walking up behind (LettingFollowersPass): their gap under kFollowerGapM [m], walking
-// (kWalkingMps, as NavigateTo reads walking) and closing at kClosingMps or more [m/s]. It drives
-// on kLetPassClearSec after the last one, or after kLetPassMaxSec [s]; it stands aside once
-// slower than kStoppedMps (or kStopWithinSec after stopping), where kAsideGainM more room is.
-constexpr double kFollowerGapM = 2.0, kWalkingMps = 0.5, kClosingMps = 0.3;
+// (kWalkingMps) and closing at kClosingMps or more [m/s]. It drives on kLetPassClearSec after the
+// last one, or after kLetPassMaxSec [s]; once stopped it stands aside where kAsideGainM more
+// room is (MakeWaySpot).
+constexpr double kFollowerGapM = 2.0, kClosingMps = 0.3;
 constexpr double kLetPassClearSec = 1.5, kLetPassMaxSec = 15.0;
-constexpr double kStoppedMps = 0.05, kStopWithinSec = 1.5, kAsideGainM = 0.1;
+constexpr double kAsideGainM = 0.1;
 
 // Who is near a door on the robot's side (or in its doorway), and whether anyone there is on
 // the move: tracked people within `watch_radius` (moving: faster than kMovingMps and kWalkedOffM
@@ -433,16 +433,11 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
       driving_to_.reset();
       return false;
     }
-    const double speed = std::hypot(belief_.V_B.vx, belief_.V_B.vy);
-    if (!aside_chosen_ &&
-        (speed <= kStoppedMps || ToSeconds(belief_.now - *letting_pass_since_) >= kStopWithinSec)) {
+    if (!aside_chosen_ && StoppedOrStopTimedOut(task_, *letting_pass_since_)) {
       aside_chosen_ = true;
-      // Their ways predicted twice the give-way horizon, on past the robot (as NavigateTo's).
-      const PeopleRoom room(task_, 2.0 * task_.config.give_way_horizon, /*sidestep=*/true);
-      const auto aside = room.BestSpotAround({belief_.X_MB}, room.Score({at}) + kAsideGainM);
+      const auto aside = MakeWaySpot(task_, kAsideGainM);
       if (aside && !InTheirWay(pass, at, aside->translation())) {
-        task_.motion->FollowPath({belief_.X_MB, *aside}, {false}, task_.motion->arm_target(),
-                                 belief_.now, task_.config.retreat_speed);
+        StepAsideTo(task_, *aside);
         Note(StrCat("stepping aside to ", PoseText(*aside)));
       }
     }

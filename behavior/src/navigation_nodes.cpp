@@ -8,12 +8,6 @@
 namespace egress::behavior::detail {
 namespace {
 
-// [m/s] The base slower than this has stopped; [s] it is given this long to stop before a
-// step aside or a retreat starts anyway (a path begun at speed the other way leaves the
-// reference behind and trips the watchdog).
-constexpr double kStoppedMps = 0.05;
-constexpr double kStopWithinSec = 1.5;
-
 // Plans and follows a path to `goal`. When the path ahead becomes blocked (an obstacle the map
 // does not show), it plans again on the updated costmap; when the costmap has no way to the
 // goal, it detours with the Bug2 local planner (round the obstacle's boundary by the laser).
@@ -67,10 +61,6 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
 
  private:
   static constexpr double kReplanPeriod = 0.5;  // [s]
-  // [m/s] People slower than this are standing, not coming (a laser-tracked person standing
-  // still reads 0.3-0.4 m/s now and then: the legs' midpoint jitters; the slowest walkers with
-  // a frame go 0.6).
-  static constexpr double kWalkingMps = 0.5;
   // [m] Someone this near the goal is whom the robot goes to (as ProxemicsConfig::goal_radius).
   static constexpr double kGoalPersonRadiusM = 1.5;
   // [m] A spot aside must give this much more room than standing where the robot is.
@@ -102,17 +92,10 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
   // seen coming has passed, or after `patience`.
   NodeStatus GiveWay() {
     GiveWayState& g = *give_way_;
-    const double speed = std::hypot(belief_.V_B.vx, belief_.V_B.vy);
-    const bool stopped = speed <= kStoppedMps || ToSeconds(belief_.now - g.since) >= kStopWithinSec;
-    if (stopped && !g.chosen) {
+    if (!g.chosen && StoppedOrStopTimedOut(task_, g.since)) {
       g.chosen = true;
-      // Their ways predicted twice the horizon: on past the robot (to the horizon alone they may
-      // stop short of it, and every spot would look as good as standing in their way).
-      const PeopleRoom room(task_, 2.0 * task_.config.give_way_horizon, /*sidestep=*/true);
-      const Eigen::Vector2d at = belief_.X_MB.translation();
-      if (const auto spot = room.BestSpotAround({belief_.X_MB}, room.Score({at}) + kMinGainM)) {
-        task_.motion->FollowPath({belief_.X_MB, *spot}, {false}, task_.motion->arm_target(),
-                                 belief_.now, task_.config.retreat_speed);
+      if (const auto spot = MakeWaySpot(task_, kMinGainM)) {
+        StepAsideTo(task_, *spot);
         Note(StrCat("stepping aside to (", PoseText(*spot), ")"));
       } else {
         Note("standing still: no spot aside leaves more room");
@@ -239,8 +222,7 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
   static constexpr double kPeopleHorizonSec = 3.0;
 
   void StartRetreatOnceStopped() {
-    const double speed = std::hypot(belief_.V_B.vx, belief_.V_B.vy);
-    if (speed > kStoppedMps && ToSeconds(belief_.now - started_) < kStopWithinSec) return;
+    if (!StoppedOrStopTimedOut(task_, started_)) return;
     if (looking_back_until_) {
       if (task_.motion->base_moving() || belief_.now < *looking_back_until_) return;
       looking_back_until_.reset();

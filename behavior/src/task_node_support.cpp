@@ -455,6 +455,23 @@ std::optional<Pose2> PeopleRoom::BestSpotAround(const std::vector<Pose2>& way, d
   return best;
 }
 
+bool StoppedOrStopTimedOut(const TaskServices& task, Time since) {
+  const Belief& belief = *task.belief;
+  return std::hypot(belief.V_B.vx, belief.V_B.vy) <= kStoppedMps ||
+         ToSeconds(belief.now - since) >= kStopWithinSec;
+}
+
+std::optional<Pose2> MakeWaySpot(const TaskServices& task, double min_gain) {
+  const PeopleRoom room(task, 2.0 * task.config.give_way_horizon, /*sidestep=*/true);
+  const Pose2& X_MB = task.belief->X_MB;
+  return room.BestSpotAround({X_MB}, room.Score({X_MB.translation()}) + min_gain);
+}
+
+void StepAsideTo(const TaskServices& task, const Pose2& spot) {
+  task.motion->FollowPath({task.belief->X_MB, spot}, {false}, task.motion->arm_target(),
+                          task.belief->now, task.config.retreat_speed);
+}
+
 double PositionSigma(const TaskServices& task) {
   const Eigen::Matrix2d C = task.belief->world.X_MB_covariance.topLeftCorner<2, 2>();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eigen(C);

@@ -279,6 +279,28 @@ class PeopleRoom {
   std::vector<Occupant> now_;
 };
 
+/// [m/s] The base slower than this has stopped; [s] it is given this long to stop before a step
+/// aside or a retreat starts anyway (a path begun at speed the other way leaves the reference
+/// behind and trips the watchdog).
+inline constexpr double kStoppedMps = 0.05;
+inline constexpr double kStopWithinSec = 1.5;
+/// [m/s] People slower than this are standing, not walking (a laser-tracked person standing
+/// still reads 0.3-0.4 m/s now and then: the legs' midpoint jitters; the slowest walkers with a
+/// frame go 0.6).
+inline constexpr double kWalkingMps = 0.5;
+
+/// The base has stopped (kStoppedMps), or has had kStopWithinSec since `since` to.
+bool StoppedOrStopTimedOut(const TaskServices& task, Time since);
+
+/// Making way for people on the move (NavigateTo's give-way; HoldForResidents letting people
+/// walking up behind pass): the spot round the robot where they leave it the most room
+/// (PeopleRoom::BestSpotAround, with sidesteps), their ways predicted twice the give-way horizon
+/// — on past the robot: to the horizon alone they may stop short of it, and every spot would
+/// look as good as standing in their way — if it leaves `min_gain` [m] more room than standing.
+std::optional<Pose2> MakeWaySpot(const TaskServices& task, double min_gain);
+/// Starts the step to `spot` at retreat_speed, the arm held where it is going.
+void StepAsideTo(const TaskServices& task, const Pose2& spot);
+
 /// The localizer's position standard deviation: the square root of the largest eigenvalue of
 /// the xy block of the belief's covariance [m].
 double PositionSigma(const TaskServices& task);

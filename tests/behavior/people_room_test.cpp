@@ -118,6 +118,28 @@ TEST_F(PeopleRoomTest, TwoAbreastAreLeftTheCorridorBySteppingToAWall) {
   const double wall_gap = std::min(spot->y, 2.0 - spot->y);
   EXPECT_LT(wall_gap, task_.config.footprint_radius + 0.25) << "at a wall: y = " << spot->y;
   EXPECT_TRUE(planner.IsValid(*spot));
+
+  // MakeWaySpot (NavigateTo's give-way, HoldForResidents letting people pass) is this spot, the
+  // ways predicted twice the give-way horizon; asking for more room than any spot gains, none.
+  task_.config.give_way_horizon = 4.0;
+  const std::optional<Pose2> made_way = MakeWaySpot(task_, 0.1);
+  ASSERT_TRUE(made_way.has_value());
+  EXPECT_NEAR(made_way->x, spot->x, 1e-9);
+  EXPECT_NEAR(made_way->y, spot->y, 1e-9);
+  EXPECT_FALSE(MakeWaySpot(task_, 100.0).has_value());
+  // StepAsideTo starts the step there at retreat speed.
+  StepAsideTo(task_, *made_way);
+  EXPECT_TRUE(motion.base_moving());
+}
+
+// The base has stopped below kStoppedMps, or is given kStopWithinSec to.
+TEST_F(PeopleRoomTest, StoppedOnceSlowOrOnceTheStopTimeHasRunOut) {
+  belief_.now = SecondsToDuration(10.0);
+  belief_.V_B = {0.3, 0.0, 0.0};
+  EXPECT_FALSE(StoppedOrStopTimedOut(task_, SecondsToDuration(9.0)));
+  EXPECT_TRUE(StoppedOrStopTimedOut(task_, SecondsToDuration(10.0 - kStopWithinSec)));
+  belief_.V_B = {0.03, 0.04, 0.5};  // 0.05 m/s: turning on the spot counts as stopped
+  EXPECT_TRUE(StoppedOrStopTimedOut(task_, SecondsToDuration(10.0)));
 }
 
 }  // namespace
