@@ -2,6 +2,7 @@
 // open for the people being evacuated, from a spot beside the door out of their way;
 // IsNobodyComing breaks an operation off when they come.
 
+#include "escort_watch.h"
 #include "task_node_support.h"
 
 #include <algorithm>
@@ -24,18 +25,12 @@ constexpr double kFacingToleranceRad = 20.0 * M_PI / 180.0;
 // ahead: the laser (270 deg) sees it with 45 deg to spare and the head turns the camera to it,
 // while the turn from the actuator and back stays short.
 constexpr double kWatchWithinRad = M_PI / 2;
-// [m] A person on the far side of the door line by more than this is through.
-constexpr double kThroughM = 0.3;
 // [m] The robot this near its wait spot is there.
 constexpr double kAtSpotM = 0.15;
 // An operation asked for that did not happen is not asked for again sooner than this [s].
 constexpr double kOperateRetrySec = 3.0;
 // [s] The head's look at the residents' way in lasts this long unless renewed (each tick).
 constexpr double kLookRequestSec = 0.5;
-// [m/s] A tracked person faster than this is on the move.
-constexpr double kMovingMps = 0.2;
-// [m] A tracked person this far from where they last stood (and on the move) walked off.
-constexpr double kWalkedOffM = 0.3;
 // [s] Still this long after people came, those left near the door are waiting for it.
 constexpr double kStillForSec = 4.0;
 // [m] The robot goes to its wait spot only with nobody this near it (or the way there).
@@ -80,37 +75,6 @@ constexpr double kOffDoorwayM = 0.6;
 constexpr double kFollowerGapM = 2.0, kClosingMps = 0.3;
 constexpr double kLetPassClearSec = 1.5, kLetPassMaxSec = 15.0;
 constexpr double kAsideGainM = 0.1;
-
-// Who is near a door on the robot's side (or in its doorway), and whether anyone there is on
-// the move: tracked people within `watch_radius` (moving: faster than kMovingMps and kWalkedOffM
-// from where they last stood) and the laser's returns off the map within `near_door` (moving:
-// Belief::moving_returns). The laser sees all round, the camera only ahead. (Furniture off the
-// map near a door counts as someone near: such a door is held until max_hold.)
-struct Surroundings {
-  bool near{false};
-  bool moving{false};
-};
-Surroundings LookAround(const Belief& belief, const DoorPass& pass, double watch_radius,
-                        double near_door) {
-  const auto this_side = [&](const Eigen::Vector2d& p, double radius) {
-    const Eigen::Vector2d d = p - pass.centre;
-    return d.dot(pass.n_M) > -kThroughM && d.norm() < radius;
-  };
-  Surroundings s;
-  for (const auto& entry : belief.world.people) {
-    if (!this_side(entry.person.p_MP, watch_radius)) continue;
-    s.near = true;
-    // Walking off, not a tracker's wobble: away from where they stood as well as fast.
-    const auto& person = entry.person;
-    s.moving = s.moving || (person.v_MP.norm() > kMovingMps &&
-                            (person.p_MP - person.p_MRest).norm() > kWalkedOffM);
-  }
-  for (const Eigen::Vector2d& p : belief.off_map_returns)
-    s.near = s.near || this_side(p, near_door);
-  for (const Eigen::Vector2d& p : belief.moving_returns)
-    s.moving = s.moving || this_side(p, near_door);
-  return s;
-}
 
 // HoldForResidents: the watch between operations while the robot keeps a door open for the
 // residents being evacuated. Until anyone comes it waits at the actuator's standoff and
@@ -171,6 +135,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // it operates every `every` seconds and watches only in between, and the wait_for clock ran
     // at a fifth of its speed (office seed 1: door_b held 100 s for a group already out).
     if (came_ || !nobody_at_last_watch_) last_tick_.reset();
+    back_from_operating_ = last_tick_.has_value();
     if (!started_) {
       started_ = belief_.now;
       if (!PlanSpot()) return NodeStatus::kFailure;
@@ -184,18 +149,23 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     const Surroundings around =
         LookAround(belief_, pass, Input<double>("watch_radius"), Input<double>("near_door"));
     if (around.moving && !came_) {
-      Note("residents coming: stepping aside");
+      Note(StrCat("residents coming (", around.mover, "): stepping aside"));
       came_ = true;
     }
     if (around.moving) last_moving_ = belief_.now;
     // Clear time counts only while the way in is in the laser's sweep: stepping aside with its
     // back to the door, the robot sees nobody there (two-wards seed 17: a resident waiting at
-    // door_e, behind it, was "everyone through" after clear_for).
+    // door_e, behind it, was "everyone through" after clear_for). The operation just done (see
+    // OnStart) counts wherever the robot faces as it turns from the actuator: else only the few
+    // seconds it watched between operations did (atrium seed 5: nobody came to the north door,
+    // everyone was past it, and the robot pressed its button every 14 s for 130 s).
     if (around.near) {
       unseen_ = 0.0;
-    } else if (last_tick_ && IsInLaserSweep(task_, belief_.X_MB, pass.centre + pass.n_M)) {
+    } else if (last_tick_ && (back_from_operating_ ||
+                              IsInLaserSweep(task_, belief_.X_MB, pass.centre + pass.n_M))) {
       unseen_ += ToSeconds(belief_.now - *last_tick_);
     }
+    back_from_operating_ = false;
     last_tick_ = belief_.now;
     nobody_at_last_watch_ = !around.near;
     if (held > Input<double>("max_hold"))
@@ -644,6 +614,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   std::optional<Time> operate_asked_at_;  // when it last returned SUCCESS: operate now
   std::optional<Time> last_tick_;         // the previous tick of an unbroken watch
   bool nobody_at_last_watch_{false};      // nobody was near at the last tick of the watch
+  bool back_from_operating_{false};       // the first tick after an operation that counts
   bool came_{false};                      // someone came during this hold
   std::optional<Time> last_moving_;       // when someone near was last seen on the move
   double unseen_{0.0};                    // [s] of watching since anyone was near
@@ -680,7 +651,7 @@ class IsNobodyComing final : public TaskNode<bt::ConditionNode> {
     const Surroundings around =
         LookAround(belief_, pass, Input<double>("watch_radius"), Input<double>("near_door"));
     if (!around.moving) return NodeStatus::kSuccess;
-    Note(StrCat("someone coming to ", door, ": breaking off"));
+    Note(StrCat("someone coming to ", door, " (", around.mover, "): breaking off"));
     return NodeStatus::kFailure;
   }
 };

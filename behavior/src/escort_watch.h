@@ -1,0 +1,36 @@
+#pragma once
+// Internal to behavior/src: what the escort's nodes (escort_nodes.cpp) see round a door they
+// hold for the residents being evacuated — who is near it on the robot's side, and whether anyone
+// is coming.
+
+#include <string>
+
+#include "egress/behavior/belief.h"
+#include "egress/behavior/door_rules.h"
+
+namespace egress::behavior::detail {
+
+/// [m] A person on the far side of the door line by more than this is through.
+inline constexpr double kThroughM = 0.3;
+/// [m/s] A tracked person faster than this is on the move.
+inline constexpr double kMovingMps = 0.2;
+/// [m] A tracked person this far from where they last stood (and on the move) walked off.
+inline constexpr double kWalkedOffM = 0.3;
+
+/// Who is near a door on the robot's side (or in its doorway), and whether anyone there is on
+/// the move.
+struct Surroundings {
+  bool near{false};
+  bool moving{false};
+  std::string mover;  ///< who or what moved first, for the notes
+};
+
+/// Tracked people within `watch_radius` [m] of the doorway on `pass`'s side (moving: faster than
+/// kMovingMps and kWalkedOffM from where they last stood) and the laser's returns off the map
+/// within `near_door` [m] (moving: Belief::moving_returns). The laser sees all round, the camera
+/// only ahead. (Furniture off the map near a door counts as someone near: such a door is held until
+/// max_hold.)
+Surroundings LookAround(const Belief& belief, const DoorPass& pass, double watch_radius,
+                        double near_door);
+
+}  // namespace egress::behavior::detail
