@@ -1,6 +1,5 @@
 #include "egress/behavior/door_rules.h"
 
-#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -224,19 +223,6 @@ bool DoorPassable(const TaskServices& task, const std::string& door, double marg
   const auto clearance = DoorClearance(task, door);
   if (!clearance || *clearance < 2 * task.config.footprint_radius + margin) return false;
   return DoorWindowLeavesTime(task, door, visit, lead_time);
-}
-
-bool MayBeSwinging(const perception::TrackedDoor& door) {
-  return !door.state.observed || door.state.steady_for < kLeafSettledSec;
-}
-
-void DropReturnsOnSwingingLeaves(const std::vector<perception::TrackedDoor>& doors, double margin,
-                                 std::vector<Eigen::Vector2d>* p_M) {
-  std::erase_if(*p_M, [&](const Eigen::Vector2d& p) {
-    return std::any_of(doors.begin(), doors.end(), [&](const perception::TrackedDoor& door) {
-      return MayBeSwinging(door) && door.model.InSweep(p, margin);
-    });
-  });
 }
 
 }  // namespace egress::behavior

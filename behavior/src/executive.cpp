@@ -540,7 +540,6 @@ bool Executive::Step(RobotPort& port) {
     for (const Eigen::Vector2d& p : perception::ScanPoints(*snapshot.scan, X_ML))
       if (!costmap_->IsNearMappedObstacle(p, kOffMapM)) belief_.off_map_returns.push_back(p);
     belief_.moving_returns = scan_motion_.Update(now, X_ML, belief_.off_map_returns);
-    DropReturnsOnSwingingLeaves(belief_.world.doors, kOffMapM, &belief_.moving_returns);
   }
   bool newly_occupied = false;
   const bool in_any_zone = IsInAnyDoorZone(services_, belief_.X_MB.translation());

@@ -112,20 +112,12 @@ void FusedPersonTracker::Update(const std::vector<PersonObservation>& observatio
     FusedTrack& track = tracks_[t];
     const PersonObservation& o = observations[k];
     auto& last = track.last_by_source[std::size_t(o.source)];
-    // Faster than anyone walks since this sensor's last measurement of it: the track took
-    // something else, not a step — the next table leg while the first was hidden, or, in a group
-    // standing close, a neighbour while its own person was hidden (office escort: a track hopped
-    // 0.8 m in one laser frame, read as someone walking off at 2 m/s, and the robot broke off
-    // opening the door for people who were still waiting). The jump is no motion.
+    // Faster than anyone walks since its last laser measurement: the track took something else
+    // (the next table leg while the first was hidden), not a step; the jump is no motion.
     const bool jumped =
-        last && stamp > last->first &&
+        o.source == PersonSource::kLaser && last && stamp > last->first &&
         (o.p_MP - last->second).norm() > config_.max_person_speed * ToSeconds(stamp - last->first);
-    if (jumped) {
-      // Where it is now, standing until measured again; the other sensor's last measurement is
-      // of whatever it tracked before.
-      track.last_by_source = {};
-      track.person.v_MP.setZero();
-    } else if (last && stamp > last->first) {
+    if (last && stamp > last->first) {
       const double dt = ToSeconds(stamp - last->first);
       if (dt >= config_.min_velocity_dt) {
         track.person.v_MP = a * (o.p_MP - last->second) / dt + (1.0 - a) * track.person.v_MP;
@@ -143,11 +135,9 @@ void FusedPersonTracker::Update(const std::vector<PersonObservation>& observatio
     } else {
       ++track.laser_hits;
     }
-    if (jumped) {
-      track.person.p_MP = o.p_MP;
-      track.person.p_MRest = o.p_MP;
-    }
     if (jumped && !track.confirmed) {
+      track.person.p_MP = o.p_MP;
+      track.person.v_MP.setZero();
       track.p_MBirth = o.p_MP;
       track.birth = stamp;
     }

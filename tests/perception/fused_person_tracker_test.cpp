@@ -134,34 +134,6 @@ TEST(FusedPersonTrackerTest, AJumpFasterThanAnyoneWalksIsNoMotion) {
   EXPECT_EQ(walker.ConfirmedPeople().size(), 1u);
 }
 
-// Two people standing 0.8 m apart, both confirmed by the camera. The first hidden, its track takes
-// the second's legs in the next scan (0.8 m in 0.1 s: faster than anyone walks): it stands there,
-// with no velocity and its rest point moved with it, so nobody reads as walking off; the camera's
-// next look at it gives no velocity either. (Office escort: a track hopping between residents
-// waiting in a group read as one walking off at 2 m/s.)
-TEST(FusedPersonTrackerTest, AConfirmedTrackThatTakesANeighbourIsStillStanding) {
-  FusedPersonTracker tracker;
-  const Eigen::Vector2d first(2.0, 0.0), second(2.8, 0.0);
-  tracker.Update({{first, PersonSource::kCamera}}, At(0.0));
-  for (int i = 1; i <= 10; ++i)
-    tracker.Update({{first, PersonSource::kLaser}}, At(0.1 * i));
-  ASSERT_EQ(tracker.ConfirmedPeople().size(), 1u);
-  tracker.Update({{second, PersonSource::kLaser}}, At(1.1));  // the first hidden: a hop
-  ASSERT_EQ(tracker.tracks().size(), 1u);
-  const TrackedPerson& hopped = tracker.tracks()[0].person;
-  EXPECT_LT(hopped.v_MP.norm(), 1e-9);
-  EXPECT_LT((hopped.p_MP - second).norm(), 1e-9);
-  EXPECT_LT((hopped.p_MRest - hopped.p_MP).norm(), 1e-9) << "it stands where it is";
-  tracker.Update({{second, PersonSource::kCamera}}, At(1.2));
-  EXPECT_LT(tracker.tracks()[0].person.v_MP.norm(), 1e-9) << "camera: nothing since the hop";
-  // A walker's steps (1.2 m/s) are no hop.
-  FusedPersonTracker walker;
-  walker.Update({{first, PersonSource::kCamera}}, At(0.0));
-  for (int i = 1; i <= 10; ++i)
-    walker.Update({{first + Eigen::Vector2d(0.12 * i, 0.0), PersonSource::kLaser}}, At(0.1 * i));
-  EXPECT_NEAR(walker.tracks()[0].person.v_MP.x(), 1.2, 0.2);
-}
-
 // Someone standing where only the laser sees them is a static spot after static_after_s; when
 // they walk off, the laser confirms them as soon as they have moved. A person the camera has
 // confirmed keeps their laser measurements while they stand.

@@ -24,10 +24,6 @@ namespace egress::behavior {
 /// [m] A laser return this far from every wall and door leaf of the costmap is off the map: three
 /// cells, more than the localizer's error at a wall.
 inline constexpr double kOffMapM = 0.15;
-/// [s] A door leaf's estimate steady this long (DoorState::steady_for) has settled: until then the
-/// leaf may still be swinging, and its returns, off the leaf painted where the estimate lags
-/// behind, are not taken for people walking (Belief::moving_returns).
-inline constexpr double kLeafSettledSec = 1.0;
 /// [s] How long Belief::swept_p_MB remembers where the base drove.
 inline constexpr double kSweptMemorySec = 5.0;
 /// [m] Belief::swept_p_MB's spacing.
@@ -45,10 +41,7 @@ struct Belief {
   /// The latest scan's returns off the map (farther than kOffMapM from every wall and door leaf
   /// of the costmap): people, and whatever else is not on the map. In M.
   std::vector<Eigen::Vector2d> off_map_returns;
-  /// Those of them that moved (perception::ScanMotion): people walking. In M. Not those in the
-  /// sweep of a leaf that may be swinging (unsettled, kLeafSettledSec): the leaf itself moves
-  /// there (atrium escort: an opening leaf the robot had just pressed for read as residents
-  /// coming, and it left the door).
+  /// Those of them that moved (perception::ScanMotion): people walking. In M.
   std::vector<Eigen::Vector2d> moving_returns;
   /// The latest head depth image, the camera in M when it was taken, and its intrinsics.
   std::optional<DepthImage> depth;

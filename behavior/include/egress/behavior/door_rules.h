@@ -6,7 +6,6 @@
 
 #include <optional>
 #include <string>
-#include <vector>
 
 #include <Eigen/Core>
 
@@ -62,13 +61,5 @@ bool DoorWindowLeavesTime(const TaskServices& task, const std::string& door, con
                           double lead_time);
 /// Clearance of the door's opening from the latest estimate, or nullopt if never observed.
 std::optional<double> DoorClearance(const TaskServices& task, const std::string& door);
-
-/// Whether the door's leaf may be swinging: never observed, or its estimate not steady for
-/// kLeafSettledSec (the estimate lags the leaf while it opens or closes).
-bool MayBeSwinging(const perception::TrackedDoor& door);
-/// Removes from `p_M` (laser returns in M) those within `margin` [m] of the sweep of a leaf
-/// that may be swinging (MayBeSwinging): there the leaf itself moves.
-void DropReturnsOnSwingingLeaves(const std::vector<perception::TrackedDoor>& doors, double margin,
-                                 std::vector<Eigen::Vector2d>* p_M);
 
 }  // namespace egress::behavior
