@@ -1,7 +1,8 @@
 // Timed command: how the crowd scales. (1) The social force model alone: N walkers crossing a
 // 30 m x 15 m hall to random goals, cost per simulated second with and without the neighbour
 // grid's benefit visible as N grows; (2) a twin run of N evacuees through the clinic's three
-// doors (propped open) with every sensor at its default rate and with sensors off.
+// doors (propped open) with every sensor at its default rate and with sensors off (the robot
+// standing, stepped through TwinRobot, whose sensors they are).
 //   crowd_bench [SECONDS]   (default 30 s simulated per case)
 // Writes crowd_bench.json in the working directory.
 
@@ -18,13 +19,14 @@
 #include "egress/twin/scenario.h"
 #include "egress/twin/sdf_world_loader.h"
 #include "egress/twin/social_force.h"
+#include "egress/twin/twin_robot.h"
 #include "egress/twin/twin_world.h"
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double Since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
+using WallClock = std::chrono::steady_clock;
+double Since(WallClock::time_point t0) {
+  return std::chrono::duration<double>(WallClock::now() - t0).count();
 }
 
 // The social force model alone: wall seconds per simulated second for n walkers.
@@ -42,9 +44,10 @@ double SfmCost(int n, double seconds) {
   const std::vector<WallSegment> walls = {
       {{0, 0}, {30, 0}}, {{30, 0}, {30, 15}}, {{30, 15}, {0, 15}}, {{0, 15}, {0, 0}}};
   const double dt = 0.01;
-  const auto t0 = Clock::now();
+  const WallCells cells(walls);  // once, as the twin does: the walls do not move
+  const auto t0 = WallClock::now();
   for (double t = 0; t < seconds; t += dt) {
-    sfm.Step(&walkers, {}, walls, dt);
+    sfm.Step(&walkers, {}, cells, {}, dt);
     for (auto& w : walkers) {
       if ((w.position - w.target).norm() < 0.5) w.target = {x(rng), y(rng)};
     }
@@ -114,8 +117,11 @@ int main(int argc, char** argv) {
           twin::LoadScenarioFromString(ClinicCrowd(n, sensors), "crowd_bench", ".");
       const twin::WorldDescription world = twin::LoadSdfWorld(scenario.world_file);
       twin::TwinWorld run(scenario, world, 1, model);
-      const auto t0 = Clock::now();
-      run.StepFor(seconds);
+      // The sensors are the robot's: stepped through it, they capture at their rates (a robot
+      // standing still; "off" sets the rates to nothing).
+      twin::TwinRobot robot(&run);
+      const auto t0 = WallClock::now();
+      robot.Advance(seconds);
       const double rtf = seconds / Since(t0);
       std::printf("  %3d evacuees, sensors %s: %.0fx real time\n", n, sensors ? "on " : "off", rtf);
       out["twin"].push_back({{"evacuees", n}, {"sensors", sensors}, {"real_time_factor", rtf}});
