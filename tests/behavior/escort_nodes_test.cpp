@@ -705,6 +705,33 @@ TEST_F(HoldForResidentsTest, WithNobodyAboutTheTimeSpentOperatingCountsTowardsWa
   EXPECT_TRUE(NotedText("nobody about"));
 }
 
+// ... wherever the robot faces as it comes back from the actuator: the way in behind it (in the
+// laser's blind sector) at the first tick after an operation still counts the operation (atrium
+// seed 5: only the seconds it watched between operations counted, and it pressed the button of a
+// door everyone was past for 130 s).
+TEST_F(HoldForResidentsTest, TheTimeSpentOperatingCountsFacingAwayFromTheWayIn) {
+  belief_.scan = node_testing::SweepScan();
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // operate (t = 1)
+  const auto facing_away = [&] {
+    // The doorway's way in at (0, 2): straight behind the robot.
+    belief_.X_MB.yaw = std::atan2(2.0 - belief_.X_MB.y, 0.0 - belief_.X_MB.x) + M_PI;
+  };
+  belief_.now = At(7.0);
+  OperatedAgo(4.0);
+  facing_away();
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  motion_.StopBase();
+  belief_.now = At(9.0);
+  OperatedAgo(6.0);
+  facing_away();
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // due again; 6 s, none of it watched
+  belief_.now = At(15.0);
+  OperatedAgo(4.0);
+  facing_away();
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kFailure);  // 12 s since it last saw anyone
+  EXPECT_TRUE(NotedText("nobody about"));
+}
+
 // ... but an operation that began with someone about does not count as clear (they may come
 // while the robot faces the actuator).
 TEST_F(HoldForResidentsTest, AnOperationBegunWithSomeoneAboutDoesNotCountAsClear) {

@@ -182,7 +182,7 @@ TEST(EvacueesTest, EveryEvacuationScenarioLoadsAndTheAtriumsResidentsGetOutOnThe
     for (const auto& p : world.people())
       EXPECT_TRUE(p.out) << p.name << " (" << p.mobility << ") at " << p.position.transpose();
   }
-  EXPECT_GE(scenarios, 5);
+  EXPECT_GE(scenarios, 7);
 }
 
 TEST(EvacueesTest, AMixedGroupLeavesTheClinicThroughProppedDoors) {
