@@ -135,7 +135,16 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // it operates every `every` seconds and watches only in between, and the wait_for clock ran
     // at a fifth of its speed (office seed 1: door_b held 100 s for a group already out).
     if (came_ || !nobody_at_last_watch_) last_tick_.reset();
-    back_from_operating_ = last_tick_.has_value();
+    // Counted wherever the robot faces now, at the actuator facing its wall (the watch below
+    // counts only time with the way in inside the laser's sweep): else only the few seconds it
+    // watched between operations did (atrium seed 5: nobody came to the north door, everyone was
+    // past it, and the robot pressed its button every 14 s for 130 s; arriving at the clinic's
+    // door_e after its residents had gone out, it pressed every 13 s until the time limit). If
+    // the first look back finds someone near, the watch resets it.
+    if (last_tick_) {
+      unseen_ += ToSeconds(belief_.now - *last_tick_);
+      last_tick_ = belief_.now;
+    }
     if (!started_) {
       started_ = belief_.now;
       if (!PlanSpot()) return NodeStatus::kFailure;
@@ -155,19 +164,13 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     if (around.moving) last_moving_ = belief_.now;
     // Clear time counts only while the way in is in the laser's sweep: stepping aside with its
     // back to the door, the robot sees nobody there (two-wards seed 17: a resident waiting at
-    // door_e, behind it, was "everyone through" after clear_for). The operation just done (see
-    // OnStart) counts wherever the robot faces at the first tick back, at the actuator facing
-    // its wall: else only the few seconds it watched between operations did (atrium seed 5:
-    // nobody came to the north door, everyone was past it, and the robot pressed its button
-    // every 14 s for 130 s; arriving at the clinic's door_e after its residents had gone out,
-    // it pressed every 13 s until the time limit).
+    // door_e, behind it, was "everyone through" after clear_for). The operation just done was
+    // counted in OnStart.
     if (around.near) {
       unseen_ = 0.0;
-    } else if (last_tick_ && (back_from_operating_ ||
-                              IsInLaserSweep(task_, belief_.X_MB, pass.centre + pass.n_M))) {
+    } else if (last_tick_ && IsInLaserSweep(task_, belief_.X_MB, pass.centre + pass.n_M)) {
       unseen_ += ToSeconds(belief_.now - *last_tick_);
     }
-    back_from_operating_ = false;
     last_tick_ = belief_.now;
     nobody_at_last_watch_ = !around.near;
     if (held > Input<double>("max_hold"))
@@ -467,7 +470,6 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     operate_asked_at_.reset();
     last_tick_.reset();
     nobody_at_last_watch_ = false;
-    back_from_operating_ = false;
     came_ = false;
     last_moving_.reset();
     unseen_ = 0.0;
@@ -617,7 +619,6 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   std::optional<Time> operate_asked_at_;  // when it last returned SUCCESS: operate now
   std::optional<Time> last_tick_;         // the previous tick of an unbroken watch
   bool nobody_at_last_watch_{false};      // nobody was near at the last tick of the watch
-  bool back_from_operating_{false};       // the first tick after an operation that counts
   bool came_{false};                      // someone came during this hold
   std::optional<Time> last_moving_;       // when someone near was last seen on the move
   double unseen_{0.0};                    // [s] of watching since anyone was near
