@@ -1,5 +1,7 @@
 #include "egress/twin/actuators.h"
 
+#include <limits>
+
 #include <gtest/gtest.h>
 
 namespace egress::twin {
@@ -69,6 +71,21 @@ TEST(ProximityPlateTest, TriggersWithinRangeOnceUntilTheHandLeaves) {
   EXPECT_FALSE(plate.Update({{1.0, 2.93 - 0.5, 1.0}}));  // leaves beyond 1.5 x range: re-armed
   EXPECT_TRUE(plate.Update({{1.0, 2.93 - 0.2, 1.0}}));
   EXPECT_NEAR(plate.DistanceTo({1.0, 2.83, 1.0}), 0.1, 1e-9);
+}
+
+TEST(ProximityPlateTest, AMountedPlateDoesNotSenseAHandBehindItsWall) {
+  // The wall behind the plate: y from 2.95 to 3.05; the plate's face looks towards -y.
+  ProximityPlate plate(WallButton(), 0.3, Eigen::Vector3d(0.0, -1.0, 0.0));
+  const Eigen::Vector3d behind_wall(1.0, 3.15, 1.0);  // 0.14 m from the box, beyond the wall
+  EXPECT_EQ(plate.DistanceTo(behind_wall), std::numeric_limits<double>::infinity());
+  EXPECT_FALSE(plate.Update({behind_wall}));
+  // Beside it on the wall's face and in front of it, it senses as before.
+  EXPECT_NEAR(plate.DistanceTo({1.2, 2.94, 1.0}), 0.15, 1e-9);
+  EXPECT_TRUE(plate.Update({{1.0, 2.93 - 0.25, 1.0}}));
+  // An unmounted plate (no facing) senses all round, the hand behind included.
+  ProximityPlate free_standing(WallButton(), 0.3);
+  EXPECT_TRUE(free_standing.Update({behind_wall}));
+  EXPECT_THROW(ProximityPlate(WallButton(), 0.3, Eigen::Vector3d(0.0, -2.0, 0.0)), std::exception);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "egress/hsr_interface/error.h"
 
@@ -69,13 +70,21 @@ PushButton::Result PushButton::Update(const Eigen::Vector3d& p_WF) {
   return Result::kNone;
 }
 
-ProximityPlate::ProximityPlate(ActuatorBox box, double range)
-    : box_(std::move(box)), range_(range) {
+ProximityPlate::ProximityPlate(ActuatorBox box, double range, std::optional<Eigen::Vector3d> n_W)
+    : box_(std::move(box)), range_(range), n_W_(std::move(n_W)) {
   ThrowUnless(range > 0, "proximity plate: range must be positive");
+  ThrowUnless(!n_W_ || std::abs(n_W_->norm() - 1.0) < 1e-6,
+              "proximity plate: its face normal must be a unit vector");
 }
 
 double ProximityPlate::DistanceTo(const Eigen::Vector3d& p_W) const {
-  const Eigen::Vector3d p_A = box_.X_WA.rotation().transpose() * (p_W - box_.X_WA.translation());
+  const Eigen::Vector3d p_AW = p_W - box_.X_WA.translation();
+  if (n_W_) {
+    // Behind the back face is the wall: its sensing field (capacitive or infrared) is in front.
+    const double half = box_.size[box_.PressAxis()] / 2;
+    if (n_W_->dot(p_AW) < -half) return std::numeric_limits<double>::infinity();
+  }
+  const Eigen::Vector3d p_A = box_.X_WA.rotation().transpose() * p_AW;
   const Eigen::Vector3d outside = (p_A.cwiseAbs() - box_.size / 2).cwiseMax(0.0);
   return outside.norm();
 }

@@ -1,3 +1,4 @@
+#include "egress/twin/building.h"
 #include "twin_world_impl.h"
 
 namespace egress::twin {
@@ -47,7 +48,9 @@ void TwinWorld::Impl::BuildDoors() {
           door.buttons.emplace_back(box, door.spec->button_stroke, door.spec->button_spring_force,
                                     door.spec->button_max_force);
         } else if (door.spec->kind == OperatorKind::kProximityPlate) {
-          door.plates.emplace_back(box, door.spec->proximity_range);
+          const BuildingActuator facing =
+              DescribeActuator(world, actuator, ActuatorKind::kProximityPlate, DescribeDoor(d));
+          door.plates.emplace_back(box, door.spec->proximity_range, facing.n_W);
         }
       }
     }

@@ -3,8 +3,10 @@
 /// The two ADA actuator types, as contact logic independent of physics. A push button counts a
 /// press when the fingertip travels the button's stroke with a force below the limit (a spring
 /// cap that bottoms out: a jab that drives past the bottom in one step reads as over-force and
-/// is refused). A proximity plate triggers when a hand point comes within its sensing range.
+/// is refused). A proximity plate triggers when a hand point comes within its sensing range in
+/// front of it (a plate on a wall does not sense a hand on the wall's other side).
 
+#include <optional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -50,18 +52,21 @@ class PushButton {
 
 class ProximityPlate {
  public:
-  /// range [m]: hand-to-face distance that triggers.
-  ProximityPlate(ActuatorBox box, double range);
+  /// range [m]: hand-to-face distance that triggers. n_W: the outward normal of its face (unit,
+  /// away from the wall it is mounted on); without it the plate senses all round.
+  ProximityPlate(ActuatorBox box, double range, std::optional<Eigen::Vector3d> n_W = std::nullopt);
   /// Feeds hand points in W for this step; true on a new trigger (re-arms once all points are
   /// beyond 1.5 × range).
   bool Update(const std::vector<Eigen::Vector3d>& hand_points_W);
-  /// Distance from a point to the plate's box [m] (0 inside).
+  /// Distance from a point to the plate's box [m] (0 inside); infinity behind the plate (past
+  /// its back face, against its outward normal), where its wall hides the point.
   double DistanceTo(const Eigen::Vector3d& p_W) const;
   const ActuatorBox& box() const { return box_; }
 
  private:
   ActuatorBox box_;
   double range_;
+  std::optional<Eigen::Vector3d> n_W_;
   bool armed_{true};
 };
 
