@@ -187,8 +187,7 @@ std::string KindFromPlaceName(const std::string& name) {
   return "place";
 }
 
-}  // namespace
-
+// The actuator `model` (its one box) as a face and a facing; `door` for the fallback facing.
 BuildingActuator DescribeActuator(const WorldDescription& world, const std::string& model,
                                   ActuatorKind kind, const BuildingDoor& door) {
   const auto shapes = world.ShapesOfModel(model);
@@ -223,8 +222,6 @@ BuildingActuator DescribeActuator(const WorldDescription& world, const std::stri
   a.protrusion = 2 * half;
   return a;
 }
-
-namespace {
 
 BuildingDescription Describe(const WorldDescription& world, const BuildingYaml& yaml) {
   BuildingDescription b;

@@ -1,4 +1,3 @@
-#include "egress/twin/building.h"
 #include "twin_world_impl.h"
 
 namespace egress::twin {
@@ -48,9 +47,10 @@ void TwinWorld::Impl::BuildDoors() {
           door.buttons.emplace_back(box, door.spec->button_stroke, door.spec->button_spring_force,
                                     door.spec->button_max_force);
         } else if (door.spec->kind == OperatorKind::kProximityPlate) {
-          const BuildingActuator facing =
-              DescribeActuator(world, actuator, ActuatorKind::kProximityPlate, DescribeDoor(d));
-          door.plates.emplace_back(box, door.spec->proximity_range, facing.n_W);
+          // Its facing as the building reads it (away from the wall it is mounted on).
+          const BuildingActuator* facing = twin_model->building().FindActuator(actuator);
+          door.plates.emplace_back(box, door.spec->proximity_range,
+                                   facing != nullptr ? std::optional(facing->n_W) : std::nullopt);
         }
       }
     }

@@ -90,12 +90,6 @@ struct BuildingDescription {
 /// The door of `door` as a floor-plan doorway (hinge, latch, swing): one definition for every
 /// reader of a world.
 BuildingDoor DescribeDoor(const DoorDescription& door);
-/// The actuator `model` of `door` (one box in `world`) as a face and a facing: the outward
-/// normal points away from the wall it is mounted on (a free-standing one faces the doorway).
-/// @throws LoadError naming the model if it is not one box or its thinnest axis is not
-/// horizontal.
-BuildingActuator DescribeActuator(const WorldDescription& world, const std::string& model,
-                                  ActuatorKind kind, const BuildingDoor& door);
 
 /// Describes `world`; `building_yaml` (optional) adds places, glass leaves and actuator
 /// assignments. @throws LoadError naming the file, line and field (YAML) or the model (an
