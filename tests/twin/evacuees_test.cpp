@@ -284,6 +284,37 @@ TEST(EvacueesTest, SomeoneWhoCannotOperateTheDoorKeepsItsActuatorClear) {
   EXPECT_GT(unable, 0);
 }
 
+// Someone who cannot operate a door, waiting at it, keeps the way to its actuator clear too:
+// before the clinic's exit door (a 2 m corridor, its button on the end wall beside the east
+// wall, its leaf swinging into the corridor), a wheelchair user waited in the corridor's middle
+// out of the leaf's sweep and left 0.5 m by the east wall: the robot could not get by to press
+// the button, and they waited to the time limit (clinic room A seeds 11, 22).
+TEST(EvacueesTest, SomeoneWhoCannotOperateTheDoorLeavesTheWayToItsActuatorClear) {
+  constexpr double kEastWallFaceX = 22.0;
+  constexpr double kRobotWidthM = 0.43;
+  int unable = 0;
+  for (std::uint64_t seed = 1; seed <= 12; ++seed) {
+    auto loaded = LoadText(
+        "world: clinic.sdf\nrobot: {off_scene: true}\npeople:\n"
+        "  - {name: w, behavior: evacuate, route: [exit_door], start: [21.4, 6.0],"
+        " goal: [21.0, 11.5], mobility: {wheelchair: 1}}\n",
+        WorldsDir() / "clinic");
+    TwinWorld world(loaded.scenario, loaded.world, seed, Hsr());
+    world.StepFor(30.0);
+    const PersonState& p = world.people().back();
+    if (p.can_operate) continue;
+    ++unable;
+    EXPECT_EQ(p.phase, PersonPhase::kWaitingForDoor) << "seed " << seed;
+    EXPECT_EQ(p.waiting_for, "exit_door") << "seed " << seed;
+    // The robot's width and a hand's breadth either side.
+    EXPECT_GT(kEastWallFaceX - (p.position.x() + p.radius), kRobotWidthM + 2 * 0.1)
+        << "seed " << seed << " at " << p.position.transpose();
+    EXPECT_LT((p.position - Eigen::Vector2d(21.0, 9.05)).norm(), 2.5)
+        << "seed " << seed << ": still waiting at the door";
+  }
+  EXPECT_GT(unable, 0);
+}
+
 // Held up short of the spot before a shut door, an evacuee queues for the door where they are,
 // and operates it if they can (clinic seed 21, no robot, the study's clinic escort group:
 // everyone who could press the exit's button stood round the spot before it, held there by

@@ -18,6 +18,10 @@ constexpr double kAtActuatorM = 0.25;
 constexpr double kArmReachM = 0.7;
 // Between whoever stands at an actuator and someone waiting who cannot operate it [m].
 constexpr double kActuatorClearMarginM = 0.15;
+// Half the width of the way to an actuator (from the room, square to its door) that someone
+// waiting who cannot operate it keeps clear: room for a wheelchair or the robot (0.43 m) to come
+// by to it [m].
+constexpr double kActuatorLaneHalfM = 0.6;
 // Kept from the actuator this long, a person gives up operating it (and for as long again) [s].
 constexpr double kOperateGiveUpSec = 12.0;
 // Held up (Person::slow_for) this long within this of the spot before a shut door, an evacuee
@@ -155,6 +159,20 @@ std::optional<Eigen::Vector2d> TwinWorld::Impl::ClearOfActuator(const Person& p,
   if (!spot) return std::nullopt;
   const Eigen::Vector2d away = p.walker.position - *spot;
   const double keep = kPersonAtActuatorRadiusM + kActuatorClearMarginM + p.walker.radius;
+  // The way to it as well, square to the door from the room: waiting in the middle of a 2 m
+  // corridor, 1.4 m before the exit door (out of its leaf's sweep), a wheelchair user left 0.5 m
+  // by the wall to its button, and nobody could get by to press it (clinic room A seeds 11, 22).
+  // They wait across the lane, on the doorway's side of it.
+  const Eigen::Vector2d along(-d.normal.y(), d.normal.x());
+  const double u_spot = (*spot - d.centre).dot(along);
+  const double u = (p.walker.position - d.centre).dot(along);
+  const double lane = kActuatorLaneHalfM + p.walker.radius;
+  const double out_spot = (*spot - d.centre).dot(d.normal) * side;
+  const double out = (p.walker.position - d.centre).dot(d.normal) * side;
+  if (out > out_spot && std::abs(u - u_spot) < lane && std::abs(u_spot) > 1e-3) {
+    const double u_clear = u_spot - std::copysign(lane, u_spot);
+    return ClearOfWalls(p.walker.position + along * (u_clear - u), p.walker.radius);
+  }
   if (away.norm() >= keep || away.norm() <= 1e-6) return std::nullopt;
   return ClearOfWalls(*spot + away.normalized() * keep, p.walker.radius);
 }
