@@ -39,7 +39,8 @@ struct Belief {
   bool gripper_at_rest{false};
   std::optional<LaserScan> scan;  ///< The latest laser scan.
   /// The latest scan's returns off the map (farther than kOffMapM from every wall and door leaf
-  /// of the costmap): people, and whatever else is not on the map. In M.
+  /// of the costmap) within the laser people detector's max_range of the laser: people, and
+  /// whatever else is not on the map. In M.
   std::vector<Eigen::Vector2d> off_map_returns;
   /// Those of them that moved (perception::ScanMotion): people walking. In M.
   std::vector<Eigen::Vector2d> moving_returns;
