@@ -165,10 +165,13 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // Clear time counts only while the way in is in the laser's sweep: stepping aside with its
     // back to the door, the robot sees nobody there (two-wards seed 17: a resident waiting at
     // door_e, behind it, was "everyone through" after clear_for). The operation just done was
-    // counted in OnStart.
+    // counted in OnStart. Nor while the way in is beyond where the laser knows people: driving
+    // to a door 17 m away, it saw nobody there for want of range.
+    const Eigen::Vector2d way_in = pass.centre + pass.n_M;
     if (around.near) {
       unseen_ = 0.0;
-    } else if (last_tick_ && IsInLaserSweep(task_, belief_.X_MB, pass.centre + pass.n_M)) {
+    } else if (last_tick_ && IsInLaserSweep(task_, belief_.X_MB, way_in) &&
+               (way_in - belief_.X_MB.translation()).norm() <= belief_.people_range) {
       unseen_ += ToSeconds(belief_.now - *last_tick_);
     }
     last_tick_ = belief_.now;

@@ -541,9 +541,9 @@ bool Executive::Step(RobotPort& port) {
     // likely a wall seen a few centimetres off (range noise, the pose's yaw error times the
     // range) as a body (clinic room A seed 22: one return by a wall 17 m away took the robot's
     // spot beside door_e, and kept someone "near" it, until the time limit).
-    const double trust_range = m.config.perception.laser_detector.max_range;
+    belief_.people_range = m.config.perception.laser_detector.max_range;
     for (const Eigen::Vector2d& p : perception::ScanPoints(*snapshot.scan, X_ML))
-      if ((p - X_ML.translation()).norm() <= trust_range &&
+      if ((p - X_ML.translation()).norm() <= belief_.people_range &&
           !costmap_->IsNearMappedObstacle(p, kOffMapM))
         belief_.off_map_returns.push_back(p);
     belief_.moving_returns = scan_motion_.Update(now, X_ML, belief_.off_map_returns);

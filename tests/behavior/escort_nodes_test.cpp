@@ -684,6 +684,20 @@ TEST_F(HoldForResidentsTest, WithNobodyAboutTheHoldEndsAfterWaitFor) {
   EXPECT_TRUE(NotedText("nobody about"));
 }
 
+// ... but only as far as the laser knows people: beyond its people range (driving to a door
+// 17 m away) seeing nobody at the way in says nothing.
+TEST_F(HoldForResidentsTest, NobodySeenBeyondThePeopleRangeIsNotNobodyAbout) {
+  belief_.people_range = 0.5;  // the way in is 1.2 m from the standoff
+  tree_.TickOnce();
+  OperatedAgo(0.5);
+  for (double t = 1.5; t <= 20.5; t += 1.0) {
+    belief_.now = At(t);
+    OperatedAgo(0.5);
+    EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning) << "at " << t;
+  }
+  EXPECT_FALSE(NotedText("nobody about"));
+}
+
 // Holding a door nobody comes to, the robot operates every `every` (6) s and watches only in
 // between: the time spent operating between two looks that found nobody counts towards
 // wait_for too (it counted only the watching, a fifth of the time, and office door_b was held

@@ -7,6 +7,7 @@
 /// task nodes only read it (they hold a const reference), so no node can leave state in it for
 /// another: state nodes share travels on blackboard ports.
 
+#include <limits>
 #include <map>
 #include <optional>
 #include <set>
@@ -42,6 +43,9 @@ struct Belief {
   /// of the costmap) within the laser people detector's max_range of the laser: people, and
   /// whatever else is not on the map. In M.
   std::vector<Eigen::Vector2d> off_map_returns;
+  /// How far from the laser people are known: its off-map returns and people detections reach
+  /// this far (the detector's max_range) [m].
+  double people_range{std::numeric_limits<double>::infinity()};
   /// Those of them that moved (perception::ScanMotion): people walking. In M.
   std::vector<Eigen::Vector2d> moving_returns;
   /// The latest head depth image, the camera in M when it was taken, and its intrinsics.
