@@ -171,7 +171,20 @@ std::optional<Eigen::Vector2d> TwinWorld::Impl::ClearOfActuator(const Person& p,
   const double out = (p.walker.position - d.centre).dot(d.normal) * side;
   if (out > out_spot && std::abs(u - u_spot) < lane && std::abs(u_spot) > 1e-3) {
     const double u_clear = u_spot - std::copysign(lane, u_spot);
-    return ClearOfWalls(p.walker.position + along * (u_clear - u), p.walker.radius);
+    // Across the lane is the hinge's side of the doorway: out of the sweep of a leaf that opens
+    // towards them, further back if need be (beside the clinic's exit hinge, waiting there, two
+    // held its leaf shut and 15 were left behind: two wards seed 21).
+    double out_clear = out;
+    if (d.swing_side * side > 0.0) {
+      const Eigen::Vector2d hinge = d.desc->p_WH.head<2>();
+      const double u_hinge = (hinge - d.centre).dot(along);
+      const double sweep = d.reach + p.walker.radius + kSweepMarginM;
+      const double du = u_clear - u_hinge;
+      if (std::abs(du) < sweep) out_clear = std::max(out, std::sqrt(sweep * sweep - du * du));
+    }
+    return ClearOfWalls(
+        p.walker.position + along * (u_clear - u) + d.normal * side * (out_clear - out),
+        p.walker.radius);
   }
   if (away.norm() >= keep || away.norm() <= 1e-6) return std::nullopt;
   return ClearOfWalls(*spot + away.normalized() * keep, p.walker.radius);
