@@ -309,6 +309,10 @@ TEST(EvacueesTest, SomeoneWhoCannotOperateTheDoorLeavesTheWayToItsActuatorClear)
     // The robot's width and a hand's breadth either side.
     EXPECT_GT(kEastWallFaceX - (p.position.x() + p.radius), kRobotWidthM + 2 * 0.1)
         << "seed " << seed << " at " << p.position.transpose();
+    // ... and out of the sweep of the exit's leaf (0.95 m, hinged at (20.525, 9.05)), which
+    // opens towards them: not beside its hinge, across the lane.
+    EXPECT_GT((p.position - Eigen::Vector2d(20.525, 9.05)).norm(), 0.95 + p.radius)
+        << "seed " << seed << " at " << p.position.transpose();
     EXPECT_LT((p.position - Eigen::Vector2d(21.0, 9.05)).norm(), 2.5)
         << "seed " << seed << ": still waiting at the door";
   }
