@@ -169,6 +169,17 @@ TEST(ExecutiveTest, ColourImagesGoThroughTheDetectorStage) {
   EXPECT_TRUE(blind.belief().world.payloads.empty());
 }
 
+// A 270 deg scan of 101 beams that sees nothing in range.
+LaserScan EmptyScan(Time stamp) {
+  LaserScan scan;
+  scan.stamp = stamp;
+  scan.angle_min = -0.75 * M_PI;
+  scan.angle_increment = 1.5 * M_PI / 100;
+  scan.range_max = 20.0;
+  scan.ranges.assign(101, std::numeric_limits<float>::infinity());
+  return scan;
+}
+
 // A robot whose base moves at a set velocity (odometry only; its laser sees nothing in range).
 class RollingRobot final : public ScriptedRobot {
  public:
@@ -182,13 +193,7 @@ class RollingRobot final : public ScriptedRobot {
  private:
   SensorSnapshot DoSense() override {
     SensorSnapshot s = Stamped();
-    LaserScan scan;
-    scan.stamp = s.stamp;
-    scan.angle_min = -0.75 * M_PI;
-    scan.angle_increment = 1.5 * M_PI / 100;
-    scan.range_max = 20.0;
-    scan.ranges.assign(101, std::numeric_limits<float>::infinity());
-    s.scan = scan;
+    s.scan = EmptyScan(s.stamp);
     s.odometry.X_OB = X_OB_;
     s.odometry.V_B = V_B_;
     return s;
@@ -233,12 +238,7 @@ class TwoReturnsRobot final : public ScriptedRobot {
  private:
   SensorSnapshot DoSense() override {
     SensorSnapshot s = Stamped();
-    LaserScan scan;
-    scan.stamp = s.stamp;
-    scan.angle_min = -0.75 * M_PI;
-    scan.angle_increment = 1.5 * M_PI / 100;
-    scan.range_max = 20.0;
-    scan.ranges.assign(101, std::numeric_limits<float>::infinity());
+    LaserScan scan = EmptyScan(s.stamp);
     scan.ranges[50] = 4.0f;   // straight ahead
     scan.ranges[51] = 12.0f;  // 2.7 deg to the left
     s.scan = scan;
