@@ -171,9 +171,9 @@ std::optional<Eigen::Vector2d> TwinWorld::Impl::ClearOfActuator(const Person& p,
   const double out = (p.walker.position - d.centre).dot(d.normal) * side;
   if (out > out_spot && std::abs(u - u_spot) < lane && std::abs(u_spot) > 1e-3) {
     const double u_clear = u_spot - std::copysign(lane, u_spot);
-    // Across the lane is the hinge's side of the doorway: out of the sweep of a leaf that opens
-    // towards them, further back if need be (beside the clinic's exit hinge, waiting there, two
-    // held its leaf shut and 15 were left behind: two wards seed 21).
+    // Across the lane may be beside the hinge: out of the sweep of a leaf that opens towards
+    // them, further back if need be (beside the clinic's exit hinge, waiting there, two held its
+    // leaf shut and 15 were left behind: two wards seed 21).
     double out_clear = out;
     if (d.swing_side * side > 0.0) {
       const Eigen::Vector2d hinge = d.desc->p_WH.head<2>();
