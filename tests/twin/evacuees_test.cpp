@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <vector>
 
@@ -251,6 +252,27 @@ TEST(EvacueesTest, SomeoneWhoCannotOperateTheDoorWaitsAtItAndTheRestGoOn) {
   EXPECT_GT(through, 0);
 }
 
+// For each seed 1..`seeds` of the clinic with `people` (YAML list items), 30 s on: the last
+// person, if they cannot operate a door, is waiting for `door` and passes `check`. The number
+// of seeds that drew such a person.
+int CheckWhoCannotOperateWaitingAt(const std::string& people, const std::string& door, int seeds,
+                                   const std::function<void(const PersonState&, int)>& check) {
+  int unable = 0;
+  for (int seed = 1; seed <= seeds; ++seed) {
+    auto loaded = LoadText("world: clinic.sdf\nrobot: {off_scene: true}\npeople:\n" + people,
+                           WorldsDir() / "clinic");
+    TwinWorld world(loaded.scenario, loaded.world, std::uint64_t(seed), Hsr());
+    world.StepFor(30.0);
+    const PersonState& p = world.people().back();
+    if (p.can_operate) continue;
+    ++unable;
+    EXPECT_EQ(p.phase, PersonPhase::kWaitingForDoor) << "seed " << seed;
+    EXPECT_EQ(p.waiting_for, door) << "seed " << seed;
+    check(p, seed);
+  }
+  return unable;
+}
+
 // Someone who cannot operate a door, waiting at it, keeps the front of its actuator clear for
 // whoever can (a resident, the robot): at door_e, whose button is on the corridor's side wall
 // beside the way in, a wheelchair user held up by those before them waited at the button,
@@ -260,27 +282,18 @@ TEST(EvacueesTest, SomeoneWhoCannotOperateTheDoorWaitsAtItAndTheRestGoOn) {
 TEST(EvacueesTest, SomeoneWhoCannotOperateTheDoorKeepsItsActuatorClear) {
   // Where one stands to press door_e's button (on the east wall at (21.99, 1.9)).
   const Eigen::Vector2d stand_at = Eigen::Vector2d(21.99, 1.9) + Eigen::Vector2d(-0.45, 0.0);
-  int unable = 0;
-  for (std::uint64_t seed = 1; seed <= 8; ++seed) {
-    auto loaded = LoadText(
-        "world: clinic.sdf\nrobot: {off_scene: true}\npeople:\n"
-        "  - {name: s, behavior: approach_and_wait, start: [20.8, 1.0], goal: [21.1, 1.35]}\n"
-        "  - {name: w, behavior: evacuate, route: [door_e, exit_door], start: [21.55, 1.7],"
-        " goal: [21.0, 11.5], mobility: {wheelchair: 1}}\n",
-        WorldsDir() / "clinic");
-    TwinWorld world(loaded.scenario, loaded.world, seed, Hsr());
-    world.StepFor(30.0);
-    const PersonState& p = world.people().back();
-    if (p.can_operate) continue;
-    ++unable;
-    EXPECT_EQ(p.phase, PersonPhase::kWaitingForDoor) << "seed " << seed;
-    EXPECT_EQ(p.waiting_for, "door_e") << "seed " << seed;
-    // Someone at the button (0.3 m) and a 0.15 m margin between them, less the walk's settling.
-    EXPECT_GT((p.position - stand_at).norm(), 0.3 + 0.15 + p.radius - 0.05)
-        << "seed " << seed << " at " << p.position.transpose();
-    EXPECT_LT((p.position - Eigen::Vector2d(21.0, 2.65)).norm(), 2.5)
-        << "seed " << seed << ": still waiting at the door";
-  }
+  const int unable = CheckWhoCannotOperateWaitingAt(
+      "  - {name: s, behavior: approach_and_wait, start: [20.8, 1.0], goal: [21.1, 1.35]}\n"
+      "  - {name: w, behavior: evacuate, route: [door_e, exit_door], start: [21.55, 1.7],"
+      " goal: [21.0, 11.5], mobility: {wheelchair: 1}}\n",
+      "door_e", 8, [&](const PersonState& p, int seed) {
+        // Someone at the button (0.3 m) and a 0.15 m margin between them, less the walk's
+        // settling.
+        EXPECT_GT((p.position - stand_at).norm(), 0.3 + 0.15 + p.radius - 0.05)
+            << "seed " << seed << " at " << p.position.transpose();
+        EXPECT_LT((p.position - Eigen::Vector2d(21.0, 2.65)).norm(), 2.5)
+            << "seed " << seed << ": still waiting at the door";
+      });
   EXPECT_GT(unable, 0);
 }
 
@@ -292,30 +305,20 @@ TEST(EvacueesTest, SomeoneWhoCannotOperateTheDoorKeepsItsActuatorClear) {
 TEST(EvacueesTest, SomeoneWhoCannotOperateTheDoorLeavesTheWayToItsActuatorClear) {
   constexpr double kEastWallFaceX = 22.0;
   constexpr double kRobotWidthM = 0.43;
-  int unable = 0;
-  for (std::uint64_t seed = 1; seed <= 12; ++seed) {
-    auto loaded = LoadText(
-        "world: clinic.sdf\nrobot: {off_scene: true}\npeople:\n"
-        "  - {name: w, behavior: evacuate, route: [exit_door], start: [21.4, 6.0],"
-        " goal: [21.0, 11.5], mobility: {wheelchair: 1}}\n",
-        WorldsDir() / "clinic");
-    TwinWorld world(loaded.scenario, loaded.world, seed, Hsr());
-    world.StepFor(30.0);
-    const PersonState& p = world.people().back();
-    if (p.can_operate) continue;
-    ++unable;
-    EXPECT_EQ(p.phase, PersonPhase::kWaitingForDoor) << "seed " << seed;
-    EXPECT_EQ(p.waiting_for, "exit_door") << "seed " << seed;
-    // The robot's width and a hand's breadth either side.
-    EXPECT_GT(kEastWallFaceX - (p.position.x() + p.radius), kRobotWidthM + 2 * 0.1)
-        << "seed " << seed << " at " << p.position.transpose();
-    // ... and out of the sweep of the exit's leaf (0.95 m, hinged at (20.525, 9.05)), which
-    // opens towards them: not beside its hinge, across the lane.
-    EXPECT_GT((p.position - Eigen::Vector2d(20.525, 9.05)).norm(), 0.95 + p.radius)
-        << "seed " << seed << " at " << p.position.transpose();
-    EXPECT_LT((p.position - Eigen::Vector2d(21.0, 9.05)).norm(), 2.5)
-        << "seed " << seed << ": still waiting at the door";
-  }
+  const int unable = CheckWhoCannotOperateWaitingAt(
+      "  - {name: w, behavior: evacuate, route: [exit_door], start: [21.4, 6.0],"
+      " goal: [21.0, 11.5], mobility: {wheelchair: 1}}\n",
+      "exit_door", 12, [&](const PersonState& p, int seed) {
+        // The robot's width and a hand's breadth either side.
+        EXPECT_GT(kEastWallFaceX - (p.position.x() + p.radius), kRobotWidthM + 2 * 0.1)
+            << "seed " << seed << " at " << p.position.transpose();
+        // ... and out of the sweep of the exit's leaf (0.95 m, hinged at (20.525, 9.05)),
+        // which opens towards them: not beside its hinge, across the lane.
+        EXPECT_GT((p.position - Eigen::Vector2d(20.525, 9.05)).norm(), 0.95 + p.radius)
+            << "seed " << seed << " at " << p.position.transpose();
+        EXPECT_LT((p.position - Eigen::Vector2d(21.0, 9.05)).norm(), 2.5)
+            << "seed " << seed << ": still waiting at the door";
+      });
   EXPECT_GT(unable, 0);
 }
 
