@@ -115,10 +115,6 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
             InputPort<double>("keep_clear", 3.5,
                               "go to (or wait at) the actuator only with nobody this close to its "
                               "standoff or to the way there [m]"),
-            InputPort<double>("reach", 6.0,
-                              "before anyone came, people standing this close to the standoff "
-                              "(others than those waiting by the doorway) may set off while the "
-                              "robot operates the actuator: it does not go [m]"),
             InputPort<double>("clear_for", 5.0,
                               "the hold is over when nobody has been near for this long [s]"),
             InputPort<double>("wait_for", 20.0,
@@ -161,15 +157,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     const double held = ToSeconds(belief_.now - *started_);
     const Surroundings around =
         LookAround(belief_, pass, Input<double>("watch_radius"), Input<double>("near_door"));
-    // Came: on the move for kComingForSec on end — not a stir in a group standing about (a
-    // track hopping between neighbours as they hide one another reads as a walk for a few
-    // tenths of a second: two wards seed 16, 4.9 s into a hold, a minute before the alarm; the
-    // robot then took the group for residents waiting at the door and went to press for them).
-    if (around.moving) {
-      if (!moving_since_ || !last_moving_ || ToSeconds(belief_.now - *last_moving_) > kStirGapSec)
-        moving_since_ = belief_.now;
-    }
-    if (around.moving && !came_ && ToSeconds(belief_.now - *moving_since_) >= kComingForSec) {
+    if (around.moving && !came_) {
       Note(StrCat("residents coming (", around.mover, "): stepping aside"));
       came_ = true;
     }
@@ -258,24 +246,11 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     if (open_since != belief_.door_open_since.end() &&
         ToSeconds(belief_.now - open_since->second) > kStillForSec)
       stood_open_ = true;
-    // Still for kStillForSec, not since the hold began: a stir nearby, too short to be people
-    // coming, is no reason to leave someone waiting (two wards seed 7: a resident waiting alone
-    // at door_e, watched from 8 m while others walked through, was left behind).
-    const bool found_waiting =
-        !came_ && !around.moving && !stood_open_ &&
-        (!last_moving_ || ToSeconds(belief_.now - *last_moving_) > kStillForSec) &&
-        ToSeconds(belief_.now - *started_) > kStillForSec &&
-        ByTheDoorway(pass, Input<double>("reach")).only;
-    // Before anyone came, not with people standing within `reach` who have yet to set off: they
-    // may at any moment, and an operation keeps the robot at the actuator, beside their way in,
-    // for ~10 s (a walker's 10 m). Going every `every` seconds while a group stood 3.5-4 m from
-    // the standoff, the robot was at the button when the alarm set them off about half the
-    // time, and drove back to its spot through them (two wards seeds 3, 16, 22; atrium seeds 23,
-    // 38: walked into). Only someone waiting by the doorway (found_waiting), or nobody near:
-    // then it opens ahead of whoever comes.
-    const bool group_within_reach = !came_ && !ByTheDoorway(pass, Input<double>("reach")).alone;
+    const bool found_waiting = !came_ && !last_moving_ && !around.moving && !stood_open_ &&
+                               ToSeconds(belief_.now - *started_) > kStillForSec &&
+                               OnlyByTheDoorway(pass, Input<double>("keep_clear"));
     const bool actuator_clear =
-        !around.moving && (!group_within_reach || found_waiting) &&
+        !around.moving &&
         (found_waiting || all_waiting ? WayClear(standoff_, kStandoffFreeM, 0.0)
                                       : WayClear(standoff_, Input<double>("keep_clear")));
     // For those waiting, once per hold window, not every `every` seconds: between operations
@@ -500,7 +475,6 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     nobody_at_last_watch_ = false;
     came_ = false;
     last_moving_.reset();
-    moving_since_.reset();
     unseen_ = 0.0;
     stood_open_ = false;
   }
@@ -583,25 +557,20 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
            std::abs(d.dot(t)) < lane;
   }
 
-  // Who stands by the doorway: each tracked person within kAtDoorwayM (plus a body) of the
-  // doorway's centre on the robot's side, and each laser return off the map on a body that does
-  // — the returns linked to one within kAtDoorwayM by steps of under kSameBodyM (one body's
-  // outline; its far side may be further out).
-  struct AtTheDoorway {
-    bool someone{false};  // someone stands by the doorway
-    bool alone{true};     // nobody else is within the radius of the standoff
-    bool only{false};     // both: those near are waiting at the door
-  };
-  AtTheDoorway ByTheDoorway(const DoorPass& pass, double radius) const {
+  // Someone stands by the doorway, and everyone within `radius` of the standoff does: each
+  // tracked person within kAtDoorwayM (plus a body) of the doorway's centre, and each laser
+  // return off the map on a body that does — the returns linked to one within kAtDoorwayM by
+  // steps of under kSameBodyM (one body's outline; its far side may be further out).
+  bool OnlyByTheDoorway(const DoorPass& pass, double radius) const {
     const Eigen::Vector2d& p_MS = standoff_.translation();
     const auto by_doorway = [&](const Eigen::Vector2d& p, double within) {
       const Eigen::Vector2d d = p - pass.centre;
       return d.norm() < within && d.dot(pass.n_M) > -kThroughM;  // on the robot's side
     };
-    bool someone = false, alone = true;
+    bool someone = false;
     for (const auto& entry : belief_.world.people) {
       const bool by = by_doorway(entry.person.p_MP, kAtDoorwayM + task_.config.person_radius);
-      if (!by && (entry.person.p_MP - p_MS).norm() < radius) alone = false;
+      if (!by && (entry.person.p_MP - p_MS).norm() < radius) return false;
       someone = someone || by;
     }
     std::vector<Eigen::Vector2d> near;
@@ -625,8 +594,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
         frontier.push_back(j);
       }
     }
-    alone = alone && std::all_of(linked.begin(), linked.end(), [](bool b) { return b; });
-    return {someone, alone, someone && alone};
+    return someone && std::all_of(linked.begin(), linked.end(), [](bool b) { return b; });
   }
 
   // Nobody within `radius` of `goal` or of the straight way from the robot to it: no tracked
@@ -656,7 +624,6 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   bool nobody_at_last_watch_{false};      // nobody was near at the last tick of the watch
   bool came_{false};                      // someone came during this hold
   std::optional<Time> last_moving_;       // when someone near was last seen on the move
-  std::optional<Time> moving_since_;      // since when, with no gap over kStirGapSec
   double unseen_{0.0};                    // [s] of watching since anyone was near
   bool making_room_{false};               // stepping away from someone too near
   Eigen::Vector2d room_to_{0.0, 0.0};     // where that step ends

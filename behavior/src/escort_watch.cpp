@@ -16,13 +16,10 @@ Surroundings LookAround(const Belief& belief, const DoorPass& pass, double watch
   for (const auto& entry : belief.world.people) {
     if (!this_side(entry.person.p_MP, watch_radius)) continue;
     s.near = true;
-    // Walking off, not a tracker's wobble: away from where they stood as well as fast, and seen
-    // so now (a standing person's track that lost them at the edge of the laser's view, or behind
-    // someone, coasts on a step's worth of wobble and walks off on its own).
+    // Walking off, not a tracker's wobble: away from where they stood as well as fast.
     const auto& person = entry.person;
     if (s.moving || person.v_MP.norm() <= kMovingMps ||
-        (person.p_MP - person.p_MRest).norm() <= kWalkedOffM ||
-        ToSeconds(belief.now - person.last_seen) > kSeenMovingWithinSec)
+        (person.p_MP - person.p_MRest).norm() <= kWalkedOffM)
       continue;
     s.moving = true;
     s.mover = StrCat("person ", person.id, " at ", PoseText({person.p_MP.x(), person.p_MP.y(), 0}),

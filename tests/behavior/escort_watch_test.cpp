@@ -17,7 +17,6 @@ DoorPass Pass() {
   return pass;
 }
 
-// Measured at Time{}, the belief's default now.
 perception::TrackedPersonWithIntent Person(int id, const Eigen::Vector2d& rest,
                                            const Eigen::Vector2d& p, const Eigen::Vector2d& v) {
   perception::TrackedPersonWithIntent entry;
@@ -50,24 +49,6 @@ TEST(EscortWatchTest, SomeoneWalkingOffIsComingAWobbleIsNot) {
   s = LookAround(belief, Pass(), kWatchM, kNearDoorM);
   EXPECT_TRUE(s.moving);
   EXPECT_NE(s.mover.find("person 3"), std::string::npos) << s.mover;
-}
-
-// A track the sensors lost (at the edge of the laser's view, behind someone) coasts on its last
-// velocity: after a spike of a step's worth, a standing person's track walks off on its own. Only
-// a person measured within kSeenMovingWithinSec is seen coming.
-TEST(EscortWatchTest, ATrackCoastingOutOfViewIsNotSomeoneComing) {
-  Belief belief;
-  belief.now = Time{} + SecondsToDuration(100.0);
-  perception::TrackedPersonWithIntent coasting = Person(1, {3.0, 0.5}, {2.5, 0.5}, {-0.6, 0.0});
-  coasting.person.last_seen = belief.now - SecondsToDuration(2 * kSeenMovingWithinSec);
-  belief.world.people = {coasting};
-  Surroundings s = LookAround(belief, Pass(), kWatchM, kNearDoorM);
-  EXPECT_TRUE(s.near);
-  EXPECT_FALSE(s.moving);
-  belief.world.people[0].person.last_seen =
-      belief.now - SecondsToDuration(0.5 * kSeenMovingWithinSec);
-  s = LookAround(belief, Pass(), kWatchM, kNearDoorM);
-  EXPECT_TRUE(s.moving);
 }
 
 // People through the door (beyond kThroughM on the far side) or beyond the watch radius are not
