@@ -139,6 +139,30 @@ double EntryDistance(const TaskServices& task, const std::string& door, const Do
   return std::max(task.config.door_entry_distance, ExitDistance(task, door));
 }
 
+std::vector<Pose2> LineUpPath(const TaskServices& task, const std::string& door,
+                              const DoorPass& pass, const Pose2& X_MB_from) {
+  const double entry_distance = EntryDistance(task, door, pass);
+  const double yaw = std::atan2(-pass.n_M.y(), -pass.n_M.x());  // facing through the door
+  const Eigen::Vector2d entry = pass.centre + pass.n_M * entry_distance;
+  std::vector<Pose2> path{X_MB_from};
+  const double out = (X_MB_from.translation() - pass.centre).dot(pass.n_M);
+  if (entry_distance > task.config.door_entry_distance && out < entry_distance - 0.05) {
+    const Eigen::Vector2d p = X_MB_from.translation() + pass.n_M * (entry_distance - out);
+    path.push_back({p.x(), p.y(), yaw});
+  }
+  path.push_back({entry.x(), entry.y(), yaw});
+  return path;
+}
+
+double DoorPathDuration(const TaskServices& task, const std::vector<Pose2>& path) {
+  double total = 0.0;
+  for (std::size_t i = 1; i < path.size(); ++i)
+    total += planning::SegmentDuration((path[i].translation() - path[i - 1].translation()).norm(),
+                                       WrapAngle(path[i].yaw - path[i - 1].yaw), true,
+                                       task.motion->trajectory_config());
+  return total;
+}
+
 }  // namespace detail
 
 using namespace detail;

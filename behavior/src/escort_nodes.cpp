@@ -40,6 +40,9 @@ constexpr double kAtDoorwayM = 1.5;
 // [m] Laser returns closer than this to one another are on one body (returns 0.25 degrees
 // apart are centimetres apart on it; people in a group stand further apart than this).
 constexpr double kSameBodyM = 0.15;
+// [m] A laser return this near a mapped wall or leaf is the wall's, seen off, rather than a
+// body's near side.
+constexpr double kHuggingWallM = 0.3;
 // [m] For residents waiting at the door, the robot goes to the actuator with nobody this near
 // its standoff: its footprint (0.215 m) and a hand's breadth. Someone waiting who cannot
 // operate the door leaves a person's room before the actuator for whoever can, not more (clinic
@@ -87,6 +90,11 @@ constexpr double kAsideGainM = 0.1;
 // doorway's side), faces the way they come and watches; it goes back to the actuator only when an
 // operation is due and nobody is within `keep_clear` of the standoff or of its way there (a gap in
 // the flow) — it never walks into the queue to reach a button: the residents there can press it.
+// Until people came to a door it held (the evacuation under way), it does not go to the actuator
+// with people standing within `reach` of it, other than someone waiting by the doorway: a group
+// yet to set off may as it operates, and it would have to drive back through them. Once under
+// way, people found standing at a door with someone by its doorway are waiting for it, and it
+// opens it for them once per hold window, waiting aside in between.
 // SUCCESS: operate now. FAILURE: the hold is over — someone came and nobody (moving or not; a
 // resident who cannot open the door waits still) has been near for `clear_for` seconds of
 // watching, or nobody at all was near for `wait_for` (they went ahead, or are elsewhere), or it
@@ -115,6 +123,11 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
             InputPort<double>("keep_clear", 3.5,
                               "go to (or wait at) the actuator only with nobody this close to its "
                               "standoff or to the way there [m]"),
+            InputPort<double>("reach", 6.0,
+                              "until people came to a door it held, people standing this close "
+                              "to the standoff on its side (others than those waiting by the "
+                              "doorway) may set off while the robot operates the actuator: it "
+                              "does not go [m]"),
             InputPort<double>("clear_for", 5.0,
                               "the hold is over when nobody has been near for this long [s]"),
             InputPort<double>("wait_for", 20.0,
@@ -157,9 +170,18 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     const double held = ToSeconds(belief_.now - *started_);
     const Surroundings around =
         LookAround(belief_, pass, Input<double>("watch_radius"), Input<double>("near_door"));
-    if (around.moving && !came_) {
+    // Came: on the move for kComingForSec on end — not a stir in a group standing about (a
+    // track hopping between neighbours as they hide one another reads as a walk for a few
+    // tenths of a second: two wards seed 16, 4.9 s into a hold, a minute before the alarm; the
+    // robot then took the group for residents waiting at the door and went to press for them).
+    if (around.moving) {
+      if (!moving_since_ || !last_moving_ || ToSeconds(belief_.now - *last_moving_) > kStirGapSec)
+        moving_since_ = belief_.now;
+    }
+    if (around.moving && !came_ && ToSeconds(belief_.now - *moving_since_) >= kComingForSec) {
       Note(StrCat("residents coming (", around.mover, "): stepping aside"));
       came_ = true;
+      under_way_ = true;
     }
     if (around.moving) last_moving_ = belief_.now;
     // Clear time counts only while the way in is in the laser's sweep: stepping aside with its
@@ -202,9 +224,14 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     }
     if (!task_.motion->base_moving() && !letting_pass_since_) driving_to_.reset();
     // Its spot taken on the way: it stops short (the drive's slowing spares whoever stands at
-    // its goal: two wards seed 10, it crept on into a resident waiting beside the spot).
+    // its goal: two wards seed 10, it crept on into a resident waiting beside the spot). Not in
+    // the residents' way in: stopped there, between the actuator and its spot, it held up a
+    // wheelchair user at door_e through two hold windows (the leaf opening towards them left
+    // 0.6 m between its edge and the robot; clinic seed 19), and the drive's slowing and the
+    // guard spare whoever it nears on its way out.
     if (driving_to_ && !letting_pass_since_ && task_.motion->base_moving() &&
         (*driving_to_ - belief_.X_MB.translation()).norm() > kAtSpotM &&
+        !InTheLane(pass, belief_.X_MB.translation()) &&
         !WayClear({driving_to_->x(), driving_to_->y(), 0.0}, drive_clear_, 0.0)) {
       task_.motion->StopBase();
       driving_to_.reset();
@@ -246,11 +273,36 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     if (open_since != belief_.door_open_since.end() &&
         ToSeconds(belief_.now - open_since->second) > kStillForSec)
       stood_open_ = true;
-    const bool found_waiting = !came_ && !last_moving_ && !around.moving && !stood_open_ &&
-                               ToSeconds(belief_.now - *started_) > kStillForSec &&
-                               OnlyByTheDoorway(pass, Input<double>("keep_clear"));
+    // Still for kStillForSec, not since the hold began: a stir nearby, too short to be people
+    // coming, is no reason to leave someone waiting (two wards seed 7: a resident waiting alone
+    // at door_e, watched from 8 m while others walked through, was left behind).
+    // Once the evacuation is under way (people came to a door this robot held), those standing
+    // at the next door with someone by its doorway are waiting for it, however many stand
+    // further out (office seed 14: two who could not wave at door_b's plate queued there, the
+    // second 1.9 m from the doorway; taken for a group yet to set off, they were left there).
+    // Before, only those by the doorway: a group standing about has its front row there too
+    // (office seed 19: a group of twelve in a grid 1 m apart, its corner 1.8 m from door_a).
+    const AtTheDoorway at_door = ByTheDoorway(pass, Input<double>("reach"));
+    // (Once the evacuation is under way, whoever stayed while the door stood open is waiting
+    // too: held up by others or by the robot, not a group yet to set off — clinic seed 19: a
+    // wheelchair user at door_e, held up by the robot through two windows, was never opened for
+    // again.)
+    const bool found_waiting =
+        !came_ && !around.moving && (!stood_open_ || under_way_) &&
+        (!last_moving_ || ToSeconds(belief_.now - *last_moving_) > kStillForSec) &&
+        ToSeconds(belief_.now - *started_) > kStillForSec &&
+        (under_way_ ? at_door.someone : at_door.only);
+    // Before the evacuation is under way, not with people standing within `reach` who have yet
+    // to set off: they
+    // may at any moment, and an operation keeps the robot at the actuator, beside their way in,
+    // for ~10 s (a walker's 10 m). Going every `every` seconds while a group stood 3.5-4 m from
+    // the standoff, the robot was at the button when the alarm set them off about half the
+    // time, and drove back to its spot through them (two wards seeds 3, 16, 22; atrium seeds 23,
+    // 38: walked into). Only someone waiting by the doorway (found_waiting), or nobody near:
+    // then it opens ahead of whoever comes.
+    const bool group_within_reach = !came_ && !under_way_ && !at_door.alone;
     const bool actuator_clear =
-        !around.moving &&
+        !around.moving && (!group_within_reach || found_waiting) &&
         (found_waiting || all_waiting ? WayClear(standoff_, kStandoffFreeM, 0.0)
                                       : WayClear(standoff_, Input<double>("keep_clear")));
     // For those waiting, once per hold window, not every `every` seconds: between operations
@@ -475,6 +527,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     nobody_at_last_watch_ = false;
     came_ = false;
     last_moving_.reset();
+    moving_since_.reset();
     unseen_ = 0.0;
     stood_open_ = false;
   }
@@ -557,27 +610,58 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
            std::abs(d.dot(t)) < lane;
   }
 
-  // Someone stands by the doorway, and everyone within `radius` of the standoff does: each
-  // tracked person within kAtDoorwayM (plus a body) of the doorway's centre, and each laser
-  // return off the map on a body that does — the returns linked to one within kAtDoorwayM by
-  // steps of under kSameBodyM (one body's outline; its far side may be further out).
-  bool OnlyByTheDoorway(const DoorPass& pass, double radius) const {
+  // Who stands by the doorway, on the robot's side: each tracked person within kAtDoorwayM (plus
+  // a body) of the doorway's centre, and each laser return off the map on a body that does — the
+  // returns linked to one within kAtDoorwayM by steps of under kSameBodyM (one body's outline;
+  // its far side may be further out), or on such a tracked person's body. And whether anyone
+  // else stands on this side within `radius` of the standoff.
+  struct AtTheDoorway {
+    bool someone{false};  // someone stands by the doorway
+    bool alone{true};     // nobody else is within the radius of the standoff
+    bool only{false};     // both: those near are waiting at the door
+  };
+  AtTheDoorway ByTheDoorway(const DoorPass& pass, double radius) const {
     const Eigen::Vector2d& p_MS = standoff_.translation();
     const auto by_doorway = [&](const Eigen::Vector2d& p, double within) {
       const Eigen::Vector2d d = p - pass.centre;
       return d.norm() < within && d.dot(pass.n_M) > -kThroughM;  // on the robot's side
     };
+    // Tracked people by the doorway.
+    const auto& people = belief_.world.people;
+    std::vector<bool> by(people.size(), false);
     bool someone = false;
-    for (const auto& entry : belief_.world.people) {
-      const bool by = by_doorway(entry.person.p_MP, kAtDoorwayM + task_.config.person_radius);
-      if (!by && (entry.person.p_MP - p_MS).norm() < radius) return false;
-      someone = someone || by;
+    for (std::size_t i = 0; i < people.size(); ++i) {
+      by[i] = by_doorway(people[i].person.p_MP, kAtDoorwayM + task_.config.person_radius);
+      someone = someone || by[i];
     }
+    // Only this side counts: those beyond the door line walk on away from it.
+    const auto within = [&](const Eigen::Vector2d& p) {
+      return (p - p_MS).norm() < radius && (p - pass.centre).dot(pass.n_M) > -kThroughM;
+    };
+    bool alone = true;
+    for (std::size_t i = 0; i < people.size(); ++i)
+      if (!by[i] && within(people[i].person.p_MP)) alone = false;
+    // Returns off the map but hugging a wall or a door's leaf are not counted out there: seen
+    // from metres away a jamb's edge lands beyond kOffMapM (the pose's yaw error times the range;
+    // atrium seed 26: a jamb 4.7 m from the standoff, read as a group standing about, kept the
+    // robot from the button while a resident waited at the door, until the time limit). The
+    // near side of anyone standing against a wall is a body's depth off it.
+    const perception::Costmap2D* costmap = belief_.world.costmap;
     std::vector<Eigen::Vector2d> near;
     for (const Eigen::Vector2d& p : belief_.off_map_returns)
-      if ((p - p_MS).norm() < radius || by_doorway(p, kAtDoorwayM)) near.push_back(p);
+      if (by_doorway(p, kAtDoorwayM) ||
+          (within(p) && (costmap == nullptr || !costmap->IsNearMappedObstacle(p, kHuggingWallM))))
+        near.push_back(p);
     std::vector<bool> linked(near.size(), false);
     std::vector<std::size_t> frontier;
+    // Returns on the body of a tracked person by the doorway count with them (their outline
+    // may reach further out).
+    const auto on_someone_by = [&](const Eigen::Vector2d& p) {
+      for (std::size_t i = 0; i < people.size(); ++i)
+        if (by[i] && (p - people[i].person.p_MP).norm() < 2.0 * task_.config.person_radius)
+          return true;
+      return false;
+    };
     for (std::size_t i = 0; i < near.size(); ++i) {
       if (by_doorway(near[i], kAtDoorwayM)) {
         linked[i] = true;
@@ -585,6 +669,12 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
       }
     }
     someone = someone || !frontier.empty();
+    for (std::size_t i = 0; i < near.size(); ++i) {
+      if (!linked[i] && on_someone_by(near[i])) {
+        linked[i] = true;
+        frontier.push_back(i);
+      }
+    }
     while (!frontier.empty()) {
       const std::size_t i = frontier.back();
       frontier.pop_back();
@@ -594,7 +684,8 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
         frontier.push_back(j);
       }
     }
-    return someone && std::all_of(linked.begin(), linked.end(), [](bool b) { return b; });
+    alone = alone && std::all_of(linked.begin(), linked.end(), [](bool b) { return b; });
+    return {someone, alone, someone && alone};
   }
 
   // Nobody within `radius` of `goal` or of the straight way from the robot to it: no tracked
@@ -623,7 +714,9 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   std::optional<Time> last_tick_;         // the previous tick of an unbroken watch
   bool nobody_at_last_watch_{false};      // nobody was near at the last tick of the watch
   bool came_{false};                      // someone came during this hold
+  bool under_way_{false};                 // someone came during any hold so far
   std::optional<Time> last_moving_;       // when someone near was last seen on the move
+  std::optional<Time> moving_since_;      // since when, with no gap over kStirGapSec
   double unseen_{0.0};                    // [s] of watching since anyone was near
   bool making_room_{false};               // stepping away from someone too near
   Eigen::Vector2d room_to_{0.0, 0.0};     // where that step ends

@@ -16,6 +16,17 @@ inline constexpr double kThroughM = 0.3;
 inline constexpr double kMovingMps = 0.2;
 /// [m] A tracked person this far from where they last stood (and on the move) walked off.
 inline constexpr double kWalkedOffM = 0.3;
+/// [s] A tracked person counts as on the move only if a sensor measured them this recently (2
+/// laser frames and a half): a track out of view coasts on its last velocity, and that is the
+/// tracker's guess, not someone seen walking.
+inline constexpr double kSeenMovingWithinSec = 0.25;
+
+/// [s] Someone near on the move this long on end (gaps under kStirGapSec) came: a stir in a group
+/// standing about (tracks hopping between neighbours) lasted up to 2.1 s (27 runs of the office,
+/// atrium and two wards before their alarms: 122 stirs, 5 over 1 s); residents walking to the
+/// door from the watch radius, several seconds.
+inline constexpr double kComingForSec = 2.5;
+inline constexpr double kStirGapSec = 0.35;
 
 /// Who is near a door on the robot's side (or in its doorway), and whether anyone there is on
 /// the move.
@@ -26,7 +37,8 @@ struct Surroundings {
 };
 
 /// Tracked people within `watch_radius` [m] of the doorway on `pass`'s side (moving: faster than
-/// kMovingMps and kWalkedOffM from where they last stood) and the laser's returns off the map
+/// kMovingMps, kWalkedOffM from where they last stood, and measured within
+/// kSeenMovingWithinSec) and the laser's returns off the map
 /// within `near_door` [m] (moving: Belief::moving_returns). The laser sees all round, the camera
 /// only ahead. (Furniture off the map near a door counts as someone near: such a door is held until
 /// max_hold.)

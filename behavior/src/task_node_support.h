@@ -187,6 +187,14 @@ const perception::TrackedDoor* FindTrackedDoor(const perception::WorldState& wor
 double ExitDistance(const TaskServices& task, const std::string& door);
 /// How far before the door line the robot lines up and waits [m].
 double EntryDistance(const TaskServices& task, const std::string& door, const DoorPass& pass);
+/// The robot's way from X_MB_from onto `door`'s axis, at EntryDistance, facing through it:
+/// straight, or, on the side the leaf opens into from nearer the door line than that, out
+/// beyond the leaf's sweep first and then across (a straight line from beside the hinge, a
+/// button's standoff, would cut the opening leaf). Starts with X_MB_from.
+std::vector<Pose2> LineUpPath(const TaskServices& task, const std::string& door,
+                              const DoorPass& pass, const Pose2& X_MB_from);
+/// How long the trajectories take along `path` at the door speed, turns included [s].
+double DoorPathDuration(const TaskServices& task, const std::vector<Pose2>& path);
 
 /// A person's body (centre and radius) or a scan return off the map (radius 0), in M, now or
 /// predicted `t` seconds ahead.

@@ -54,6 +54,18 @@ double SegmentDuration(double base_distance, bool through_door, const Trajectory
                   config.min_duration);
 }
 
+// Peak speed / average speed of a rest-to-rest quintic.
+constexpr double kQuinticPeakFactor = 1.875;
+
+double SegmentDuration(double base_distance, double base_turn, bool through_door,
+                       const TrajectoryConfig& config) {
+  ThrowUnless(std::isfinite(base_turn), "Invalid segment: base turn (", base_turn,
+              ") must be finite.");
+  // The base turns no faster than the tracking controller can follow.
+  return std::max(SegmentDuration(base_distance, through_door, config),
+                  kQuinticPeakFactor * std::abs(base_turn) / config.max_yaw_rate);
+}
+
 WholeBodyTrajectory WholeBodyTrajectory::Plan(const std::vector<WholeBodyVector>& waypoints,
                                               const RobotModel& model,
                                               const TrajectoryConfig& config,
@@ -64,8 +76,6 @@ WholeBodyTrajectory WholeBodyTrajectory::Plan(const std::vector<WholeBodyVector>
   ThrowUnless(through_door.empty() || through_door.size() == waypoints.size() - 1,
               "Invalid trajectory: through_door ", "has ", through_door.size(), " entries for ",
               waypoints.size() - 1, " segments.");
-  constexpr double kQuinticPeakFactor =
-      1.875;  // peak speed / average speed of a rest-to-rest quintic
   WholeBodyTrajectory trajectory;
   WholeBodyVector previous = waypoints[0];
   ThrowUnless(previous.allFinite(), "Invalid trajectory: waypoint 0 is not finite.");
@@ -77,10 +87,8 @@ WholeBodyTrajectory WholeBodyTrajectory::Plan(const std::vector<WholeBodyVector>
         previous[kBaseYaw] + WrapAngle(next[kBaseYaw] - previous[kBaseYaw]);  // the short way
     const double distance =
         std::hypot(next[kBaseX] - previous[kBaseX], next[kBaseY] - previous[kBaseY]);
-    double T = SegmentDuration(distance, !through_door.empty() && through_door[s - 1], config);
-    // The base turns no faster than the tracking controller can follow.
-    T = std::max(T, kQuinticPeakFactor * std::abs(next[kBaseYaw] - previous[kBaseYaw]) /
-                        config.max_yaw_rate);
+    double T = SegmentDuration(distance, next[kBaseYaw] - previous[kBaseYaw],
+                               !through_door.empty() && through_door[s - 1], config);
     for (int j = kArmLift; j < kNumWholeBodyJoints; ++j) {
       const double limit = model.limits(WholeBodyJoint(j)).velocity;
       if (limit > 0.0)

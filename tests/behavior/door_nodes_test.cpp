@@ -2,6 +2,8 @@
 
 #include "task_node_fixture.h"
 
+#include "task_node_support.h"
+
 namespace egress::behavior {
 namespace {
 
@@ -335,6 +337,37 @@ TEST_F(DoorNodesTest, TraverseDoorLinesUpStraightWhenTheWindowLeavesNoTimeToLook
     ASSERT_GE(motion_.path().size(), 2u);
     EXPECT_NEAR(motion_.path().back().x, restarted ? 0.0 : 0.74, 1e-6) << restarted;
   }
+}
+
+// The way onto the door's axis from a button's standoff beside the hinge: on the side the leaf
+// opens into, out beyond its sweep first, then across; on the other side, straight. Its time
+// counts the turn (from facing a side wall's button to facing through the door, a quarter turn
+// at max_yaw_rate), not only the distance: the straight line's 3.5 s for the 6.5 s it took let
+// the robot count on a window that closed before it was through (two wards seed 7, door_e).
+TEST_F(DoorNodesTest, TheLineUpGoesOutRoundALeafOpeningTowardsTheRobotAndCountsItsTurn) {
+  const Pose2 X_MB_standoff{1.075, 2.4, 0.0};  // facing a button on a wall running north-south
+  map_.doors[0].swing_sign = 1.0;              // opens south, towards the robot
+  const DoorPass pass = CalcDoorPass(map_, "lab_door", X_MB_standoff);
+  const double entry = detail::EntryDistance(services_, "lab_door", pass);
+  ASSERT_GT(entry, services_.config.door_entry_distance);
+  const std::vector<Pose2> line_up = detail::LineUpPath(services_, "lab_door", pass, X_MB_standoff);
+  ASSERT_EQ(line_up.size(), 3u);
+  EXPECT_NEAR(line_up[1].x, 1.075, 1e-9);  // straight out ...
+  EXPECT_NEAR(line_up[1].y, 3.0 - entry, 1e-9);
+  EXPECT_NEAR(line_up[2].x, 0.0, 1e-9);  // ... then across, facing through the door
+  EXPECT_NEAR(line_up[2].y, 3.0 - entry, 1e-9);
+  EXPECT_NEAR(line_up[2].yaw, M_PI / 2, 1e-9);
+  const auto& trajectory = motion_.trajectory_config();
+  const double turn = 1.875 * (M_PI / 2) / trajectory.max_yaw_rate;
+  EXPECT_NEAR(detail::DoorPathDuration(services_, line_up),
+              std::max(turn, planning::SegmentDuration(entry - 0.6, true, trajectory)) +
+                  planning::SegmentDuration(1.075, true, trajectory),
+              1e-9);
+  map_.doors[0].swing_sign = -1.0;  // opens away: straight onto the axis
+  const std::vector<Pose2> straight =
+      detail::LineUpPath(services_, "lab_door", pass, X_MB_standoff);
+  ASSERT_EQ(straight.size(), 2u);
+  EXPECT_NEAR(straight[1].y, 3.0 - services_.config.door_entry_distance, 1e-9);
 }
 
 TEST_F(DoorNodesTest, TraverseDoorLinesUpOnTheDoorsAxisBeforeGoing) {

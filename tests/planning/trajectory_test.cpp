@@ -36,6 +36,23 @@ TEST(TrajectoryTest, DurationRule) {
   EXPECT_THROW(SegmentDuration(-1.0, false, config), InvalidArgument);
 }
 
+// A base that turns far takes longer than its distance says: its yaw peaks at max_yaw_rate (a
+// quarter turn, 1.875 * (pi / 2) / 0.6 = 4.9 s), and the whole-body plan takes the same time.
+TEST(TrajectoryTest, DurationRuleWithATurn) {
+  const TrajectoryConfig config;
+  const double quarter = std::numbers::pi / 2;
+  EXPECT_DOUBLE_EQ(SegmentDuration(0.5, quarter, true, config), 1.875 * quarter / 0.6);
+  EXPECT_DOUBLE_EQ(SegmentDuration(0.5, -quarter, true, config), 1.875 * quarter / 0.6);
+  EXPECT_DOUBLE_EQ(SegmentDuration(2.0, 0.1, true, config), 5.0);  // the distance rules
+  EXPECT_THROW(SegmentDuration(0.5, std::nan(""), true, config), InvalidArgument);
+  const RobotModel model = RobotModel::LoadDefault();
+  WholeBodyVector a = WholeBodyVector::Zero(), b = a;
+  b[kBaseX] = 0.5;
+  b[kBaseYaw] = quarter;
+  EXPECT_DOUBLE_EQ(WholeBodyTrajectory::Plan({a, b}, model, config, {true}).duration(),
+                   SegmentDuration(0.5, quarter, true, config));
+}
+
 TEST(TrajectoryTest, WholeBodySegmentsAreSynchronizedAndTurnTheShortWay) {
   const RobotModel model = RobotModel::LoadDefault();
   WholeBodyVector a = WholeBodyVector::Zero(), b = a, c = a;

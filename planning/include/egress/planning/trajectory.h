@@ -42,6 +42,10 @@ struct TrajectoryConfig {
 
 /// The paper's duration rule for a segment whose base travels `base_distance` metres.
 double SegmentDuration(double base_distance, bool through_door, const TrajectoryConfig& config);
+/// The same, stretched so that a base turning `base_turn` radians (either way) peaks at no more
+/// than config.max_yaw_rate: what WholeBodyTrajectory::Plan gives a base-only segment [s].
+double SegmentDuration(double base_distance, double base_turn, bool through_door,
+                       const TrajectoryConfig& config);
 
 /// One sample of a whole-body trajectory.
 struct TrajectorySample {
