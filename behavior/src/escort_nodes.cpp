@@ -35,14 +35,6 @@ constexpr double kLookRequestSec = 0.5;
 constexpr double kStillForSec = 4.0;
 // [m] The robot goes to its wait spot only with nobody this near it (or the way there).
 constexpr double kSpotClearM = 1.0;
-// [m] Someone this near the doorway's centre, on the robot's side, stands by the door.
-constexpr double kAtDoorwayM = 1.5;
-// [m] Laser returns closer than this to one another are on one body (returns 0.25 degrees
-// apart are centimetres apart on it; people in a group stand further apart than this).
-constexpr double kSameBodyM = 0.15;
-// [m] A laser return this near a mapped wall or leaf is the wall's, seen off, rather than a
-// body's near side.
-constexpr double kHuggingWallM = 0.3;
 // [m] For residents waiting at the door, the robot goes to the actuator with nobody this near
 // its standoff: its footprint (0.215 m) and a hand's breadth. Someone waiting who cannot
 // operate the door leaves a person's room before the actuator for whoever can, not more (clinic
@@ -282,7 +274,8 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // second 1.9 m from the doorway; taken for a group yet to set off, they were left there).
     // Before, only those by the doorway: a group standing about has its front row there too
     // (office seed 19: a group of twelve in a grid 1 m apart, its corner 1.8 m from door_a).
-    const AtTheDoorway at_door = ByTheDoorway(pass, Input<double>("reach"));
+    const AtTheDoorway at_door = ByTheDoorway(belief_, pass, standoff_.translation(),
+                                              Input<double>("reach"), task_.config.person_radius);
     // (Once the evacuation is under way, whoever stayed while the door stood open is waiting
     // too: held up by others or by the robot, not a group yet to set off — clinic seed 19: a
     // wheelchair user at door_e, held up by the robot through two windows, was never opened for
@@ -608,84 +601,6 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     const double lane = pass.width / 2 + task_.config.footprint_radius + task_.config.person_radius;
     return out > -(task_.config.footprint_radius + kThroughM) && out < kLookOutM &&
            std::abs(d.dot(t)) < lane;
-  }
-
-  // Who stands by the doorway, on the robot's side: each tracked person within kAtDoorwayM (plus
-  // a body) of the doorway's centre, and each laser return off the map on a body that does — the
-  // returns linked to one within kAtDoorwayM by steps of under kSameBodyM (one body's outline;
-  // its far side may be further out), or on such a tracked person's body. And whether anyone
-  // else stands on this side within `radius` of the standoff.
-  struct AtTheDoorway {
-    bool someone{false};  // someone stands by the doorway
-    bool alone{true};     // nobody else is within the radius of the standoff
-    bool only{false};     // both: those near are waiting at the door
-  };
-  AtTheDoorway ByTheDoorway(const DoorPass& pass, double radius) const {
-    const Eigen::Vector2d& p_MS = standoff_.translation();
-    const auto by_doorway = [&](const Eigen::Vector2d& p, double within) {
-      const Eigen::Vector2d d = p - pass.centre;
-      return d.norm() < within && d.dot(pass.n_M) > -kThroughM;  // on the robot's side
-    };
-    // Tracked people by the doorway.
-    const auto& people = belief_.world.people;
-    std::vector<bool> by(people.size(), false);
-    bool someone = false;
-    for (std::size_t i = 0; i < people.size(); ++i) {
-      by[i] = by_doorway(people[i].person.p_MP, kAtDoorwayM + task_.config.person_radius);
-      someone = someone || by[i];
-    }
-    // Only this side counts: those beyond the door line walk on away from it.
-    const auto within = [&](const Eigen::Vector2d& p) {
-      return (p - p_MS).norm() < radius && (p - pass.centre).dot(pass.n_M) > -kThroughM;
-    };
-    bool alone = true;
-    for (std::size_t i = 0; i < people.size(); ++i)
-      if (!by[i] && within(people[i].person.p_MP)) alone = false;
-    // Returns off the map but hugging a wall or a door's leaf are not counted out there: seen
-    // from metres away a jamb's edge lands beyond kOffMapM (the pose's yaw error times the range;
-    // atrium seed 26: a jamb 4.7 m from the standoff, read as a group standing about, kept the
-    // robot from the button while a resident waited at the door, until the time limit). The
-    // near side of anyone standing against a wall is a body's depth off it.
-    const perception::Costmap2D* costmap = belief_.world.costmap;
-    std::vector<Eigen::Vector2d> near;
-    for (const Eigen::Vector2d& p : belief_.off_map_returns)
-      if (by_doorway(p, kAtDoorwayM) ||
-          (within(p) && (costmap == nullptr || !costmap->IsNearMappedObstacle(p, kHuggingWallM))))
-        near.push_back(p);
-    std::vector<bool> linked(near.size(), false);
-    std::vector<std::size_t> frontier;
-    // Returns on the body of a tracked person by the doorway count with them (their outline
-    // may reach further out).
-    const auto on_someone_by = [&](const Eigen::Vector2d& p) {
-      for (std::size_t i = 0; i < people.size(); ++i)
-        if (by[i] && (p - people[i].person.p_MP).norm() < 2.0 * task_.config.person_radius)
-          return true;
-      return false;
-    };
-    for (std::size_t i = 0; i < near.size(); ++i) {
-      if (by_doorway(near[i], kAtDoorwayM)) {
-        linked[i] = true;
-        frontier.push_back(i);
-      }
-    }
-    someone = someone || !frontier.empty();
-    for (std::size_t i = 0; i < near.size(); ++i) {
-      if (!linked[i] && on_someone_by(near[i])) {
-        linked[i] = true;
-        frontier.push_back(i);
-      }
-    }
-    while (!frontier.empty()) {
-      const std::size_t i = frontier.back();
-      frontier.pop_back();
-      for (std::size_t j = 0; j < near.size(); ++j) {
-        if (linked[j] || (near[j] - near[i]).norm() >= kSameBodyM) continue;
-        linked[j] = true;
-        frontier.push_back(j);
-      }
-    }
-    alone = alone && std::all_of(linked.begin(), linked.end(), [](bool b) { return b; });
-    return {someone, alone, someone && alone};
   }
 
   // Nobody within `radius` of `goal` or of the straight way from the robot to it: no tracked

@@ -1,10 +1,23 @@
 #include "escort_watch.h"
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "task_node_support.h"
 
 namespace egress::behavior::detail {
+
+namespace {
+// [m] Someone this near the doorway's centre, on the robot's side, stands by the door.
+constexpr double kAtDoorwayM = 1.5;
+// [m] Laser returns closer than this to one another are on one body (returns 0.25 degrees
+// apart are centimetres apart on it; people in a group stand further apart than this).
+constexpr double kSameBodyM = 0.15;
+// [m] A laser return this near a mapped wall or leaf is the wall's, seen off, rather than a
+// body's near side.
+constexpr double kHuggingWallM = 0.3;
+}  // namespace
 
 Surroundings LookAround(const Belief& belief, const DoorPass& pass, double watch_radius,
                         double near_door) {
@@ -49,6 +62,73 @@ Surroundings LookAround(const Belief& belief, const DoorPass& pass, double watch
     s.mover = StrCat("laser returns moving at ", PoseText({p.x(), p.y(), 0}));
   }
   return s;
+}
+
+AtTheDoorway ByTheDoorway(const Belief& belief, const DoorPass& pass, const Eigen::Vector2d& p_MS,
+                          double radius, double person_radius) {
+  const auto by_doorway = [&](const Eigen::Vector2d& p, double within) {
+    const Eigen::Vector2d d = p - pass.centre;
+    return d.norm() < within && d.dot(pass.n_M) > -kThroughM;  // on the robot's side
+  };
+  // Tracked people by the doorway.
+  const auto& people = belief.world.people;
+  std::vector<bool> by(people.size(), false);
+  bool someone = false;
+  for (std::size_t i = 0; i < people.size(); ++i) {
+    by[i] = by_doorway(people[i].person.p_MP, kAtDoorwayM + person_radius);
+    someone = someone || by[i];
+  }
+  // Only this side counts: those beyond the door line walk on away from it.
+  const auto within = [&](const Eigen::Vector2d& p) {
+    return (p - p_MS).norm() < radius && (p - pass.centre).dot(pass.n_M) > -kThroughM;
+  };
+  bool alone = true;
+  for (std::size_t i = 0; i < people.size(); ++i)
+    if (!by[i] && within(people[i].person.p_MP)) alone = false;
+  // Returns off the map but hugging a wall or a door's leaf are not counted out there: seen
+  // from metres away a jamb's edge lands beyond kOffMapM (the pose's yaw error times the range;
+  // atrium seed 26: a jamb 4.7 m from the standoff, read as a group standing about, kept the
+  // robot from the button while a resident waited at the door, until the time limit). The
+  // near side of anyone standing against a wall is a body's depth off it.
+  const perception::Costmap2D* costmap = belief.world.costmap;
+  std::vector<Eigen::Vector2d> near;
+  for (const Eigen::Vector2d& p : belief.off_map_returns)
+    if (by_doorway(p, kAtDoorwayM) ||
+        (within(p) && (costmap == nullptr || !costmap->IsNearMappedObstacle(p, kHuggingWallM))))
+      near.push_back(p);
+  std::vector<bool> linked(near.size(), false);
+  std::vector<std::size_t> frontier;
+  // Returns on the body of a tracked person by the doorway count with them (their outline
+  // may reach further out).
+  const auto on_someone_by = [&](const Eigen::Vector2d& p) {
+    for (std::size_t i = 0; i < people.size(); ++i)
+      if (by[i] && (p - people[i].person.p_MP).norm() < 2.0 * person_radius) return true;
+    return false;
+  };
+  for (std::size_t i = 0; i < near.size(); ++i) {
+    if (by_doorway(near[i], kAtDoorwayM)) {
+      linked[i] = true;
+      frontier.push_back(i);
+    }
+  }
+  someone = someone || !frontier.empty();
+  for (std::size_t i = 0; i < near.size(); ++i) {
+    if (!linked[i] && on_someone_by(near[i])) {
+      linked[i] = true;
+      frontier.push_back(i);
+    }
+  }
+  while (!frontier.empty()) {
+    const std::size_t i = frontier.back();
+    frontier.pop_back();
+    for (std::size_t j = 0; j < near.size(); ++j) {
+      if (linked[j] || (near[j] - near[i]).norm() >= kSameBodyM) continue;
+      linked[j] = true;
+      frontier.push_back(j);
+    }
+  }
+  alone = alone && std::all_of(linked.begin(), linked.end(), [](bool b) { return b; });
+  return {someone, alone, someone && alone};
 }
 
 }  // namespace egress::behavior::detail

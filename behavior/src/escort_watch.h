@@ -45,4 +45,19 @@ struct Surroundings {
 Surroundings LookAround(const Belief& belief, const DoorPass& pass, double watch_radius,
                         double near_door);
 
+/// Who stands by `pass`'s doorway on the robot's side: each tracked person within 1.5 m (plus a
+/// body of `person_radius`) of the doorway's centre, and each laser return off the map on a body
+/// that does — the returns linked to one within 1.5 m by steps of under 0.15 m (one body's
+/// outline; its far side may be further out), or on such a tracked person's body. And whether
+/// anyone else stands on this side within `radius` of p_MS (the standoff) [m]: tracked people,
+/// and returns off the map other than those within 0.3 m of a mapped wall or leaf (a wall seen a
+/// little off from metres away).
+struct AtTheDoorway {
+  bool someone{false};  ///< someone stands by the doorway
+  bool alone{true};     ///< nobody else is within the radius of the standoff
+  bool only{false};     ///< both: those near are waiting at the door
+};
+AtTheDoorway ByTheDoorway(const Belief& belief, const DoorPass& pass, const Eigen::Vector2d& p_MS,
+                          double radius, double person_radius);
+
 }  // namespace egress::behavior::detail
