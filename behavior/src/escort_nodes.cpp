@@ -265,34 +265,30 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     if (open_since != belief_.door_open_since.end() &&
         ToSeconds(belief_.now - open_since->second) > kStillForSec)
       stood_open_ = true;
-    // Still for kStillForSec, not since the hold began: a stir nearby, too short to be people
-    // coming, is no reason to leave someone waiting (two wards seed 7: a resident waiting alone
-    // at door_e, watched from 8 m while others walked through, was left behind).
-    // Once the evacuation is under way (people came to a door this robot held), those standing
-    // at the next door with someone by its doorway are waiting for it, however many stand
-    // further out (office seed 14: two who could not wave at door_b's plate queued there, the
-    // second 1.9 m from the doorway; taken for a group yet to set off, they were left there).
-    // Before, only those by the doorway: a group standing about has its front row there too
-    // (office seed 19: a group of twelve in a grid 1 m apart, its corner 1.8 m from door_a).
+    // Found waiting: still for kStillForSec (not since the hold began: a stir nearby, too short
+    // to be people coming, is no reason to leave someone waiting — two wards seed 7), with
+    // someone by the doorway. Before the evacuation is under way, only those by the doorway
+    // near the actuator: a group standing about has its front row there too (office seed 19: a
+    // grid of twelve 1 m apart, its corner 1.8 m from door_a), and a group that stayed while the
+    // door stood open before it is not waiting for it. Once under way (people came to a door
+    // this robot held), whoever stands at the next door with someone by its doorway is waiting,
+    // however many stand further out (office seed 14: a queue of two at door_b, the second 1.9 m
+    // from the doorway) and even if they stayed while it stood open (clinic seed 19: a
+    // wheelchair user held up at door_e by the robot through two windows).
     const AtTheDoorway at_door = ByTheDoorway(belief_, pass, standoff_.translation(),
                                               Input<double>("reach"), task_.config.person_radius);
-    // (Once the evacuation is under way, whoever stayed while the door stood open is waiting
-    // too: held up by others or by the robot, not a group yet to set off — clinic seed 19: a
-    // wheelchair user at door_e, held up by the robot through two windows, was never opened for
-    // again.)
     const bool found_waiting =
         !came_ && !around.moving && (!stood_open_ || under_way_) &&
         (!last_moving_ || ToSeconds(belief_.now - *last_moving_) > kStillForSec) &&
         ToSeconds(belief_.now - *started_) > kStillForSec &&
         (under_way_ ? at_door.someone : at_door.only);
     // Before the evacuation is under way, not with people standing within `reach` who have yet
-    // to set off: they
-    // may at any moment, and an operation keeps the robot at the actuator, beside their way in,
-    // for ~10 s (a walker's 10 m). Going every `every` seconds while a group stood 3.5-4 m from
-    // the standoff, the robot was at the button when the alarm set them off about half the
-    // time, and drove back to its spot through them (two wards seeds 3, 16, 22; atrium seeds 23,
-    // 38: walked into). Only someone waiting by the doorway (found_waiting), or nobody near:
-    // then it opens ahead of whoever comes.
+    // to set off: they may at any moment, and an operation keeps the robot at the actuator,
+    // beside their way in, for ~10 s (a walker's 10 m). Going every `every` seconds while a
+    // group stood 3.5-4 m from the standoff, the robot was at the button when the alarm set them
+    // off about half the time, and drove back to its spot through them (two wards seeds 3, 16,
+    // 22; atrium seeds 23, 38: walked into). Only someone waiting by the doorway
+    // (found_waiting), or nobody near: then it opens ahead of whoever comes.
     const bool group_within_reach = !came_ && !under_way_ && !at_door.alone;
     const bool actuator_clear =
         !around.moving && (!group_within_reach || found_waiting) &&

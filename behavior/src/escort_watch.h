@@ -38,8 +38,9 @@ struct Surroundings {
 
 /// Tracked people within `watch_radius` [m] of the doorway on `pass`'s side (moving: faster than
 /// kMovingMps, kWalkedOffM from where they last stood, and measured within
-/// kSeenMovingWithinSec) and the laser's returns off the map
-/// within `near_door` [m] (moving: Belief::moving_returns). The laser sees all round, the camera
+/// kSeenMovingWithinSec) and the laser's returns off the map within `near_door` [m] (moving:
+/// Belief::moving_returns), but for those where a leaf estimated opening or closing sweeps (the
+/// leaf itself, drawn in the costmap behind it). The laser sees all round, the camera
 /// only ahead. (Furniture off the map near a door counts as someone near: such a door is held until
 /// max_hold.)
 Surroundings LookAround(const Belief& belief, const DoorPass& pass, double watch_radius,
