@@ -405,7 +405,11 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     const double now = stepping_to ? worth(*stepping_to) : room_at(at);
     const perception::Costmap2D* costmap = belief_.world.costmap;
     std::optional<Pose2> best;  // never in their way (InTheirWay)
-    double best_room = now + kRoomGainM;
+    // Only a step predicted to leave them room: where every step still meets someone (a
+    // resident pushed at 1.5 m/s into the corner it stood in), the robot keeps its course, which
+    // they can see and avoid, rather than turn about into their way (atrium seed 32: a metre's
+    // step chosen at a predicted -0.16 m reversed the robot into them).
+    double best_room = std::max(now + kRoomGainM, 0.0);
     for (const double step : kRoomStepsM) {
       for (int k = 0; k < kRoomHeadings; ++k) {
         const double a = 2 * M_PI * k / kRoomHeadings;

@@ -730,6 +730,40 @@ TEST_F(HoldForResidentsTest, MakesRoomToTheSideOfSomeoneWalkingAtIt) {
   EXPECT_GT(std::abs(motion_.path().back().x - -1.8), 0.5) << "off their path";
 }
 
+// Someone running at the robot, too near for any step to take it out of their way in time: it
+// keeps still, where they see it and go round, rather than start a step they run into (atrium
+// seed 32: a metre's step, predicted to meet them anyway, reversed the robot into a resident
+// pushed along by the crowd).
+TEST_F(HoldForResidentsTest, KeepsStillForSomeoneTooNearForAnyStepToClear) {
+  tree_.TickOnce();
+  OperatedAgo(1.0);
+  const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
+  belief_.X_MB = spot;  // arrived
+  motion_.StopBase();
+  belief_.now = At(2.0);
+  const auto walking_at_it = [&](double from, double speed) {
+    auto walker =
+        node_testing::Person({spot.x, spot.y - from}, perception::PersonIntent::kApproaching);
+    walker.person.v_MP = {0.0, speed};
+    for (int k = 1; k <= 4; ++k)
+      walker.person.forecast.push_back(walker.person.p_MP + walker.person.v_MP * (0.2 * k));
+    return walker;
+  };
+  // Running at 2 m/s from 1.2 m: on the robot in under half a second.
+  See({walking_at_it(1.2, 2.0)});
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_FALSE(NotedText("making room"));
+  // (It may turn where it stands, to watch them.)
+  EXPECT_TRUE(!motion_.base_moving() ||
+              (motion_.path().back().translation() - spot.translation()).norm() < 1e-9);
+  // Walking at 1 m/s from 1.5 m, they leave the robot time for a step out of their way: it
+  // takes it.
+  See({walking_at_it(1.5, 1.0)});
+  belief_.now = At(2.5);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(NotedText("making room"));
+}
+
 // A step under way is re-aimed when someone comes at where it ends: taking a 0.6 m step for
 // one person, the robot did not look again for the seconds it took, while another walked 2 m
 // at it (clinic seed 4, a contact).
