@@ -379,8 +379,8 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   // Where to step to make room when someone is within kMakeRoomGapM of the robot's edge (or,
   // during a step to `stepping_to`, of that step's end): of the poses a free straight step away
   // (the same heading), not in the residents' way in, the one farthest from everyone near, if
-  // it gains kRoomGainM over staying (over the step's end). nullopt: nobody that near, or no
-  // better place.
+  // it gains kRoomGainM over staying (over the step's end) and is predicted to leave everyone
+  // room. nullopt: nobody that near, or no better place.
   std::optional<Pose2> FindRoom(const DoorPass& pass,
                                 const std::optional<Eigen::Vector2d>& stepping_to) const {
     const Eigen::Vector2d at = belief_.X_MB.translation();
