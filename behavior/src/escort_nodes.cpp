@@ -271,17 +271,19 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // near the actuator: a group standing about has its front row there too (office seed 19: a
     // grid of twelve 1 m apart, its corner 1.8 m from door_a), and a group that stayed while the
     // door stood open before it is not waiting for it. Once under way (people came to a door
-    // this robot held), whoever stands at the next door with someone by its doorway is waiting,
-    // however many stand further out (office seed 14: a queue of two at door_b, the second 1.9 m
-    // from the doorway) and even if they stayed while it stood open (clinic seed 19: a
-    // wheelchair user held up at door_e by the robot through two windows).
+    // this robot held), whoever stands at the next door is waiting: with someone by its
+    // doorway, however many stand further out (office seed 14: a queue of two at door_b, the
+    // second 1.9 m from the doorway), or anyone within `reach` of the standoff (clinic seed 37: a
+    // wheelchair user 2.4 m from door_e's doorway, across the lane to the actuator they made
+    // way for), and even if they stayed while it stood open (clinic seed 19: a wheelchair user
+    // held up at door_e by the robot through two windows).
     const AtTheDoorway at_door = ByTheDoorway(belief_, pass, standoff_.translation(),
                                               Input<double>("reach"), task_.config.person_radius);
     const bool found_waiting =
         !came_ && !around.moving && (!stood_open_ || under_way_) &&
         (!last_moving_ || ToSeconds(belief_.now - *last_moving_) > kStillForSec) &&
         ToSeconds(belief_.now - *started_) > kStillForSec &&
-        (under_way_ ? at_door.someone : at_door.only);
+        (under_way_ ? at_door.someone || !at_door.alone : at_door.only);
     // Before the evacuation is under way, not with people standing within `reach` who have yet
     // to set off: they may at any moment, and an operation keeps the robot at the actuator,
     // beside their way in, for ~10 s (a walker's 10 m). Going every `every` seconds while a

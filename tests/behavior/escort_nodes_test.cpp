@@ -453,6 +453,33 @@ TEST_F(HoldForResidentsTest, OnceTheEvacuationIsUnderWayAQueueAtTheDoorIsWaiting
   EXPECT_TRUE(NotedText("releasing")) << "the first hold's end";
 }
 
+// ... and so is someone standing alone, still, near the door but not by its doorway: a
+// wheelchair user who cannot operate it, who made way for whoever would (the twin's residents
+// wait across a lane to the actuator). Read as not waiting, they kept the robot from the
+// actuator (clinic seed 37: left behind at the time limit).
+TEST_F(HoldForResidentsTest, OnceUnderWaySomeoneStandingStillNearTheDoorIsWaitingForIt) {
+  const Eigen::Vector2d aside{0.3, 0.8};
+  ASSERT_GT((aside - Eigen::Vector2d(0.0, 3.0)).norm(), 1.5);  // not by the doorway
+  ASSERT_LT((aside - Standoff().translation()).norm(), 3.5);   // within keep_clear
+  const auto stands_from = [&](double from) {
+    See({node_testing::Person(aside, perception::PersonIntent::kStationary)});
+    for (double t = from; t < from + 8.0; t += 1.0) {
+      belief_.now = At(t);
+      motion_.StopBase();
+      const NodeStatus status = tree_.TickOnce();
+      if (status == NodeStatus::kSuccess) return t;  // to the actuator
+      EXPECT_EQ(status, NodeStatus::kRunning) << "at " << t;
+    }
+    return -1.0;
+  };
+  tree_.TickOnce();
+  OperatedAgo(1.0);
+  const double t = HoldThroughWhichResidentsCame(2.0);
+  BeginFarFromAShutDoor();
+  const double went = stands_from(t + 1.0);
+  EXPECT_GT(went, t + 4.0) << "went before they stood still kStillForSec";
+}
+
 // People came once someone near was on the move kComingForSec on end: a stir of a few tenths
 // of a second in a group standing about (a track hopping between neighbours who hide one
 // another) is not residents coming (two wards seed 16: taken for it 4.9 s into the hold, a
