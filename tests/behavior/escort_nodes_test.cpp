@@ -102,6 +102,20 @@ class HoldForResidentsTest : public EscortNodesTest {
     log_.Take();
     return spot;
   }
+  // `people` stand where they are from `from`, a tick a second for `seconds`, the robot at
+  // rest: the time it goes to the actuator (SUCCESS), or -1 if it does not.
+  double TimeItGoesForThoseStanding(std::vector<perception::TrackedPersonWithIntent> people,
+                                    double from, double seconds) {
+    See(std::move(people));
+    for (double t = from; t < from + seconds; t += 1.0) {
+      belief_.now = At(t);
+      motion_.StopBase();
+      const NodeStatus status = tree_.TickOnce();
+      if (status == NodeStatus::kSuccess) return t;  // to the actuator
+      EXPECT_EQ(status, NodeStatus::kRunning) << "at " << t;
+    }
+    return -1.0;
+  }
   static constexpr double kTickSec = 0.25;  // under kStirGapSec
   bool NotedText(const std::string& text) const {
     for (const auto& note : log_.pending())
@@ -430,15 +444,9 @@ TEST_F(HoldForResidentsTest, OnceTheEvacuationIsUnderWayAQueueAtTheDoorIsWaiting
   ASSERT_GT((second - Eigen::Vector2d(0.0, 3.0)).norm(), 2.0);
   const auto stationary = perception::PersonIntent::kStationary;
   const auto queue_stands_from = [&](double from) {
-    See({node_testing::Person(front, stationary), node_testing::Person(second, stationary)});
-    for (double t = from; t < from + 6.0; t += 1.0) {
-      belief_.now = At(t);
-      motion_.StopBase();
-      const NodeStatus status = tree_.TickOnce();
-      if (status == NodeStatus::kSuccess) return t;  // to the actuator
-      EXPECT_EQ(status, NodeStatus::kRunning) << "at " << t;
-    }
-    return -1.0;
+    return TimeItGoesForThoseStanding(
+        {node_testing::Person(front, stationary), node_testing::Person(second, stationary)}, from,
+        6.0);
   };
   // Before anyone came: a group standing about, never operated for.
   BeginFarFromAShutDoor();
@@ -461,22 +469,12 @@ TEST_F(HoldForResidentsTest, OnceUnderWaySomeoneStandingStillNearTheDoorIsWaitin
   const Eigen::Vector2d aside{0.3, 0.8};
   ASSERT_GT((aside - Eigen::Vector2d(0.0, 3.0)).norm(), 1.5);  // not by the doorway
   ASSERT_LT((aside - Standoff().translation()).norm(), 3.5);   // within keep_clear
-  const auto stands_from = [&](double from) {
-    See({node_testing::Person(aside, perception::PersonIntent::kStationary)});
-    for (double t = from; t < from + 8.0; t += 1.0) {
-      belief_.now = At(t);
-      motion_.StopBase();
-      const NodeStatus status = tree_.TickOnce();
-      if (status == NodeStatus::kSuccess) return t;  // to the actuator
-      EXPECT_EQ(status, NodeStatus::kRunning) << "at " << t;
-    }
-    return -1.0;
-  };
   tree_.TickOnce();
   OperatedAgo(1.0);
   const double t = HoldThroughWhichResidentsCame(2.0);
   BeginFarFromAShutDoor();
-  const double went = stands_from(t + 1.0);
+  const double went = TimeItGoesForThoseStanding(
+      {node_testing::Person(aside, perception::PersonIntent::kStationary)}, t + 1.0, 8.0);
   EXPECT_GT(went, t + 4.0) << "went before they stood still kStillForSec";
 }
 
