@@ -2,6 +2,8 @@
 // how, whether a doorway is taken, and where someone who cannot operate it waits.
 #include "twin_world_impl.h"
 
+#include "doorway_way.h"
+
 #include <cmath>
 #include <optional>
 
@@ -133,19 +135,14 @@ bool TwinWorld::Impl::OperateDoor(Person& p, int gate) {
 
 bool TwinWorld::Impl::DoorwayTaken(const Person& me, int door) const {
   const Door& d = doors[std::size_t(door)];
-  const double my_side = (me.walker.position - d.fixed->centre).dot(d.fixed->normal) >= 0 ? 1 : -1;
-  const Eigen::Vector2d my_heading = -d.fixed->normal * my_side;
   const bool evacuee = me.state.behavior == PersonBehavior::kEvacuate;
+  const DoorwayFrame frame{d.fixed->centre, d.fixed->normal, d.fixed->along, 0.5 * d.fixed->reach};
   for (const auto& other : people) {
     if (&other == &me || !other.state.started || other.state.out) continue;
     if ((other.walker.position - d.fixed->centre).norm() >= 0.9) continue;
-    // In an evacuation people go through one behind the other: only someone coming the other
-    // way (from the far side, or walking against them) keeps an evacuee waiting.
-    if (evacuee) {
-      const double side = (other.walker.position - d.fixed->centre).dot(d.fixed->normal);
-      const bool my_way = side * my_side > 0.0 || other.walker.velocity.dot(my_heading) > 0.2;
-      if (my_way) continue;
-    }
+    if (evacuee && !KeepsEvacueeWaiting(frame, me.walker.position, other.walker.position,
+                                        other.walker.velocity))
+      continue;
     return true;
   }
   return false;
