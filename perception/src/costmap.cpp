@@ -20,6 +20,8 @@ void CostmapConfig::Validate() const {
               ") must be > 0.");
   ThrowUnless(obstacle_max_range > 0.0 && raytrace_max_range > 0.0,
               "Invalid CostmapConfig: obstacle_max_range and raytrace_max_range must be > 0.");
+  ThrowUnless(unseen_mark_lifetime >= 0.0, "Invalid CostmapConfig: unseen_mark_lifetime (",
+              unseen_mark_lifetime, ") must be >= 0.");
 }
 
 namespace {
@@ -38,6 +40,8 @@ Costmap2D::Costmap2D(const OccupancyGrid& static_map, CostmapConfig config)
               "Costmap: the inflation radius (", config_.inflation_radius, " m) spans more than ",
               kMaxInflationCells, " cells of ", geometry_.resolution, " m");
   obstacle_.assign(geometry_.size(), kFreeCost);
+  marked_at_.assign(geometry_.size(), 0.0);
+  in_marked_.assign(geometry_.size(), 0);
   projection_.assign(geometry_.size(), kFreeCost);
   leaves_.assign(geometry_.size(), kFreeCost);
   doorway_zone_.assign(geometry_.size(), 0);
@@ -114,14 +118,38 @@ void Costmap2D::UpdateWithScan(const LaserScan& scan, const Pose2& X_ML) {
     }
     if (hit_cell && r <= config_.obstacle_max_range) marks.push_back(*hit_cell);
   }
+  const double now = ToSeconds(scan.stamp);
   for (const Eigen::Vector2i& cell : marks) {
-    if (std::uint8_t& value = obstacle_[geometry_.Index(cell.x(), cell.y())];
-        value != kLethalCost) {
+    const std::size_t index = geometry_.Index(cell.x(), cell.y());
+    if (std::uint8_t& value = obstacle_[index]; value != kLethalCost) {
       value = kLethalCost;
       touch(cell.x(), cell.y());
     }
+    if (!in_marked_[index]) marked_.push_back(index);
+    in_marked_[index] = 1;
+    marked_at_[index] = now;
   }
+  ForgetUnseenMarks(now, p_MO, touch);
   if (x1 >= x0) RecomputeWindow(x0, y0, x1, y1);
+}
+
+template <typename Touch>
+void Costmap2D::ForgetUnseenMarks(double now, const Eigen::Vector2d& p_MO, Touch&& touch) {
+  // Drops the cells the rays have cleared and forgets the stale ones out of their reach.
+  const double reach = config_.raytrace_max_range;
+  std::erase_if(marked_, [&](std::size_t index) {
+    std::uint8_t& value = obstacle_[index];
+    if (value == kLethalCost) {
+      if (now - marked_at_[index] <= config_.unseen_mark_lifetime) return false;
+      const int ix = int(index % std::size_t(geometry_.width));
+      const int iy = int(index / std::size_t(geometry_.width));
+      if ((geometry_.CellCenter(ix, iy) - p_MO).norm() <= reach) return false;  // a ray's job
+      value = kFreeCost;  // stale and out of every ray's reach
+      touch(ix, iy);
+    }
+    in_marked_[index] = 0;
+    return true;
+  });
 }
 
 void Costmap2D::SetProjectedObstacles(const std::vector<Eigen::Vector2d>& p_MObstacles) {
@@ -262,6 +290,9 @@ bool Costmap2D::IsNearLethal(const Eigen::Vector2d& p_MQ, double radius,
 
 void Costmap2D::ClearObstacles() {
   std::fill(obstacle_.begin(), obstacle_.end(), kFreeCost);
+  for (const std::size_t index : marked_)
+    in_marked_[index] = 0;
+  marked_.clear();
   RecomputeWindow(0, 0, geometry_.width - 1, geometry_.height - 1);
 }
 

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <random>
 
 #include <gmock/gmock.h>
@@ -253,6 +254,44 @@ TEST(CostmapTest, AMalformedPersonalSpaceIsRefusedNamingWhatIsWrong) {
   EXPECT_EQ(costmap.PersonalSpaceCostAt({5.02, 5.02}), kPersonalSpacePeakCost);
 }
 
+// A scan at `stamp_s` whose beams all return nothing (they clear up to raytrace_max_range).
+LaserScan EmptyScanAt(double stamp_s) {
+  LaserScan scan = testing::MakeScan(1081);
+  scan.stamp = SecondsToDuration(stamp_s);
+  return scan;
+}
+
+TEST(CostmapTest, AMarkNoScanCanClearIsForgottenAfterItsLifetime) {
+  Costmap2D costmap(EmptyMap());  // unseen_mark_lifetime 15 s, raytrace_max_range 3 m
+  const Eigen::Vector2d p_MMark(7.02, 5.02);
+  LaserScan hit = SingleReturn(0.0, 2.0f);  // from (5, 5) facing +x: a return at (7, 5)
+  hit.stamp = SecondsToDuration(0.0);
+  costmap.UpdateWithScan(hit, {5.0, 5.0, 0.0});
+  ASSERT_EQ(costmap.CostAt(p_MMark), kLethalCost);
+  // Marked again at 10 s: its clock restarts.
+  hit.stamp = SecondsToDuration(10.0);
+  costmap.UpdateWithScan(hit, {5.0, 5.0, 0.0});
+  // The robot drives 4 m west: the mark is 6 m away, out of every ray's reach.
+  const Pose2 X_MLAway{1.0, 5.0, 0.0};
+  costmap.UpdateWithScan(EmptyScanAt(24.0), X_MLAway);
+  EXPECT_EQ(costmap.CostAt(p_MMark), kLethalCost) << "14 s after the last mark: kept";
+  costmap.UpdateWithScan(EmptyScanAt(25.5), X_MLAway);
+  EXPECT_EQ(costmap.CostAt(p_MMark), kFreeCost) << "15.5 s after the last mark: forgotten";
+  EXPECT_EQ(costmap.CostAt(p_MMark - Eigen::Vector2d(0.1, 0.0)), kFreeCost) << "and its inflation";
+}
+
+TEST(CostmapTest, AnOldMarkWithinClearingRangeIsLeftToTheRays) {
+  // A return a ray stops at (the wall of someone standing still) is not forgotten however old:
+  // within reach, only a ray that passes the cell clears it.
+  Costmap2D costmap(EmptyMap());
+  LaserScan hit = SingleReturn(0.0, 2.0f);
+  hit.stamp = SecondsToDuration(0.0);
+  costmap.UpdateWithScan(hit, {5.0, 5.0, 0.0});
+  // 60 s later, from 2.5 m away and facing away (the rear 90 degrees are blind): within reach.
+  costmap.UpdateWithScan(EmptyScanAt(60.0), {4.5, 5.0, std::numbers::pi});
+  EXPECT_EQ(costmap.CostAt({7.02, 5.02}), kLethalCost);
+}
+
 TEST(CostmapTest, MalformedInputIsRejectedWithoutCrashing) {
   Costmap2D costmap(EmptyMap());
   LaserScan empty = testing::MakeScan(2);
@@ -264,6 +303,9 @@ TEST(CostmapTest, MalformedInputIsRejectedWithoutCrashing) {
   EXPECT_THROW(costmap.UpdateWithScan(testing::MakeScan(10), {kInf, 5, 0}), InvalidArgument);
   EXPECT_NO_THROW(costmap.UpdateWithScan(testing::MakeScan(10), {50, 50, 0}));  // off the map
   EXPECT_THROW(Costmap2D(EmptyMap(), CostmapConfig{0.3, 0.2}), InvalidArgument);
+  CostmapConfig negative_lifetime;
+  negative_lifetime.unseen_mark_lifetime = -1.0;
+  EXPECT_THROW(Costmap2D(EmptyMap(), negative_lifetime), InvalidArgument);
   EXPECT_THROW(costmap.FootprintCost({std::nan(""), 0, 0}), InvalidArgument);
 }
 

@@ -36,6 +36,11 @@ struct CostmapConfig {
   double cost_scaling_factor{10.0};  ///< k in the exponential decay [1/m].
   double obstacle_max_range{2.5};    ///< Scan returns beyond this do not mark [m].
   double raytrace_max_range{3.0};    ///< Scan rays clear free space up to this range [m].
+  /// A mark farther from the laser than raytrace_max_range can be cleared by no scan: once the
+  /// robot has moved away, someone who walked on would stay in the map for good (Nav2 keeps
+  /// such marks until the robot comes back). Such a mark is forgotten this long after a scan
+  /// last marked it [s]; a mark within clearing range is cleared by the rays as before.
+  double unseen_mark_lifetime{15.0};
   /// @throws InvalidArgument naming the field.
   void Validate() const;
 };
@@ -71,7 +76,9 @@ class Costmap2D {
   Costmap2D(const OccupancyGrid& static_map, CostmapConfig config = {});
 
   /// Marks returns within obstacle_max_range and clears cells along every ray (up to
-  /// raytrace_max_range). X_ML is the laser's pose in M at the scan's time.
+  /// raytrace_max_range); forgets marks out of clearing range that no scan has marked for
+  /// unseen_mark_lifetime (the scan's stamp is the clock). X_ML is the laser's pose in M at
+  /// the scan's time.
   /// @throws InvalidArgument for an invalid scan or pose.
   void UpdateWithScan(const LaserScan& scan, const Pose2& X_ML);
   /// Replaces the projected 3D obstacles (points in M).
@@ -129,11 +136,18 @@ class Costmap2D {
   bool IsNearLethal(const Eigen::Vector2d& p_MQ, double radius,
                     std::initializer_list<const std::vector<std::uint8_t>*> layers) const;
   void MarkLeaf(const Doorway& doorway, double angle, std::uint8_t value);
+  // Clears the marks farther than raytrace_max_range from p_MO last marked before
+  // now - unseen_mark_lifetime; `touch` widens the window to recompute.
+  template <typename Touch>
+  void ForgetUnseenMarks(double now, const Eigen::Vector2d& p_MO, Touch&& touch);
 
   CostmapConfig config_;
   GridGeometry geometry_;
   std::vector<std::uint8_t> static_;
   std::vector<std::uint8_t> obstacle_;
+  std::vector<double> marked_at_;    ///< When a scan last marked each obstacle cell [s].
+  std::vector<std::size_t> marked_;  ///< The cells a scan marked, each once (some since cleared).
+  std::vector<std::uint8_t> in_marked_;  ///< 1 for a cell in marked_.
   std::vector<std::uint8_t> projection_;
   std::vector<std::uint8_t> leaves_;
   std::vector<std::uint8_t> doorway_zone_;  ///< 1 inside a doorway threshold.
