@@ -283,8 +283,13 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
     task_.motion->FollowPath(path, std::vector<bool>(path.size() - 1, false),
                              TuckedArm(*task_.model), belief_.now, task_.config.retreat_speed);
     this->SetOutput("retreating", true);
+    const bool out_of_doorway_only =
+        !aside && (spot.translation() - belief_.last_safe->translation()).norm() > 0.05;
     Note(aside ? StrCat("stepping aside, out of people's way, to (", PoseText(spot), ")")
-               : StrCat("backing off to the last safe waypoint (", PoseText(spot), ")"),
+         : out_of_doorway_only
+             ? StrCat("backing out of the doorway to (", PoseText(spot),
+                      "): the way on is not clear yet")
+             : StrCat("backing off to the last safe waypoint (", PoseText(spot), ")"),
          DecisionEvent::kRetreating);
   }
 
@@ -294,7 +299,8 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
   // where they will be farthest (less kWayCostPerM per metre of way), if that beats the last
   // safe pose. No way may pass nearer anyone than the footprint and kPassMarginM (people where
   // they are now: a retreat into someone standing behind the robot, P1 seed 2000). nullopt:
-  // every way does. Second: whether it is a spot aside.
+  // every way does, unless the way's first leg, out of a doorway, is clear: then its end.
+  // Second: whether it is a spot aside.
   std::optional<std::pair<Pose2, bool>> ChooseSpot(const std::vector<Pose2>& way) const {
     const Pose2 safe = *belief_.last_safe;
     const PeopleRoom room(task_, kPeopleHorizonSec);
@@ -308,6 +314,16 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
     const double beat = safe_ok ? room.Score(corners) : -std::numeric_limits<double>::infinity();
     if (const auto aside = room.BestSpotAround(way, beat)) return std::pair{*aside, true};
     if (safe_ok) return std::pair{safe, false};
+    // Out of the doorway at least, where the way out is clear: a leaf may close on a robot
+    // standing in it. (O2 seed 2005: halted just past the door line, the way on to the last
+    // safe pose was in the laser's blind sector and, while the robot turned to see it, the
+    // memory of where it had just driven ran out; it turned on in the doorway, and the closing
+    // leaf struck it.)
+    if (way.size() >= 2) {
+      corners.pop_back();
+      if (room.IsWayClear(corners) && task_.planner->IsPathValid(way))
+        return std::pair{way.back(), false};
+    }
     return std::nullopt;
   }
 

@@ -315,6 +315,43 @@ TEST_F(NavigationNodesTest, RetractToSafeTurnsToSeeTheWayBackAndTrustsWhereItJus
         << "the way would pass through the person";
 }
 
+// Halted just past the door line, the way on to its last safe pose (beside the door, where the
+// robot came from) in the laser's blind sector and the spots ahead taken: it backs out of the
+// doorway along the way it has just driven, seen, rather than turn to look in the leaf's sweep
+// (O2 seed 2005: it turned there while the memory of the way it drove ran out, and the closing
+// leaf struck it).
+TEST_F(NavigationNodesTest, RetractToSafeBacksOutOfTheDoorwayWhenTheWayOnIsUnseen) {
+  auto blackboard = bt::Blackboard::Create();
+  DoorVisit visit;
+  visit.door = "lab_door";
+  visit.approach_side = Eigen::Vector2d(0.0, -1.0);  // it came from the south (wall y = 3)
+  blackboard->Set("door_visit", bt::Any(visit));
+  bt::Tree tree = Tree(R"(<RetractToSafe/>)", blackboard);
+  belief_.X_MB = {0.0, 3.12, M_PI / 2};            // just past the door line, facing north
+  belief_.last_safe = Pose2{1.0, 2.38, M_PI / 2};  // beside the door: 132 deg off, unseen
+  belief_.scan = node_testing::SweepScan();
+  belief_.X_BL = Pose2{0.17, 0.0, 0.0};
+  belief_.now = At(10.0);
+  for (double y = 2.0; y < 3.12; y += kSweptSampleM)  // driven up the axis, facing north
+    belief_.swept_p_MB.emplace_back(At(10.0 - (3.12 - y) / 0.4), Eigen::Vector2d(0.0, y));
+  belief_.world.people = {Person({0.0, 4.3}, perception::PersonIntent::kStationary)};
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(Noted(DecisionEvent::kRetreating));
+  EXPECT_TRUE(NotedText("backing out of the doorway"));
+  ASSERT_GE(motion_.path().size(), 2u);
+  const Pose2 out = motion_.path().back();
+  EXPECT_NEAR(out.x, 0.0, 1e-6) << "straight back along the door's normal";
+  EXPECT_LT(out.y, 3.0 - 0.5) << "out of the doorway";
+  // Someone seen standing on that way back too: it stays (it never passes them).
+  tree.HaltTree();
+  motion_.StopBase();
+  log_.Take();
+  belief_.world.people.push_back(Person({0.0, 2.6}, perception::PersonIntent::kStationary));
+  belief_.now = At(10.1);
+  tree.TickOnce();
+  EXPECT_FALSE(Noted(DecisionEvent::kRetreating));
+}
+
 // Halted just past the door line, having left the door's zone on the far side before (its last
 // safe pose is there): it goes on to that pose, never back through the doorway (clinic family
 // seed 2007: it backed through door_b as the leaf closed on it).
