@@ -315,17 +315,23 @@ TEST_F(NavigationNodesTest, RetractToSafeTurnsToSeeTheWayBackAndTrustsWhereItJus
         << "the way would pass through the person";
 }
 
+// A blackboard whose door visit came to the lab door from the south (its wall is at y = 3).
+bt::Blackboard::Ptr VisitFromTheSouth() {
+  auto blackboard = bt::Blackboard::Create();
+  DoorVisit visit;
+  visit.door = "lab_door";
+  visit.approach_side = Eigen::Vector2d(0.0, -1.0);
+  blackboard->Set("door_visit", bt::Any(visit));
+  return blackboard;
+}
+
 // Halted just past the door line, the way on to its last safe pose (beside the door, where the
 // robot came from) in the laser's blind sector and the spots ahead taken: it backs out of the
 // doorway along the way it has just driven, seen, rather than turn to look in the leaf's sweep
 // (O2 seed 2005: it turned there while the memory of the way it drove ran out, and the closing
 // leaf struck it).
 TEST_F(NavigationNodesTest, RetractToSafeBacksOutOfTheDoorwayWhenTheWayOnIsUnseen) {
-  auto blackboard = bt::Blackboard::Create();
-  DoorVisit visit;
-  visit.door = "lab_door";
-  visit.approach_side = Eigen::Vector2d(0.0, -1.0);  // it came from the south (wall y = 3)
-  blackboard->Set("door_visit", bt::Any(visit));
+  auto blackboard = VisitFromTheSouth();
   bt::Tree tree = Tree(R"(<RetractToSafe/>)", blackboard);
   belief_.X_MB = {0.0, 3.12, M_PI / 2};            // just past the door line, facing north
   belief_.last_safe = Pose2{1.0, 2.38, M_PI / 2};  // beside the door: 132 deg off, unseen
@@ -356,11 +362,7 @@ TEST_F(NavigationNodesTest, RetractToSafeBacksOutOfTheDoorwayWhenTheWayOnIsUnsee
 // safe pose is there): it goes on to that pose, never back through the doorway (clinic family
 // seed 2007: it backed through door_b as the leaf closed on it).
 TEST_F(NavigationNodesTest, RetractToSafePastTheDoorLineNeverBacksThroughTheDoorway) {
-  auto blackboard = bt::Blackboard::Create();
-  DoorVisit visit;
-  visit.door = "lab_door";
-  visit.approach_side = Eigen::Vector2d(0.0, -1.0);  // it came from the south (wall y = 3)
-  blackboard->Set("door_visit", bt::Any(visit));
+  auto blackboard = VisitFromTheSouth();
   bt::Tree tree = Tree(R"(<RetractToSafe/>)", blackboard);
   belief_.X_MB = {0.0, 3.3, M_PI / 2};
   belief_.last_safe = Pose2{0.0, 4.4, M_PI / 2};
