@@ -2,6 +2,7 @@
 #include "ray_bins.h"
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -11,32 +12,101 @@ namespace {
 
 using Box = std::pair<Eigen::Vector2d, Eigen::Vector2d>;
 
-// Whether the segment a-b touches the box (slab test, closed intervals).
-bool SegmentTouchesBox(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Box& box) {
+// Where the segment a-b first touches the box, in t on a-b; infinity where it does not.
+double EntryAlong(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Box& box) {
   double t0 = 0.0, t1 = 1.0;
   const Eigen::Vector2d d = b - a;
   for (int i = 0; i < 2; ++i) {
     if (std::abs(d[i]) < 1e-15) {
-      if (a[i] < box.first[i] || a[i] > box.second[i]) return false;
+      if (a[i] < box.first[i] || a[i] > box.second[i]) return INFINITY;
       continue;
     }
     double ta = (box.first[i] - a[i]) / d[i], tb = (box.second[i] - a[i]) / d[i];
     if (ta > tb) std::swap(ta, tb);
     t0 = std::max(t0, ta);
     t1 = std::min(t1, tb);
-    if (t0 > t1) return false;
+    if (t0 > t1) return INFINITY;
   }
-  return true;
+  return t0;
+}
+
+// Whether the segment a-b touches the box (closed intervals).
+bool SegmentTouchesBox(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Box& box) {
+  return std::isfinite(EntryAlong(a, b, box));
+}
+
+// n boxes of 0.05-3 m sides in the square -5..25 m.
+std::vector<Box> RandomBoxes(std::mt19937_64& rng, int n) {
+  std::uniform_real_distribution<double> pos(-5.0, 25.0), size(0.05, 3.0);
+  std::vector<Box> boxes;
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector2d lo(pos(rng), pos(rng));
+    boxes.emplace_back(lo, lo + Eigen::Vector2d(size(rng), size(rng)));
+  }
+  return boxes;
+}
+
+TEST(RayBinsTest, AWalkYieldsBoxesOnceInOrderAndCanStopAtTheClosest) {
+  // What a ray cast relies on: each box comes once; none still to come touches the segment
+  // before the step's t_beyond; so stopping once the closest entry so far is before t_beyond
+  // finds the closest box (lowest index on a tie) an exhaustive search finds.
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> pos(-5.0, 25.0);
+  std::vector<Box> boxes = RandomBoxes(rng, 300);
+  boxes.emplace_back(Eigen::Vector2d::Constant(-INFINITY), Eigen::Vector2d::Constant(INFINITY));
+  RayBins bins;
+  bins.Build(boxes, 1.0);
+  std::vector<int> step_boxes;
+  int stopped_early = 0;
+  for (int k = 0; k < 3000; ++k) {
+    const Eigen::Vector2d a(pos(rng), pos(rng));
+    const double reach = k % 3 == 0 ? 40.0 : 4.0;
+    std::uniform_real_distribution<double> step(-reach, reach);
+    Eigen::Vector2d b = a + Eigen::Vector2d(step(rng), step(rng));
+    if (k % 7 == 0) b.x() = a.x();  // along a cell line's direction
+    double exhaustive = INFINITY;
+    int exhaustive_box = -1;
+    for (std::size_t i = 0; i + 1 < boxes.size(); ++i) {  // the plane is not a box to hit
+      const double t = EntryAlong(a, b, boxes[i]);
+      if (t < exhaustive) {
+        exhaustive = t;
+        exhaustive_box = int(i);
+      }
+    }
+    RayBins::Walk walk(bins, a, b);
+    std::vector<int> seen;
+    double t_beyond = 0.0, previous_beyond = 0.0, closest = INFINITY;
+    int closest_box = -1;
+    bool stopped = false;
+    while (walk.Next(&step_boxes, &t_beyond)) {
+      for (const int i : step_boxes) {
+        ASSERT_EQ(std::find(seen.begin(), seen.end(), i), seen.end()) << "box " << i << " twice";
+        seen.push_back(i);
+        if (std::size_t(i) + 1 == boxes.size()) continue;
+        const double t = EntryAlong(a, b, boxes[std::size_t(i)]);
+        ASSERT_GE(t, previous_beyond - 1e-9) << "box " << i << " came after a step past it";
+        if (t < closest || (t == closest && i < closest_box)) {
+          closest = t;
+          closest_box = i;
+        }
+      }
+      previous_beyond = t_beyond;
+      if (closest < t_beyond - 1e-9) {
+        stopped = true;
+        break;
+      }
+    }
+    ASSERT_EQ(closest_box, exhaustive_box)
+        << "(" << a.transpose() << ") - (" << b.transpose() << ")";
+    stopped_early += stopped && walk.Next(&step_boxes, &t_beyond);
+  }
+  EXPECT_GT(stopped_early, 500);  // the walks did stop short of their ends
 }
 
 TEST(RayBinsTest, ReturnsEveryBoxTheSegmentTouchesAscendingAndOnce) {
   std::mt19937_64 rng(3);
-  std::uniform_real_distribution<double> pos(-5.0, 25.0), size(0.05, 3.0);
-  std::vector<Box> boxes;
-  for (int i = 0; i < 300; ++i) {
-    const Eigen::Vector2d lo(pos(rng), pos(rng));
-    boxes.emplace_back(lo, lo + Eigen::Vector2d(size(rng), size(rng)));
-  }
+  std::uniform_real_distribution<double> pos(-5.0, 25.0);
+  std::vector<Box> boxes = RandomBoxes(rng, 300);
   RayBins bins;
   bins.Build(boxes, 1.0);
   std::vector<int> got;

@@ -1,5 +1,7 @@
 #include "egress/twin/social_force.h"
 
+#include "egress/hsr_interface/error.h"
+
 #include <cmath>
 #include <random>
 
@@ -230,10 +232,42 @@ TEST(SocialForceModelTest, BinnedFixedWallsAndMovingOnesStepAsAllTheWallsTogethe
   EXPECT_GT(moved, 1.0);  // they walked
 }
 
-TEST(SocialForceModelTest, ForcesHeldOverTwoStepsStayNearForcesSummedEveryStep) {
-  // What the twin does (TwinConfig::crowd_force_rate_hz): the sums every other step, integrated
-  // every step. Two walkers crossing near a wall for 3 s end within a few centimetres of where
-  // summing every step takes them, and the held forces still keep them apart.
+TEST(SocialForceModelTest, SocialTermsSummedNowAddUpToTheWholeAcceleration) {
+  // The split the twin uses is the same model: social terms plus the drive and contact summed
+  // from the same state give CalcAccelerations (to rounding: the sums are in another order).
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> pos(0.0, 8.0), unit(-1.0, 1.0);
+  std::vector<Walker> walkers(40);
+  for (auto& w : walkers) {
+    w.position = {pos(rng), pos(rng) / 2.0};  // dense: many touch
+    w.velocity = {unit(rng), unit(rng)};
+    w.target = {pos(rng), pos(rng) / 2.0};
+  }
+  const WallCells walls(
+      {{{-1.0, -0.2}, {9.0, -0.2}, 0}, {{9.0, -0.2}, {9.0, 4.2}, 0}, {{2.0, 4.2}, {6.0, 4.2}, -1}});
+  const std::vector<WallSegment> leaves = {{{4.0, 1.0}, {4.0, 2.0}}};
+  const std::vector<DiscObstacle> discs = {{{3.0, 2.0}, {0.2, 0.0}, 0.25}};
+  SocialForceModel sfm;
+  const auto whole = sfm.CalcAccelerations(walkers, discs, walls, leaves);
+  const auto social = sfm.CalcSocialAccelerations(walkers, discs, walls, leaves);
+  const auto split = sfm.CalcAccelerationsWithSocial(social, walkers, discs, walls, leaves);
+  ASSERT_EQ(split.size(), whole.size());
+  int touching = 0;
+  for (std::size_t i = 0; i < walkers.size(); ++i) {
+    EXPECT_NEAR((split[i] - whole[i]).norm(), 0.0, 1e-9 * (1.0 + whole[i].norm())) << i;
+    for (std::size_t j = 0; j < i; ++j) {
+      touching += (walkers[i].position - walkers[j].position).norm() <
+                  walkers[i].radius + walkers[j].radius;
+    }
+  }
+  EXPECT_GT(touching, 3) << "bodies did touch: contact terms were summed";
+  EXPECT_THROW(sfm.CalcAccelerationsWithSocial({}, walkers, discs, walls, leaves), InvalidArgument);
+}
+
+TEST(SocialForceModelTest, SocialTermsHeldOverStepsStayNearTermsSummedEveryStep) {
+  // What the twin does (TwinConfig::crowd_social_rate_hz): the social terms every fourth step
+  // (60 Hz), the drive and contact every step. Two walkers crossing near a wall for 3 s end
+  // within a few centimetres of where summing every step takes them, and still keep apart.
   const WallCells walls({{{-5.0, -1.0}, {5.0, -1.0}}});
   std::vector<Walker> every(2);
   every[0].position = {-3.0, 0.0};
@@ -243,12 +277,12 @@ TEST(SocialForceModelTest, ForcesHeldOverTwoStepsStayNearForcesSummedEveryStep) 
   std::vector<Walker> held = every;
   SocialForceModel sfm;
   const double dt = 1.0 / 240;
-  std::vector<Eigen::Vector2d> accelerations;
+  std::vector<Eigen::Vector2d> social;
   double closest = 1e9;
   for (int step = 0; step < 720; ++step) {
     sfm.Step(&every, {}, walls, {}, dt);
-    if (step % 2 == 0) accelerations = sfm.CalcAccelerations(held, {}, walls, {});
-    sfm.Integrate(&held, accelerations, dt);
+    if (step % 4 == 0) social = sfm.CalcSocialAccelerations(held, {}, walls, {});
+    sfm.Integrate(&held, sfm.CalcAccelerationsWithSocial(social, held, {}, walls, {}), dt);
     closest = std::min(closest, (held[0].position - held[1].position).norm());
   }
   for (std::size_t i = 0; i < every.size(); ++i) {
@@ -259,6 +293,28 @@ TEST(SocialForceModelTest, ForcesHeldOverTwoStepsStayNearForcesSummedEveryStep) 
         2.0);  // they walked
   }
   EXPECT_GT(closest, every[0].radius + every[1].radius);  // no overlap
+}
+
+TEST(SocialForceModelTest, ContactIsSummedFreshUnderHeldSocialTerms) {
+  // Two bodies pressed together, with social terms held from when they were apart (zero): the
+  // contact still pushes them apart at once, and a body in a wall is pushed out of it.
+  std::vector<Walker> walkers(2);
+  walkers[0].position = {0.0, 0.0};
+  walkers[1].position = {0.4, 0.0};  // radii 0.25: 0.1 m of overlap
+  for (auto& w : walkers) {
+    w.desired_speed = 0.0;
+    w.target = w.position;
+  }
+  SocialForceModel sfm;
+  const std::vector<Eigen::Vector2d> zero(2, Eigen::Vector2d::Zero());
+  const WallCells none(std::vector<WallSegment>{});
+  const auto a = sfm.CalcAccelerationsWithSocial(zero, walkers, {}, none, {});
+  EXPECT_LT(a[0].x(), -1.0);
+  EXPECT_GT(a[1].x(), 1.0);
+  const WallCells wall({{{-1.0, 0.1}, {1.0, 0.1}}});  // 0.15 m into walker 0
+  const auto b =
+      sfm.CalcAccelerationsWithSocial({Eigen::Vector2d::Zero()}, {walkers[0]}, {}, wall, {});
+  EXPECT_LT(b[0].y(), -1.0);
 }
 
 }  // namespace

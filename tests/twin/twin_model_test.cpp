@@ -72,10 +72,10 @@ TEST_F(TwinModelTest, ABadConfigNamesTheField) {
   EXPECT_THAT([&] { TwinModel(scenario_, world_, Hsr(), config); },
               ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("physics_rate_hz")));
   config = {};
-  config.crowd_force_rate_hz = 480.0;  // above the physics rate
+  config.crowd_social_rate_hz = 480.0;  // above the physics rate
   EXPECT_THAT(
       [&] { TwinModel(scenario_, world_, Hsr(), config); },
-      ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("crowd_force_rate_hz")));
+      ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("crowd_social_rate_hz")));
   config = {};
   config.robot_mass = std::nan("");
   EXPECT_THAT([&] { TwinModel(scenario_, world_, Hsr(), config); },

@@ -2,19 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 namespace egress::twin::world_detail {
-
-long RayBins::CellX(double x) const {
-  return std::clamp(long(std::floor((x - origin_.x()) / cell_)), 0L, nx_ - 1);
-}
-long RayBins::CellY(double y) const {
-  return std::clamp(long(std::floor((y - origin_.y()) / cell_)), 0L, ny_ - 1);
-}
 
 void RayBins::Build(const std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>>& boxes,
                     double cell) {
   cell_ = cell;
+  box_count_ = boxes.size();
   everywhere_.clear();
   bins_.clear();
   nx_ = ny_ = 0;
@@ -45,75 +40,144 @@ void RayBins::Build(const std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d
   }
 }
 
+namespace {
+// Which boxes a walk has yielded already, by walk number: a long walk meets a wall in many
+// cells. Per thread, as the bins of a compiled model are shared by the runs of a study's
+// threads.
+struct Yielded {
+  std::vector<std::uint32_t> walk_of;  // per box index: the last walk that yielded it
+  std::uint32_t walk{0};
+};
+thread_local Yielded yielded;
+}  // namespace
+
 void RayBins::Query(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
                     std::vector<int>* out) const {
-  out->assign(everywhere_.begin(), everywhere_.end());
-  if (nx_ > 0 && a.allFinite() && b.allFinite()) WalkCells(a, b, out);
+  out->clear();
+  Walk walk(*this, a, b);
+  thread_local std::vector<int> cell;
+  double t_beyond = 0.0;
+  while (walk.Next(&cell, &t_beyond))
+    out->insert(out->end(), cell.begin(), cell.end());
   std::sort(out->begin(), out->end());
-  out->erase(std::unique(out->begin(), out->end()), out->end());
 }
 
-void RayBins::WalkCells(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
-                        std::vector<int>* out) const {
+RayBins::Walk::Walk(const RayBins& bins, const Eigen::Vector2d& a, const Eigen::Vector2d& b)
+    : bins_(bins) {
+  if (yielded.walk_of.size() < bins.box_count_) yielded.walk_of.resize(bins.box_count_, 0);
+  if (++yielded.walk == 0) {  // wrapped: forget every mark
+    std::fill(yielded.walk_of.begin(), yielded.walk_of.end(), 0);
+    yielded.walk = 1;
+  }
+  walk_ = yielded.walk;
+  gridded_ = bins.nx_ > 0 && a.allFinite() && b.allFinite();
+  if (!gridded_) return;
   // The segment clipped to the grid's (closed) extent.
-  const Eigen::Vector2d lo = origin_, hi = origin_ + cell_ * Eigen::Vector2d(nx_, ny_);
+  const Eigen::Vector2d lo = bins.origin_,
+                        hi = bins.origin_ + bins.cell_ * Eigen::Vector2d(bins.nx_, bins.ny_);
   const Eigen::Vector2d d = b - a;
-  double t0 = 0.0, t1 = 1.0;
-  for (int i = 0; i < 2; ++i) {
+  for (int i = 0; i < 2 && gridded_; ++i) {
     if (d[i] == 0.0) {
-      if (a[i] < lo[i] || a[i] > hi[i]) return;
+      gridded_ = a[i] >= lo[i] && a[i] <= hi[i];
       continue;
     }
     double ta = (lo[i] - a[i]) / d[i], tb = (hi[i] - a[i]) / d[i];
     if (ta > tb) std::swap(ta, tb);
-    t0 = std::max(t0, ta);
-    t1 = std::min(t1, tb);
-    if (t0 > t1) return;
+    t0_ = std::max(t0_, ta);
+    t1_ = std::min(t1_, tb);
+    gridded_ = t0_ <= t1_;
   }
-  const Eigen::Vector2d p = a + t0 * d, q = a + t1 * d, e = q - p;
-  const auto add = [&](long x, long y) {
-    if (x < 0 || y < 0 || x >= nx_ || y >= ny_) return;
-    const auto& bin = bins_[std::size_t(y * nx_ + x)];
-    out->insert(out->end(), bin.begin(), bin.end());
-  };
+  if (!gridded_) return;
+  const Eigen::Vector2d p = a + t0_ * d, q = a + t1_ * d, e = q - p;
   // Amanatides & Woo's grid walk from p's cell to q's, in steps of one cell; t in [0, 1] on
-  // p-q. Where the walk passes a corner (both crossings at once, to rounding) the two cells
-  // beside it are added too, so that no cell the segment touches is missed.
-  long x = CellX(p.x()), y = CellY(p.y());
-  const long x_end = CellX(q.x()), y_end = CellY(q.y());
-  const long step_x = e.x() > 0 ? 1 : (e.x() < 0 ? -1 : 0);
-  const long step_y = e.y() > 0 ? 1 : (e.y() < 0 ? -1 : 0);
+  // p-q.
+  x_ = bins.CellX(p.x());
+  y_ = bins.CellY(p.y());
+  x_end_ = bins.CellX(q.x());
+  y_end_ = bins.CellY(q.y());
+  step_x_ = e.x() > 0 ? 1 : (e.x() < 0 ? -1 : 0);
+  step_y_ = e.y() > 0 ? 1 : (e.y() < 0 ? -1 : 0);
   const auto first_crossing = [&](long c, long step, double start, double extent, double origin) {
     if (step == 0) return double(INFINITY);
-    return (origin + double(c + (step > 0 ? 1 : 0)) * cell_ - start) / extent;
+    return (origin + double(c + (step > 0 ? 1 : 0)) * bins.cell_ - start) / extent;
   };
-  double t_x = first_crossing(x, step_x, p.x(), e.x(), origin_.x());
-  double t_y = first_crossing(y, step_y, p.y(), e.y(), origin_.y());
-  const double dt_x = step_x != 0 ? cell_ / std::abs(e.x()) : INFINITY;
-  const double dt_y = step_y != 0 ? cell_ / std::abs(e.y()) : INFINITY;
-  constexpr double kCornerTol = 1e-9;  // crossings this close (in t) are one corner
-  add(x, y);
-  for (long left = std::abs(x_end - x) + std::abs(y_end - y); left > 0; --left) {
-    if (std::abs(t_x - t_y) <= kCornerTol) {
-      add(x + step_x, y);
-      add(x, y + step_y);
-      x += step_x;
-      y += step_y;
-      t_x += dt_x;
-      t_y += dt_y;
-      --left;  // two cells' worth of the count
-    } else if (t_x < t_y) {
-      x += step_x;
-      t_x += dt_x;
-    } else {
-      y += step_y;
-      t_y += dt_y;
-    }
-    add(x, y);
-    if (x == x_end && y == y_end) break;
+  t_x_ = first_crossing(x_, step_x_, p.x(), e.x(), bins.origin_.x());
+  t_y_ = first_crossing(y_, step_y_, p.y(), e.y(), bins.origin_.y());
+  dt_x_ = step_x_ != 0 ? bins.cell_ / std::abs(e.x()) : INFINITY;
+  dt_y_ = step_y_ != 0 ? bins.cell_ / std::abs(e.y()) : INFINITY;
+  left_ = std::abs(x_end_ - x_) + std::abs(y_end_ - y_);
+}
+
+void RayBins::Walk::Add(long x, long y, std::vector<int>* out) const {
+  if (x < 0 || y < 0 || x >= bins_.nx_ || y >= bins_.ny_) return;
+  for (const int i : bins_.bins_[std::size_t(y * bins_.nx_ + x)]) {
+    std::uint32_t& last = yielded.walk_of[std::size_t(i)];
+    if (last == walk_) continue;
+    last = walk_;
+    out->push_back(i);
   }
-  // Rounding may stop the walk a cell short of q's: q's cell always counts.
-  if (x != x_end || y != y_end) add(x_end, y_end);
+}
+
+bool RayBins::Walk::Next(std::vector<int>* boxes, double* t_beyond) {
+  boxes->clear();
+  switch (phase_) {
+    case Phase::kDone:
+      return false;
+    case Phase::kStart:
+      for (const int i : bins_.everywhere_) {
+        yielded.walk_of[std::size_t(i)] = walk_;
+        boxes->push_back(i);
+      }
+      if (!gridded_) {
+        phase_ = Phase::kDone;
+        *t_beyond = INFINITY;
+        return true;
+      }
+      Add(x_, y_, boxes);
+      phase_ = Phase::kWalking;
+      break;
+    case Phase::kWalking: {
+      if (left_ <= 0 || (x_ == x_end_ && y_ == y_end_)) {
+        phase_ = Phase::kDone;
+        // Rounding may stop the walk a cell short of q's: q's cell always counts.
+        if (x_ == x_end_ && y_ == y_end_) return false;
+        Add(x_end_, y_end_, boxes);
+        *t_beyond = INFINITY;
+        return true;
+      }
+      // Where the walk passes a corner (both crossings at once, to rounding) the two cells
+      // beside it are added too, so that no cell the segment touches is missed.
+      constexpr double kCornerTol = 1e-9;  // crossings this close (in t) are one corner
+      if (std::abs(t_x_ - t_y_) <= kCornerTol) {
+        Add(x_ + step_x_, y_, boxes);
+        Add(x_, y_ + step_y_, boxes);
+        x_ += step_x_;
+        y_ += step_y_;
+        t_x_ += dt_x_;
+        t_y_ += dt_y_;
+        left_ -= 2;  // two cells' worth of the count
+      } else if (t_x_ < t_y_) {
+        x_ += step_x_;
+        t_x_ += dt_x_;
+        --left_;
+      } else {
+        y_ += step_y_;
+        t_y_ += dt_y_;
+        --left_;
+      }
+      Add(x_, y_, boxes);
+      break;
+    }
+  }
+  // The cells still to come start where the walk next crosses a cell line.
+  if (x_ == x_end_ && y_ == y_end_) {
+    *t_beyond = INFINITY;  // nothing is left
+  } else if (left_ <= 0) {
+    *t_beyond = t0_;  // q's cell, which rounding left out, may hold anything
+  } else {
+    *t_beyond = t0_ + std::min(t_x_, t_y_) * (t1_ - t0_);
+  }
+  return true;
 }
 
 }  // namespace egress::twin::world_detail

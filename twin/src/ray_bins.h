@@ -5,7 +5,10 @@
 /// (a hundred evacuees are a hundred targets). A superset, never a miss: every box whose XY
 /// extent the segment's XY projection touches is returned.
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <utility>
 #include <vector>
 
@@ -28,12 +31,38 @@ class RayBins {
 
   static constexpr long kMaxCellsPerBox = 4096;
 
- private:
-  // Appends the boxes of every cell the segment a-b crosses (a grid walk).
-  void WalkCells(const Eigen::Vector2d& a, const Eigen::Vector2d& b, std::vector<int>* out) const;
-  long CellX(double x) const;
-  long CellY(double y) const;
+  /// The boxes the segment a-b (XY in W) may cross, cell by cell from a towards b (Amanatides &
+  /// Woo's grid walk), each once: a ray cast tests them in that order and stops once its closest
+  /// hit lies before every cell still to come. One walk per thread at a time.
+  class Walk {
+   public:
+    Walk(const RayBins& bins, const Eigen::Vector2d& a, const Eigen::Vector2d& b);
+    /// The boxes of the next cell(s) not yielded before (the unbinned ones first), and
+    /// `t_beyond`: no box still to come touches the segment before a + t_beyond (b - a).
+    /// False when the walk is over.
+    bool Next(std::vector<int>* boxes, double* t_beyond);
 
+   private:
+    void Add(long x, long y, std::vector<int>* out) const;
+    enum class Phase { kStart, kWalking, kDone };
+    const RayBins& bins_;
+    std::uint32_t walk_{0};
+    Phase phase_{Phase::kStart};
+    bool gridded_{false};
+    double t0_{0.0}, t1_{1.0};  // the segment's piece inside the grid, in t on a-b
+    long x_{0}, y_{0}, x_end_{0}, y_end_{0}, step_x_{0}, step_y_{0}, left_{0};
+    double t_x_{0.0}, t_y_{0.0}, dt_x_{0.0}, dt_y_{0.0};  // in t on the piece inside
+  };
+
+ private:
+  long CellX(double x) const {
+    return std::clamp(long(std::floor((x - origin_.x()) / cell_)), 0L, nx_ - 1);
+  }
+  long CellY(double y) const {
+    return std::clamp(long(std::floor((y - origin_.y()) / cell_)), 0L, ny_ - 1);
+  }
+
+  std::size_t box_count_{0};
   double cell_{1.0};
   Eigen::Vector2d origin_{Eigen::Vector2d::Zero()};
   long nx_{0}, ny_{0};

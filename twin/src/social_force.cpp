@@ -1,5 +1,6 @@
 #include "egress/twin/social_force.h"
 
+#include "egress/hsr_interface/error.h"
 #include "egress/hsr_interface/geometry.h"
 
 #include <algorithm>
@@ -69,7 +70,18 @@ Eigen::Vector2d SocialForceModel::CalcAcceleration(std::size_t i,
 Eigen::Vector2d SocialForceModel::CalcAccelerationAmong(
     std::size_t i, const std::vector<Walker>& walkers, const Neighbours& near,
     const std::vector<DiscObstacle>& discs, const std::vector<WallSegment>& walls) const {
-  const Walker& w = walkers[i];
+  return ClampAcceleration(CalcTermsAmong(i, walkers, near, discs, walls, Terms::kAll,
+                                          CalcDriveAcceleration(walkers[i])));
+}
+
+Eigen::Vector2d SocialForceModel::ClampAcceleration(const Eigen::Vector2d& a) const {
+  const double a_norm = a.norm();
+  return a_norm > params_.max_acceleration
+             ? Eigen::Vector2d(a * (params_.max_acceleration / a_norm))
+             : a;
+}
+
+Eigen::Vector2d SocialForceModel::CalcDriveAcceleration(const Walker& w) const {
   const auto& P = params_;
   Eigen::Vector2d desired = Eigen::Vector2d::Zero();
   const Eigen::Vector2d to_goal = w.target - w.position;
@@ -80,7 +92,19 @@ Eigen::Vector2d SocialForceModel::CalcAccelerationAmong(
     desired = to_goal.normalized() * speed;
   }
   const double tau = w.relaxation_time > 0.0 ? w.relaxation_time : P.relaxation_time;
-  Eigen::Vector2d a = P.drive_factor * (desired - w.velocity) / tau;
+  return P.drive_factor * (desired - w.velocity) / tau;
+}
+
+Eigen::Vector2d SocialForceModel::CalcTermsAmong(std::size_t i, const std::vector<Walker>& walkers,
+                                                 const Neighbours& near,
+                                                 const std::vector<DiscObstacle>& discs,
+                                                 const std::vector<WallSegment>& walls, Terms terms,
+                                                 Eigen::Vector2d a) const {
+  const Walker& w = walkers[i];
+  const auto& P = params_;
+  const bool social_terms = terms != Terms::kContact;
+  const bool contact_terms = terms != Terms::kSocial;
+  const Eigen::Vector2d to_goal = w.target - w.position;
   const Eigen::Vector2d heading =
       w.velocity.norm() > 0.05 ? Eigen::Vector2d(w.velocity.normalized())
                                : (to_goal.norm() > 1e-3 ? Eigen::Vector2d(to_goal.normalized())
@@ -115,19 +139,23 @@ Eigen::Vector2d SocialForceModel::CalcAccelerationAmong(
     if (j == i) continue;
     const Walker& o = walkers[j];
     // Beyond its reach (and touching distance) another walker does nothing: no square roots.
-    const Reach reach = near.reach ? (*near.reach)[j] : WalkerReach(o);
-    const bool social_near = (w.position - reach.social_centre).squaredNorm() <=
-                             reach.social_radius * reach.social_radius;
+    bool social_near = false;
+    if (social_terms) {
+      const Reach reach = near.reach ? (*near.reach)[j] : WalkerReach(o);
+      social_near = (w.position - reach.social_centre).squaredNorm() <=
+                    reach.social_radius * reach.social_radius;
+    }
     if (!social_near && (w.position - o.position).squaredNorm() > kMaxBodyReachM * kMaxBodyReachM)
       continue;
     // Social terms scale with the drive (their balance is what HM95 tuned); walls do not.
     if (social_near)
       a += social(o.position, o.velocity, P.drive_factor * P.social_strength, P.social_range);
-    a += BodyForce(w, o.position, o.velocity, o.radius) / P.mass;
+    if (contact_terms) a += BodyForce(w, o.position, o.velocity, o.radius) / P.mass;
   }
   for (const auto& d : discs) {
-    a += social(d.position, d.velocity, P.drive_factor * P.robot_strength, P.robot_range);
-    a += BodyForce(w, d.position, d.velocity, d.radius) / P.mass;
+    if (social_terms)
+      a += social(d.position, d.velocity, P.drive_factor * P.robot_strength, P.robot_range);
+    if (contact_terms) a += BodyForce(w, d.position, d.velocity, d.radius) / P.mass;
   }
   // The nearest point of each obstacle (or of each loose segment) repels. Obstacles are summed
   // in the order of their first segment in `walls`, whichever segments are near.
@@ -143,6 +171,9 @@ Eigen::Vector2d SocialForceModel::CalcAccelerationAmong(
     const std::size_t s = near.walls ? (*near.walls)[k] : k;
     const WallSegment& wall = walls[s];
     const Eigen::Vector2d q = ClosestPointOnSegment(w.position, wall);
+    // Contact alone: only an obstacle the body overlaps pushes, from its nearest point, which
+    // is then among the segments it overlaps.
+    if (!social_terms && (w.position - q).squaredNorm() >= w.radius * w.radius) continue;
     auto it = wall.obstacle < 0 ? nearest.end()
                                 : std::find_if(nearest.begin(), nearest.end(), [&](const auto& e) {
                                     return e.id == wall.obstacle;
@@ -162,17 +193,16 @@ Eigen::Vector2d SocialForceModel::CalcAccelerationAmong(
     if (dist < 1e-9 || dist > kWallCutoffM) continue;
     const Eigen::Vector2d n = r / dist;
     const double gap = dist - w.radius;
-    Eigen::Vector2d f =
-        w.wall_scale * (P.wall_strength / P.wall_range) * std::exp(-gap / P.wall_range) * n;
-    if (gap < 0.0) {
+    Eigen::Vector2d f = Eigen::Vector2d::Zero();
+    if (social_terms)
+      f = w.wall_scale * (P.wall_strength / P.wall_range) * std::exp(-gap / P.wall_range) * n;
+    if (contact_terms && gap < 0.0) {
       const Eigen::Vector2d t(-n.y(), n.x());
       f += (P.body_compression * -gap * n - P.sliding_friction * -gap * w.velocity.dot(t) * t) /
            P.mass;
     }
     a += f;
   }
-  const double a_norm = a.norm();
-  if (a_norm > P.max_acceleration) a *= P.max_acceleration / a_norm;
   return a;
 }
 
@@ -201,7 +231,20 @@ WallCells::WallCells(std::vector<WallSegment> walls) : walls_(std::move(walls)) 
     for (long cx = x0; cx <= x1; ++cx)
       for (long cy = y0; cy <= y1; ++cy)
         cells_[{cx, cy}].push_back(s);
+    // The same within touching distance: the segments a body in the cell may press against.
+    const Eigen::Vector2d touch_lo = wall.a.cwiseMin(wall.b).array() - kMaxBodyReachM;
+    const Eigen::Vector2d touch_hi = wall.a.cwiseMax(wall.b).array() + kMaxBodyReachM;
+    const auto [tx0, ty0] = WallCellOf(touch_lo.x(), touch_lo.y());
+    const auto [tx1, ty1] = WallCellOf(touch_hi.x(), touch_hi.y());
+    for (long cx = tx0; cx <= tx1; ++cx)
+      for (long cy = ty0; cy <= ty1; ++cy)
+        touching_cells_[{cx, cy}].push_back(s);
   }
+}
+
+const std::vector<std::size_t>& WallCells::NearTouching(const Eigen::Vector2d& p) const {
+  const auto it = touching_cells_.find(WallCellOf(p.x(), p.y()));
+  return it != touching_cells_.end() ? it->second : none_;
 }
 
 const std::vector<std::size_t>& WallCells::Near(const Eigen::Vector2d& p) const {
@@ -223,14 +266,37 @@ void SocialForceModel::Step(std::vector<Walker>* walkers, const std::vector<Disc
 std::vector<Eigen::Vector2d> SocialForceModel::CalcAccelerations(
     const std::vector<Walker>& all, const std::vector<DiscObstacle>& discs, const WallCells& fixed,
     const std::vector<WallSegment>& moving) const {
+  return SumTerms(all, discs, fixed, moving, Terms::kAll, nullptr);
+}
+
+std::vector<Eigen::Vector2d> SocialForceModel::CalcSocialAccelerations(
+    const std::vector<Walker>& all, const std::vector<DiscObstacle>& discs, const WallCells& fixed,
+    const std::vector<WallSegment>& moving) const {
+  return SumTerms(all, discs, fixed, moving, Terms::kSocial, nullptr);
+}
+
+std::vector<Eigen::Vector2d> SocialForceModel::CalcAccelerationsWithSocial(
+    const std::vector<Eigen::Vector2d>& social, const std::vector<Walker>& all,
+    const std::vector<DiscObstacle>& discs, const WallCells& fixed,
+    const std::vector<WallSegment>& moving) const {
+  ThrowUnless(social.size() == all.size(), "SocialForceModel: ", social.size(),
+              " social accelerations for ", all.size(), " walkers");
+  return SumTerms(all, discs, fixed, moving, Terms::kContact, &social);
+}
+
+std::vector<Eigen::Vector2d> SocialForceModel::SumTerms(
+    const std::vector<Walker>& all, const std::vector<DiscObstacle>& discs, const WallCells& fixed,
+    const std::vector<WallSegment>& moving, Terms terms,
+    const std::vector<Eigen::Vector2d>* social) const {
   // A uniform grid over the walkers: each cell lists, in ascending index, every walker whose
   // reach (the box round its social circle and touching distance) overlaps the cell, so a walker
   // meets only those that may reach it, in the order of the whole crowd: the sums (and the run) are
   // the same as without the grid, in O(n) instead of O(n^2).
   std::vector<Eigen::Vector2d> accelerations(all.size());
+  const bool contact_only = terms == Terms::kContact;
   std::vector<Reach> reach(all.size());
   for (std::size_t j = 0; j < all.size(); ++j)
-    reach[j] = WalkerReach(all[j]);
+    reach[j] = contact_only ? Reach{all[j].position, 0.0} : WalkerReach(all[j]);
   // The grid spans the walkers' bounding box (a crowd spans tens of metres at most). Walkers that
   // are not finite, or a box too large to hold densely, make it one cell (everyone meets
   // everyone in it, as without the grid).
@@ -261,7 +327,7 @@ std::vector<Eigen::Vector2d> SocialForceModel::CalcAccelerations(
   start.assign(std::size_t(nx * ny) + 1, 0);
   for (std::size_t j = 0; j < all.size(); ++j) {
     const Eigen::Vector2d& p = all[j].position;
-    // The box round both: the social circle and touching distance.
+    // The box round both: the social circle and touching distance (contact alone: the latter).
     const Eigen::Vector2d& c = reach[j].social_centre;
     const double r = reach[j].social_radius;
     blocks[j] = {cell_x(std::min(c.x() - r, p.x() - kMaxBodyReachM)),
@@ -294,12 +360,25 @@ std::vector<Eigen::Vector2d> SocialForceModel::CalcAccelerations(
     const Eigen::Vector2d& p = all[i].position;
     const std::size_t c = std::size_t(cell_y(p.y()) * nx + cell_x(p.x()));
     near.assign(members.begin() + long(start[c]), members.begin() + long(start[c + 1]));
-    const std::vector<std::size_t>& fixed_near = fixed.Near(all[i].position);
+    const std::vector<std::size_t>& fixed_near =
+        terms == Terms::kContact ? fixed.NearTouching(p) : fixed.Near(p);
     near_walls.assign(fixed_near.begin(), fixed_near.end());
     for (std::size_t s = fixed.walls().size(); s < walls.size(); ++s)
       near_walls.push_back(s);
-    const Neighbours neighbours{&near, &near_walls, &wall_rank, &reach};
-    accelerations[i] = CalcAccelerationAmong(i, all, neighbours, discs, walls);
+    const Neighbours neighbours{&near, &near_walls, &wall_rank, contact_only ? nullptr : &reach};
+    switch (terms) {
+      case Terms::kAll:
+        accelerations[i] = CalcAccelerationAmong(i, all, neighbours, discs, walls);
+        break;
+      case Terms::kSocial:
+        accelerations[i] =
+            CalcTermsAmong(i, all, neighbours, discs, walls, terms, Eigen::Vector2d::Zero());
+        break;
+      case Terms::kContact:
+        accelerations[i] = ClampAcceleration(CalcTermsAmong(
+            i, all, neighbours, discs, walls, terms, CalcDriveAcceleration(all[i]) + (*social)[i]));
+        break;
+    }
   }
   return accelerations;
 }

@@ -444,19 +444,22 @@ void TwinWorld::Impl::UpdatePeople() {
   const Twist2 V_B = RobotVelocity();
   const Eigen::Vector2d v_W = X_WB.rotation() * Eigen::Vector2d(V_B.vx, V_B.vy);
   const std::vector<DiscObstacle> discs = {{X_WB.translation(), v_W, robot_radius}};
-  // The forces every few steps, held between (sums of every walker's neighbours and walls are
-  // most of a crowd's cost); integrated every step, so bodies move smoothly.
-  const auto sum_every = std::max<std::uint64_t>(
-      1, std::uint64_t(std::lround(config.physics_rate_hz / config.crowd_force_rate_hz)));
-  std::vector<Eigen::Vector2d> accelerations;
-  if (step % sum_every == 0) {
-    accelerations = sfm.CalcAccelerations(walkers, discs, fixed.wall_cells, leaves);
+  // The social terms every few steps, held between (sums of every walker's neighbours and walls
+  // within a few metres are most of a crowd's cost); the drive and body contact, which are
+  // stiff, every step, as is the integration, so bodies move smoothly.
+  const auto social_every = std::max<std::uint64_t>(
+      1, std::uint64_t(std::lround(config.physics_rate_hz / config.crowd_social_rate_hz)));
+  std::vector<Eigen::Vector2d> social;
+  if (step % social_every == 0) {
+    social = sfm.CalcSocialAccelerations(walkers, discs, fixed.wall_cells, leaves);
     for (std::size_t k = 0; k < walkers.size(); ++k)
-      people[walker_of[k]].acceleration = accelerations[k];
+      people[walker_of[k]].social_acceleration = social[k];
   } else {
     for (std::size_t k = 0; k < walkers.size(); ++k)
-      accelerations.push_back(people[walker_of[k]].acceleration);
+      social.push_back(people[walker_of[k]].social_acceleration);
   }
+  const std::vector<Eigen::Vector2d> accelerations =
+      sfm.CalcAccelerationsWithSocial(social, walkers, discs, fixed.wall_cells, leaves);
   sfm.Integrate(&walkers, accelerations, dt);
   // Standing people do not integrate (they would drift under wall forces).
   for (std::size_t k = 0; k < walkers.size(); ++k) {

@@ -58,13 +58,18 @@ std::optional<Eigen::Vector2d> TwinWorld::Impl::ActuatorSpot(int door, double si
   // person stands in front of the face, on their side of the door.
   const DoorModel& d = *doors[std::size_t(door)].fixed;
   std::optional<Eigen::Vector2d> best;
-  for (const BuildingActuator& a : twin_model->building().actuators) {
+  const auto& actuators = twin_model->building().actuators;
+  actuator_spots.resize(actuators.size());
+  for (std::size_t k = 0; k < actuators.size(); ++k) {
+    const BuildingActuator& a = actuators[k];
     if (a.door != d.desc->name) continue;
     const Eigen::Vector2d n = a.n_W.head<2>();
     if (n.norm() < 1e-6) continue;
-    Eigen::Vector2d spot = a.p_W.head<2>() + n.normalized() * kActuatorStandOffM;
-    if ((spot - d.centre).dot(d.normal) * side <= 0.0) continue;
-    spot = ClearOfWalls(spot, kPersonAtActuatorRadiusM);
+    const Eigen::Vector2d front = a.p_W.head<2>() + n.normalized() * kActuatorStandOffM;
+    if ((front - d.centre).dot(d.normal) * side <= 0.0) continue;
+    // Cleared of the walls once: the walls do not move, and people wait here every step.
+    if (!actuator_spots[k]) actuator_spots[k] = ClearOfWalls(front, kPersonAtActuatorRadiusM);
+    const Eigen::Vector2d spot = *actuator_spots[k];
     if (!best || (spot - p_W).norm() < (*best - p_W).norm()) best = spot;
   }
   return best;

@@ -10,10 +10,10 @@ using namespace world_detail;
 void TwinConfig::Validate() const {
   ThrowUnless(std::isfinite(physics_rate_hz) && physics_rate_hz >= 60.0,
               "TwinConfig: physics_rate_hz must be at least 60 (got ", physics_rate_hz, ")");
-  ThrowUnless(std::isfinite(crowd_force_rate_hz) && crowd_force_rate_hz > 0.0 &&
-                  crowd_force_rate_hz <= physics_rate_hz,
-              "TwinConfig: crowd_force_rate_hz must be positive and at most physics_rate_hz (got ",
-              crowd_force_rate_hz, ")");
+  ThrowUnless(std::isfinite(crowd_social_rate_hz) && crowd_social_rate_hz > 0.0 &&
+                  crowd_social_rate_hz <= physics_rate_hz,
+              "TwinConfig: crowd_social_rate_hz must be positive and at most physics_rate_hz (got ",
+              crowd_social_rate_hz, ")");
   const std::pair<const char*, double> positive[] = {
       {"base_max_linear_acceleration", base_max_linear_acceleration},
       {"base_max_angular_acceleration", base_max_angular_acceleration},

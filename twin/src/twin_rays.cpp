@@ -118,84 +118,113 @@ RayHit TwinWorld::Impl::CastSegment(const Eigen::Vector3d& from, const Eigen::Ve
   // that hit: the mesh's BVH walk costs in proportion to the ray's length. Dynamic bodies are
   // cast as convex polytopes of their shapes (see BuildRayProxies): exact, and much cheaper than
   // Bullet's iterative convex cast or a BVH walk of their triangles.
-  // Only the targets and boxes the ray's ground track may cross, in index order as over all.
+  // Only the targets and boxes the ray's ground track may cross, cell by cell from `from`.
+  // The walks stop once the closest hit so far lies before every cell still to come (less a
+  // margin for rounding: a box on a cell line is binned in the cell beyond it).
+  constexpr double kWalkMargin = 1e-9;
   thread_local std::vector<int> near;
   const btTransform from_T(btMatrix3x3::getIdentity(), a), to_T(btMatrix3x3::getIdentity(), b);
   // Nothing past an opaque plane's crossing can be the closest hit: the ground track is walked
   // only that far (most of a downward camera's rays end on the floor a few metres out).
   const double plane_clip = PlaneClip(from, to);
-  ray_target_bins.Query(from.head<2>(), from.head<2>() + (to - from).head<2>() * plane_clip, &near);
-  for (const int k : near) {
-    const std::size_t i = std::size_t(k);
-    const btCollisionObject* target = ray_targets[i];
-    btVector3 normal;
-    btScalar param = cb.m_closestHitFraction;
-    const bool plane = target->getCollisionShape()->getShapeType() == STATIC_PLANE_PROXYTYPE;
-    if (!plane &&
-        !btRayAabb(a, b, ray_target_aabbs[i].first, ray_target_aabbs[i].second, param, normal))
-      continue;
-    if (const world_detail::ConvexPolytope* body = ray_target_polytopes[i]) {
-      // A moving body: its faces analytically, in its own frame. The nearer crossing first; the
-      // far one counts when the near one is glass the ray passes through.
-      const btTransform& X_WT = target->getWorldTransform();
-      const Eigen::Vector3d o = FromBt(X_WT.invXform(a));
-      const Eigen::Vector3d v = FromBt((b - a) * X_WT.getBasis());  // R^T (b - a)
-      std::array<world_detail::ConvexPolytope::Crossing, 2> crossings;
-      const int n = body->Cross(o, v, &crossings);
-      const int entity = ray_entity_of(target, -1);
-      for (int k = 0; k < n; ++k) {
-        const auto& c = crossings[std::size_t(k)];
-        if (c.t >= cb.m_closestHitFraction) break;
-        if (cb.Offer(btScalar(c.t), X_WT.getBasis() * ToBt(c.normal), target, entity)) break;
+  // The targets a walk step yields, in its order: a hit closer than the closest so far is kept.
+  const auto test_targets = [&](const std::vector<int>& near) {
+    for (const int k : near) {
+      const std::size_t i = std::size_t(k);
+      const btCollisionObject* target = ray_targets[i];
+      btVector3 normal;
+      btScalar param = cb.m_closestHitFraction;
+      const bool plane = target->getCollisionShape()->getShapeType() == STATIC_PLANE_PROXYTYPE;
+      if (!plane &&
+          !btRayAabb(a, b, ray_target_aabbs[i].first, ray_target_aabbs[i].second, param, normal))
+        continue;
+      if (const world_detail::ConvexPolytope* body = ray_target_polytopes[i]) {
+        // A moving body: its faces analytically, in its own frame. The nearer crossing first; the
+        // far one counts when the near one is glass the ray passes through.
+        const btTransform& X_WT = target->getWorldTransform();
+        const Eigen::Vector3d o = FromBt(X_WT.invXform(a));
+        const Eigen::Vector3d v = FromBt((b - a) * X_WT.getBasis());  // R^T (b - a)
+        std::array<world_detail::ConvexPolytope::Crossing, 2> crossings;
+        const int n = body->Cross(o, v, &crossings);
+        const int entity = ray_entity_of(target, -1);
+        for (int k = 0; k < n; ++k) {
+          const auto& c = crossings[std::size_t(k)];
+          if (c.t >= cb.m_closestHitFraction) break;
+          if (cb.Offer(btScalar(c.t), X_WT.getBasis() * ToBt(c.normal), target, entity)) break;
+        }
+        continue;
       }
-      continue;
+      btCollisionWorld::rayTestSingle(from_T, to_T, const_cast<btCollisionObject*>(target),
+                                      target->getCollisionShape(), target->getWorldTransform(), cb);
     }
-    btCollisionWorld::rayTestSingle(from_T, to_T, const_cast<btCollisionObject*>(target),
-                                    target->getCollisionShape(), target->getWorldTransform(), cb);
+  };
+  world_detail::RayBins::Walk targets(ray_target_bins, from.head<2>(),
+                                      from.head<2>() + (to - from).head<2>() * plane_clip);
+  double t_beyond = 0.0;
+  while (targets.Next(&near, &t_beyond)) {
+    test_targets(near);
+    if (cb.m_closestHitFraction < t_beyond * plane_clip - kWalkMargin) break;
   }
   // Static boxes and planes: slab tests in each shape's frame, on the ray as a segment t in
   // [0, 1]. A ray starting inside a box hits its far side (as the triangles' did).
   const Eigen::Vector3d d = to - from;
   // Nor can a box past the closest hit so far be closer (the same margin).
   const double box_clip = std::min(1.0, double(cb.m_closestHitFraction) * 1.001 + 1e-6);
-  fixed.ray_box_bins.Query(from.head<2>(),
-                           from.head<2>() + d.head<2>() * std::min(box_clip, plane_clip), &near);
-  for (const int k : near) {
-    const RayBox& box = fixed.ray_boxes[std::size_t(k)];
-    const Eigen::Vector3d o = box.R_SW * (from - box.p_WS);
-    const Eigen::Vector3d v = box.R_SW * d;
-    double t_in = -std::numeric_limits<double>::infinity();
-    double t_out = std::numeric_limits<double>::infinity();
-    int axis_in = -1, axis_out = -1;
-    bool miss = false;
-    for (int i = 0; i < 3 && !miss; ++i) {
-      if (std::abs(v[i]) < 1e-12) {
-        miss = std::abs(o[i]) > box.half[i] || box.half[i] == 0.0;
-        continue;
+  const double box_reach = std::min(box_clip, plane_clip);
+  const double target_t = cb.m_closestHitFraction;
+  // The closest box; a tie goes to the lower index, as a test in index order gives it.
+  struct {
+    double t{std::numeric_limits<double>::infinity()};
+    int k{-1};
+    Eigen::Vector3d n_W{Eigen::Vector3d::Zero()};
+  } closest_box;
+  world_detail::RayBins::Walk boxes(fixed.ray_box_bins, from.head<2>(),
+                                    from.head<2>() + d.head<2>() * box_reach);
+  while (boxes.Next(&near, &t_beyond)) {
+    for (const int k : near) {
+      const RayBox& box = fixed.ray_boxes[std::size_t(k)];
+      const Eigen::Vector3d o = box.R_SW * (from - box.p_WS);
+      const Eigen::Vector3d v = box.R_SW * d;
+      double t_in = -std::numeric_limits<double>::infinity();
+      double t_out = std::numeric_limits<double>::infinity();
+      int axis_in = -1, axis_out = -1;
+      bool miss = false;
+      for (int i = 0; i < 3 && !miss; ++i) {
+        if (std::abs(v[i]) < 1e-12) {
+          miss = std::abs(o[i]) > box.half[i] || box.half[i] == 0.0;
+          continue;
+        }
+        double ta = (-box.half[i] - o[i]) / v[i], tb = (box.half[i] - o[i]) / v[i];
+        if (ta > tb) std::swap(ta, tb);
+        if (ta > t_in) {
+          t_in = ta;
+          axis_in = i;
+        }
+        if (tb < t_out) {
+          t_out = tb;
+          axis_out = i;
+        }
+        miss = t_in > t_out;
       }
-      double ta = (-box.half[i] - o[i]) / v[i], tb = (box.half[i] - o[i]) / v[i];
-      if (ta > tb) std::swap(ta, tb);
-      if (ta > t_in) {
-        t_in = ta;
-        axis_in = i;
-      }
-      if (tb < t_out) {
-        t_out = tb;
-        axis_out = i;
-      }
-      miss = t_in > t_out;
+      if (miss) continue;
+      const bool inside = t_in < 0.0;
+      const double t = inside ? t_out : t_in;
+      const int axis = inside ? axis_out : axis_in;
+      if (axis < 0 || t < 0.0 || t >= target_t) continue;
+      if (t > closest_box.t || (t == closest_box.t && k > closest_box.k)) continue;
+      // Outward normal of the face the ray meets.
+      const double sign = (v[axis] > 0.0) == inside ? 1.0 : -1.0;
+      closest_box.t = t;
+      closest_box.k = k;
+      closest_box.n_W = box.R_SW.row(axis).transpose() * sign;
     }
-    if (miss) continue;
-    const bool inside = t_in < 0.0;
-    const double t = inside ? t_out : t_in;
-    const int axis = inside ? axis_out : axis_in;
-    if (axis < 0 || t < 0.0 || t >= cb.m_closestHitFraction) continue;
-    // Outward normal of the face the ray meets.
-    const double sign = (v[axis] > 0.0) == inside ? 1.0 : -1.0;
-    cb.m_closestHitFraction = btScalar(t);
+    if (std::min(target_t, closest_box.t) < t_beyond * box_reach - kWalkMargin) break;
+  }
+  if (closest_box.k >= 0) {
+    cb.m_closestHitFraction = btScalar(closest_box.t);
     cb.m_collisionObject = static_mesh_body;
-    cb.normal = ToBt(box.R_SW.row(axis).transpose() * sign);
-    cb.entity = box.entity;
+    cb.normal = ToBt(closest_box.n_W);
+    cb.entity = fixed.ray_boxes[std::size_t(closest_box.k)].entity;
     cb.glass = false;
   }
   if (fixed.ray_mesh_shape != nullptr) {

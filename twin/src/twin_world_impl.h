@@ -33,9 +33,9 @@ struct Door {
 struct Person {
   PersonState state;
   Walker walker;
-  // [m/s²] The social forces' acceleration, summed every few steps and held between
-  // (TwinConfig::crowd_force_rate_hz).
-  Eigen::Vector2d acceleration{Eigen::Vector2d::Zero()};
+  // [m/s²] The social terms' acceleration, summed every few steps and held between
+  // (TwinConfig::crowd_social_rate_hz).
+  Eigen::Vector2d social_acceleration{Eigen::Vector2d::Zero()};
   TriggerSpec trigger;
   double trigger_delay{0.0};
   double speed{1.3};
@@ -173,6 +173,8 @@ struct TwinWorld::Impl {
   std::optional<Eigen::Vector2d> ClearOfActuator(const Person& p, int gate) const;
   // Where a person on `side` (+1/-1 along the door's normal) stands to operate door `door`'s
   // actuator: in front of its free face, on their side of the door; nullopt if none is there.
+  // Per building actuator: the spot in front of it cleared of the walls, once found.
+  mutable std::vector<std::optional<Eigen::Vector2d>> actuator_spots;
   std::optional<Eigen::Vector2d> ActuatorSpot(int door, double side,
                                               const Eigen::Vector2d& p_W) const;
   // A waiting person who can goes to the actuator, operates it for their operate_time and

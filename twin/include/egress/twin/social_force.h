@@ -88,6 +88,8 @@ class WallCells {
   /// Indices into walls() of every segment within the wall reach of p (and maybe a few more),
   /// ascending.
   const std::vector<std::size_t>& Near(const Eigen::Vector2d& p) const;
+  /// The same within touching distance of p (a body there may press against them): a subset.
+  const std::vector<std::size_t>& NearTouching(const Eigen::Vector2d& p) const;
   /// Per wall: the index of the first wall of its obstacle (the order obstacles are summed).
   const std::vector<std::size_t>& rank() const { return rank_; }
 
@@ -95,6 +97,7 @@ class WallCells {
   std::vector<WallSegment> walls_;
   std::vector<std::size_t> rank_;
   std::map<std::pair<long, long>, std::vector<std::size_t>> cells_;
+  std::map<std::pair<long, long>, std::vector<std::size_t>> touching_cells_;
   std::vector<std::size_t> none_;
 };
 
@@ -120,6 +123,23 @@ class SocialForceModel {
                                                  const std::vector<DiscObstacle>& discs,
                                                  const WallCells& fixed,
                                                  const std::vector<WallSegment>& moving) const;
+  /// The slowly varying part of every walker's acceleration [m/s²]: the other walkers' and the
+  /// discs' social repulsion and the walls' (HM95's exponential terms). A caller may hold it
+  /// over several steps and pass it to CalcAccelerationsWithSocial each step: these terms change
+  /// over the tenths of a second people take to close a social range, and they are most of a
+  /// crowd's cost (an exp and three square roots per pair within ~2 m).
+  std::vector<Eigen::Vector2d> CalcSocialAccelerations(
+      const std::vector<Walker>& walkers, const std::vector<DiscObstacle>& discs,
+      const WallCells& fixed, const std::vector<WallSegment>& moving) const;
+  /// Every walker's acceleration [m/s²] with its social part taken from `social` (one per walker,
+  /// from CalcSocialAccelerations, maybe a few steps old) and the rest summed now: the drive
+  /// towards the target and body contact with walkers, discs and walls, which are stiff (held
+  /// over steps they let bodies sink into each other and jam a doorway).
+  /// @throws InvalidArgument when `social` does not hold one per walker.
+  std::vector<Eigen::Vector2d> CalcAccelerationsWithSocial(
+      const std::vector<Eigen::Vector2d>& social, const std::vector<Walker>& walkers,
+      const std::vector<DiscObstacle>& discs, const WallCells& fixed,
+      const std::vector<WallSegment>& moving) const;
   /// Advances every walker by dt [s] under `accelerations` (one per walker), as Step does: a
   /// caller may hold accelerations over several steps (the forces are the costly part).
   void Integrate(std::vector<Walker>* walkers, const std::vector<Eigen::Vector2d>& accelerations,
@@ -148,6 +168,23 @@ class SocialForceModel {
                                         const Neighbours& near,
                                         const std::vector<DiscObstacle>& discs,
                                         const std::vector<WallSegment>& walls) const;
+  // Which terms a sum takes: all of them, the social (slow) ones, or the contact (stiff) ones.
+  enum class Terms { kAll, kSocial, kContact };
+  // `start` plus walker i's `terms` among `near` (the drive is not among them).
+  Eigen::Vector2d CalcTermsAmong(std::size_t i, const std::vector<Walker>& walkers,
+                                 const Neighbours& near, const std::vector<DiscObstacle>& discs,
+                                 const std::vector<WallSegment>& walls, Terms terms,
+                                 Eigen::Vector2d start) const;
+  // The drive towards the walker's target: (desired velocity - velocity) / τ, with its gain.
+  Eigen::Vector2d CalcDriveAcceleration(const Walker& w) const;
+  Eigen::Vector2d ClampAcceleration(const Eigen::Vector2d& a) const;
+  // Every walker's `terms` through the cell lists; kContact adds the drive and `social`'s entry
+  // and clamps (as kAll does).
+  std::vector<Eigen::Vector2d> SumTerms(const std::vector<Walker>& walkers,
+                                        const std::vector<DiscObstacle>& discs,
+                                        const WallCells& fixed,
+                                        const std::vector<WallSegment>& moving, Terms terms,
+                                        const std::vector<Eigen::Vector2d>* social) const;
   Eigen::Vector2d BodyForce(const Walker& w, const Eigen::Vector2d& other_p,
                             const Eigen::Vector2d& other_v, double other_r) const;
   SocialForceParams params_;

@@ -23,12 +23,13 @@ namespace egress::twin {
 /// Physics and robot-body settings.
 struct TwinConfig {
   double physics_rate_hz{240.0};
-  /// The people's social forces are summed at this rate and held between (each physics step
-  /// still integrates them) [Hz]; at most physics_rate_hz. The sums are most of a crowd's cost:
-  /// 120 Hz runs 100 residents ~1.2x faster, but jammed the clinic's door_e for good in more
-  /// runs (clinic escort, 30 seeds: 11 residents left behind against 0), so by default they
-  /// are summed every step.
-  double crowd_force_rate_hz{240.0};
+  /// The people's social terms (HM95's repulsion from each other, the robot and walls) are
+  /// summed at this rate and held between [Hz]; at most physics_rate_hz. The drive and body
+  /// contact are summed every physics step. The social sums are most of a crowd's cost; they
+  /// change over the tenths of a second people take to close a social range (σ 0.3 m at
+  /// 1-2 m/s). Holding everything, contact included, at 120 Hz jammed the clinic's door_e for
+  /// good in more runs (clinic escort, 30 seeds: 11 residents left behind against 0).
+  double crowd_social_rate_hz{60.0};
   double base_max_linear_acceleration{1.0};   ///< [m/s²]
   double base_max_angular_acceleration{2.0};  ///< [rad/s²]
   double base_max_linear_speed{0.8};          ///< [m/s] (HSR: ~3 km/h)
@@ -39,7 +40,7 @@ struct TwinConfig {
   double grasp_tolerance{0.02};               ///< Lateral centring error a grasp accepts [m]
   double person_hold_force{100.0};            ///< Force a person holds a door with [N]
   double door_crossed_open_angle_deg{60.0};   ///< "Open when crossed" threshold [deg]
-  /// @throws InvalidArgument naming the field for a physics rate below 60 Hz, a crowd force rate
+  /// @throws InvalidArgument naming the field for a physics rate below 60 Hz, a crowd social rate
   /// above it, or a non-positive or non-finite limit.
   void Validate() const;
 };
