@@ -175,6 +175,8 @@ void RunSim(const SimOptions& o) {
   }
   twin::RunOptions options;
   options.duration = o.duration;
+  // The trace only when something is made of it (recording it costs a few per cent of a run).
+  options.record_trace = !o.trace.empty() || !o.png.empty() || !o.mp4.empty();
   if (!o.quiet && ::isatty(::fileno(stderr))) options.on_progress = ProgressBar;
   const auto started = std::chrono::steady_clock::now();
   std::unique_ptr<twin::TwinWorld> world_owner;
@@ -236,18 +238,19 @@ void RunSim(const SimOptions& o) {
     trial_options.run = options;
     // The video shows the running action, the planned path and, once a second, the costmap
     // (the map frame is W here: the brain starts from the twin's start pose).
-    trial_options.annotate = [next_costmap = 0.0](const twin::TwinWorld& world,
-                                                  const behavior::Executive& b) mutable {
-      twin::TraceAnnotation note;
-      note.label = b.active_action();
-      for (const Pose2& X : b.services().motion->path())
-        note.path.push_back(X.translation());
-      if (world.time() + 1e-9 >= next_costmap) {
-        next_costmap = world.time() + kCostmapSnapshotPeriodSec;
-        note.costmap = CostmapLayer(b.costmap());
-      }
-      return note;
-    };
+    if (options.record_trace)
+      trial_options.annotate = [next_costmap = 0.0](const twin::TwinWorld& world,
+                                                    const behavior::Executive& b) mutable {
+        twin::TraceAnnotation note;
+        note.label = b.active_action();
+        for (const Pose2& X : b.services().motion->path())
+          note.path.push_back(X.translation());
+        if (world.time() + 1e-9 >= next_costmap) {
+          next_costmap = world.time() + kCostmapSnapshotPeriodSec;
+          note.costmap = CostmapLayer(b.costmap());
+        }
+        return note;
+      };
     BrainTrial trial = RunBrainTrial(scenario, world_description, seed, model, trial_options);
     world_owner = std::move(trial.world);
     brain = std::move(trial.brain);
