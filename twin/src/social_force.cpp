@@ -169,7 +169,7 @@ Eigen::Vector2d SocialForceModel::CalcTermsAmong(std::size_t i, const std::vecto
   const std::size_t candidates = near.walls ? near.walls->size() : walls.size();
   for (std::size_t k = 0; k < candidates; ++k) {
     const std::size_t s = near.walls ? (*near.walls)[k] : k;
-    const WallSegment& wall = walls[s];
+    const WallSegment& wall = s < walls.size() ? walls[s] : (*near.moving)[s - walls.size()];
     const Eigen::Vector2d q = ClosestPointOnSegment(w.position, wall);
     // Contact alone: only an obstacle the body overlaps pushes, from its nearest point, which
     // is then among the segments it overlaps.
@@ -179,7 +179,8 @@ Eigen::Vector2d SocialForceModel::CalcTermsAmong(std::size_t i, const std::vecto
                                     return e.id == wall.obstacle;
                                   });
     if (it == nearest.end()) {
-      nearest.push_back({near.wall_rank ? (*near.wall_rank)[s] : s, wall.obstacle, q});
+      const bool ranked = near.wall_rank && s < near.wall_rank->size();
+      nearest.push_back({ranked ? (*near.wall_rank)[s] : s, wall.obstacle, q});
     } else if ((w.position - q).squaredNorm() < (w.position - it->q).squaredNorm()) {
       it->q = q;
     }
@@ -350,11 +351,7 @@ std::vector<Eigen::Vector2d> SocialForceModel::SumTerms(
         members[fill[std::size_t(y * nx + x)]++] = j;
   }
   // The fixed walls, then the moving ones (few: every walker meets each).
-  std::vector<WallSegment> walls = fixed.walls();
-  walls.insert(walls.end(), moving.begin(), moving.end());
-  std::vector<std::size_t> wall_rank = fixed.rank();
-  for (std::size_t s = fixed.walls().size(); s < walls.size(); ++s)
-    wall_rank.push_back(s);
+  const std::vector<WallSegment>& walls = fixed.walls();
   std::vector<std::size_t> near_walls, near;
   for (std::size_t i = 0; i < all.size(); ++i) {
     const Eigen::Vector2d& p = all[i].position;
@@ -363,9 +360,10 @@ std::vector<Eigen::Vector2d> SocialForceModel::SumTerms(
     const std::vector<std::size_t>& fixed_near =
         terms == Terms::kContact ? fixed.NearTouching(p) : fixed.Near(p);
     near_walls.assign(fixed_near.begin(), fixed_near.end());
-    for (std::size_t s = fixed.walls().size(); s < walls.size(); ++s)
-      near_walls.push_back(s);
-    const Neighbours neighbours{&near, &near_walls, &wall_rank, contact_only ? nullptr : &reach};
+    for (std::size_t k = 0; k < moving.size(); ++k)
+      near_walls.push_back(walls.size() + k);
+    const Neighbours neighbours{&near, &near_walls, &fixed.rank(), contact_only ? nullptr : &reach,
+                                &moving};
     switch (terms) {
       case Terms::kAll:
         accelerations[i] = CalcAccelerationAmong(i, all, neighbours, discs, walls);

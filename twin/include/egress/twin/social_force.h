@@ -162,6 +162,9 @@ class SocialForceModel {
     // Per wall: the index of the first wall of its obstacle (the order obstacles are summed).
     const std::vector<std::size_t>* wall_rank{nullptr};
     const std::vector<Reach>* reach{nullptr};  // per walker: WalkerReach
+    // Walls past the end of `walls` (index walls.size() + k is moving[k]), each its own
+    // obstacle, ranked by that index: door leaves, without copying the building's walls.
+    const std::vector<WallSegment>* moving{nullptr};
   };
   Reach WalkerReach(const Walker& o) const;
   Eigen::Vector2d CalcAccelerationAmong(std::size_t i, const std::vector<Walker>& walkers,
