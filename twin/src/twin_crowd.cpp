@@ -449,17 +449,23 @@ void TwinWorld::Impl::UpdatePeople() {
   // stiff, every step, as is the integration, so bodies move smoothly.
   const auto social_every = std::max<std::uint64_t>(
       1, std::uint64_t(std::lround(config.physics_rate_hz / config.crowd_social_rate_hz)));
-  std::vector<Eigen::Vector2d> social;
-  if (step % social_every == 0) {
-    social = sfm.CalcSocialAccelerations(walkers, discs, fixed.wall_cells, leaves);
-    for (std::size_t k = 0; k < walkers.size(); ++k)
-      people[walker_of[k]].social_acceleration = social[k];
+  std::vector<Eigen::Vector2d> accelerations;
+  if (social_every == 1) {
+    // Every term every step: one sum.
+    accelerations = sfm.CalcAccelerations(walkers, discs, fixed.wall_cells, leaves);
   } else {
-    for (std::size_t k = 0; k < walkers.size(); ++k)
-      social.push_back(people[walker_of[k]].social_acceleration);
+    std::vector<Eigen::Vector2d> social;
+    if (step % social_every == 0) {
+      social = sfm.CalcSocialAccelerations(walkers, discs, fixed.wall_cells, leaves);
+      for (std::size_t k = 0; k < walkers.size(); ++k)
+        people[walker_of[k]].social_acceleration = social[k];
+    } else {
+      for (std::size_t k = 0; k < walkers.size(); ++k)
+        social.push_back(people[walker_of[k]].social_acceleration);
+    }
+    accelerations =
+        sfm.CalcAccelerationsWithSocial(social, walkers, discs, fixed.wall_cells, leaves);
   }
-  const std::vector<Eigen::Vector2d> accelerations =
-      sfm.CalcAccelerationsWithSocial(social, walkers, discs, fixed.wall_cells, leaves);
   sfm.Integrate(&walkers, accelerations, dt);
   // Standing people do not integrate (they would drift under wall forces).
   for (std::size_t k = 0; k < walkers.size(); ++k) {

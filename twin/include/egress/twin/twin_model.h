@@ -24,12 +24,14 @@ namespace egress::twin {
 struct TwinConfig {
   double physics_rate_hz{240.0};
   /// The people's social terms (HM95's repulsion from each other, the robot and walls) are
-  /// summed at this rate and held between [Hz]; at most physics_rate_hz. The drive and body
-  /// contact are summed every physics step. The social sums are most of a crowd's cost; they
-  /// change over the tenths of a second people take to close a social range (σ 0.3 m at
-  /// 1-2 m/s). Holding everything, contact included, at 120 Hz jammed the clinic's door_e for
-  /// good in more runs (clinic escort, 30 seeds: 11 residents left behind against 0).
-  double crowd_social_rate_hz{60.0};
+  /// summed at this rate and held between [Hz]; at most physics_rate_hz. Below it, the drive
+  /// and body contact are still summed every physics step (holding them too, at 120 Hz, jammed
+  /// the clinic's door_e for good: 11 residents left behind in 30 clinic runs against 0). The
+  /// social sums are most of a crowd's cost: at 60 Hz the 100-resident bench runs ~1.2x faster,
+  /// but the study's robot trials came out otherwise in ways not yet understood (505 trials:
+  /// 8 with the robot in a doorway beside a resident against 2, one robot-resident contact
+  /// against none), so by default every term is summed every step.
+  double crowd_social_rate_hz{240.0};
   double base_max_linear_acceleration{1.0};   ///< [m/s²]
   double base_max_angular_acceleration{2.0};  ///< [rad/s²]
   double base_max_linear_speed{0.8};          ///< [m/s] (HSR: ~3 km/h)
