@@ -12,6 +12,7 @@
 
 #include "egress/hsr_interface/error.h"
 #include "egress/twin/mobility.h"
+#include "egress/twin/twin_model.h"
 #include "twin_test_util.h"
 
 namespace egress::twin {
@@ -57,27 +58,43 @@ std::string LabDoorFlow(int count, const std::string& mobility = "") {
          std::to_string(count) + mobility + ", trigger: {at: 3.0}}\n";
 }
 
-TEST(EvacueesTest, DenseFlowThroughAFullyOpenDoorIsWithinTheHydraulicBand) {
-  // Clear width 0.95 m: SFPE 1.3 /(s m) x (0.95 - 0.3) = 0.85 /s; IMO 1.3 x 0.95 = 1.24 /s.
-  // Steady flow: 5th to 25th crossing (the group's head and tail left out). The mean over
-  // twelve groups is in the band; one group of 30 varies widely (seeds 1-12: 0.61 to 1.20 /s),
-  // so each is only held to within 40 % of the band: far outside it is a model bug.
+// Clear width 0.95 m: SFPE 1.3 /(s m) x (0.95 - 0.3) = 0.85 /s; IMO 1.3 x 0.95 = 1.24 /s.
+// Steady flow: 5th to 25th crossing (the group's head and tail left out). The mean over twelve
+// groups is in the band; one group of 30 varies widely (seeds 1-12: 0.61 to 1.20 /s), so each
+// is only held to within 40 % of the band: far outside it is a model bug. Returns the mean.
+double ExpectDenseFlowInTheHydraulicBand(const TwinConfig& config) {
   double sum = 0.0;
   constexpr int kGroups = 12;
   for (std::uint64_t seed = 1; seed <= kGroups; ++seed) {
     auto loaded = LoadText(LabDoorFlow(30), WorldsDir() / "lab");
-    TwinWorld world(loaded.scenario, loaded.world, seed, Hsr());
+    TwinWorld world(std::make_shared<const TwinModel>(loaded.scenario, loaded.world, Hsr(), config),
+                    seed);
     const std::vector<double> t = CrossingTimes(world, 3.0, 90.0);
-    ASSERT_EQ(t.size(), 30u) << "seed " << seed;
+    EXPECT_EQ(t.size(), 30u) << "seed " << seed;
+    if (t.size() < 25) return 0.0;
     const double flow = 20.0 / (t[24] - t[4]);
-    RecordProperty("flow_persons_per_s_seed_" + std::to_string(seed), std::to_string(flow));
+    ::testing::Test::RecordProperty("flow_persons_per_s_seed_" + std::to_string(seed),
+                                    std::to_string(flow));
     EXPECT_GT(flow, 0.85 * 0.6) << "seed " << seed;
     EXPECT_LT(flow, 1.24 * 1.4) << "seed " << seed;
     sum += flow;
   }
-  RecordProperty("flow_persons_per_s_mean", std::to_string(sum / kGroups));
+  ::testing::Test::RecordProperty("flow_persons_per_s_mean", std::to_string(sum / kGroups));
   EXPECT_GT(sum / kGroups, 0.85);
   EXPECT_LT(sum / kGroups, 1.24);
+  return sum / kGroups;
+}
+
+TEST(EvacueesTest, DenseFlowThroughAFullyOpenDoorIsWithinTheHydraulicBand) {
+  ExpectDenseFlowInTheHydraulicBand(TwinConfig{});
+}
+
+TEST(EvacueesTest, WithSocialTermsHeldAt60HzTheDenseFlowStaysInTheHydraulicBand) {
+  // TwinConfig::crowd_social_rate_hz below the physics rate (the drive and contact still every
+  // step): the same groups, the same band.
+  TwinConfig config;
+  config.crowd_social_rate_hz = 60.0;
+  ExpectDenseFlowInTheHydraulicBand(config);
 }
 
 // The office: room 1 (x < 5), door_a (x = 5, push buttons), room 2, door_b (x = 9, glass,

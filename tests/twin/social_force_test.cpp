@@ -265,9 +265,10 @@ TEST(SocialForceModelTest, SocialTermsSummedNowAddUpToTheWholeAcceleration) {
 }
 
 TEST(SocialForceModelTest, SocialTermsHeldOverStepsStayNearTermsSummedEveryStep) {
-  // What the twin does (TwinConfig::crowd_social_rate_hz): the social terms every fourth step
-  // (60 Hz), the drive and contact every step. Two walkers crossing near a wall for 3 s end
-  // within a few centimetres of where summing every step takes them, and still keep apart.
+  // What the twin does with TwinConfig::crowd_social_rate_hz below the physics rate: at 60 Hz,
+  // the social terms every fourth step, the drive and contact every step. Two walkers crossing near
+  // a wall for 3 s end within a few centimetres of where summing every step takes them, and still
+  // keep apart.
   const WallCells walls({{{-5.0, -1.0}, {5.0, -1.0}}});
   std::vector<Walker> every(2);
   every[0].position = {-3.0, 0.0};
