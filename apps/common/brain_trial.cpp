@@ -99,7 +99,8 @@ std::shared_ptr<const twin::TwinModel> TwinModelForSeed(
 BrainTrial RunBrainTrial(const twin::Scenario& scenario, const twin::WorldDescription& world,
                          std::uint64_t seed, std::shared_ptr<const RobotModel> model,
                          const BrainTrialOptions& options) {
-  return RunBrainTrial(std::make_shared<const twin::TwinModel>(scenario, world, std::move(model)),
+  return RunBrainTrial(std::make_shared<const twin::TwinModel>(scenario, world, std::move(model),
+                                                               options.twin_config),
                        seed, options);
 }
 

@@ -50,6 +50,9 @@ std::unique_ptr<behavior::Executive> MakeScenarioExecutive(const twin::Scenario&
 
 struct BrainTrialOptions {
   behavior::ExecutiveConfig config;
+  /// The twin's physics and crowd settings (RunBrainTrial from a scenario; a compiled model
+  /// carries its own).
+  twin::TwinConfig twin_config;
   /// How the twin runs (duration, trace, progress); its control_period is replaced by the
   /// executive's 1 / config.control_rate_hz.
   twin::RunOptions run;

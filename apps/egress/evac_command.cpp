@@ -30,6 +30,7 @@
 #include "commands.h"
 #include "egress/hsr_interface/error.h"
 #include "egress/twin/sdf_world_loader.h"
+#include "egress/twin/twin_model.h"
 #include "egress/twin/twin_robot.h"
 #include "egress/twin/twin_run.h"
 #include "study_stats.h"
@@ -56,6 +57,7 @@ struct StudyOptions {
   std::vector<std::string> conditions{std::begin(kConditions), std::end(kConditions)};
   bool overwrite{false};
   bool quiet{false};
+  double crowd_social_rate_hz{twin::TwinConfig{}.crowd_social_rate_hz};
 };
 
 bool IsEvacuee(const twin::PersonState& p) {
@@ -96,8 +98,9 @@ std::vector<DoorLine> DoorLines(const twin::TwinWorld& world) {
 // One trial of one condition.
 nlohmann::json RunStudyTrial(const twin::Scenario& scenario, const twin::WorldDescription& world,
                              const std::shared_ptr<const RobotModel>& hsr,
-                             const std::string& condition, std::uint64_t seed) {
-  auto model = std::make_shared<const twin::TwinModel>(scenario, world, hsr);
+                             const twin::TwinConfig& twin_config, const std::string& condition,
+                             std::uint64_t seed) {
+  auto model = std::make_shared<const twin::TwinModel>(scenario, world, hsr, twin_config);
   twin::TwinWorld twin_world(model, seed);
   twin::TwinRobot robot(&twin_world);
   behavior::ExecutiveConfig config;
@@ -267,6 +270,13 @@ void RunStudy(const StudyOptions& o) {
       throw CommandFailed(
           fmt::format("'{}' exists; pass --overwrite to replace it", (dir / f).string()));
   }
+  twin::TwinConfig twin_config;
+  twin_config.crowd_social_rate_hz = o.crowd_social_rate_hz;
+  try {
+    twin_config.Validate();
+  } catch (const InvalidArgument& e) {
+    throw CommandFailed(fmt::format("--crowd-social-rate: {}", e.what()));
+  }
   const twin::Scenario loaded = twin::LoadScenario(o.scenario);
   if (!loaded.mission)
     throw CommandFailed(fmt::format(
@@ -298,7 +308,7 @@ void RunStudy(const StudyOptions& o) {
                conditions.size(), std::min(o.jobs, int(work.size())));
   const std::vector<nlohmann::json> results =
       RunInWorkers(work.size(), o.jobs, !o.quiet && ::isatty(::fileno(stderr)), [&](std::size_t k) {
-        return RunStudyTrial(scenarios.at(work[k].first), world, hsr, work[k].first,
+        return RunStudyTrial(scenarios.at(work[k].first), world, hsr, twin_config, work[k].first,
                              work[k].second);
       });
   std::map<std::string, std::vector<nlohmann::json>> by_condition;
@@ -311,6 +321,7 @@ void RunStudy(const StudyOptions& o) {
   nlohmann::json study = {{"scenario", o.scenario},
                           {"trials", o.trials},
                           {"seed_base", o.seed_base},
+                          {"crowd_social_rate_hz", twin_config.crowd_social_rate_hz},
                           {"conditions", nlohmann::json::array()}};
   fmt::print("\n{:<14} {:>7} {:>24} {:>12} {:>9} {:>9} {:>12}\n", "condition", "trials",
              "evacuation time [s]", "left behind", "contacts", "closest", "in doorway");
@@ -418,6 +429,11 @@ void AddEvacCommand(CLI::App& app) {
       ->add_option("--conditions", o->conditions,
                    "Conditions to run (no_robot, robot, propped_open; default: all three)")
       ->check(CLI::IsMember({"no_robot", "robot", "propped_open"}))
+      ->capture_default_str();
+  study
+      ->add_option("--crowd-social-rate", o->crowd_social_rate_hz,
+                   "Sum the people's social terms at this rate, held between [Hz] "
+                   "(TwinConfig::crowd_social_rate_hz)")
       ->capture_default_str();
   study->add_flag("--overwrite", o->overwrite, "Replace existing output files");
   study->add_flag("-q,--quiet", o->quiet, "No progress bar");

@@ -27,6 +27,7 @@
 #include "egress/bt/loggers.h"
 #include "egress/hsr_interface/error.h"
 #include "egress/twin/sdf_world_loader.h"
+#include "egress/twin/twin_model.h"
 #include "egress/twin/twin_run.h"
 #include "goal_scenario.h"
 #include "trace_render.h"
@@ -83,6 +84,7 @@ struct SimOptions {
   std::optional<std::uint16_t> groot2_port;
   std::string groot2_bind{"127.0.0.1"};
   double pace{0.0};  ///< Real-time factor to hold the run to (0: as fast as it goes).
+  double crowd_social_rate_hz{twin::TwinConfig{}.crowd_social_rate_hz};
 };
 
 void RefuseOverwrite(const std::string& path, bool overwrite) {
@@ -173,6 +175,13 @@ void RunSim(const SimOptions& o) {
                  opened.empty() ? "none" : opened);
     }
   }
+  twin::TwinConfig twin_config;
+  twin_config.crowd_social_rate_hz = o.crowd_social_rate_hz;
+  try {
+    twin_config.Validate();
+  } catch (const InvalidArgument& e) {
+    throw CommandFailed(fmt::format("--crowd-social-rate: {}", e.what()));
+  }
   twin::RunOptions options;
   options.duration = o.duration;
   // The trace only when something is made of it (recording it costs a few per cent of a run).
@@ -234,6 +243,7 @@ void RunSim(const SimOptions& o) {
       }
     }
     trial_options.config.use_octomap = !o.no_octomap;
+    trial_options.twin_config = twin_config;
     trial_options.config.perception.laser_people = o.laser_people;
     trial_options.run = options;
     // The video shows the running action, the planned path and, once a second, the costmap
@@ -264,7 +274,8 @@ void RunSim(const SimOptions& o) {
       fmt::print("btlog     {} (replay it in Groot2)\n", o.btlog);
     }
   } else {
-    world_owner = std::make_unique<twin::TwinWorld>(scenario, world_description, seed, model);
+    world_owner =
+        std::make_unique<twin::TwinWorld>(scenario, world_description, seed, model, twin_config);
     twin::TwinRobot robot(world_owner.get());
     result = twin::RunScenario(robot, controller, options);
   }
@@ -364,6 +375,9 @@ void AddSimCommand(CLI::App& app) {
   sim->add_option("--pace", o->pace,
                   "hold the run to this many times real time (e.g. 1 to watch it in Groot2)")
       ->check(CLI::NonNegativeNumber);
+  sim->add_option("--crowd-social-rate", o->crowd_social_rate_hz,
+                  "sum the people's social terms at this rate, held between [Hz] (default: every "
+                  "physics step, 240; TwinConfig::crowd_social_rate_hz)");
   sim->add_flag("--overwrite", o->overwrite, "replace existing output files");
   sim->add_flag("-q,--quiet", o->quiet, "print only the verdict");
   sim->add_flag("--laser-people,!--camera-people-only", o->laser_people,

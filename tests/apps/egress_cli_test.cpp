@@ -405,6 +405,32 @@ TEST(EgressCliTest, SimRunWithTheBrainPrintsDecisionsAndTracesTheRunningAction) 
   std::filesystem::remove_all(dir);
 }
 
+TEST(EgressCliTest, TheCrowdsSocialRateIsAnOptionOfSimRunAndEvacStudy) {
+  const auto dir = egress::testing::TestTempPath("social_rate");
+  std::filesystem::create_directories(dir);
+  const std::string scenario = kWorldsDir + "/scenarios/evacuation/lab_escort.yaml";
+  // The residents set off at 25 s: by 35 s the held social terms have moved them otherwise.
+  const auto hash = [&](const std::string& extra, const std::string& name) {
+    const Result run = RunEgress("sim run " + scenario + " --duration 35 -q --trace " +
+                                 (dir / name).string() + extra);
+    const std::size_t at = run.output.find("hash ");
+    EXPECT_NE(at, std::string::npos) << run.output;
+    return at == std::string::npos ? std::string() : run.output.substr(at, 21);
+  };
+  const std::string every = hash("", "every.jsonl");
+  EXPECT_EQ(hash(" --crowd-social-rate 240", "every_again.jsonl"), every);  // the default
+  EXPECT_NE(hash(" --crowd-social-rate 60", "held.jsonl"), every);
+  for (const std::string& command :
+       {"sim run " + scenario + " -q",
+        "evac study " + scenario + " -q --trials 1 --out " + (dir / "study").string()}) {
+    const Result bad = RunEgress(command + " --crowd-social-rate 480");
+    EXPECT_EQ(bad.exit_code, 1) << command;
+    EXPECT_THAT(bad.output, HasSubstr("--crowd-social-rate")) << command;
+    EXPECT_THAT(bad.output, HasSubstr("at most physics_rate_hz")) << command;
+  }
+  std::filesystem::remove_all(dir);
+}
+
 TEST(EgressCliTest, EvacStudyComparesTheThreeConditionsOnTheSameSeeds) {
   const auto dir = egress::testing::TestTempPath("study");
   const std::string scenario = kWorldsDir + "/scenarios/evacuation/lab_escort.yaml";
@@ -430,6 +456,7 @@ TEST(EgressCliTest, EvacStudyComparesTheThreeConditionsOnTheSameSeeds) {
   EXPECT_LE(by["propped_open"].at("t_evac_median_s").get<double>(),
             by["no_robot"].at("t_evac_median_s").get<double>());
   EXPECT_EQ(by["robot"].at("contacts").get<int>(), 0);
+  EXPECT_EQ(study.at("crowd_social_rate_hz").get<double>(), 240.0);  // every physics step
   // What each buys over no robot, seed by seed: one seed, one pair, the difference of the times.
   EXPECT_TRUE(by["no_robot"].at("vs_no_robot").is_null());
   for (const char* c : {"robot", "propped_open"}) {

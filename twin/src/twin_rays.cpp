@@ -128,8 +128,8 @@ RayHit TwinWorld::Impl::CastSegment(const Eigen::Vector3d& from, const Eigen::Ve
   // only that far (most of a downward camera's rays end on the floor a few metres out).
   const double plane_clip = PlaneClip(from, to);
   // The targets a walk step yields, in its order: a hit closer than the closest so far is kept.
-  const auto test_targets = [&](const std::vector<int>& near) {
-    for (const int k : near) {
+  const auto test_targets = [&](const std::vector<int>& candidates) {
+    for (const int k : candidates) {
       const std::size_t i = std::size_t(k);
       const btCollisionObject* target = ray_targets[i];
       btVector3 normal;
