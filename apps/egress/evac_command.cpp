@@ -271,12 +271,7 @@ void RunStudy(const StudyOptions& o) {
           fmt::format("'{}' exists; pass --overwrite to replace it", (dir / f).string()));
   }
   twin::TwinConfig twin_config;
-  twin_config.crowd_social_rate_hz = o.crowd_social_rate_hz;
-  try {
-    twin_config.Validate();
-  } catch (const InvalidArgument& e) {
-    throw CommandFailed(fmt::format("--crowd-social-rate: {}", e.what()));
-  }
+  twin_config.crowd_social_rate_hz = o.crowd_social_rate_hz;  // checked by its option
   const twin::Scenario loaded = twin::LoadScenario(o.scenario);
   if (!loaded.mission)
     throw CommandFailed(fmt::format(
@@ -434,7 +429,8 @@ void AddEvacCommand(CLI::App& app) {
       ->add_option("--crowd-social-rate", o->crowd_social_rate_hz,
                    "Sum the people's social terms at this rate, held between [Hz] "
                    "(TwinConfig::crowd_social_rate_hz)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(FiniteIn(1.0, twin::TwinConfig{}.physics_rate_hz));
   study->add_flag("--overwrite", o->overwrite, "Replace existing output files");
   study->add_flag("-q,--quiet", o->quiet, "No progress bar");
   study->callback([o] { RunStudy(*o); });

@@ -176,12 +176,7 @@ void RunSim(const SimOptions& o) {
     }
   }
   twin::TwinConfig twin_config;
-  twin_config.crowd_social_rate_hz = o.crowd_social_rate_hz;
-  try {
-    twin_config.Validate();
-  } catch (const InvalidArgument& e) {
-    throw CommandFailed(fmt::format("--crowd-social-rate: {}", e.what()));
-  }
+  twin_config.crowd_social_rate_hz = o.crowd_social_rate_hz;  // checked by its option
   twin::RunOptions options;
   options.duration = o.duration;
   // The trace only when something is made of it (recording it costs a few per cent of a run).
@@ -377,7 +372,8 @@ void AddSimCommand(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   sim->add_option("--crowd-social-rate", o->crowd_social_rate_hz,
                   "sum the people's social terms at this rate, held between [Hz] (default: every "
-                  "physics step, 240; TwinConfig::crowd_social_rate_hz)");
+                  "physics step, 240; TwinConfig::crowd_social_rate_hz)")
+      ->check(FiniteIn(1.0, twin::TwinConfig{}.physics_rate_hz));
   sim->add_flag("--overwrite", o->overwrite, "replace existing output files");
   sim->add_flag("-q,--quiet", o->quiet, "print only the verdict");
   sim->add_flag("--laser-people,!--camera-people-only", o->laser_people,

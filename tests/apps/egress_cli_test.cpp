@@ -424,9 +424,9 @@ TEST(EgressCliTest, TheCrowdsSocialRateIsAnOptionOfSimRunAndEvacStudy) {
        {"sim run " + scenario + " -q",
         "evac study " + scenario + " -q --trials 1 --out " + (dir / "study").string()}) {
     const Result bad = RunEgress(command + " --crowd-social-rate 480");
-    EXPECT_EQ(bad.exit_code, 1) << command;
+    EXPECT_NE(bad.exit_code, 0) << command;
     EXPECT_THAT(bad.output, HasSubstr("--crowd-social-rate")) << command;
-    EXPECT_THAT(bad.output, HasSubstr("at most physics_rate_hz")) << command;
+    EXPECT_THAT(bad.output, HasSubstr("240")) << command;  // at most the physics rate
   }
   std::filesystem::remove_all(dir);
 }
