@@ -33,7 +33,8 @@ class RayBins {
 
   /// The boxes the segment a-b (XY in W) may cross, cell by cell from a towards b (Amanatides &
   /// Woo's grid walk), each once: a ray cast tests them in that order and stops once its closest
-  /// hit lies before every cell still to come. One walk per thread at a time.
+  /// hit lies before every cell still to come. Walks interleaved on one thread still miss
+  /// nothing, but may yield a box twice (the marks of what was yielded are per thread).
   class Walk {
    public:
     Walk(const RayBins& bins, const Eigen::Vector2d& a, const Eigen::Vector2d& b);

@@ -173,10 +173,10 @@ struct TwinWorld::Impl {
   std::optional<Eigen::Vector2d> ClearOfActuator(const Person& p, int gate) const;
   // Where a person on `side` (+1/-1 along the door's normal) stands to operate door `door`'s
   // actuator: in front of its free face, on their side of the door; nullopt if none is there.
-  // Per building actuator: the spot in front of it cleared of the walls, once found.
-  mutable std::vector<std::optional<Eigen::Vector2d>> actuator_spots;
   std::optional<Eigen::Vector2d> ActuatorSpot(int door, double side,
                                               const Eigen::Vector2d& p_W) const;
+  // Per building actuator: the spot in front of it cleared of the walls, once found.
+  mutable std::vector<std::optional<Eigen::Vector2d>> actuator_spots;
   // A waiting person who can goes to the actuator, operates it for their operate_time and
   // triggers the door; true while they are busy with it (their walker is set).
   bool OperateDoor(Person& p, int gate);
