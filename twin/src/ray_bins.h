@@ -56,15 +56,18 @@ class RayBins {
   };
 
  private:
+  // By the reciprocal (a walk's set-up finds four cells): exact for a cell of a power of two
+  // metres, as kRayBinCellM is, and the same function bins and walks whatever the cell.
   long CellX(double x) const {
-    return std::clamp(long(std::floor((x - origin_.x()) / cell_)), 0L, nx_ - 1);
+    return std::clamp(long(std::floor((x - origin_.x()) * per_metre_)), 0L, nx_ - 1);
   }
   long CellY(double y) const {
-    return std::clamp(long(std::floor((y - origin_.y()) / cell_)), 0L, ny_ - 1);
+    return std::clamp(long(std::floor((y - origin_.y()) * per_metre_)), 0L, ny_ - 1);
   }
 
   std::size_t box_count_{0};
   double cell_{1.0};
+  double per_metre_{1.0};  // 1 / cell_
   Eigen::Vector2d origin_{Eigen::Vector2d::Zero()};
   long nx_{0}, ny_{0};
   std::vector<std::vector<int>> bins_;  // row-major, nx_ * ny_

@@ -11,7 +11,7 @@ class TwinRayCallback : public btCollisionWorld::RayResultCallback {
   TwinRayCallback(const btVector3& dir, GlassMode mode, double glass_max_incidence,
                   const std::function<bool(int)>& is_glass,
                   const std::function<int(const btCollisionObject*, int)>& entity_of)
-      : dir_(dir.normalized()),
+      : dir_(dir),
         mode_(mode),
         glass_max_incidence_(glass_max_incidence),
         is_glass_(is_glass),
@@ -33,8 +33,8 @@ class TwinRayCallback : public btCollisionWorld::RayResultCallback {
   bool Offer(btScalar fraction, const btVector3& n_W, const btCollisionObject* object, int entity) {
     const bool glass = is_glass_(entity);
     if (glass && (mode_ == GlassMode::kTransparent ||
-                  (mode_ == GlassMode::kLaser &&
-                   std::abs(n_W.normalized().dot(dir_)) < std::cos(glass_max_incidence_)))) {
+                  (mode_ == GlassMode::kLaser && std::abs(n_W.normalized().dot(dir_.normalized())) <
+                                                     std::cos(glass_max_incidence_)))) {
       return false;  // the ray passes through the glass
     }
     m_closestHitFraction = fraction;
@@ -50,7 +50,7 @@ class TwinRayCallback : public btCollisionWorld::RayResultCallback {
   bool glass{false};
 
  private:
-  btVector3 dir_;
+  btVector3 dir_;  // the ray's; normalized only where a glass hit needs it (few rays do)
   GlassMode mode_;
   double glass_max_incidence_;  // [rad]; its cosine is needed only on a glass hit
   const std::function<bool(int)>& is_glass_;
