@@ -460,6 +460,8 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     const double lateral = std::abs(offset.dot(Eigen::Vector2d(-pass_.n_M.y(), pass_.n_M.x())));
     phase_ = Phase::kWaiting;
     waiting_since_ = belief_.now;
+    passage_busy_since_.reset();
+    passage_wait_over_ = false;
     if (lateral > 0.05 || offset.dot(pass_.n_M) > entry_distance_ + 0.05) {
       if (const NodeStatus s = StartLineUp(); s != NodeStatus::kRunning) return s;
     }
@@ -526,13 +528,18 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
         const Eigen::Vector2d offset = belief_.X_MB.translation() - centre;
         std::vector<Pose2> path{belief_.X_MB};
         std::vector<bool> through;
-        if (offset.dot(pass_.n_M) > 0.1) {  // square up on the opening's centre line first
-          const Eigen::Vector2d in = centre + pass_.n_M * std::min(offset.dot(pass_.n_M), 0.4);
+        // Squared up on the opening's centre line first, by a step sideways where the robot
+        // stands: every waypoint is a stop, and one in the doorway (as 0.4 m before the line
+        // was) stands there a second beside whoever walks past (two wards seed 35).
+        const Eigen::Vector2d in = centre + pass_.n_M * offset.dot(pass_.n_M);
+        if (offset.dot(pass_.n_M) > 0.1 &&
+            (in - belief_.X_MB.translation()).norm() > kSquareUpTolerance) {
           path.push_back({in.x(), in.y(), yaw_});
           through.push_back(true);
         }
         path.push_back({exit.x(), exit.y(), yaw_});
         through.push_back(true);
+        if (PassageBusy(DoorPathDuration(task_, path))) return NodeStatus::kRunning;
         task_.motion->FollowPath(path, through, TuckedArm(*task_.model), belief_.now);
         Note(StrCat("door open: driving through at ", task_.motion->trajectory_config().door_speed,
                     " m/s"));
@@ -540,6 +547,18 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
         return NodeStatus::kRunning;
       }
       case Phase::kThrough: {
+        // Someone come into view who will pass the doorway beside the robot: it stops short of
+        // the doorway and waits at the entry again, if it is still far enough out to stop there.
+        const double along = (belief_.X_MB.translation() - pass_.centre).dot(pass_.n_M);
+        if (task_.config.passage_clearance > 0.0 && !passage_wait_over_ &&
+            along > kPassageCommitDistance && task_.motion->base_moving() &&
+            IsPassageBusy(task_, door_, DoorPathDuration(task_, task_.motion->path()))) {
+          task_.motion->StopBase();
+          Note("stopping short of the doorway: someone will pass it beside the robot");
+          phase_ = Phase::kWaiting;
+          waiting_since_ = belief_.now;
+          return NodeStatus::kRunning;
+        }
         const NodeStatus s = BaseMotionStatus(task_, note);
         if (s == NodeStatus::kSuccess) {
           Note("through the door");
@@ -614,6 +633,32 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     return Pose2{p.x(), p.y(), yaw_};
   }
 
+  // Whether the robot waits at the entry for people to pass the doorway (IsPassageClear over the
+  // pass's `duration` [s]), at most TaskConfig::passage_max_wait from the first such wait.
+  bool PassageBusy(double duration) {
+    if (task_.config.passage_clearance <= 0.0 ||
+        IsPassageClear(task_, door_, duration, task_.config.passage_quiet_time)) {
+      passage_busy_since_.reset();
+      return false;
+    }
+    if (!passage_busy_since_) {
+      passage_busy_since_ = belief_.now;
+      Note("waiting at the entry: people would pass the doorway beside the robot");
+    }
+    if (ToSeconds(belief_.now - *passage_busy_since_) < task_.config.passage_max_wait) return true;
+    Note("people still pass the doorway after the longest wait: going");
+    passage_wait_over_ = true;  // and not stopping short for them on the way in
+    return false;
+  }
+
+  // Off the opening's centre line by no more than this, the robot drives straight through [m].
+  static constexpr double kSquareUpTolerance = 0.02;
+  // Nearer the door line than this, a passage turned busy no longer stops the drive through: the
+  // base takes ~0.15 m to stop from the door speed, which would leave it standing in the doorway
+  // beside the passer-by (the reactive door-zone check still halts it for anyone entering the
+  // zone) [m].
+  static constexpr double kPassageCommitDistance = 0.65;
+
   // The entry pose's position: on the door's axis, entry_distance_ before the door line.
   Eigen::Vector2d EntryPoint() const { return pass_.centre + pass_.n_M * entry_distance_; }
 
@@ -656,6 +701,8 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
   double yaw_{0.0};
   Phase phase_{Phase::kWaiting};
   Time waiting_since_{};
+  std::optional<Time> passage_busy_since_;  // waiting at the entry for people to pass since
+  bool passage_wait_over_{false};           // waited the longest for them: going regardless
 };
 
 }  // namespace

@@ -1,9 +1,11 @@
 #include "egress/behavior/door_rules.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
 #include "egress/hsr_interface/error.h"
+#include "egress/hsr_interface/geometry.h"
 #include "egress/perception/person_tracker.h"
 #include "task_node_support.h"
 
@@ -95,6 +97,27 @@ bool IsDoorZoneOccupied(const TaskServices& task, const std::string& door) {
     }
   }
   return false;
+}
+
+bool IsPassageBusy(const TaskServices& task, const std::string& door, double horizon) {
+  const DoorPass pass = CalcDoorPass(*task.map, door, task.belief->X_MB);
+  for (const auto& entry : task.belief->world.people) {
+    if (IsHoldingDoorAside(task, entry, door)) continue;
+    const Eigen::Vector2d& p = entry.person.p_MP;
+    const Eigen::Vector2d later = p + entry.person.v_MP * std::max(horizon, 0.0);
+    if ((ClosestPointOnSegment(pass.centre, p, later) - pass.centre).norm() <
+        task.config.passage_clearance)
+      return true;
+  }
+  return false;
+}
+
+bool IsPassageClear(const TaskServices& task, const std::string& door, double horizon,
+                    double quiet_for) {
+  if (IsPassageBusy(task, door, horizon)) return false;
+  const auto it = task.belief->passage_used_at.find(door);
+  return it == task.belief->passage_used_at.end() ||
+         ToSeconds(task.belief->now - it->second) >= quiet_for;
 }
 
 bool IsDoorZoneClearFor(const TaskServices& task, const std::string& door, double clear_for) {

@@ -553,6 +553,8 @@ bool Executive::Step(RobotPort& port) {
   for (const auto& door : m.map.doors) {
     const bool occupied = IsDoorZoneOccupied(services_, door.id);
     if (occupied) belief_.zone_occupied_at[door.id] = now;
+    if (services_.config.passage_clearance > 0.0 && IsPassageBusy(services_, door.id, 0.0))
+      belief_.passage_used_at[door.id] = now;
     if (occupied && !m.zone_occupied[door.id]) newly_occupied = true;
     m.zone_occupied[door.id] = occupied;
   }

@@ -232,6 +232,7 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
     // the jamb or the leaf), then on.
     std::vector<Pose2> path{belief_.X_MB};
     const std::optional<DoorVisit> visit = Shared<DoorVisit>("visit");
+    bool stay_this_side = false;
     for (const auto& door : task_.map->doors) {
       const DoorPass pass = CalcKnownPass(task_, door.id, visit ? &*visit : nullptr);
       const Eigen::Vector2d offset = belief_.X_MB.translation() - pass.centre;
@@ -245,13 +246,32 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
         // doorway (clinic family seed 2007: it backed through door_b as the leaf closed).
         if (along < 0.0 && (belief_.last_safe->translation() - pass.centre).dot(pass.n_M) < 0.0)
           break;
+        // Past the door line, out of the leaf's reach, with someone near the doorway (walking
+        // past it on this side): back through it would stand the robot in the doorway beside
+        // them. It makes room on this side instead (two wards seed 14: halted a step into the
+        // corridor, it backed into door_d's doorway as a resident hurried by, 3 s beside them).
+        // In the leaf's sweep it backs out, as below: the leaf may be closing on it.
+        if (along < 0.0 &&
+            !door.InSweep(belief_.X_MB.translation(),
+                          task_.config.footprint_radius + kLeafClearance) &&
+            IsPassageBusy(task_, door.id, kPeopleHorizonSec)) {
+          stay_this_side = true;
+          break;
+        }
         const Eigen::Vector2d out = belief_.X_MB.translation() + pass.n_M * (entry - along);
         path.push_back({out.x(), out.y(), belief_.X_MB.yaw});
         break;
       }
     }
-    const auto chosen = ChooseSpot(path);
-    if (!chosen && !looked_back_) {
+    std::optional<std::pair<Pose2, bool>> chosen;
+    if (stay_this_side) {
+      if (const auto aside = PeopleRoom(task_, kPeopleHorizonSec)
+                                 .BestSpotAround(path, -std::numeric_limits<double>::infinity()))
+        chosen = std::pair{*aside, true};
+    } else {
+      chosen = ChooseSpot(path);
+    }
+    if (!chosen && !looked_back_ && !stay_this_side) {
       // The way back may only be unseen: it is behind the robot, in the laser's blind sector
       // (two-wards seed 12: driving through door_d, halted for residents crossing the doorway's
       // far side, the robot stood 7 s in the doorway beside them, then the door shut on it).

@@ -15,6 +15,11 @@ void TaskConfig::Validate() const {
               "TaskConfig: motion times must be positive");
   ThrowUnless(std::isfinite(door_peek_time) && door_peek_time >= 0,
               "TaskConfig: door_peek_time must be >= 0 (s)");
+  ThrowUnless(std::isfinite(passage_clearance) && passage_clearance >= 0 &&
+                  std::isfinite(passage_quiet_time) && passage_quiet_time >= 0 &&
+                  std::isfinite(passage_max_wait) && passage_max_wait >= 0,
+              "TaskConfig: passage_clearance (m), passage_quiet_time and passage_max_wait (s) "
+              "must be >= 0");
   ThrowUnless(right_of_way_radius >= 0 && right_of_way_time >= 0,
               "TaskConfig: right_of_way_radius and right_of_way_time must be >= 0");
   ThrowUnless(std::isfinite(comfort_distance) && comfort_distance >= 0,

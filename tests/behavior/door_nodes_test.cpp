@@ -384,5 +384,120 @@ TEST_F(DoorNodesTest, TraverseDoorLinesUpOnTheDoorsAxisBeforeGoing) {
   EXPECT_NEAR(entry.yaw, M_PI / 2, 1e-6);
 }
 
+// Issue 17: the robot never stands in a doorway beside a resident. Every waypoint of a path is
+// a stop: squaring up on the opening's centre line is a step sideways where the robot stands at
+// the entry, not a stop 0.4 m before the line.
+TEST_F(DoorNodesTest, TheDriveThroughStopsNowhereBetweenTheEntryAndTheExit) {
+  services_.config.door_peek_time = 0.0;
+  for (const double angle : {80.0, 90.0}) {
+    bt::Tree tree = Tree(R"(<TraverseDoor door="lab_door"/>)");
+    belief_.X_MB = {0.0, 2.3, M_PI / 2};  // at the entry, on the door's axis
+    belief_.now = At(1.0);
+    DoorSeenOpen(angle, 0.0);
+    motion_.StopBase();
+    ASSERT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+    ASSERT_TRUE(motion_.base_moving());
+    const std::vector<Pose2>& path = motion_.path();
+    EXPECT_GT(path.back().y, 3.0) << "the exit is beyond the line";
+    // At 80° the leaf narrows the opening from the hinge side: a sideways step onto the clear
+    // opening's middle first, at the entry; at 90° straight through.
+    ASSERT_EQ(path.size(), angle < 85.0 ? 3u : 2u) << angle;
+    for (std::size_t i = 1; i + 1 < path.size(); ++i) {
+      EXPECT_NEAR(path[i].y, 2.3, 1e-9) << "waypoint " << i << " at " << angle << " deg";
+      EXPECT_LT(path[i].x, -0.02) << "towards the latch, away from the leaf";
+    }
+  }
+}
+
+// Issue 17: someone walking past the doorway's far side would be beside the robot in it: it
+// waits at the entry, outside the doorway, until they have passed and the passage has been quiet
+// (people seen passing it lately are a stream still walking by, out of view).
+TEST_F(DoorNodesTest, TraverseDoorWaitsAtTheEntryWhileSomeoneWalksPastTheDoorway) {
+  services_.config.door_peek_time = 0.0;
+  bt::Tree tree = Tree(R"(<TraverseDoor door="lab_door"/>)");
+  belief_.X_MB = {0.0, 2.3, M_PI / 2};
+  auto passer = node_testing::Person({-3.5, 4.0}, perception::PersonIntent::kApproaching);
+  passer.person.v_MP = {1.0, 0.0};
+  const auto at = [&](double t, double x) {
+    belief_.now = At(t);
+    DoorSeenOpen(90.0, 0.0);  // a fresh opening each time: the window is never the reason
+    passer.person.p_MP.x() = x;
+    See({passer});
+    return tree.TickOnce();
+  };
+  EXPECT_EQ(at(1.0, -3.5), NodeStatus::kRunning);
+  EXPECT_FALSE(motion_.base_moving()) << "they will be abreast of the doorway during the pass";
+  EXPECT_TRUE(NotedText("waiting at the entry"));
+  EXPECT_EQ(at(4.5, 0.0), NodeStatus::kRunning);
+  EXPECT_FALSE(motion_.base_moving()) << "abreast of it";
+  EXPECT_EQ(at(7.0, 2.5), NodeStatus::kRunning);
+  EXPECT_FALSE(motion_.base_moving()) << "walking away, but near it 2.5 s ago";
+  EXPECT_EQ(at(10.0, 5.5), NodeStatus::kRunning);
+  EXPECT_TRUE(motion_.base_moving()) << "quiet for passage_quiet_time: through";
+  EXPECT_GT(motion_.path().back().y, 3.0);
+}
+
+TEST_F(DoorNodesTest, TraverseDoorGoesAfterTheLongestWaitForSomeoneWhoStaysByTheDoorway) {
+  services_.config.door_peek_time = 0.0;
+  services_.config.passage_max_wait = 4.0;
+  bt::Tree tree = Tree(R"(<TraverseDoor door="lab_door"/>)");
+  belief_.X_MB = {0.0, 2.3, M_PI / 2};
+  // Standing 1.5 m beyond the line, off to the side: not in the door's zone, near the doorway.
+  const auto stander = node_testing::Person({-1.2, 4.5}, perception::PersonIntent::kStationary);
+  for (const double t : {1.0, 3.0, 4.9}) {
+    belief_.now = At(t);
+    DoorSeenOpen(90.0, 0.0);
+    See({stander});
+    EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+    EXPECT_FALSE(motion_.base_moving()) << t;
+  }
+  belief_.now = At(5.1);
+  DoorSeenOpen(90.0, 0.0);
+  See({stander});
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(motion_.base_moving());
+  EXPECT_TRUE(NotedText("after the longest wait"));
+  // On the way in it does not stop short for them again.
+  belief_.X_MB = {0.0, 2.25, M_PI / 2};
+  belief_.now = At(5.3);
+  See({stander});
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(motion_.base_moving());
+  EXPECT_FALSE(NotedText("stopping short"));
+}
+
+TEST_F(DoorNodesTest, TraverseDoorStopsShortOfTheDoorwayForSomeoneComingIntoViewAndWaitsAgain) {
+  services_.config.door_peek_time = 0.0;
+  bt::Tree tree = Tree(R"(<TraverseDoor door="lab_door"/>)");
+  belief_.X_MB = {0.0, 2.3, M_PI / 2};
+  belief_.now = At(1.0);
+  DoorSeenOpen(90.0, 0.0);
+  See({});
+  ASSERT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  ASSERT_TRUE(motion_.base_moving());
+  // 0.1 m on, someone comes into view along the passage beyond.
+  belief_.X_MB = {0.0, 2.2, M_PI / 2};
+  belief_.now = At(1.5);
+  auto passer = node_testing::Person({-1.8, 4.0}, perception::PersonIntent::kApproaching);
+  passer.person.v_MP = {1.0, 0.0};
+  See({passer});
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_FALSE(motion_.base_moving());
+  EXPECT_TRUE(NotedText("stopping short of the doorway"));
+  // Past the point of no return (0.6 m before the line), it drives on: a stop would stand it in
+  // the doorway beside them.
+  belief_.X_MB = {0.0, 2.3, M_PI / 2};
+  belief_.now = At(20.0);
+  DoorSeenOpen(90.0, 0.0);
+  See({});
+  ASSERT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  ASSERT_TRUE(motion_.base_moving()) << "quiet again: through";
+  belief_.X_MB = {0.0, 2.4, M_PI / 2};
+  belief_.now = At(20.5);
+  See({passer});
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(motion_.base_moving());
+}
+
 }  // namespace
 }  // namespace egress::behavior

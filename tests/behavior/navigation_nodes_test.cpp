@@ -384,5 +384,49 @@ TEST_F(NavigationNodesTest, RetractToSafePastTheDoorLineNeverBacksThroughTheDoor
   EXPECT_LT((motion_.path().back().translation() - Eigen::Vector2d(0.0, 1.5)).norm(), 1e-6);
 }
 
+// Issue 17: halted a step past the door line, out of the leaf's reach, as someone walks past
+// the doorway on that side: backing through it would stand the robot in the doorway beside
+// them (two wards seed 14). It makes room on the side it is on; with nobody near the doorway it
+// backs through to its last safe pose, as before.
+TEST_F(NavigationNodesTest,
+       RetractToSafePastTheDoorLineStaysOnThatSideWhileSomeonePassesTheDoorway) {
+  auto blackboard = bt::Blackboard::Create();
+  DoorVisit visit;
+  visit.door = "lab_door";
+  visit.approach_side = Eigen::Vector2d(0.0, 1.0);  // from the north, the side the leaf opens to
+  blackboard->Set("door_visit", bt::Any(visit));
+  bt::Tree tree = Tree(R"(<RetractToSafe/>)", blackboard);
+  const auto halt_past_the_line = [&](double t) {
+    tree.HaltTree();
+    motion_.StopBase();
+    log_.Take();
+    belief_.X_MB = {0.0, 2.4, -M_PI / 2};  // 0.6 m past the line, facing south
+    belief_.last_safe = Pose2{0.0, 4.4, -M_PI / 2};
+    belief_.scan = node_testing::SweepScan();
+    belief_.X_BL = Pose2{0.17, 0.0, 0.0};
+    belief_.now = At(t);
+    belief_.swept_p_MB.clear();
+    for (double y = 4.4; y > 2.4; y -= kSweptSampleM)  // driven down the axis, facing south
+      belief_.swept_p_MB.emplace_back(At(t - (y - 2.4) / 0.4), Eigen::Vector2d(0.0, y));
+    return tree.TickOnce();
+  };
+  auto passer = Person({-2.0, 2.0}, perception::PersonIntent::kApproaching);
+  passer.person.v_MP = {1.0, 0.0};  // along the passage south of the door, past its doorway
+  belief_.world.people = {passer};
+  ASSERT_TRUE(IsPassageBusy(services_, "lab_door", 3.0));
+  EXPECT_EQ(halt_past_the_line(1.0), NodeStatus::kRunning);
+  ASSERT_TRUE(Noted(DecisionEvent::kRetreating));
+  ASSERT_GE(motion_.path().size(), 2u);
+  for (const Pose2& p : motion_.path())
+    EXPECT_LT(p.y, 3.0) << "back through the doorway";
+  EXPECT_FALSE(IsInAnyDoorZone(services_, motion_.path().back().translation()))
+      << "out of the door's way";
+  // Nobody near the doorway: back through it to the last safe pose.
+  belief_.world.people = {};
+  EXPECT_EQ(halt_past_the_line(2.0), NodeStatus::kRunning);
+  ASSERT_GE(motion_.path().size(), 2u);
+  EXPECT_LT((motion_.path().back().translation() - Eigen::Vector2d(0.0, 4.4)).norm(), 1e-6);
+}
+
 }  // namespace
 }  // namespace egress::behavior

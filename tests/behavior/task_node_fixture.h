@@ -110,12 +110,13 @@ class TaskNodeFixture : public ::testing::Test {
       belief_.door_opening_witnessed.erase("lab_door");
     }
   }
-  // The people the robot sees now, and the door zones they occupy recorded in the belief as the
-  // executive records them every control step.
+  // The people the robot sees now, and the door zones they occupy and the doorways they are near
+  // recorded in the belief as the executive records them every control step.
   void See(std::vector<perception::TrackedPersonWithIntent> people) {
     belief_.world.people = std::move(people);
     for (const auto& door : map_.doors) {
       if (IsDoorZoneOccupied(services_, door.id)) belief_.zone_occupied_at[door.id] = belief_.now;
+      if (IsPassageBusy(services_, door.id, 0.0)) belief_.passage_used_at[door.id] = belief_.now;
     }
   }
   // Whether any note so far carries `event`.

@@ -152,6 +152,53 @@ TEST_F(DoorWindowTest, AnOpeningNotSeenBeginningMayCloseAnyMoment) {
   EXPECT_TRUE(PassableAfter(15.0, -1.0, 0.0, false));
 }
 
+// Issue 17: a robot driving through a door is in the doorway for the seconds the pass takes;
+// whoever walks past the doorway meanwhile passes beside it.
+TEST_F(DoorZoneRulesTest, SomeoneWalkingPastTheFarSideMakesThePassageBusyOverTheTimeTheyComeNear) {
+  // 1 m beyond the line, 3.5 m to the side, walking past at 1 m/s: 3.6 m from the opening's
+  // middle now, 1 m when abreast of it 3.5 s from now.
+  auto passer = StillPerson({-3.5, 4.0}, perception::PersonIntent::kApproaching);
+  passer.person.v_MP = {1.0, 0.0};
+  belief_.world.people = {passer};
+  ASSERT_DOUBLE_EQ(services_.config.passage_clearance, 2.0);
+  EXPECT_FALSE(IsPassageBusy(services_, "lab_door", 0.0));
+  EXPECT_FALSE(IsPassageBusy(services_, "lab_door", 1.0));  // 2.7 m away then
+  EXPECT_TRUE(IsPassageBusy(services_, "lab_door", 3.0));
+  // Walking the other way, away from the doorway: never near it.
+  passer.person.v_MP = {-1.0, 0.0};
+  belief_.world.people = {passer};
+  EXPECT_FALSE(IsPassageBusy(services_, "lab_door", 10.0));
+  // Standing 1.5 m from it: busy whatever the horizon; unless the rule is off.
+  belief_.world.people = {StillPerson({1.5, 3.0}, perception::PersonIntent::kStationary)};
+  EXPECT_TRUE(IsPassageBusy(services_, "lab_door", 0.0));
+  services_.config.passage_clearance = 0.0;
+  EXPECT_FALSE(IsPassageBusy(services_, "lab_door", 0.0));
+  // Someone holding the door aside is why the robot may pass.
+  services_.config.passage_clearance = 2.0;
+  const auto holder = StillPerson({0.475 + 0.25, 3.4}, perception::PersonIntent::kHoldingDoor);
+  belief_.world.people = {holder};
+  ASSERT_TRUE(IsHoldingDoorAside(services_, holder, "lab_door"));
+  EXPECT_FALSE(IsPassageBusy(services_, "lab_door", 5.0));
+}
+
+// From before a door the robot sees a metre or so along the passage beyond: people seen passing
+// the doorway lately are a stream still walking by, out of view.
+TEST_F(DoorZoneRulesTest, APassageIsClearOnlyOnceNobodyHasBeenNearTheDoorwayForTheQuietTime) {
+  belief_.now = Time{} + SecondsToDuration(20.0);
+  belief_.world.people = {};
+  EXPECT_TRUE(IsPassageClear(services_, "lab_door", 5.0, 5.0));  // nobody ever seen there
+  belief_.passage_used_at["lab_door"] = belief_.now - SecondsToDuration(3.0);
+  EXPECT_FALSE(IsPassageClear(services_, "lab_door", 5.0, 5.0));
+  EXPECT_TRUE(IsPassageClear(services_, "lab_door", 5.0, 2.0));
+  belief_.passage_used_at["lab_door"] = belief_.now - SecondsToDuration(6.0);
+  EXPECT_TRUE(IsPassageClear(services_, "lab_door", 5.0, 5.0));
+  // Quiet long enough, but someone coming: not clear.
+  auto passer = StillPerson({-3.5, 4.0}, perception::PersonIntent::kApproaching);
+  passer.person.v_MP = {1.0, 0.0};
+  belief_.world.people = {passer};
+  EXPECT_FALSE(IsPassageClear(services_, "lab_door", 5.0, 5.0));
+}
+
 TEST_F(DoorZoneRulesTest, AnUnknownDoorIsAClearError) {
   EXPECT_THROW(IsDoorZoneOccupied(services_, "door_z"), InvalidArgument);
 }

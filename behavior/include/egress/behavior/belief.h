@@ -70,6 +70,9 @@ struct Belief {
   /// Per door: the last step at which a person (not one holding the door aside) was in, or
   /// forecast into, its zone. Absent: never seen occupied.
   std::map<std::string, Time> zone_occupied_at;
+  /// Per door: the last step at which a person (not one holding the door aside) was within
+  /// TaskConfig::passage_clearance of its opening's middle (IsPassageBusy now). Absent: never.
+  std::map<std::string, Time> passage_used_at;
 
   double now_s() const { return ToSeconds(now); }
 };

@@ -41,6 +41,14 @@ bool IsInAnyDoorZone(const TaskServices& task, const Eigen::Vector2d& p_MB);
 /// `door`; or crossing it (TaskConfig::yield_to_crossing); or, on its far side, waiting for it
 /// while its opening is young (TaskConfig::right_of_way_time).
 bool IsDoorZoneOccupied(const TaskServices& task, const std::string& door);
+/// True when someone (not holding `door` aside) would come within config.passage_clearance of
+/// the middle of its opening within `horizon` [s], walking on at the velocity they are tracked
+/// at: a robot passing the door in that time would be in the doorway beside them.
+bool IsPassageBusy(const TaskServices& task, const std::string& door, double horizon);
+/// IsPassageBusy false over `horizon` [s], and nobody within config.passage_clearance of the
+/// opening's middle for at least `quiet_for` [s], by the belief's passage_used_at.
+bool IsPassageClear(const TaskServices& task, const std::string& door, double horizon,
+                    double quiet_for);
 /// The zone of `door` has been free of people (IsDoorZoneOccupied false) for at least
 /// `clear_for` [s], by the belief's zone_occupied_at.
 bool IsDoorZoneClearFor(const TaskServices& task, const std::string& door, double clear_for);

@@ -42,6 +42,20 @@ struct TaskConfig {
   /// A door still steady this long past the window is held by someone out of sight (the
   /// holder often stands behind the jamb) [s].
   double door_hold_margin{2.0};
+  /// Before driving through a door the robot waits at its entry pose (outside the doorway)
+  /// while someone would come within this of the opening's middle during the pass, at the
+  /// velocity they are tracked at: a robot driving through then stood in the doorway beside
+  /// people walking past it (the doorway rule of the evacuation study, a resident within 2 m).
+  /// 0: no wait [m].
+  double passage_clearance{2.0};
+  /// ... and until nobody has been within passage_clearance of the opening's middle for this
+  /// long: from the entry the robot sees a metre or so either way along the passage beyond, and
+  /// someone walking it comes into view a second before the doorway; people seen passing it
+  /// lately are the sign of a stream still walking by (two wards seed 35) [s] ...
+  double passage_quiet_time{5.0};
+  /// ... for at most this long; then it goes (the reactive door-zone check still stops it for
+  /// anyone stepping into the zone) [s].
+  double passage_max_wait{10.0};
   double zone_depth{1.0};     ///< People-free zone each side of a door line [m].
   double person_radius{0.3};  ///< [m]
   /// A person the tracker classifies as crossing a door (their straight path goes through its
