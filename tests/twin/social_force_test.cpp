@@ -159,6 +159,38 @@ TEST(SocialForceModelTest, StepsCellListsMatchTheSumOverEverything) {
   EXPECT_GT(pushed_by_walls, 20);  // walls did act
 }
 
+// A person not yet set off is a walker the others meet as any other, but no force moves them:
+// their own sum is skipped (a group waiting for its alarm was a twelfth of the crowd bench's
+// social force cost, summed and thrown away).
+TEST(SocialForceModelTest, AHeldWalkerPushesTheOthersButIsNotMoved) {
+  std::vector<Walker> walkers(3);
+  walkers[0].position = {0.0, 0.0};
+  walkers[1].position = {0.6, 0.05};  // near enough to push and be pushed
+  walkers[2].position = {-0.5, 0.4};
+  for (auto& w : walkers) {
+    w.target = {5.0, 0.0};
+    w.desired_speed = 1.2;
+  }
+  SocialForceModel sfm;
+  const WallCells no_walls(std::vector<WallSegment>{});
+  const std::vector<Eigen::Vector2d> free = sfm.CalcAccelerations(walkers, {}, no_walls, {});
+  walkers[1].held = true;
+  const std::vector<Eigen::Vector2d> held = sfm.CalcAccelerations(walkers, {}, no_walls, {});
+  EXPECT_GT(free[1].norm(), 0.1);
+  EXPECT_EQ(held[1], Eigen::Vector2d::Zero());
+  // The others' sums are unchanged, bit for bit: the held walker still acts on them.
+  for (const std::size_t i : {0u, 2u}) {
+    EXPECT_EQ(held[i].x(), free[i].x()) << i;
+    EXPECT_EQ(held[i].y(), free[i].y()) << i;
+  }
+  walkers[1].velocity = {0.3, 0.0};
+  std::vector<Walker> stepped = walkers;
+  sfm.Step(&stepped, {}, no_walls, {}, 0.01);
+  EXPECT_EQ(stepped[1].position, walkers[1].position);
+  EXPECT_EQ(stepped[1].velocity, walkers[1].velocity);
+  EXPECT_NE(stepped[0].position, walkers[0].position);
+}
+
 TEST(SocialForceModelTest, CellListsMatchTheSumOverEverythingWhateverTheSpeedsAndSpread) {
   // Fast walkers reach farther (their step ellipse) than slow ones: each cell lists everyone
   // whose own reach overlaps it. A crowd spread over more cells than the grid holds densely

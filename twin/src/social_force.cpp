@@ -293,7 +293,7 @@ std::vector<Eigen::Vector2d> SocialForceModel::SumTerms(
   // reach (the box round its social circle and touching distance) overlaps the cell, so a walker
   // meets only those that may reach it, in the order of the whole crowd: the sums (and the run) are
   // the same as without the grid, in O(n) instead of O(n^2).
-  std::vector<Eigen::Vector2d> accelerations(all.size());
+  std::vector<Eigen::Vector2d> accelerations(all.size(), Eigen::Vector2d::Zero());
   const bool contact_only = terms == Terms::kContact;
   std::vector<Reach> reach(all.size());
   for (std::size_t j = 0; j < all.size(); ++j)
@@ -354,6 +354,7 @@ std::vector<Eigen::Vector2d> SocialForceModel::SumTerms(
   const std::vector<WallSegment>& walls = fixed.walls();
   std::vector<std::size_t> near_walls, near;
   for (std::size_t i = 0; i < all.size(); ++i) {
+    if (all[i].held) continue;  // zero
     const Eigen::Vector2d& p = all[i].position;
     const std::size_t c = std::size_t(cell_y(p.y()) * nx + cell_x(p.x()));
     near.assign(members.begin() + long(start[c]), members.begin() + long(start[c + 1]));
@@ -386,6 +387,7 @@ void SocialForceModel::Integrate(std::vector<Walker>* walkers,
                                  double dt) const {
   for (std::size_t i = 0; i < walkers->size(); ++i) {
     Walker& w = (*walkers)[i];
+    if (w.held) continue;
     w.velocity += accelerations[i] * dt;
     const double v_max = params_.max_speed_factor * std::max(w.desired_speed, 0.3);
     if (w.velocity.norm() > v_max) w.velocity *= v_max / w.velocity.norm();

@@ -434,6 +434,7 @@ void TwinWorld::Impl::UpdatePeople() {
   for (std::size_t i = 0; i < people.size(); ++i) {
     if (people[i].state.out) continue;
     walkers.push_back(people[i].walker);
+    walkers.back().held = !people[i].state.started;  // standing people do not integrate
     walker_of.push_back(i);
   }
   std::vector<WallSegment> leaves;

@@ -57,6 +57,9 @@ struct Walker {
   /// room from walls than a walker does, or it would never pass a 1 m ADA doorway (both jambs
   /// push it back). Body compression at contact is not scaled.
   double wall_scale{1.0};
+  /// Held where it stands (a person not yet set off): it acts on the others as any walker does,
+  /// but no force moves it (its acceleration is zero, not summed, and Integrate leaves it).
+  bool held{false};
 };
 
 /// A disc that walkers avoid but the model does not move (the robot).
