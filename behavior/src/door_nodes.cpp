@@ -460,7 +460,6 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     const double lateral = std::abs(offset.dot(Eigen::Vector2d(-pass_.n_M.y(), pass_.n_M.x())));
     phase_ = Phase::kWaiting;
     waiting_since_ = belief_.now;
-    passage_busy_since_.reset();
     passage_wait_over_ = false;
     if (lateral > 0.05 || offset.dot(pass_.n_M) > entry_distance_ + 0.05) {
       if (const NodeStatus s = StartLineUp(); s != NodeStatus::kRunning) return s;
@@ -634,18 +633,20 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
   }
 
   // Whether the robot waits at the entry for people to pass the doorway (IsPassageClear over the
-  // pass's `duration` [s]), at most TaskConfig::passage_max_wait from the first such wait.
+  // pass's `duration` [s]), at most TaskConfig::passage_max_wait from the visit's first such
+  // wait.
   bool PassageBusy(double duration) {
     if (task_.config.passage_clearance <= 0.0 ||
-        IsPassageClear(task_, door_, duration, task_.config.passage_quiet_time)) {
-      passage_busy_since_.reset();
+        IsPassageClear(task_, door_, duration, task_.config.passage_quiet_time))
       return false;
-    }
-    if (!passage_busy_since_) {
-      passage_busy_since_ = belief_.now;
+    DoorVisit visit = Visit();
+    if (!visit.passage_wait_began) {
+      visit.passage_wait_began = belief_.now;
+      Remember(visit);
       Note("waiting at the entry: people would pass the doorway beside the robot");
     }
-    if (ToSeconds(belief_.now - *passage_busy_since_) < task_.config.passage_max_wait) return true;
+    if (ToSeconds(belief_.now - *visit.passage_wait_began) < task_.config.passage_max_wait)
+      return true;
     Note("people still pass the doorway after the longest wait: going");
     passage_wait_over_ = true;  // and not stopping short for them on the way in
     return false;
@@ -701,8 +702,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
   double yaw_{0.0};
   Phase phase_{Phase::kWaiting};
   Time waiting_since_{};
-  std::optional<Time> passage_busy_since_;  // waiting at the entry for people to pass since
-  bool passage_wait_over_{false};           // waited the longest for them: going regardless
+  bool passage_wait_over_{false};  // waited the longest for them: going regardless
 };
 
 }  // namespace

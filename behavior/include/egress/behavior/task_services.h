@@ -173,6 +173,10 @@ struct DoorVisit {
   /// Set when a press or wave found the door already open: the operator restarted its hold
   /// window when the hand reached the actuator (operated_at).
   std::optional<Time> window_restarted_at;
+  /// Since when the robot has waited at the entry for people passing the doorway
+  /// (TaskConfig::passage_max_wait counts from here, across a retry's new press: a wait that
+  /// outlasted one opening would otherwise begin again with the next, clinic family seed 2005).
+  std::optional<Time> passage_wait_began;
 };
 
 /// A grasp, planned by PlanGrasp and carried out by the grasp leaves after it (DriveToGrasp,
