@@ -351,6 +351,8 @@ void Register(bt::BehaviorTreeFactory& factory, const std::string& id,
 void RegisterConditionNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 void RegisterNavigationNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 void RegisterDoorNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
+/// TraverseDoor (traverse_door.cpp), registered by RegisterDoorNodes.
+void RegisterTraverseDoor(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 void RegisterManipulationNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 void RegisterGraspNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 void RegisterReleaseNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);

@@ -354,7 +354,9 @@ std::vector<Eigen::Vector2d> SocialForceModel::SumTerms(
   const std::vector<WallSegment>& walls = fixed.walls();
   std::vector<std::size_t> near_walls, near;
   for (std::size_t i = 0; i < all.size(); ++i) {
-    if (all[i].held) continue;  // zero
+    // A held walker's sum would be thrown away, but for its social terms alone: held between
+    // sums, they are what it sets off with if its hold ends before the next sum.
+    if (all[i].held && terms != Terms::kSocial) continue;  // zero
     const Eigen::Vector2d& p = all[i].position;
     const std::size_t c = std::size_t(cell_y(p.y()) * nx + cell_x(p.x()));
     near.assign(members.begin() + long(start[c]), members.begin() + long(start[c + 1]));

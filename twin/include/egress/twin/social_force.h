@@ -58,7 +58,8 @@ struct Walker {
   /// push it back). Body compression at contact is not scaled.
   double wall_scale{1.0};
   /// Held where it stands (a person not yet set off): it acts on the others as any walker does,
-  /// but no force moves it (its acceleration is zero, not summed, and Integrate leaves it).
+  /// but no force moves it (its acceleration is zero, not summed, and Integrate leaves it; its
+  /// social terms alone, CalcSocialAccelerations, are summed: they are held between sums).
   bool held{false};
 };
 

@@ -1,0 +1,295 @@
+// TraverseDoor, the door node that drives through the doorway (door_nodes.cpp has the others:
+// finding, approaching and operating the actuator).
+
+#include "task_node_support.h"
+
+#include <cmath>
+#include <optional>
+
+namespace egress::behavior::detail {
+namespace {
+
+// Drives through a door in two legs: to the entry pose on the door's axis (the arm tucking on
+// the way), where the laser sees through the opening; then, once the leaf leaves room for the
+// footprint, through the doorway to the exit pose. Both legs run at the door speed: the ADA
+// hold window is short. Coming from beside the lane to a door that opens away, the first leg
+// stops at the lane's edge until the leaf is open and the robot has looked through the opening
+// (TaskConfig::door_peek_time): whoever waited on the far side is seen setting off before the
+// robot stands in their way.
+class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
+ public:
+  using TaskNode::TaskNode;
+  static PortsList ProvidedPorts() {
+    return {InputPort<std::string>("door", "door to drive through"),
+            InputPort<double>("wait_timeout", 8.0,
+                              "how long to wait for the leaf to open before failing [s]"),
+            VisitPort(bt::PortDirection::kInOut)};
+  }
+  NodeStatus OnStart() override {
+    gate_.Reset();
+    DoorVisit visit = Visit();
+    door_ = visit.door;
+    pass_ = CalcApproachPass(task_, visit);
+    Remember(visit);
+    if (!ArmAt(task_.motion->arm_target(), TuckedArm(*task_.model)) ||
+        task_.motion->arm_moving(belief_.now)) {
+      task_.motion->MoveArm({{task_.config.arm_tuck_time, TuckedArm(*task_.model)}}, belief_.now);
+    }
+    yaw_ = std::atan2(-pass_.n_M.y(), -pass_.n_M.x());  // facing through the door
+    entry_distance_ = EntryDistance(task_, door_, pass_);
+    const Eigen::Vector2d offset = belief_.X_MB.translation() - pass_.centre;
+    const double lateral = std::abs(offset.dot(Eigen::Vector2d(-pass_.n_M.y(), pass_.n_M.x())));
+    phase_ = Phase::kWaiting;
+    waiting_since_ = belief_.now;
+    passage_wait_over_ = false;
+    if (lateral > 0.05 || offset.dot(pass_.n_M) > entry_distance_ + 0.05) {
+      if (const NodeStatus s = StartLineUp(); s != NodeStatus::kRunning) return s;
+    }
+    return OnRunning();
+  }
+  NodeStatus OnRunning() override {
+    const auto note = [this](const std::string& t) { Note(t); };
+    switch (phase_) {
+      case Phase::kToPeek: {
+        const NodeStatus s = DriveStatus(task_, note, true);
+        if (s != NodeStatus::kSuccess) return s;
+        phase_ = Phase::kPeeking;
+        waiting_since_ = belief_.now;
+        [[fallthrough]];
+      }
+      case Phase::kPeeking: {
+        if (const NodeStatus arm = ArmMotionStatus(task_, note); arm != NodeStatus::kSuccess)
+          return arm;
+        const Eigen::Vector2d entry = EntryPoint();
+        const double slide_time = planning::SegmentDuration(
+            (entry - belief_.X_MB.translation()).norm(), true, task_.motion->trajectory_config());
+        const double looked = ToSeconds(belief_.now - waiting_since_);
+        // From beside the lane the leaf is often behind the jamb: its clearance is checked
+        // again on the axis, where it is in view.
+        const DoorVisit visit = Visit();
+        const bool window_leaves_time =
+            LeafSeenNow() ? DoorPassable(task_, door_, 0.0, &visit, slide_time)
+                          : DoorWindowLeavesTime(task_, door_, &visit, slide_time);
+        if (looked < task_.config.door_peek_time || LeafOpening() || !window_leaves_time) {
+          if (looked > Input<double>("wait_timeout")) {
+            Note("the door did not open in time");
+            return NodeStatus::kFailure;
+          }
+          return NodeStatus::kRunning;
+        }
+        if (const NodeStatus s = StartLineUp(); s != NodeStatus::kRunning) return s;
+        return NodeStatus::kRunning;
+      }
+      case Phase::kToEntry: {
+        const NodeStatus s = DriveStatus(task_, note, true);
+        if (s != NodeStatus::kSuccess) return s;
+        phase_ = Phase::kWaiting;
+        waiting_since_ = belief_.now;
+        [[fallthrough]];
+      }
+      case Phase::kWaiting: {
+        if (gate_.Check(task_, "driving through the door", EventNoter()) == NodeStatus::kRunning)
+          return NodeStatus::kRunning;
+        if (const NodeStatus arm =
+                ArmMotionStatus(task_, [this](const std::string& t) { Note(t); });
+            arm != NodeStatus::kSuccess) {
+          return arm;
+        }
+        if (const DoorVisit visit = Visit(); !DoorPassable(task_, door_, 0.0, &visit)) {
+          if (ToSeconds(belief_.now - waiting_since_) > Input<double>("wait_timeout")) {
+            Note("the door did not open in time");
+            return NodeStatus::kFailure;
+          }
+          return NodeStatus::kRunning;  // the leaf is still opening
+        }
+        // Through the middle of the clear opening, between the latch jamb and the leaf.
+        const Eigen::Vector2d centre = ClearOpeningCentre();
+        const Eigen::Vector2d exit = centre - pass_.n_M * ExitDistance(task_, door_);
+        const Eigen::Vector2d offset = belief_.X_MB.translation() - centre;
+        std::vector<Pose2> path{belief_.X_MB};
+        std::vector<bool> through;
+        // Squared up on the opening's centre line first, by a step sideways where the robot
+        // stands: every waypoint is a stop, and one in the doorway (as 0.4 m before the line
+        // was) stands there a second beside whoever walks past (two wards seed 35).
+        const Eigen::Vector2d in = centre + pass_.n_M * offset.dot(pass_.n_M);
+        if (offset.dot(pass_.n_M) > 0.1 &&
+            (in - belief_.X_MB.translation()).norm() > kSquareUpTolerance) {
+          path.push_back({in.x(), in.y(), yaw_});
+          through.push_back(true);
+        }
+        path.push_back({exit.x(), exit.y(), yaw_});
+        through.push_back(true);
+        if (PassageBusy(DoorPathDuration(task_, path))) return NodeStatus::kRunning;
+        task_.motion->FollowPath(path, through, TuckedArm(*task_.model), belief_.now);
+        Note(StrCat("door open: driving through at ", task_.motion->trajectory_config().door_speed,
+                    " m/s"));
+        phase_ = Phase::kThrough;
+        return NodeStatus::kRunning;
+      }
+      case Phase::kThrough: {
+        // Someone come into view who will pass the doorway beside the robot: it stops short of
+        // the doorway and waits at the entry again, if it is still far enough out to stop there.
+        const double along = (belief_.X_MB.translation() - pass_.centre).dot(pass_.n_M);
+        if (task_.config.passage_clearance > 0.0 && !passage_wait_over_ &&
+            along > kPassageCommitDistance && task_.motion->base_moving() &&
+            IsPassageBusy(task_, door_, DoorPathDuration(task_, task_.motion->path()))) {
+          task_.motion->StopBase();
+          Note("stopping short of the doorway: someone will pass it beside the robot");
+          phase_ = Phase::kWaiting;
+          waiting_since_ = belief_.now;
+          return NodeStatus::kRunning;
+        }
+        const NodeStatus s = BaseMotionStatus(task_, note);
+        if (s == NodeStatus::kSuccess) {
+          Note("through the door");
+          DoorVisit visit = Visit();
+          visit.approach_side.reset();  // a later traversal may come the other way
+          Remember(visit);
+        }
+        return s;
+      }
+    }
+    return NodeStatus::kFailure;
+  }
+  void OnHalted() override { task_.motion->StopBase(); }
+
+ private:
+  RelocalizeGate gate_;
+
+  // Drives to the entry pose on the door's axis (phase kToEntry), or first to the lane's edge
+  // (phase kToPeek, PeekPose).
+  NodeStatus StartLineUp() {
+    if (const auto peek = PeekPose()) {
+      // Only when the hold window leaves time for the stop as well (a press that restarted the
+      // window of an open door leaves 10 s, about what the direct line-up and the pass take).
+      const auto& trajectory = task_.motion->trajectory_config();
+      const Eigen::Vector2d entry = EntryPoint();
+      const double lead =
+          planning::SegmentDuration((peek->translation() - belief_.X_MB.translation()).norm(), true,
+                                    trajectory) +
+          task_.config.door_peek_time +
+          planning::SegmentDuration((entry - peek->translation()).norm(), true, trajectory);
+      const std::vector<Pose2> path{belief_.X_MB, *peek};
+      if (const DoorVisit visit = Visit();
+          DoorWindowLeavesTime(task_, door_, &visit, lead) && task_.planner->IsPathValid(path)) {
+        task_.motion->FollowPath(path, {true}, TuckedArm(*task_.model), belief_.now);
+        Note("to the lane's edge, to look through the door before lining up");
+        phase_ = Phase::kToPeek;
+        return NodeStatus::kRunning;
+      }
+    }
+    const Eigen::Vector2d entry = EntryPoint();
+    // Straight when the costmap allows (the usual case), else round what is in the way.
+    const Pose2 X_MB_entry{entry.x(), entry.y(), yaw_};
+    const std::vector<Pose2> line_up = LineUpPath(task_, door_, pass_, belief_.X_MB);
+    if (task_.planner->IsPathValid(line_up)) {
+      task_.motion->FollowPath(line_up, std::vector<bool>(line_up.size() - 1, true),
+                               TuckedArm(*task_.model), belief_.now);
+      Note("lining up on the door's axis");
+    } else {
+      const NodeStatus s = StartPath(
+          task_, X_MB_entry, "the door's axis", [this](const std::string& t) { Note(t); }, true);
+      if (s != NodeStatus::kRunning) return s;
+    }
+    phase_ = Phase::kToEntry;
+    return NodeStatus::kRunning;
+  }
+
+  // Where the robot stops to look through the door before lining up: on the entry line, just
+  // clear of the lane through the opening on the robot's side. Only for a door that opens away
+  // (one that opens towards the robot stands its leaf between the lane's edge and the far
+  // side) and a robot beside the lane, farther out than that.
+  std::optional<Pose2> PeekPose() const {
+    if (task_.config.door_peek_time <= 0.0) return std::nullopt;
+    const perception::DoorModel& door = *task_.map->FindDoor(door_);
+    if (pass_.n_M.dot(door.SwingSide()) > 0.0) return std::nullopt;
+    constexpr double kEdgeClearance = 0.05;  // [m] between the footprint and the lane
+    constexpr double kMinSlide = 0.15;       // [m] nearer than this, straight onto the axis
+    const Eigen::Vector2d along(-pass_.n_M.y(), pass_.n_M.x());
+    const double lateral = (belief_.X_MB.translation() - pass_.centre).dot(along);
+    const double edge = door.width() / 2 + task_.config.footprint_radius + kEdgeClearance;
+    if (std::abs(lateral) < edge + kMinSlide) return std::nullopt;
+    const Eigen::Vector2d p = EntryPoint() + along * std::copysign(edge, lateral);
+    return Pose2{p.x(), p.y(), yaw_};
+  }
+
+  // Whether the robot waits at the entry for people to pass the doorway (IsPassageClear over the
+  // pass's `duration` [s]), at most TaskConfig::passage_max_wait from the visit's first such
+  // wait.
+  bool PassageBusy(double duration) {
+    if (task_.config.passage_clearance <= 0.0 ||
+        IsPassageClear(task_, door_, duration, task_.config.passage_quiet_time))
+      return false;
+    DoorVisit visit = Visit();
+    if (!visit.passage_wait_began) {
+      visit.passage_wait_began = belief_.now;
+      Remember(visit);
+      Note("waiting at the entry: people would pass the doorway beside the robot");
+    }
+    if (ToSeconds(belief_.now - *visit.passage_wait_began) < task_.config.passage_max_wait)
+      return true;
+    Note("people still pass the doorway after the longest wait: going");
+    passage_wait_over_ = true;  // and not stopping short for them on the way in
+    return false;
+  }
+
+  // Off the opening's centre line by no more than this, the robot drives straight through [m].
+  static constexpr double kSquareUpTolerance = 0.02;
+  // Nearer the door line than this, a passage turned busy no longer stops the drive through: the
+  // base takes ~0.15 m to stop from the door speed, which would leave it standing in the doorway
+  // beside the passer-by (the reactive door-zone check still halts it for anyone entering the
+  // zone) [m].
+  static constexpr double kPassageCommitDistance = 0.65;
+
+  // The entry pose's position: on the door's axis, entry_distance_ before the door line.
+  Eigen::Vector2d EntryPoint() const { return pass_.centre + pass_.n_M * entry_distance_; }
+
+  const perception::TrackedDoor* Estimate() const { return FindTrackedDoor(belief_.world, door_); }
+  bool LeafSeenNow() const {
+    const auto* d = Estimate();
+    return d != nullptr && ToSeconds(belief_.now - d->state.stamp) <= kDoorSeenRecentlySec;
+  }
+  // The leaf may still be swinging open: it hides part of the far side, and people there wait for
+  // it. Out of view, it had the operator's opening time since the robot's own press (or since it
+  // was last seen opening).
+  bool LeafOpening() const {
+    const auto* d = Estimate();
+    if (d == nullptr) return false;
+    const DoorVisit visit = Visit();
+    if (LeafSeenNow()) return d->state.motion == perception::DoorMotion::kOpening;
+    if (visit.operated_at)
+      return ToSeconds(belief_.now - *visit.operated_at) < kOperatorOpeningTime;
+    return d->state.motion == perception::DoorMotion::kOpening &&
+           ToSeconds(belief_.now - d->state.stamp) < kOperatorOpeningTime;
+  }
+
+  Eigen::Vector2d ClearOpeningCentre() const {
+    const perception::DoorModel& door = *task_.map->FindDoor(door_);
+    double angle = M_PI / 2;
+    for (const auto& d : belief_.world.doors) {
+      if (d.model.id == door_ && d.state.observed) angle = std::min(d.state.angle, M_PI / 2);
+    }
+    constexpr double kLeafHalfThickness = 0.03;  // [m] with a margin
+    const double w = door.width();
+    const double clear_from = std::min(w, w * std::cos(angle) + kLeafHalfThickness);
+    const Eigen::Vector2d along = (door.p_MLatch - door.p_MHinge) / w;
+    return door.p_MHinge + along * (clear_from + w) / 2;
+  }
+
+  enum class Phase { kToPeek, kPeeking, kToEntry, kWaiting, kThrough };
+  std::string door_;
+  DoorPass pass_;
+  double entry_distance_{0.0};
+  double yaw_{0.0};
+  Phase phase_{Phase::kWaiting};
+  Time waiting_since_{};
+  bool passage_wait_over_{false};  // waited the longest for them: going regardless
+};
+
+}  // namespace
+
+void RegisterTraverseDoor(bt::BehaviorTreeFactory& factory, const TaskServices* services) {
+  Register<TraverseDoor>(factory, "TraverseDoor", services);
+}
+
+}  // namespace egress::behavior::detail
