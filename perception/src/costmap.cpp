@@ -272,17 +272,25 @@ bool Costmap2D::IsNearLethal(const Eigen::Vector2d& p_MQ, double radius,
   const auto c = geometry_.CellOf(p_MQ);
   if (!c) return false;
   const int n = int(std::ceil(radius / geometry_.resolution));
+  if (n < 0) return false;
+  // Nearest first, ring by ring out from its own cell: most points asked about are a wall's
+  // laser returns, in or beside a lethal cell.
   const double r2 = std::pow(radius / geometry_.resolution, 2);
-  for (int dy = -n; dy <= n; ++dy) {
-    for (int dx = -n; dx <= n; ++dx) {
-      const int x = c->x() + dx, y = c->y() + dy;
-      if (dx * dx + dy * dy > r2 || x < 0 || y < 0 || x >= geometry_.width ||
-          y >= geometry_.height) {
-        continue;
-      }
-      const std::size_t i = geometry_.Index(x, y);
-      for (const auto* layer : layers)
-        if ((*layer)[i] == kLethalCost) return true;
+  const auto lethal = [&](int dx, int dy) {
+    const int x = c->x() + dx, y = c->y() + dy;
+    if (dx * dx + dy * dy > r2 || x < 0 || y < 0 || x >= geometry_.width || y >= geometry_.height)
+      return false;
+    const std::size_t i = geometry_.Index(x, y);
+    for (const auto* layer : layers)
+      if ((*layer)[i] == kLethalCost) return true;
+    return false;
+  };
+  if (lethal(0, 0)) return true;
+  for (int k = 1; k <= n; ++k) {
+    for (int dy = -k; dy <= k; ++dy) {
+      const int step = dy == -k || dy == k ? 1 : 2 * k;  // the ring's rows, else its two ends
+      for (int dx = -k; dx <= k; dx += step)
+        if (lethal(dx, dy)) return true;
     }
   }
   return false;

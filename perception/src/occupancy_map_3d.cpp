@@ -28,6 +28,54 @@ octomap::OcTreeKey KeyOfMortonCode(std::uint64_t code) {
   }
   return key;
 }
+
+// Adds each Morton code to `out` once, in the order first offered: an open-addressing table of
+// code + 1 (0 marks an empty slot) in `slots`, kept from image to image for its memory. A depth
+// image's carving rays offer the same voxels near the camera over and over.
+class UniqueCodes {
+ public:
+  UniqueCodes(std::vector<std::uint64_t>* slots, std::vector<std::uint64_t>* out)
+      : slots_(*slots), out_(*out) {
+    out_.clear();
+    if (slots_.size() < kMinSlots) slots_.resize(kMinSlots);
+    std::fill(slots_.begin(), slots_.end(), 0);
+    SetBits();
+  }
+  void Add(std::uint64_t code) {
+    if (2 * (out_.size() + 1) > slots_.size()) Grow();
+    if (Place(code + 1)) out_.push_back(code);
+  }
+
+ private:
+  static constexpr std::size_t kMinSlots = 1024;  // a power of two
+  std::vector<std::uint64_t>& slots_;
+  std::vector<std::uint64_t>& out_;
+  int shift_{0};
+
+  void SetBits() {
+    shift_ = 64;
+    for (std::size_t n = slots_.size(); n > 1; n /= 2)
+      --shift_;
+  }
+  // False when already there.
+  bool Place(std::uint64_t stored) {
+    const std::size_t mask = slots_.size() - 1;
+    // Fibonacci hashing: neighbouring voxels differ in the low bits of their codes.
+    std::size_t i = std::size_t((stored * 0x9E3779B97F4A7C15ull) >> shift_);
+    while (slots_[i] != 0) {
+      if (slots_[i] == stored) return false;
+      i = (i + 1) & mask;
+    }
+    slots_[i] = stored;
+    return true;
+  }
+  void Grow() {
+    slots_.assign(slots_.size() * 2, 0);
+    SetBits();
+    for (const std::uint64_t code : out_)
+      Place(code + 1);
+  }
+};
 }  // namespace
 
 void OccupancyMap3DConfig::Validate() const {
@@ -66,7 +114,13 @@ std::size_t OccupancyMap3D::InsertDepthImage(const DepthImage& depth,
   ThrowUnless(X_MC.IsFinite(), "Invalid camera pose X_MC: must be finite.");
   const Eigen::Vector3d& p_MC = X_MC.translation();
   const octomap::point3d origin(float(p_MC.x()), float(p_MC.y()), float(p_MC.z()));
-  octomap::KeySet occupied, free;
+  // The voxels to mark and to carve by Morton code, each once, then sorted: written in the tree's
+  // own order (each leaf is written once per image, so the order changes nothing but the cache
+  // misses).
+  std::vector<std::uint64_t>& occupied = occupied_scratch_;
+  std::vector<std::uint64_t>& free = free_scratch_;
+  UniqueCodes occupied_codes(&occupied_slots_, &occupied);
+  UniqueCodes free_codes(&free_slots_, &free);
   octomap::KeyRay ray;
   std::size_t inserted = 0;
   for (int v = 0; v < depth.height; ++v) {
@@ -81,7 +135,7 @@ std::size_t OccupancyMap3D::InsertDepthImage(const DepthImage& depth,
       if (mark && distance <= config_.max_range && (!keep || keep(p_MQ))) {
         octomap::OcTreeKey key;
         if (tree_->coordToKeyChecked(p_MQ.x(), p_MQ.y(), p_MQ.z(), key)) {
-          occupied.insert(key);
+          occupied_codes.Add(MortonCode(key));
           ++inserted;
         }
       }
@@ -89,17 +143,20 @@ std::size_t OccupancyMap3D::InsertDepthImage(const DepthImage& depth,
         const Eigen::Vector3d end = p_MC + ray_M * std::min(1.0, config_.clearing_range / distance);
         if (tree_->computeRayKeys(
                 origin, octomap::point3d(float(end.x()), float(end.y()), float(end.z())), ray)) {
-          free.insert(ray.begin(), ray.end());
+          for (const octomap::OcTreeKey& key : ray)
+            free_codes.Add(MortonCode(key));
         }
       }
     }
   }
+  std::sort(occupied.begin(), occupied.end());
+  std::sort(free.begin(), free.end());
   // Every leaf written is noted (its occupancy may have changed): the inner nodes above them are
   // brought up to date, and the occupied leaves kept, without walking the whole tree.
   std::vector<std::uint64_t> touched;
   touched.reserve(free.size() + occupied.size());
-  const auto note = [&](const octomap::OcTreeKey& key, const octomap::OcTreeNode* leaf) {
-    const std::uint64_t code = MortonCode(key);
+  const auto note = [&](std::uint64_t code, const octomap::OcTreeKey& key,
+                        const octomap::OcTreeNode* leaf) {
     touched.push_back(code);
     const double z = tree_->keyToCoord(key[2]);
     if (leaf != nullptr && tree_->isNodeOccupied(leaf) && z >= config_.min_obstacle_height &&
@@ -109,14 +166,23 @@ std::size_t OccupancyMap3D::InsertDepthImage(const DepthImage& depth,
       occupied_in_band_.erase(code);
     }
   };
-  for (const auto& key : free) {
-    if (occupied.count(key) == 0) note(key, tree_->updateNode(key, false, /*lazy_eval=*/true));
+  // A voxel both marked and carved is marked.
+  auto marked = occupied.begin();
+  for (const std::uint64_t code : free) {
+    while (marked != occupied.end() && *marked < code)
+      ++marked;
+    if (marked != occupied.end() && *marked == code) continue;
+    const octomap::OcTreeKey key = KeyOfMortonCode(code);
+    note(code, key, tree_->updateNode(key, false, /*lazy_eval=*/true));
   }
+  const auto carved_end = long(touched.size());
   const double now = ToSeconds(depth.stamp);
-  for (const auto& key : occupied) {
-    note(key, tree_->updateNode(key, true, /*lazy_eval=*/true));
+  for (const std::uint64_t code : occupied) {
+    const octomap::OcTreeKey key = KeyOfMortonCode(code);
+    note(code, key, tree_->updateNode(key, true, /*lazy_eval=*/true));
     marked_at_[key] = now;
   }
+  const auto marked_end = long(touched.size());
   if (config_.decay_s > 0.0) {
     for (auto it = marked_at_.begin(); it != marked_at_.end();) {
       if (now - it->second <= config_.decay_s) {
@@ -124,11 +190,15 @@ std::size_t OccupancyMap3D::InsertDepthImage(const DepthImage& depth,
         continue;
       }
       // Even odds: as if unseen.
-      note(it->first, tree_->setNodeValue(it->first, 0.0f, /*lazy_eval=*/true));
+      note(MortonCode(it->first), it->first,
+           tree_->setNodeValue(it->first, 0.0f, /*lazy_eval=*/true));
       it = marked_at_.erase(it);
     }
   }
-  std::sort(touched.begin(), touched.end());
+  // Carved and marked are each in order already; the decayed come in the table's order.
+  std::inplace_merge(touched.begin(), touched.begin() + carved_end, touched.begin() + marked_end);
+  std::sort(touched.begin() + marked_end, touched.end());
+  std::inplace_merge(touched.begin(), touched.begin() + marked_end, touched.end());
   touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
   if (tree_->getRoot() != nullptr) UpdateInnerNodes(tree_->getRoot(), 0, touched);
   return inserted;

@@ -123,6 +123,39 @@ TEST(CostmapTest, ProjectedObstaclesAndFootprint) {
   EXPECT_EQ(costmap.FootprintCost({0.1, 0.1, 0.0}), kUnknownCost);  // leaves the map
 }
 
+// The search runs ring by ring out from the point's own cell (nearest first, for speed): it must
+// find a lethal cell anywhere within the radius, as a scan of the whole disc of cells does.
+TEST(CostmapTest, IsNearMappedObstacleFindsALethalCellAnywhereWithinTheRadius) {
+  const double res = 0.05;
+  const OccupancyGrid grid =
+      OccupancyGrid::FromBoxes({{{5.0, 5.0, 0.3}, {0.12, 0.07}}}, {0, 0}, {10, 10}, res);
+  const Costmap2D costmap(grid);
+  const auto brute_force = [&](const Eigen::Vector2d& p, double radius) {
+    const int cx = int(std::floor(p.x() / res)), cy = int(std::floor(p.y() / res));
+    const int n = int(std::ceil(radius / res));
+    for (int y = cy - n; y <= cy + n; ++y)
+      for (int x = cx - n; x <= cx + n; ++x)
+        if ((x - cx) * (x - cx) + (y - cy) * (y - cy) <= std::pow(radius / res, 2) &&
+            costmap.CostAt({(x + 0.5) * res, (y + 0.5) * res}) == kLethalCost)
+          return true;
+    return false;
+  };
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> offset(-0.6, 0.6), radius(0.0, 0.5);
+  int near = 0, far = 0;
+  for (int k = 0; k < 2000; ++k) {
+    const Eigen::Vector2d p(5.0 + offset(rng), 5.0 + offset(rng));
+    const double r = radius(rng);
+    const bool expected = brute_force(p, r);
+    ASSERT_EQ(costmap.IsNearMappedObstacle(p, r), expected) << p.transpose() << " r " << r;
+    (expected ? near : far)++;
+  }
+  EXPECT_GT(near, 200);
+  EXPECT_GT(far, 200);
+  EXPECT_TRUE(costmap.IsNearMappedObstacle({5.0, 5.0}, 0.0)) << "its own cell";
+  EXPECT_FALSE(costmap.IsNearMappedObstacle({5.0, 5.0}, -0.2)) << "no radius";
+}
+
 TEST(CostmapTest, SensedObstaclesAreTheMapTheLaserAndLeavesNotTheProjection) {
   const OccupancyGrid walls =
       OccupancyGrid::FromBoxes({{{5.0, 2.25, 0.0}, {0.1, 4.5}}}, {0, 0}, {10, 10}, 0.05);

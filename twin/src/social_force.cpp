@@ -110,10 +110,17 @@ Eigen::Vector2d SocialForceModel::CalcTermsAmong(std::size_t i, const std::vecto
                                : (to_goal.norm() > 1e-3 ? Eigen::Vector2d(to_goal.normalized())
                                                         : Eigen::Vector2d::UnitX());
   const double cos_fov = cos_half_fov_;
+  const double cos_fov_squared = cos_fov * cos_fov;
   auto weight = [&](const Eigen::Vector2d& force) {
-    // A force pointing along −heading comes from something ahead (in view). Compared without
-    // dividing by its length: the division's latency was a fifth of the pair terms' time.
-    return -force.dot(heading) >= cos_fov * force.norm() ? 1.0 : P.behind_weight;
+    // A force pointing along −heading comes from something ahead (in view): −f·h ≥ cos·|f|,
+    // compared squared, without the square root (its latency was a fifth of the pair terms'
+    // time), by the signs of both sides.
+    const double ahead = -force.dot(heading);
+    const double ahead_squared = ahead * ahead;
+    const double bound_squared = cos_fov_squared * force.squaredNorm();
+    const bool in_view = cos_fov >= 0.0 ? ahead >= 0.0 && ahead_squared >= bound_squared
+                                        : ahead >= 0.0 || ahead_squared <= bound_squared;
+    return in_view ? 1.0 : P.behind_weight;
   };
   auto social = [&](const Eigen::Vector2d& other_p, const Eigen::Vector2d& other_v, double strength,
                     double range) {
@@ -185,9 +192,10 @@ Eigen::Vector2d SocialForceModel::CalcTermsAmong(std::size_t i, const std::vecto
       it->q = q;
     }
   }
-  if (near.wall_rank)
-    std::sort(nearest.begin(), nearest.end(),
-              [](const Nearest& a, const Nearest& b) { return a.rank < b.rank; });
+  // WallCells lists a cell's segments by rank already (few sums need the sort).
+  const auto by_rank = [](const Nearest& a, const Nearest& b) { return a.rank < b.rank; };
+  if (near.wall_rank && !std::is_sorted(nearest.begin(), nearest.end(), by_rank))
+    std::sort(nearest.begin(), nearest.end(), by_rank);
   for (const Nearest& e : nearest) {
     const Eigen::Vector2d r = w.position - e.q;
     const double dist = r.norm();
@@ -241,6 +249,14 @@ WallCells::WallCells(std::vector<WallSegment> walls) : walls_(std::move(walls)) 
       for (long cy = ty0; cy <= ty1; ++cy)
         touching_cells_[{cx, cy}].push_back(s);
   }
+  // Each cell's segments by rank (an obstacle's together, in index order): a walker's nearest
+  // points come out in the order they are summed in, without sorting them.
+  const auto by_rank = [&](std::size_t a, std::size_t b) {
+    return std::pair(rank_[a], a) < std::pair(rank_[b], b);
+  };
+  for (auto* cells : {&cells_, &touching_cells_})
+    for (auto& [cell, segments] : *cells)
+      std::sort(segments.begin(), segments.end(), by_rank);
 }
 
 const std::vector<std::size_t>& WallCells::NearTouching(const Eigen::Vector2d& p) const {

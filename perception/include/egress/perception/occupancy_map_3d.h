@@ -82,6 +82,8 @@ class OccupancyMap3D {
   std::unordered_set<std::uint64_t> occupied_in_band_;
   /// [s] When each voxel was last marked (the image's stamp), for decay_s.
   std::unordered_map<octomap::OcTreeKey, double, octomap::OcTreeKey::KeyHash> marked_at_;
+  /// Scratch of InsertDepthImage (Morton codes and their tables), kept to reuse its memory.
+  std::vector<std::uint64_t> occupied_scratch_, free_scratch_, occupied_slots_, free_slots_;
 };
 
 }  // namespace egress::perception
