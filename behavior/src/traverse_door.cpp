@@ -117,6 +117,17 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
           path.push_back({in.x(), in.y(), yaw_});
           through.push_back(true);
         }
+        // From an entry beyond the sweep of a leaf that opens towards it, the laser sees little of
+        // the far side, and the pass would be at speed by the time it crosses the commit distance:
+        // someone coming into view there found the base sliding into the doorway (two wards seed
+        // 35). The pass stops first at the ordinary entry distance, out of the doorway, and sets
+        // off from there: the view is wider, and the commit distance crossed slowly.
+        const double look = task_.config.door_entry_distance;
+        if (offset.dot(pass_.n_M) > look + kLookThroughMinStep) {
+          const Eigen::Vector2d p = centre + pass_.n_M * look;
+          path.push_back({p.x(), p.y(), yaw_});
+          through.push_back(true);
+        }
         path.push_back({exit.x(), exit.y(), yaw_});
         through.push_back(true);
         if (PassageBusy(DoorPathDuration(task_, path))) return NodeStatus::kRunning;
@@ -240,6 +251,9 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
   // beside the passer-by (the reactive door-zone check still halts it for anyone entering the
   // zone) [m].
   static constexpr double kPassageCommitDistance = 0.65;
+  // Farther out than the ordinary entry distance by more than this, the pass stops there first
+  // to look through (nearer, it sets off slowly enough as it is) [m].
+  static constexpr double kLookThroughMinStep = 0.2;
 
   // The entry pose's position: on the door's axis, entry_distance_ before the door line.
   Eigen::Vector2d EntryPoint() const { return pass_.centre + pass_.n_M * entry_distance_; }
