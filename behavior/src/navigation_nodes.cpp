@@ -33,7 +33,7 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
   NodeStatus OnRunning() override {
     if (give_way_) return GiveWay();
     if (task_.config.give_way && !task_.motion->bug_active()) {
-      if (const auto coming = PeopleComing(); !coming.empty()) {
+      if (const auto coming = PeopleComing(task_, goal_); !coming.empty()) {
         const perception::TrackedPerson& p = *coming.front().first;
         task_.motion->StopBase();
         give_way_ = GiveWayState{belief_.now, belief_.now, false};
@@ -61,10 +61,6 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
 
  private:
   static constexpr double kReplanPeriod = 0.5;  // [s]
-  // [m] Someone this near the goal is whom the robot goes to (as ProxemicsConfig::goal_radius).
-  static constexpr double kGoalPersonRadiusM = 1.5;
-  // [m] A spot aside must give this much more room than standing where the robot is.
-  static constexpr double kMinGainM = 0.1;
   // [s] A slow walker far off is not waited for longer than this.
   static constexpr double kMaxPassSec = 15.0;
 
@@ -74,19 +70,6 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
     bool chosen{false};  // the spot is chosen (once the base has stopped)
   };
 
-  // The people coming (see TaskConfig::give_way) and when each passes nearest [s from now].
-  std::vector<std::pair<const perception::TrackedPerson*, double>> PeopleComing() const {
-    const Eigen::Vector2d at = belief_.X_MB.translation();
-    std::vector<std::pair<const perception::TrackedPerson*, double>> coming;
-    for (const auto& entry : belief_.world.people) {
-      if (goal_ && (entry.person.p_MP - goal_->translation()).norm() < kGoalPersonRadiusM) continue;
-      if (const auto t_pass = OncomingPassTime(
-              entry.person, at, task_.config.footprint_radius, task_.config.person_radius,
-              task_.config.comfort_distance, task_.config.give_way_horizon, kWalkingMps))
-        coming.emplace_back(&entry.person, *t_pass);
-    }
-    return coming;
-  }
   // Making way: once stopped, to the spot round the robot where the people coming will leave it
   // the most room (or stand still if none is better); on give_way_clear_for after the last one
   // seen coming has passed, or after `patience`.
@@ -94,7 +77,7 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
     GiveWayState& g = *give_way_;
     if (!g.chosen && StoppedOrStopTimedOut(task_, g.since)) {
       g.chosen = true;
-      if (const auto spot = MakeWaySpot(task_, kMinGainM)) {
+      if (const auto spot = MakeWaySpot(task_, kMakeWayMinGainM)) {
         StepAsideTo(task_, *spot);
         Note(StrCat("stepping aside to (", PoseText(*spot), ")"));
       } else {
@@ -104,7 +87,7 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
     if (task_.motion->base_failed()) task_.motion->StopBase();  // blocked: stay where it is
     // Until everyone seen coming has passed (by their last prediction: a person the camera
     // loses behind another is still coming) and give_way_clear_for after.
-    for (const auto& [person, t_pass] : PeopleComing())
+    for (const auto& [person, t_pass] : PeopleComing(task_, goal_))
       g.until = std::max(g.until, belief_.now + SecondsToDuration(std::min(t_pass, kMaxPassSec)));
     const bool clear = ToSeconds(belief_.now - g.until) >= task_.config.give_way_clear_for;
     const bool waited = ToSeconds(belief_.now - g.since) > Input<double>("patience");
@@ -167,8 +150,10 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
 
 // The safe standby's retreat: the arm tucked and, with `back_off`, the base out of the door's
 // way — to the last pose outside every door zone, unless people will come near it: then to
-// where they will be farthest (out of their predicted path, not only back along its own).
-// The retreat starts once the base has stopped (a path begun at speed the other way leaves
+// where they will be farthest (out of their predicted path, not only back along its own; also
+// out of a straight way through the robot's place for anyone near and coming nearer, and
+// through the doorway for anyone in the visited door's zone: PeopleHypotheses). The retreat
+// starts once the base has stopped (a path begun at speed the other way leaves
 // the reference behind and trips the watchdog).
 class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
  public:
@@ -263,13 +248,16 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
         break;
       }
     }
+    // Whoever is in the zone of the door it was passing may come through it.
+    PeopleHypotheses hypotheses{.head_on = true};
+    if (visit && task_.map->FindDoor(visit->door) != nullptr) hypotheses.through_door = visit->door;
     std::optional<std::pair<Pose2, bool>> chosen;
     if (stay_this_side) {
-      if (const auto aside = PeopleRoom(task_, kPeopleHorizonSec)
+      if (const auto aside = PeopleRoom(task_, kPeopleHorizonSec, hypotheses)
                                  .BestSpotAround(path, -std::numeric_limits<double>::infinity()))
         chosen = std::pair{*aside, true};
     } else {
-      chosen = ChooseSpot(path);
+      chosen = ChooseSpot(path, hypotheses);
     }
     if (!chosen && !looked_back_ && !stay_this_side) {
       // The way back may only be unseen: it is behind the robot, in the laser's blind sector
@@ -314,16 +302,17 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
   }
 
   // Where the retreat that begins with `way` (the robot's pose, maybe a point out of the
-  // doorway) ends: the last safe pose if people will stay comfort_distance from it; else, of the
-  // spots round the robot out of every door's way and reachable in a straight line, the one
-  // where they will be farthest (less kWayCostPerM per metre of way), if that beats the last
-  // safe pose. No way may pass nearer anyone than the footprint and kPassMarginM (people where
-  // they are now: a retreat into someone standing behind the robot, P1 seed 2000). nullopt:
-  // every way does, unless the way's first leg, out of a doorway, is clear: then its end.
-  // Second: whether it is a spot aside.
-  std::optional<std::pair<Pose2, bool>> ChooseSpot(const std::vector<Pose2>& way) const {
+  // doorway) ends, people predicted with `hypotheses`: the last safe pose if people will stay
+  // comfort_distance from it; else, of the spots round the robot out of every door's way and
+  // reachable in a straight line, the one where they will be farthest (less kWayCostPerM per metre
+  // of way), if that beats the last safe pose. No way may pass nearer anyone than the footprint and
+  // kPassMarginM (people where they are now: a retreat into someone standing behind the robot, P1
+  // seed 2000). nullopt: every way does, unless the way's first leg, out of a doorway, is clear:
+  // then its end. Second: whether it is a spot aside.
+  std::optional<std::pair<Pose2, bool>> ChooseSpot(const std::vector<Pose2>& way,
+                                                   const PeopleHypotheses& hypotheses) const {
     const Pose2 safe = *belief_.last_safe;
-    const PeopleRoom room(task_, kPeopleHorizonSec);
+    const PeopleRoom room(task_, kPeopleHorizonSec, hypotheses);
     const double comfortable = task_.config.footprint_radius + task_.config.comfort_distance;
     std::vector<Eigen::Vector2d> corners;
     for (const Pose2& p : way)
@@ -359,7 +348,12 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
 };
 
 // Waits until the door zone has been clear as long as IsPathClear asks (the same hysteresis,
-// from the belief), so the retry after a standby finds the path clear.
+// from the belief), so the retry after a standby finds the path clear. Meanwhile it makes way
+// (TaskConfig::give_way) for anyone walking at the robot to pass within comfort_distance, and for
+// anyone in the door's zone who, walking straight through the doorway, would: a step to
+// MakeWaySpot with that hypothesis. The retreat chose its spot on what it knew then, often a
+// first glimpse through the opening door (S2: a track a few frames old, barely moving; the
+// robot stood at the last safe pose and the crosser passed 0.69 m from it).
 class WaitForClear final : public TaskNode<bt::StatefulActionNode> {
  public:
   using TaskNode::TaskNode;
@@ -371,21 +365,57 @@ class WaitForClear final : public TaskNode<bt::StatefulActionNode> {
   }
   NodeStatus OnStart() override {
     started_ = belief_.now;
+    next_make_way_ = belief_.now;
+    stepping_ = false;
     Note("waiting for the door zone to clear");
     return OnRunning();
   }
   NodeStatus OnRunning() override {
-    if (IsDoorZoneClearFor(task_, Door(), Input<double>("clear_for"))) return NodeStatus::kSuccess;
+    MakeWay();
+    // Not while stepping aside: the retry's path would start at speed the other way.
+    if (!stepping_ && IsDoorZoneClearFor(task_, Door(), Input<double>("clear_for")))
+      return NodeStatus::kSuccess;
     if (ToSeconds(belief_.now - started_) > Input<double>("timeout")) {
+      if (stepping_) task_.motion->StopBase();
       Note("gave up waiting");
       return NodeStatus::kFailure;
     }
     return NodeStatus::kRunning;
   }
-  void OnHalted() override {}
+  void OnHalted() override {
+    if (stepping_) task_.motion->StopBase();
+    stepping_ = false;
+  }
 
  private:
+  // [s] After a step aside (or finding none better), who is coming is looked at again after this.
+  static constexpr double kMakeWayPeriodSec = 1.0;
+
+  void MakeWay() {
+    if (stepping_) {
+      if (task_.motion->base_failed()) task_.motion->StopBase();  // blocked: stay where it is
+      if (task_.motion->base_moving()) return;
+      stepping_ = false;
+    }
+    if (!task_.config.give_way || belief_.now < next_make_way_) return;
+    const double horizon = 2.0 * task_.config.give_way_horizon;  // as MakeWaySpot's
+    const bool coming = !PeopleComing(task_, std::nullopt).empty();
+    const bool through =
+        RoomAt(ThroughDoorWays(task_, Door(), horizon), belief_.X_MB.translation()) <
+        task_.config.footprint_radius + task_.config.comfort_distance;
+    if ((!coming && !through) || !StoppedOrStopTimedOut(task_, started_)) return;
+    next_make_way_ = belief_.now + SecondsToDuration(kMakeWayPeriodSec);
+    const auto spot = MakeWaySpot(task_, kMakeWayMinGainM, {.through_door = Door()});
+    if (!spot) return;
+    StepAsideTo(task_, *spot);
+    stepping_ = true;
+    Note(StrCat("making way for ", coming ? "someone coming" : "whoever comes through the doorway",
+                ": stepping aside to (", PoseText(*spot), ")"));
+  }
+
   Time started_{};
+  Time next_make_way_{};
+  bool stepping_{false};
 };
 
 }  // namespace

@@ -8,6 +8,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "egress/behavior/proxemics.h"
 #include "egress/planning/trajectory.h"
 
 namespace egress::behavior::detail {
@@ -254,46 +255,88 @@ constexpr double kWallTurnRad = 15.0 * M_PI / 180.0;
 constexpr int kMaxWallTurns = 6;
 }  // namespace
 
-std::vector<Occupant> PeopleAround(const TaskServices& task, const Eigen::Vector2d& at, double look,
-                                   double horizon, double step) {
-  std::vector<Occupant> near;
-  for (const Eigen::Vector2d& p : task.belief->off_map_returns)
-    if ((p - at).norm() < look) near.push_back({p, 0.0});
+void AppendPredictedWay(const TaskServices& task, const Eigen::Vector2d& at, double look,
+                        double horizon, double step, int first_step, Eigen::Vector2d p_MP,
+                        Eigen::Vector2d v_MP, std::vector<Occupant>& near) {
   const perception::Costmap2D* costmap = task.belief->world.costmap;
   const double wall_gap = 0.5 * task.config.person_radius;
   const auto walkable = [&](const Eigen::Vector2d& p) {
     return !costmap || !costmap->IsNearMappedObstacle(p, wall_gap);
   };
-  for (const auto& entry : task.belief->world.people) {
-    Eigen::Vector2d p_MP = entry.person.p_MP, v_MP = entry.person.v_MP;
-    const Eigen::Vector2d v_MStart = v_MP;
-    for (int k = 0; step > 0 ? k * step <= horizon + 1e-9 : k == 0; ++k) {
-      if (k > 0) {
-        // Nobody walks through a wall: a way predicted into one (a velocity a few degrees askew
-        // along a corridor, over seconds) turns along it, by the least turn that is free. Never
-        // back the way they came (more than kMaxWallTurns from where they walk now): at a dead
-        // end, or a wall straight ahead, they stop there (P2's group, walking to the corridor's
-        // end, was predicted back along the wall onto the robot's spot aside).
-        bool free = walkable(p_MP + v_MP * step);
-        for (int turn = 1; !free && turn <= kMaxWallTurns; ++turn) {
-          for (const double sign : {1.0, -1.0}) {
-            const Eigen::Vector2d v = Eigen::Rotation2Dd(sign * turn * kWallTurnRad) * v_MP;
-            if (v.dot(v_MStart) >= -1e-9 && walkable(p_MP + v * step)) {
-              v_MP = v;
-              free = true;
-              break;
-            }
+  const Eigen::Vector2d v_MStart = v_MP;
+  for (int k = 0; step > 0 ? k * step <= horizon + 1e-9 : k == 0; ++k) {
+    if (k > 0) {
+      // Nobody walks through a wall: a way predicted into one (a velocity a few degrees askew
+      // along a corridor, over seconds) turns along it, by the least turn that is free. Never
+      // back the way they came (more than kMaxWallTurns from where they walk now): at a dead
+      // end, or a wall straight ahead, they stop there (P2's group, walking to the corridor's
+      // end, was predicted back along the wall onto the robot's spot aside).
+      bool free = walkable(p_MP + v_MP * step);
+      for (int turn = 1; !free && turn <= kMaxWallTurns; ++turn) {
+        for (const double sign : {1.0, -1.0}) {
+          const Eigen::Vector2d v = Eigen::Rotation2Dd(sign * turn * kWallTurnRad) * v_MP;
+          if (v.dot(v_MStart) >= -1e-9 && walkable(p_MP + v * step)) {
+            v_MP = v;
+            free = true;
+            break;
           }
         }
-        if (!free) v_MP.setZero();
-        p_MP += v_MP * step;
       }
-      if ((p_MP - at).norm() < look)
-        near.push_back({p_MP, task.config.person_radius, k * step, v_MP});
-      if (step <= 0) break;
+      if (!free) v_MP.setZero();
+      p_MP += v_MP * step;
     }
+    if (k >= first_step && (p_MP - at).norm() < look)
+      near.push_back({p_MP, task.config.person_radius, k * step, v_MP});
+    if (step <= 0) break;
   }
+}
+
+std::vector<Occupant> PeopleAround(const TaskServices& task, const Eigen::Vector2d& at, double look,
+                                   double horizon, double step) {
+  std::vector<Occupant> near;
+  for (const Eigen::Vector2d& p : task.belief->off_map_returns)
+    if ((p - at).norm() < look) near.push_back({p, 0.0});
+  for (const auto& entry : task.belief->world.people)
+    AppendPredictedWay(task, at, look, horizon, step, 0, entry.person.p_MP, entry.person.v_MP,
+                       near);
   return near;
+}
+
+std::vector<Occupant> ThroughDoorWays(const TaskServices& task, const std::string& door,
+                                      double horizon) {
+  const perception::DoorModel* model = task.map->FindDoor(door);
+  ThrowUnless(model != nullptr, "unknown door '", door, "' (not in the building map)");
+  const perception::DoorZone zone{*model, task.config.zone_depth, task.config.person_radius};
+  const DoorPass pass = CalcDoorPass(*task.map, door, task.belief->X_MB);
+  const Eigen::Vector2d at = task.belief->X_MB.translation();
+  const double step = PeopleRoom::kPeopleStepSec;
+  std::vector<Occupant> ways;
+  for (const auto& entry : task.belief->world.people) {
+    const perception::TrackedPerson& person = entry.person;
+    const Eigen::Vector2d to_centre = pass.centre - person.p_MP;
+    const double distance = to_centre.norm();
+    const bool far_side = -to_centre.dot(pass.n_M) < 0.0;
+    if (distance > kThroughDoorRadiusM || !(far_side || zone.Contains(person.p_MP)) ||
+        IsHoldingDoorAside(task, entry, door) ||
+        (distance > 1e-6 && person.v_MP.dot(to_centre / distance) < -PeopleRoom::kSidestepMinMps))
+      continue;
+    const double speed = std::max(person.v_MP.norm(), kWalkingMps);
+    // To the middle of the opening, then on along the normal (walls turning the way).
+    const double t_centre = distance / speed;
+    int k = 1;
+    for (; k * step < t_centre && k * step <= horizon + 1e-9; ++k) {
+      const Eigen::Vector2d p = person.p_MP + to_centre * (k * step / t_centre);
+      if ((p - at).norm() < PeopleRoom::kPeopleLookM)
+        ways.push_back({p, task.config.person_radius, k * step, to_centre / distance * speed});
+    }
+    if (k * step > horizon + 1e-9) continue;
+    const std::size_t first = ways.size();
+    AppendPredictedWay(task, at, PeopleRoom::kPeopleLookM, horizon - t_centre, step, 0, pass.centre,
+                       pass.n_M * speed, ways);
+    for (std::size_t i = first; i < ways.size(); ++i)
+      ways[i].t += t_centre;
+  }
+  return ways;
 }
 
 double RoomAt(const std::vector<Occupant>& near, const Eigen::Vector2d& q) {
@@ -303,11 +346,28 @@ double RoomAt(const std::vector<Occupant>& near, const Eigen::Vector2d& q) {
   return room;
 }
 
-PeopleRoom::PeopleRoom(const TaskServices& task, double horizon, bool sidestep)
+PeopleRoom::PeopleRoom(const TaskServices& task, double horizon, PeopleHypotheses hypotheses)
     : task_(task),
       at_(task.belief->X_MB.translation()),
       predicted_(PeopleAround(task, at_, kPeopleLookM, horizon, kPeopleStepSec)),
       now_(PeopleAround(task, at_, kPeopleLookM, 0.0, 0.0)) {
+  const bool sidestep = hypotheses.sidestep;
+  if (!hypotheses.through_door.empty()) {
+    const std::vector<Occupant> through = ThroughDoorWays(task, hypotheses.through_door, horizon);
+    predicted_.insert(predicted_.end(), through.begin(), through.end());
+  }
+  if (hypotheses.head_on) {
+    for (const auto& entry : task.belief->world.people) {
+      const Eigen::Vector2d to_robot = at_ - entry.person.p_MP;
+      const double speed = entry.person.v_MP.norm(), distance = to_robot.norm();
+      if (distance >= kHeadOnRadiusM || distance < 1e-6 || speed < kSidestepMinMps ||
+          entry.person.v_MP.dot(to_robot) <= 0.0)
+        continue;
+      // Their place now is already predicted: the way from the first step on.
+      AppendPredictedWay(task, at_, kPeopleLookM, horizon, kPeopleStepSec, 1, entry.person.p_MP,
+                         to_robot * (speed / distance), predicted_);
+    }
+  }
   const perception::Costmap2D* costmap = task.belief->world.costmap;
   const double body = task.config.person_radius;
   for (const Occupant& o : predicted_) {
@@ -461,10 +521,27 @@ bool StoppedOrStopTimedOut(const TaskServices& task, Time since) {
          ToSeconds(belief.now - since) >= kStopWithinSec;
 }
 
-std::optional<Pose2> MakeWaySpot(const TaskServices& task, double min_gain) {
-  const PeopleRoom room(task, 2.0 * task.config.give_way_horizon, /*sidestep=*/true);
+std::optional<Pose2> MakeWaySpot(const TaskServices& task, double min_gain,
+                                 PeopleHypotheses hypotheses) {
+  hypotheses.sidestep = true;
+  const PeopleRoom room(task, 2.0 * task.config.give_way_horizon, std::move(hypotheses));
   const Pose2& X_MB = task.belief->X_MB;
   return room.BestSpotAround({X_MB}, room.Score({X_MB.translation()}) + min_gain);
+}
+
+std::vector<std::pair<const perception::TrackedPerson*, double>> PeopleComing(
+    const TaskServices& task, const std::optional<Pose2>& goal) {
+  const Belief& belief = *task.belief;
+  const Eigen::Vector2d at = belief.X_MB.translation();
+  std::vector<std::pair<const perception::TrackedPerson*, double>> coming;
+  for (const auto& entry : belief.world.people) {
+    if (goal && (entry.person.p_MP - goal->translation()).norm() < kGoalPersonRadiusM) continue;
+    if (const auto t_pass = OncomingPassTime(
+            entry.person, at, task.config.footprint_radius, task.config.person_radius,
+            task.config.comfort_distance, task.config.give_way_horizon, kWalkingMps))
+      coming.emplace_back(&entry.person, *t_pass);
+  }
+  return coming;
 }
 
 void StepAsideTo(const TaskServices& task, const Pose2& spot) {

@@ -209,6 +209,23 @@ struct Occupant {
 /// there), and the latest scan's returns off the map.
 std::vector<Occupant> PeopleAround(const TaskServices& task, const Eigen::Vector2d& at, double look,
                                    double horizon, double step);
+/// [m] People this near a door's opening, on its far side, may come through it (ThroughDoorWays).
+inline constexpr double kThroughDoorRadiusM = 3.0;
+/// The ways of the people within kThroughDoorRadiusM of `door`'s opening on its far side from
+/// the robot, or in its zone (not holding it aside, not walking away from the opening faster
+/// than PeopleRoom::kSidestepMinMps), if they walk through the middle of the opening and on
+/// straight along the door's normal to the robot's side, at their speed or kWalkingMps if
+/// faster: every PeopleRoom::kPeopleStepSec up to `horizon` [s], from the first step on (where
+/// they are now is their tracked way's). People walk through a doorway's middle, not along the
+/// line they happen to walk on (S2: a crosser tracked 0.27 m off the axis passed 0.12 m off it).
+/// @throws InvalidArgument for an unknown door.
+std::vector<Occupant> ThroughDoorWays(const TaskServices& task, const std::string& door,
+                                      double horizon);
+/// Appends to `near` the way of someone at p_MP walking at v_MP, as PeopleAround predicts it:
+/// every `step` [s] from `first_step` up to `horizon` [s], kept where within `look` of `at`.
+void AppendPredictedWay(const TaskServices& task, const Eigen::Vector2d& at, double look,
+                        double horizon, double step, int first_step, Eigen::Vector2d p_MP,
+                        Eigen::Vector2d v_MP, std::vector<Occupant>& near);
 /// The distance from `q` to the nearest edge among `near` (infinity for none) [m].
 double RoomAt(const std::vector<Occupant>& near, const Eigen::Vector2d& q);
 
@@ -216,15 +233,31 @@ double RoomAt(const std::vector<Occupant>& near, const Eigen::Vector2d& q);
 /// base at X_MB, or under the robot; true without a scan (nothing to tell).
 bool IsInLaserSweep(const TaskServices& task, const Pose2& X_MB, const Eigen::Vector2d& p_M);
 
+/// What people may do beyond walking on at their tracked velocity.
+struct PeopleHypotheses {
+  /// People walking past step round the robot (TaskConfig::person_sidestep): each predicted
+  /// position is a short segment across the walk, and the room a spot leaves a person is from
+  /// its far end.
+  bool sidestep{false};
+  /// Anyone walking within PeopleRoom::kHeadOnRadiusM and coming nearer may also walk on straight
+  /// through the robot's place, at their speed: a velocity tracked while they veer round the robot
+  /// points off their way (H12 seed 2086: someone through the door, tracked heading east as
+  /// they skirted the halted robot, went on west; the retreat chose a spot 1 m west, across
+  /// their way, and the robot drove into them).
+  bool head_on{false};
+  /// A door's id (empty: none): anyone near it on its far side, or in its zone, may also walk
+  /// through it to the robot's side (ThroughDoorWays): someone dawdling in a doorway as the leaf
+  /// opens reads as standing until they stride out (S2: the crosser read 0.2-0.3 m/s in the
+  /// doorway for 1.5 s, then passed the waiting robot 0.69 m off).
+  std::string through_door{};
+};
+
 /// People's room round the robot, for choosing where to stand out of their way (a standby's
 /// retreat, a give-way in a corridor): where the tracked people (and the latest scan's returns
 /// off the map) are now and will be over `horizon` [s], and which straight ways pass them.
 class PeopleRoom {
  public:
-  /// With `sidestep`, people walking past step round the robot (TaskConfig::person_sidestep):
-  /// each predicted position is a short segment across the walk, and the room a spot leaves a
-  /// person is from its far end.
-  PeopleRoom(const TaskServices& task, double horizon, bool sidestep = false);
+  PeopleRoom(const TaskServices& task, double horizon, PeopleHypotheses hypotheses = {});
   /// The distance from `q` to the nearest person's edge, now or predicted at any time [m].
   double Predicted(const Eigen::Vector2d& q) const;
   /// The least room people's predicted bodies leave the base while it drives `corners` (the
@@ -267,6 +300,7 @@ class PeopleRoom {
   static constexpr double kLookTurnStepRad = 5.0 * M_PI / 180.0;  ///< see YawSeeing
   static constexpr double kSidestepSampleM = 0.05;  ///< sidesteps checked against walls this often
   static constexpr double kSidestepMinMps = 0.3;    ///< slower people are standing, not passing
+  static constexpr double kHeadOnRadiusM = 1.5;     ///< see Hypotheses::head_on
 
  private:
   /// p is inside the laser's sweep with the base at X_MB (IsInLaserSweep), or where the base
@@ -305,9 +339,21 @@ bool StoppedOrStopTimedOut(const TaskServices& task, Time since);
 /// (PeopleRoom::BestSpotAround, with sidesteps), their ways predicted twice the give-way horizon
 /// — on past the robot: to the horizon alone they may stop short of it, and every spot would
 /// look as good as standing in their way — if it leaves `min_gain` [m] more room than standing.
-std::optional<Pose2> MakeWaySpot(const TaskServices& task, double min_gain);
+/// `hypotheses` beyond the sidestep (always on).
+std::optional<Pose2> MakeWaySpot(const TaskServices& task, double min_gain,
+                                 PeopleHypotheses hypotheses = {});
 /// Starts the step to `spot` at retreat_speed, the arm held where it is going.
 void StepAsideTo(const TaskServices& task, const Pose2& spot);
+/// [m] A spot aside must give this much more room than standing where the robot is.
+inline constexpr double kMakeWayMinGainM = 0.1;
+/// [m] Someone this near the robot's goal is whom it goes to, not someone to make way for (as
+/// ProxemicsConfig::goal_radius).
+inline constexpr double kGoalPersonRadiusM = 1.5;
+/// The people the robot standing where it is should make way for (TaskConfig::give_way): walking
+/// at it to pass within comfort_distance within give_way_horizon (OncomingPassTime), each with
+/// when they pass nearest [s from now]; anyone within kGoalPersonRadiusM of `goal` excepted.
+std::vector<std::pair<const perception::TrackedPerson*, double>> PeopleComing(
+    const TaskServices& task, const std::optional<Pose2>& goal);
 
 /// The localizer's position standard deviation: the square root of the largest eigenvalue of
 /// the xy block of the belief's covariance [m].

@@ -1,5 +1,7 @@
 // The navigation nodes (behavior/src/navigation_nodes.cpp), ticked in one-node trees.
 
+#include <optional>
+
 #include "task_node_fixture.h"
 
 namespace egress::behavior {
@@ -132,6 +134,8 @@ TEST_F(NavigationNodesTest, RetractToSafeWithNowhereToGoOnlyStops) {
 }
 
 TEST_F(NavigationNodesTest, WaitForClearWaitsForTheZoneAndGivesUpAfterItsTimeout) {
+  // In the doorway's lane: with give_way it would step out of it (the next test).
+  services_.config.give_way = false;
   bt::Tree tree = Tree(R"(<WaitForClear door="lab_door" timeout="4.0" clear_for="1.0"/>)");
   belief_.now = At(1.0);
   See({Person({0.0, 3.3}, perception::PersonIntent::kStationary)});
@@ -151,6 +155,52 @@ TEST_F(NavigationNodesTest, WaitForClearWaitsForTheZoneAndGivesUpAfterItsTimeout
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
   belief_.now = At(14.5);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
+}
+
+// Waiting beside the opening, 0.9 m off its axis, with someone dawdling in the doorway: they may
+// stride through it any moment and pass the robot within comfort_distance, so it steps aside,
+// farther off the axis, and does not report the zone clear while the step lasts (the retry's
+// path would start at speed the other way). Nobody near the door, or give_way off: it stands.
+TEST_F(NavigationNodesTest, WaitForClearStepsOutOfTheWayOfWhoeverMayComeThroughTheDoorway) {
+  std::optional<bt::Tree> tree;
+  const auto wait_with = [&](bool give_way,
+                             const std::vector<perception::TrackedPersonWithIntent>& people) {
+    services_.config.give_way = give_way;
+    motion_.StopBase();
+    log_.Take();
+    belief_.zone_occupied_at.clear();
+    belief_.X_MB = {0.9, 2.3, M_PI / 2};
+    belief_.V_B = {};
+    belief_.now = At(1.0);
+    tree.emplace(Tree(R"(<WaitForClear door="lab_door" timeout="30" clear_for="1.0"/>)"));
+    See(people);
+    return tree->TickOnce();
+  };
+  auto dawdler = Person({-0.1, 3.4}, perception::PersonIntent::kUnknown);
+  dawdler.person.v_MP = {0.0, -0.2};
+
+  EXPECT_EQ(wait_with(true, {dawdler}), NodeStatus::kRunning);
+  ASSERT_TRUE(motion_.base_moving());
+  EXPECT_TRUE(NotedText("making way"));
+  const Eigen::Vector2d spot = motion_.path().back().translation();
+  EXPECT_GT(std::abs(spot.x()), 0.9 + 0.3) << "farther off the doorway's axis: " << spot.x();
+  EXPECT_FALSE(IsInAnyDoorZone(services_, spot));
+  // They went back; the zone is clear long enough, but the step is under way.
+  belief_.now = At(1.1);
+  See({});
+  belief_.now = At(2.5);
+  EXPECT_EQ(tree->TickOnce(), NodeStatus::kRunning);
+  motion_.StopBase();
+  belief_.X_MB = {spot.x(), spot.y(), M_PI / 2};
+  belief_.now = At(2.6);
+  EXPECT_EQ(tree->TickOnce(), NodeStatus::kSuccess);
+
+  EXPECT_EQ(wait_with(false, {dawdler}), NodeStatus::kRunning);
+  EXPECT_FALSE(motion_.base_moving()) << "give_way off";
+  auto far = Person({-0.1, 6.5}, perception::PersonIntent::kUnknown);
+  far.person.v_MP = {0.0, -0.2};
+  EXPECT_EQ(wait_with(true, {far}), NodeStatus::kSuccess) << "nobody near the door";
+  EXPECT_FALSE(motion_.base_moving());
 }
 
 // A retreat begun while the base still rolls the other way would leave its reference behind

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "task_node_fixture.h"
 #include "task_node_support.h"
 
 namespace egress::behavior::detail {
@@ -74,8 +75,8 @@ TEST_F(PeopleRoomTest, PeopleWalkingPastStepRoundTheRobotAsFarAsTheWallsLet) {
   belief_.world.people = {Walker({9.0, 1.0}, {-1.0, 0.0})};
   belief_.X_MB = {5.0, 1.0, 0.0};
   task_.config.person_sidestep = 0.6;
-  const PeopleRoom straight(task_, 8.0, /*sidestep=*/false);
-  const PeopleRoom sidestep(task_, 8.0, /*sidestep=*/true);
+  const PeopleRoom straight(task_, 8.0);
+  const PeopleRoom sidestep(task_, 8.0, {.sidestep = true});
   const double body = task_.config.person_radius;
   const Eigen::Vector2d middle(5.0, 1.0), at_wall(5.0, 0.3);
   EXPECT_LT(straight.Predicted(middle), 0.0) << "on their line";
@@ -91,7 +92,7 @@ TEST_F(PeopleRoomTest, PeopleWalkingPastStepRoundTheRobotAsFarAsTheWallsLet) {
   // Squeezed between a wall and the far side: a sidestep stops where the body meets the wall.
   task_.config.person_sidestep = 2.0;
   task_.config.person_sidestep_speed = 10.0;
-  const PeopleRoom far(task_, 8.0, /*sidestep=*/true);
+  const PeopleRoom far(task_, 8.0, {.sidestep = true});
   EXPECT_NEAR(far.Predicted({5.0, 0.3}), (2.0 - body - 0.3) - body, 0.06);
 }
 
@@ -109,7 +110,7 @@ TEST_F(PeopleRoomTest, TwoAbreastAreLeftTheCorridorBySteppingToAWall) {
   belief_.X_MB = {3.0, 0.95, 0.0};
   belief_.world.people = {Walker({8.0, 0.6}, {-1.1, 0.0}), Walker({8.0, 1.35}, {-1.1, 0.0})};
   const auto spot_for = [&](bool sidestep) {
-    const PeopleRoom room(task_, 8.0, sidestep);
+    const PeopleRoom room(task_, 8.0, {.sidestep = sidestep});
     const Eigen::Vector2d at = belief_.X_MB.translation();
     return room.BestSpotAround({belief_.X_MB}, room.Score({at}) + 0.1);
   };
@@ -130,6 +131,86 @@ TEST_F(PeopleRoomTest, TwoAbreastAreLeftTheCorridorBySteppingToAWall) {
   // StepAsideTo starts the step there at retreat speed.
   StepAsideTo(task_, *made_way);
   EXPECT_TRUE(motion.base_moving());
+}
+
+// Someone near, coming nearer while veering (their tracked velocity points at the wall, as when
+// skirting the robot): with head_on they may also walk on straight through the robot's place,
+// so a spot beyond the robot on that line is in their way; the velocity alone takes them to the
+// wall and along it, clear of it. Anyone walking away, or farther than kHeadOnRadiusM, is
+// predicted as before.
+TEST_F(PeopleRoomTest, SomeoneNearComingNearerMayWalkStraightThroughTheRobotsPlace) {
+  belief_.X_MB = {5.0, 1.0, 0.0};
+  const Eigen::Vector2d beyond(4.0, 1.0);  // on the line from them through the robot
+  const auto predicted = [&](bool head_on, const Eigen::Vector2d& q) {
+    return PeopleRoom(task_, 3.0, {.head_on = head_on}).Predicted(q);
+  };
+  belief_.world.people = {Walker({6.2, 1.0}, {-0.3, -1.0})};
+  EXPECT_LT(predicted(true, beyond), 0.0) << "their straight way passes through it";
+  EXPECT_GT(predicted(false, beyond), 0.3) << "their tracked way keeps clear of it";
+  // Their tracked way is still predicted too: a hypothesis only takes room.
+  EXPECT_LT(predicted(true, {5.9, 0.3}), 0.1) << "where the tracked way meets the wall";
+  for (const Eigen::Vector2d& q : {Eigen::Vector2d(5.9, 0.3), Eigen::Vector2d(5.0, 0.3)})
+    EXPECT_LE(predicted(true, q), predicted(false, q));
+
+  for (const auto& walker : {Walker({6.2, 1.0}, {0.3, -1.0}),  // walking away from the robot
+                             Walker({5.0 + PeopleRoom::kHeadOnRadiusM + 0.1, 1.0}, {-1.0, -0.3}),
+                             Walker({6.2, 1.0}, {-0.1, -0.1})}) {  // standing (slower than 0.3)
+    belief_.world.people = {walker};
+    for (const Eigen::Vector2d& q :
+         {beyond, Eigen::Vector2d(3.0, 1.0), Eigen::Vector2d(5.0, 0.3), Eigen::Vector2d(7.0, 1.5)})
+      EXPECT_DOUBLE_EQ(predicted(true, q), predicted(false, q))
+          << "at (" << q.transpose() << ") for a walker at (" << walker.person.p_MP.transpose()
+          << ") moving (" << walker.person.v_MP.transpose() << ")";
+  }
+}
+
+// People near a door's far side (or in its zone) may walk through the middle of its opening and
+// on to the robot's side: the way goes through the opening's middle whatever line they walk on
+// now, then along the normal, at their speed (or a walker's, if they dawdle). Nobody walking
+// away from the opening, on the robot's side outside the zone, or farther than
+// kThroughDoorRadiusM has such a way.
+TEST(ThroughDoorWaysTest, PeopleNearADoorsFarSideWalkThroughTheMiddleOfItsOpening) {
+  const MissionMap map = node_testing::LabDoor();  // door line y = 3, the middle at (0, 3)
+  Belief belief;
+  belief.X_MB = {1.0, 2.4, M_PI / 2};  // beside the opening, on its south side
+  TaskServices task;
+  task.map = &map;
+  task.belief = &belief;
+  const auto ways_of = [&](const Eigen::Vector2d& p_MP, const Eigen::Vector2d& v_MP) {
+    auto entry = node_testing::Person(p_MP, perception::PersonIntent::kUnknown);
+    entry.person.v_MP = v_MP;
+    belief.world.people = {entry};
+    return ThroughDoorWays(task, "lab_door", 4.0);
+  };
+
+  // Off the axis, walking south at 0.8 m/s: through (0, 3), then down x = 0.
+  const std::vector<Occupant> way = ways_of({-0.3, 4.5}, {0.0, -0.8});
+  ASSERT_FALSE(way.empty());
+  const double to_middle = std::hypot(0.3, 1.5);
+  double t_before = 0.0, nearest_middle = 1e9;
+  for (const Occupant& o : way) {
+    EXPECT_GT(o.t, t_before);
+    t_before = o.t;
+    nearest_middle = std::min(nearest_middle, (o.p_M - Eigen::Vector2d(0.0, 3.0)).norm());
+    if (o.t > to_middle / 0.8 + 1e-9) {
+      EXPECT_NEAR(o.p_M.x(), 0.0, 1e-9) << "along the normal after the middle";
+      EXPECT_NEAR(o.p_M.y(), 3.0 - 0.8 * (o.t - to_middle / 0.8), 1e-9) << "at t = " << o.t;
+    }
+  }
+  EXPECT_LT(nearest_middle, 0.8 * PeopleRoom::kPeopleStepSec);
+  EXPECT_NEAR(way.back().t, 4.0, PeopleRoom::kPeopleStepSec);
+  EXPECT_NEAR(RoomAt(way, belief.X_MB.translation()), 1.0 - task.config.person_radius, 0.01)
+      << "the way passes 1 m from the robot beside the opening (sampled every 0.16 m)";
+
+  // Standing in the doorway: as if walking at kWalkingMps.
+  const std::vector<Occupant> dawdling = ways_of({0.0, 3.2}, {0.0, -0.1});
+  ASSERT_FALSE(dawdling.empty());
+  EXPECT_NEAR(dawdling.back().p_M.y(), 3.2 - kWalkingMps * dawdling.back().t, 1e-9);
+
+  EXPECT_TRUE(ways_of({-0.3, 4.5}, {0.0, 0.8}).empty()) << "walking away from the opening";
+  EXPECT_TRUE(ways_of({1.5, 1.0}, {0.0, 0.8}).empty()) << "on the robot's side, off the zone";
+  EXPECT_TRUE(ways_of({0.0, 3.0 + kThroughDoorRadiusM + 0.2}, {0.0, -1.0}).empty()) << "far";
+  EXPECT_THROW(ThroughDoorWays(task, "no_such_door", 4.0), InvalidArgument);
 }
 
 // The base has stopped below kStoppedMps, or is given kStopWithinSec to.
