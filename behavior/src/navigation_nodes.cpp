@@ -152,9 +152,9 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
 // way — to the last pose outside every door zone, unless people will come near it: then to
 // where they will be farthest (out of their predicted path, not only back along its own; also
 // out of a straight way through the robot's place for anyone near and coming nearer, and
-// through the doorway for anyone in the visited door's zone: PeopleHypotheses). The retreat
-// starts once the base has stopped (a path begun at speed the other way leaves
-// the reference behind and trips the watchdog).
+// through the doorway for anyone near the visited door's far side or in its zone:
+// PeopleHypotheses). The retreat starts once the base has stopped (a path begun at speed the
+// other way leaves the reference behind and trips the watchdog).
 class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
  public:
   using TaskNode::TaskNode;
@@ -248,7 +248,7 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
         break;
       }
     }
-    // Whoever is in the zone of the door it was passing may come through it.
+    // Whoever is near the far side of the door it was passing, or in its zone, may come through.
     PeopleHypotheses hypotheses{.head_on = true};
     if (visit && task_.map->FindDoor(visit->door) != nullptr) hypotheses.through_door = visit->door;
     std::optional<std::pair<Pose2, bool>> chosen;
@@ -350,7 +350,7 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
 // Waits until the door zone has been clear as long as IsPathClear asks (the same hysteresis,
 // from the belief), so the retry after a standby finds the path clear. Meanwhile it makes way
 // (TaskConfig::give_way) for anyone walking at the robot to pass within comfort_distance, and for
-// anyone in the door's zone who, walking straight through the doorway, would: a step to
+// anyone near the door's far side or in its zone who, walking through the doorway, would: a step to
 // MakeWaySpot with that hypothesis. The retreat chose its spot on what it knew then, often a
 // first glimpse through the opening door (S2: a track a few frames old, barely moving; the
 // robot stood at the last safe pose and the crosser passed 0.69 m from it).
