@@ -194,6 +194,9 @@ class Executive {
   std::vector<Decision> decisions_;
   std::vector<std::pair<double, double>> preemptions_;
   static constexpr double kPoseHistorySec = 1.0;  ///< Longer than the detector's latency.
+  /// Depth images kept to place late detections with [s]: the detector's latency and a depth
+  /// image's period (0.2 s each in the HSR's twin), and some.
+  static constexpr double kDepthHistorySec = 0.6;
   /// [m/s] Slower, the base is turning or standing: RememberSwept keeps nothing.
   static constexpr double kSweptMinMps = 0.05;
   /// [rad] The head turned more than this between an image and the depth image that places its
