@@ -101,6 +101,7 @@ class ApproachButton final : public TaskNode<bt::StatefulActionNode> {
         break;
       }
       if (!found) {
+        if (LookAgainAt(visit, plan.X_MB_standoff)) return NodeStatus::kRunning;
         Note(StrCat("no free standoff from which the arm reaches ", actuator->id));
         return NodeStatus::kFailure;
       }
@@ -112,9 +113,53 @@ class ApproachButton final : public TaskNode<bt::StatefulActionNode> {
                      [this](const std::string& s) { Note(s); });
   }
   NodeStatus OnRunning() override {
-    return DriveStatus(task_, [this](const std::string& s) { Note(s); });
+    const auto note = [this](const std::string& s) { Note(s); };
+    if (looking_until_) {
+      if (const NodeStatus s = BaseMotionStatus(task_, note); s != NodeStatus::kSuccess) return s;
+      if (belief_.now < *looking_until_) return NodeStatus::kRunning;
+      looking_until_.reset();
+      return OnStart();  // planned again on what it sees now
+    }
+    return DriveStatus(task_, note);
   }
-  void OnHalted() override { task_.motion->StopBase(); }
+  void OnHalted() override {
+    looking_until_.reset();
+    task_.motion->StopBase();
+  }
+
+ private:
+  // The standoff found blocked may be blocked only by what the costmap and the 3D map last saw
+  // there: people who have since walked on, out of the laser's and the camera's view (office
+  // escort seed 54: residents marked round door_a's button as they crowded through; the robot,
+  // stepped back out of their way with the button behind it, found no free standoff for 180 s
+  // and two residents waited at the next door to the time limit). It turns to face the
+  // standoff, the head on it, and plans again after kLookDwellSec; at most once per
+  // kLookAgainSec for a door.
+  bool LookAgainAt(DoorVisit& visit, const Pose2& standoff) {
+    if (visit.standoff_looked_at &&
+        ToSeconds(belief_.now - *visit.standoff_looked_at) < kLookAgainSec)
+      return false;
+    visit.standoff_looked_at = belief_.now;
+    Remember(visit);
+    const Eigen::Vector2d d = standoff.translation() - belief_.X_MB.translation();
+    const double yaw = d.norm() > kFacingMinM ? std::atan2(d.y(), d.x()) : belief_.X_MB.yaw;
+    task_.motion->FollowPath({belief_.X_MB, {belief_.X_MB.x, belief_.X_MB.y, yaw}}, {false},
+                             task_.motion->arm_target(), belief_.now);
+    looking_until_ = belief_.now + SecondsToDuration(kLookDwellSec);
+    if (task_.gaze) {
+      task_.gaze->RequestLook({standoff.x, standoff.y, belief_.X_MC.translation().z()},
+                              *looking_until_ + SecondsToDuration(kLookTurnAllowanceSec));
+    }
+    Note("the standoff looks blocked: turning to look at it again");
+    return true;
+  }
+
+  static constexpr double kLookAgainSec = 10.0;  ///< [s]
+  static constexpr double kLookDwellSec = 1.0;   ///< [s] from the turn's start, at least
+  /// [s] The head's request outlasts the dwell by this: the turn may take longer.
+  static constexpr double kLookTurnAllowanceSec = 3.0;
+  static constexpr double kFacingMinM = 0.05;  ///< nearer, the base keeps its heading [m]
+  std::optional<Time> looking_until_;
 };
 
 // The base pose relative to the actuator's wall, corrected by the laser: the distance to the

@@ -73,6 +73,75 @@ TEST_F(DoorNodesTest, ApproachButtonDrivesToAStandoffFacingTheButton) {
   EXPECT_TRUE(motion_.base_moving());
 }
 
+// A scan from (1.2, 1.0) facing north, 81 beams over +-0.7 rad, each ending at y = `y_hit`
+// (marks along the button's wall there, clearing the cells before them).
+void ScanNorthTo(perception::Costmap2D* costmap, double y_hit, Time stamp) {
+  LaserScan scan;
+  scan.stamp = stamp;
+  scan.angle_min = -0.7;
+  scan.angle_increment = 1.4 / 80;
+  scan.range_max = 20.0;
+  for (int i = 0; i <= 80; ++i)
+    scan.ranges.push_back(
+        float((y_hit - 1.0) / std::cos(scan.angle_min + i * scan.angle_increment)));
+  costmap->UpdateWithScan(scan, {1.2, 1.0, M_PI / 2});
+}
+
+// A standoff found blocked may be blocked only by marks of people who have since gone, out of
+// view: ApproachButton turns to face it and plans again on what it sees then; still blocked, it
+// gives up, and does not turn to look again for a while (office escort seed 54: 180 s of "no
+// free standoff" with the button behind the robot, the marks long stale).
+TEST_F(DoorNodesTest, ApproachButtonLooksAgainAtABlockedStandoffBeforeGivingUp) {
+  const Eigen::Vector2d standoff(1.1, 2.45);  // about where it stands (the next test checks)
+  const auto blocked_then_looks = [&](const bt::Blackboard::Ptr& blackboard, bt::Tree& tree) {
+    ScanNorthTo(&costmap_, standoff.y(), belief_.now);
+    belief_.X_MB = {0.0, 1.0, -M_PI / 2};  // its back to the button's wall
+    EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+    EXPECT_TRUE(NotedText("the standoff looks blocked: turning to look at it again"));
+    EXPECT_FALSE(blackboard->Get<DoorVisit>("door_visit")->button_plan.has_value());
+    ASSERT_EQ(motion_.path().size(), 2u);
+    const Pose2 turned = motion_.path().back();
+    EXPECT_NEAR((turned.translation() - belief_.X_MB.translation()).norm(), 0.0, 1e-9)
+        << "on the spot";
+    const Eigen::Vector2d to_standoff = standoff - belief_.X_MB.translation();
+    EXPECT_NEAR(std::remainder(turned.yaw - std::atan2(to_standoff.y(), to_standoff.x()), 2 * M_PI),
+                0.0, 0.2);
+    motion_.StopBase();
+    belief_.X_MB = turned;
+  };
+
+  // Seen clear once it looks: it drives to the standoff.
+  {
+    auto blackboard = bt::Blackboard::Create();
+    bt::Tree tree = Tree(R"(<ApproachButton door="lab_door"/>)", blackboard);
+    belief_.now = At(1.0);
+    blocked_then_looks(blackboard, tree);
+    ScanNorthTo(&costmap_, 2.9, At(1.5));  // the marks cleared, up to the wall
+    belief_.now = At(1.5);
+    EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning) << "the look lasts a while";
+    EXPECT_FALSE(blackboard->Get<DoorVisit>("door_visit")->button_plan.has_value());
+    belief_.now = At(2.5);
+    EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+    const auto visit = blackboard->Get<DoorVisit>("door_visit");
+    ASSERT_TRUE(visit->button_plan.has_value());
+    EXPECT_LT((visit->button_plan->X_MB_standoff.translation() - standoff).norm(), 0.3);
+    EXPECT_TRUE(motion_.base_moving());
+  }
+  // Still blocked when it has looked: no free standoff, and no second look within a while.
+  {
+    auto blackboard = bt::Blackboard::Create();
+    bt::Tree tree = Tree(R"(<ApproachButton door="lab_door"/>)", blackboard);
+    belief_.now = At(10.0);
+    blocked_then_looks(blackboard, tree);
+    belief_.now = At(11.0);
+    EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
+    EXPECT_TRUE(NotedText("no free standoff from which the arm reaches lab_button"));
+    belief_.now = At(12.0);
+    EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);
+    EXPECT_FALSE(motion_.base_moving()) << "no second turn";
+  }
+}
+
 TEST_F(DoorNodesTest, PressButtonNeedsTheApproachFirst) {
   bt::Tree tree = Tree(R"(<PressButton door="lab_door"/>)");
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kFailure);

@@ -177,6 +177,9 @@ struct DoorVisit {
   /// (TaskConfig::passage_max_wait counts from here, across a retry's new press: a wait that
   /// outlasted one opening would otherwise begin again with the next, clinic family seed 2005).
   std::optional<Time> passage_wait_began;
+  /// When ApproachButton last turned to look at an actuator's standoff it found blocked (what
+  /// blocked it may have gone out of sight: it looks again only so often).
+  std::optional<Time> standoff_looked_at;
 };
 
 /// A grasp, planned by PlanGrasp and carried out by the grasp leaves after it (DriveToGrasp,
