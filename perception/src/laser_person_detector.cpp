@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <optional>
 
 #include <Eigen/Dense>
@@ -84,32 +85,44 @@ std::vector<LaserPersonDetection> LaserPersonDetector::Detect(
   ThrowUnless(X_ML.IsFinite(), "LaserPersonDetector: the laser pose X_ML must be finite");
   const Eigen::Vector2d p_ML = X_ML.translation();
 
-  // Clusters of returns off the map on neighbouring beams, closer than cluster_gap in turn.
-  std::vector<std::vector<Eigen::Vector2d>> clusters;
-  std::vector<Eigen::Vector2d> current;
+  // Clusters of returns off the map on neighbouring beams, closer than cluster_gap in turn. A
+  // cluster on the scan's first or last beam may go on past the field of view's edge (unless the
+  // scan goes all round).
+  const std::size_t n = scan.ranges.size();
+  const bool has_edges = double(n) * scan.angle_increment < 2 * std::numbers::pi - 1e-9;
+  struct Cluster {
+    std::vector<Eigen::Vector2d> points;
+    bool at_edge{false};
+  };
+  std::vector<Cluster> clusters;
+  Cluster current;
   std::size_t last_beam = 0;
   const auto close_cluster = [&] {
-    if (int(current.size()) >= config_.min_points) clusters.push_back(current);
-    current.clear();
+    if (int(current.points.size()) >= config_.min_points) {
+      current.at_edge = current.at_edge || (has_edges && last_beam + 1 == n);
+      clusters.push_back(current);
+    }
+    current = {};
   };
-  for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
+  for (std::size_t i = 0; i < n; ++i) {
     if (!scan.IsValidReturn(i) || scan.ranges[i] > config_.max_range) continue;
     const double angle = scan.AngleAt(i);
     const Eigen::Vector2d p_M =
         X_ML * Eigen::Vector2d(scan.ranges[i] * std::cos(angle), scan.ranges[i] * std::sin(angle));
     if (is_background && is_background(p_M)) continue;
-    if (!current.empty() &&
-        (i != last_beam + 1 || (p_M - current.back()).norm() > config_.cluster_gap)) {
+    if (!current.points.empty() &&
+        (i != last_beam + 1 || (p_M - current.points.back()).norm() > config_.cluster_gap)) {
       close_cluster();
     }
-    current.push_back(p_M);
+    if (current.points.empty()) current.at_edge = has_edges && i == 0;
+    current.points.push_back(p_M);
     last_beam = i;
   }
   close_cluster();
 
   std::vector<LaserPersonDetection> people;
   std::vector<LaserPersonDetection> legs;
-  for (const auto& points : clusters) {
+  for (const auto& [points, at_edge] : clusters) {
     const double width = (points.back() - points.front()).norm();
     if (width < config_.leg_min_width || width > config_.body_max_width) continue;
     if (is_structure && is_structure(points)) continue;
@@ -119,6 +132,12 @@ std::vector<LaserPersonDetection> LaserPersonDetector::Detect(
     centroid /= double(points.size());
     const Eigen::Vector2d away = (centroid - p_ML).normalized();  // from the laser, through it
     if (width <= config_.leg_max_width) {
+      // Leg-wide at the field of view's edge may be the edge of a wider body (a wheelchair user
+      // beside and behind the robot): its centre is a body's radius further on, not a leg's
+      // (office escort seed 49: a user standing still "walked" 0.36 m each time the robot's
+      // turn put them at the edge, and read as someone coming to the door). The circle fit
+      // below still finds a body on a wider arc.
+      if (at_edge) continue;
       const double radius = width / 2;
       legs.push_back(
           {centroid + away * kArcCentroidOffset * radius, radius, 1, int(points.size())});

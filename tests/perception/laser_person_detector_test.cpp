@@ -57,6 +57,29 @@ TEST(LaserPersonDetectorTest, ABodySectionIsFoundAtItsCentreNotItsNearSide) {
   }
 }
 
+// A wide body (a wheelchair user, 0.33 m) just past the edge of the 270 degree view shows a
+// leg-wide sliver: that is no leg, and a leg put there would be 0.3 m off the person. Whatever is
+// reported lies at the body's centre; a leg-wide sliver inside the view is still a leg.
+TEST(LaserPersonDetectorTest, ASliverOfABodyAtTheEdgeOfTheViewIsNotALeg) {
+  constexpr double kRadius = 0.33;
+  constexpr double kEdge = 135.0 * std::numbers::pi / 180.0;
+  for (const double side : {-1.0, 1.0}) {
+    for (const double past_deg : {3.0, 5.0, 7.0}) {
+      const double bearing = side * (kEdge + past_deg * std::numbers::pi / 180.0);
+      const Eigen::Vector2d centre(2.0 * std::cos(bearing), 2.0 * std::sin(bearing));
+      for (const auto& person : DetectDiscs({{centre, kRadius}}))
+        EXPECT_LT((person.p_MP - centre).norm(), 0.15)
+            << "side " << side << ", " << past_deg << " deg past the edge: a person at "
+            << person.p_MP.transpose() << ", " << person.legs << " legs";
+    }
+  }
+  const double inside = kEdge - 5.0 * std::numbers::pi / 180.0;
+  const Eigen::Vector2d leg(2.0 * std::cos(inside), 2.0 * std::sin(inside));
+  const auto people = DetectDiscs({{leg, 0.06}});
+  ASSERT_EQ(people.size(), 1u);
+  EXPECT_EQ(people[0].legs, 1);
+}
+
 TEST(LaserPersonDetectorTest, PeopleAllRoundTheRobotAreFoundInTheMapFrame) {
   // Behind the robot's right shoulder, beside it and ahead: where the head camera is not.
   const Pose2 X_ML{5.0, 3.0, std::numbers::pi / 2};

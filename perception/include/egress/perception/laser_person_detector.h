@@ -11,6 +11,10 @@
 /// Straight runs of returns (a box's face) and box corners of faces 0.4 m or more are not
 /// bodies: their circle fits leave more than `body_max_residual`.
 ///
+/// A leg-wide cluster on the scan's first or last beam (a 270° scan's edges) is not reported as
+/// a leg: it may be the sliver of a wider body past the edge, whose centre lies a body's radius
+/// beyond it. Wider clusters there are still circle-fitted.
+///
 /// What it cannot tell: a table leg from a person's leg, a round bin from a body, or a smaller
 /// box corner (faces under ~0.4 m fit a circle within the range noise) from a body. The tracker
 /// that consumes these detections (with the camera's) confirms people over several scans and by
