@@ -339,6 +339,31 @@ TEST(EvacueesTest, SomeoneWhoCannotOperateTheDoorLeavesTheWayToItsActuatorClear)
   EXPECT_GT(unable, 0);
 }
 
+// Carried by the crowd past a via point of their route (here: started 1 m past it, along the
+// clinic's corridor towards door_e), an evacuee goes on from where they are, not back to it
+// against the crowd (clinic two wards seed 26: a pushed wheelchair swept 0.6 m past the point
+// beyond door_d and 10 m on by the group behind walked back the 10 m to it, and met the robot
+// in door_d's doorway).
+TEST(EvacueesTest, SomeoneCarriedPastAWaypointGoesOnFromThere) {
+  for (const char* mobility : {"walker", "wheelchair_pushed"}) {
+    auto loaded = LoadText(std::string("world: clinic.sdf\nrobot: {off_scene: true}\npeople:\n"
+                                       "  - {name: e, behavior: evacuate, via: [[9.0, 0.9]],"
+                                       " route: [door_e, exit_door], start: [10.0, 0.9],"
+                                       " goal: [21.0, 11.5], mobility: {") +
+                               mobility + ": 1}}\n",
+                           WorldsDir() / "clinic");
+    TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+    const double x0 = world.people().front().position.x();
+    double west_most = x0;
+    while (world.time() < 6.0) {
+      world.Step();
+      west_most = std::min(west_most, world.people().front().position.x());
+    }
+    EXPECT_GT(west_most, x0 - 0.1) << mobility << " walked back to the via point";
+    EXPECT_GT(world.people().front().position.x(), x0 + 2.0) << mobility << " did not go on";
+  }
+}
+
 // Held up short of the spot before a shut door, an evacuee queues for the door where they are,
 // and operates it if they can (clinic seed 21, no robot, the study's clinic escort group:
 // everyone who could press the exit's button stood round the spot before it, held there by

@@ -422,7 +422,7 @@ void TwinWorld::Impl::UpdatePeople() {
     const bool shut_doorway =
         doorway != p.doorway_waypoints.end() &&
         doors[std::size_t(doorway->second)].angle < config.door_crossed_open_angle_deg * kDegToRad;
-    if ((p.walker.position - p.route.front()).norm() < reached_radius &&
+    if (((p.walker.position - p.route.front()).norm() < reached_radius || PassedWaypoint(p)) &&
         p.state.phase != PersonPhase::kWaitingForDoor && !shut_doorway) {
       SkipRouteTo(p, p.reached + 1);
     }
@@ -480,6 +480,22 @@ void TwinWorld::Impl::UpdatePeople() {
     p.body->getMotionState()->setWorldTransform(T);
     p.body->setWorldTransform(T);
   }
+}
+
+bool TwinWorld::Impl::PassedWaypoint(const Person& p) const {
+  // Doorway centres and the spots before them are where people line up and wait: passing those
+  // is the doors' business (AdvancePastDoorways, the gate); a way round a leaf moves with it.
+  const auto at_door = [&](int waypoint) {
+    return p.doorway_waypoints.count(waypoint) > 0 || waypoint == p.wait_before_waypoint;
+  };
+  if (p.route.size() < 2 || p.round_leaf >= 0 || at_door(p.reached) || at_door(p.reached + 1))
+    return false;
+  const Eigen::Vector2d& at = p.walker.position;
+  const Eigen::Vector2d& waypoint = p.route[0];
+  const Eigen::Vector2d& next = p.route[1];
+  if ((at - waypoint).dot(next - waypoint) <= 0.0) return false;
+  return std::none_of(fixed.walls.begin(), fixed.walls.end(),
+                      [&](const WallSegment& w) { return SegmentsCross(at, next, w.a, w.b); });
 }
 
 void TwinWorld::Impl::RewindIfPushedBack(Person& p) {

@@ -159,6 +159,12 @@ struct TwinWorld::Impl {
   // Drops the route's waypoints before index `waypoint` of the whole route (p.reached indexes
   // the first remaining one), with any way round a leaf: every step on along the route.
   static void SkipRouteTo(Person& p, int waypoint);
+  // Whether the crowd carried the person past their next waypoint (a via point along a corridor,
+  // not a doorway's or the spot before one) towards the one after it, in sight of it: they go
+  // on from there rather than back against the crowd (clinic two wards seed 26: a pushed
+  // wheelchair swept 0.6 m past the point beyond door_d, on 10 m along the corridor by the
+  // group behind, walked back the 10 m to it, meeting the robot in door_d's doorway).
+  bool PassedWaypoint(const Person& p) const;
   // An evacuee stuck with a wall between them and their next waypoint, on the near side of a
   // doorway of their route they had passed (the crowd pushed them back through it), takes up
   // their route again from before that doorway.
