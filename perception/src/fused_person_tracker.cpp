@@ -24,6 +24,7 @@ void FusedPersonTrackerConfig::Validate() const {
   positive(confirm_window_s, "confirm_window_s");
   positive(static_radius, "static_radius");
   positive(max_person_speed, "max_person_speed");
+  positive(edge_gate, "edge_gate");
   positive(static_after_s, "static_after_s");
   positive(static_gap_s, "static_gap_s");
   positive(static_forget_s, "static_forget_s");
@@ -111,6 +112,13 @@ void FusedPersonTracker::Update(const std::vector<PersonObservation>& observatio
   for (const auto& [t, k] : match.pairs) {
     FusedTrack& track = tracks_[t];
     const PersonObservation& o = observations[k];
+    if (o.at_edge && track.confirmed && (o.p_MP - then[t]).norm() > config_.edge_gate) {
+      // Seen, but where exactly is unknown: alive, unmoved.
+      track.person.misses = 0;
+      track.last_measured = std::max(track.last_measured, stamp);
+      track.person.last_seen = track.last_measured;
+      continue;
+    }
     auto& last = track.last_by_source[std::size_t(o.source)];
     // Faster than anyone walks since its last laser measurement: the track took something else
     // (the next table leg while the first was hidden), not a step; the jump is no motion.

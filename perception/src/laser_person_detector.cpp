@@ -133,14 +133,11 @@ std::vector<LaserPersonDetection> LaserPersonDetector::Detect(
     const Eigen::Vector2d away = (centroid - p_ML).normalized();  // from the laser, through it
     if (width <= config_.leg_max_width) {
       // Leg-wide at the field of view's edge may be the edge of a wider body (a wheelchair user
-      // beside and behind the robot): its centre is a body's radius further on, not a leg's
-      // (office escort seed 49: a user standing still "walked" 0.36 m each time the robot's
-      // turn put them at the edge, and read as someone coming to the door). The circle fit
-      // below still finds a body on a wider arc.
-      if (at_edge) continue;
+      // beside and behind the robot), whose centre is a body's radius further on: marked, for
+      // the tracker to weigh (FusedPersonTrackerConfig::edge_gate).
       const double radius = width / 2;
       legs.push_back(
-          {centroid + away * kArcCentroidOffset * radius, radius, 1, int(points.size())});
+          {centroid + away * kArcCentroidOffset * radius, radius, 1, int(points.size()), at_edge});
       continue;
     }
     // A body section: an arc whose circle's centre lies beyond it, seen from the laser. A
@@ -174,7 +171,7 @@ std::vector<LaserPersonDetection> LaserPersonDetector::Detect(
     paired[a] = paired[b] = true;
     people.push_back({(legs[a].p_MP + legs[b].p_MP) / 2,
                       best / 2 + std::max(legs[a].radius, legs[b].radius), 2,
-                      legs[a].points + legs[b].points});
+                      legs[a].points + legs[b].points, legs[a].at_edge || legs[b].at_edge});
   }
   for (std::size_t i = 0; i < legs.size(); ++i) {
     if (!paired[i]) people.push_back(legs[i]);

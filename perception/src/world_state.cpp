@@ -140,7 +140,7 @@ void PerceptionPipeline::ProcessScan(
       return false;
     };
     for (const auto& d : laser_detector_.Detect(scan, X_ML, is_background, is_leaf))
-      observations.push_back({d.p_MP, PersonSource::kLaser});
+      observations.push_back({d.p_MP, PersonSource::kLaser, d.at_edge});
     // The laser covers its 270 degrees out to the detector's reach.
     const double reach = config_.laser_detector.max_range;
     fused_.Update(observations, scan.stamp, [&](const Eigen::Vector2d& p) {

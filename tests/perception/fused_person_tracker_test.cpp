@@ -175,6 +175,40 @@ TEST(FusedPersonTrackerTest, TwoPeoplePassingStayTwoTracks) {
   }
 }
 
+// A confirmed person standing still; the robot turns and the laser sees only a sliver of them at
+// its edge, 0.3 m off their centre (office escort seed 49: a wheelchair user's side). The track
+// stays where they stand, alive; the same observation unmarked would have dragged it there. A
+// walker coming into view at the edge is tracked from their first marked observation on.
+TEST(FusedPersonTrackerTest, ASliverAtTheLasersEdgeKeepsATrackWithoutDraggingIt) {
+  const Eigen::Vector2d stand(1.0, -2.0);
+  const Eigen::Vector2d sliver = stand + Eigen::Vector2d(0.28, 0.14);
+  double dragged[2] = {0.0, 0.0};
+  for (const bool at_edge : {true, false}) {
+    FusedPersonTracker tracker;
+    tracker.Update({{stand, PersonSource::kCamera}}, At(0.0));
+    for (int i = 1; i <= 10; ++i)
+      tracker.Update({{stand, PersonSource::kLaser}}, At(0.1 * i));
+    for (int i = 11; i <= 30; ++i)
+      tracker.Update({{sliver, PersonSource::kLaser, at_edge}}, At(0.1 * i));
+    ASSERT_EQ(tracker.tracks().size(), 1u) << at_edge;
+    const FusedTrack& track = tracker.tracks()[0];
+    dragged[at_edge] = (track.person.p_MP - stand).norm();
+    EXPECT_EQ(track.person.misses, 0);
+    if (at_edge) {
+      EXPECT_LT(track.person.v_MP.norm(), 0.05);
+    }
+  }
+  EXPECT_LT(dragged[1], 0.02);
+  EXPECT_GT(dragged[0], 0.25);
+
+  FusedPersonTracker tracker;
+  for (int i = 0; i <= 10; ++i)
+    tracker.Update({{Eigen::Vector2d(-2.0, 0.1 * i), PersonSource::kLaser, true}}, At(0.1 * i));
+  ASSERT_EQ(tracker.ConfirmedPeople().size(), 1u);
+  EXPECT_NEAR(tracker.ConfirmedPeople()[0].p_MP.y(), 1.0, 0.1);
+  EXPECT_NEAR(tracker.ConfirmedPeople()[0].v_MP.y(), 1.0, 0.2);
+}
+
 TEST(FusedPersonTrackerTest, BadInputIsRefusedNamingIt) {
   FusedPersonTracker tracker;
   tracker.Update({}, At(1.0));
@@ -187,6 +221,9 @@ TEST(FusedPersonTrackerTest, BadInputIsRefusedNamingIt) {
   EXPECT_THROW(FusedPersonTracker{config}, InvalidArgument);
   config = {};
   config.alpha = 0.0;
+  EXPECT_THROW(FusedPersonTracker{config}, InvalidArgument);
+  config = {};
+  config.edge_gate = 0.0;
   EXPECT_THROW(FusedPersonTracker{config}, InvalidArgument);
 }
 

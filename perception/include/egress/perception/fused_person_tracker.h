@@ -51,6 +51,10 @@ enum class PersonSource { kCamera, kLaser };
 struct PersonObservation {
   Eigen::Vector2d p_MP{Eigen::Vector2d::Zero()};  ///< In M [m].
   PersonSource source{PersonSource::kLaser};
+  /// Cut by the sensor's field of view (LaserPersonDetection::at_edge): the person may be up to
+  /// a body's radius off it. It starts tracks and keeps them alive, but moves a confirmed track
+  /// only within FusedPersonTrackerConfig::edge_gate of its prediction.
+  bool at_edge{false};
 };
 
 struct FusedPersonTrackerConfig {
@@ -68,6 +72,10 @@ struct FusedPersonTrackerConfig {
   /// An unconfirmed track whose laser observation jumped faster than this since the last one
   /// took something else (a neighbouring table leg): it starts its confirm window there [m/s].
   double max_person_speed{4.0};
+  /// An at_edge observation farther than this from a confirmed track's prediction moves it not
+  /// at all (it only keeps it alive): a wide body's sliver at the laser's edge lies 0.3 m off
+  /// its centre, and pulled a standing person's track there as if they walked [m].
+  double edge_gate{0.2};
   double static_radius{0.08};    ///< Laser observations this near are the same spot [m].
   double static_after_s{0.8};    ///< Seen at one spot this long: a thing, not a person [s].
   double static_gap_s{1.0};      ///< A spot unseen longer than this starts its count again [s].

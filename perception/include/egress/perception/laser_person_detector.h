@@ -11,9 +11,10 @@
 /// Straight runs of returns (a box's face) and box corners of faces 0.4 m or more are not
 /// bodies: their circle fits leave more than `body_max_residual`.
 ///
-/// A leg-wide cluster on the scan's first or last beam (a 270° scan's edges) is not reported as
-/// a leg: it may be the sliver of a wider body past the edge, whose centre lies a body's radius
-/// beyond it. Wider clusters there are still circle-fitted.
+/// A leg-wide cluster on the scan's first or last beam (a 270° scan's edges) may be a leg, or the
+/// sliver of a wider body past the edge, whose centre lies a body's radius beyond it: it is
+/// reported as a leg marked `at_edge` (and so is a pair with such a leg). Wider clusters there
+/// are circle-fitted as anywhere.
 ///
 /// What it cannot tell: a table leg from a person's leg, a round bin from a body, or a smaller
 /// box corner (faces under ~0.4 m fit a circle within the range noise) from a body. The tracker
@@ -52,6 +53,9 @@ struct LaserPersonDetection {
   double radius{0.0};  ///< Estimated body radius [m] (half a leg pair's span for legs).
   int legs{0};         ///< 2: a pair of legs; 1: one leg seen; 0: a body section.
   int points{0};       ///< Returns that make it up.
+  /// A leg-wide cluster cut by the field of view's edge: the person's centre may lie up to a
+  /// body's radius further on (a wheelchair user's side seen past the edge).
+  bool at_edge{false};
 };
 
 class LaserPersonDetector {
