@@ -364,6 +364,38 @@ TEST(EvacueesTest, SomeoneCarriedPastAWaypointGoesOnFromThere) {
   }
 }
 
+// Pushed by the crowd into the doorway of a door not on their route, whose open leaf stands
+// across their way on, an evacuee steps back out into the corridor, not round the leaf into the
+// room beyond it (clinic two wards seed 23: a north-ward resident walking east along the
+// corridor's south wall was pressed into door_d's doorway as it stood open for the south ward;
+// round the leaf's free edge they were in the south ward, a wall between them and the corridor,
+// to the time limit). door_d, hinged at (7.475, -0.05), opens south; the via point (in the south
+// ward) brings the resident into its doorway from the corridor, a shoulder south of the wall's
+// midline, where the leaf stands between them and the corridor to the east.
+TEST(EvacueesTest, SomeonePushedIntoTheDoorwayOfAnotherRoomStepsBackOutOfIt) {
+  for (const char* mobility : {"walker", "wheelchair", "frame"}) {
+    auto loaded = LoadText(
+        std::string("world: clinic.sdf\nrobot: {off_scene: true}\n"
+                    "doors: [{door: door_d, operator: push, open_angle_deg: 80, hold_open_s: 1000,"
+                    " open_at: [0.0]}]\n"
+                    "people:\n"
+                    "  - {name: e, behavior: evacuate, via: [[7.1, -0.7]], route: [door_e,"
+                    " exit_door], start: [6.5, 1.7], goal: [21.0, 11.5], mobility: {") +
+            mobility + ": 1}, trigger: {at: 7.0}}\n",
+        WorldsDir() / "clinic");
+    TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+    double south_most = 0.0;
+    while (world.time() < 30.0) {
+      world.Step();
+      south_most = std::min(south_most, world.people().front().position.y());
+    }
+    const Eigen::Vector2d p = world.people().front().position;
+    EXPECT_GT(south_most, -0.6) << mobility << " went round door_d's leaf into the south ward";
+    EXPECT_GT(p.y(), 0.5) << mobility << " is not in the corridor at " << p.transpose();
+    EXPECT_GT(p.x(), 9.0) << mobility << " did not go on along the corridor";
+  }
+}
+
 // Held up short of the spot before a shut door, an evacuee queues for the door where they are,
 // and operates it if they can (clinic seed 21, no robot, the study's clinic escort group:
 // everyone who could press the exit's button stood round the spot before it, held there by

@@ -330,7 +330,7 @@ void TwinWorld::Impl::UpdatePeople() {
       const Door& d = doors[std::size_t(gate)];
       const double side =
           (p.walker.position - d.fixed->centre).dot(d.fixed->normal) >= 0 ? 1.0 : -1.0;
-      p.route.insert(p.route.begin(), d.fixed->centre + d.fixed->normal * side * 0.8);
+      p.route.insert(p.route.begin(), d.fixed->centre + d.fixed->normal * side * kOutOfDoorwayM);
       --p.reached;  // the doorway centre stays the next waypoint after this one
       p.realigned = true;
       p.stuck_for = 0.0;
@@ -375,8 +375,24 @@ void TwinWorld::Impl::UpdatePeople() {
         const Eigen::Vector2d& next =
             p.round_leaf == int(k) && p.route.size() > 1 ? p.route[1] : p.route.front();
         const double to_next = across.dot(next - hinge) >= 0.0 ? 1.0 : -1.0;
+        // In the doorway of a door not on their route (pushed there by the crowd), with its leaf
+        // swung to the far side from the waypoint, the way on is back out of the doorway on the
+        // waypoint's side: round the leaf's free edge lies the room beyond, a wall between it and
+        // the route (clinic two wards seed 23: a north-ward resident walking the corridor, pressed
+        // into door_d's doorway as it stood open for the south ward, went round its leaf into the
+        // south ward and walked into the ward's wall to the time limit).
+        const double next_side = (next - d.fixed->centre).dot(d.fixed->normal);
+        const bool on_route =
+            p.door == int(k) || std::any_of(p.doorway_waypoints.begin(), p.doorway_waypoints.end(),
+                                            [&](const auto& w) { return w.second == int(k); });
+        const bool back_out =
+            !on_route && next_side * (edge - d.fixed->centre).dot(d.fixed->normal) < 0.0;
         const Eigen::Vector2d round =
-            edge + along * kStepRoundLeaf + across * to_next * p.walker.radius;
+            back_out ? Eigen::Vector2d(d.fixed->centre + d.fixed->normal *
+                                                             (next_side >= 0.0 ? 1.0 : -1.0) *
+                                                             kOutOfDoorwayM)
+                     : Eigen::Vector2d(edge + along * kStepRoundLeaf +
+                                       across * to_next * p.walker.radius);
         if (p.round_leaf == int(k)) {
           // Carried on past the way round by the crowd behind, towards the doorway: once the
           // straight way on clears the leaf (by a body's width past its free edge), the detour

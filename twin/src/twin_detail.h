@@ -48,6 +48,9 @@ constexpr double kStuckSec =
 // [m] beyond an open leaf's free edge a walker blocked by the leaf steps round it: a shoulder
 // (0.25 m) and a margin
 constexpr double kStepRoundLeaf = 0.45;
+// [m] Off a doorway's midline, a step out of it onto one side: clear of the jambs and of a body
+// in the doorway.
+constexpr double kOutOfDoorwayM = 0.8;
 constexpr double kKeepRight = 0.2;  // [m] off the doorway axis, clear of a 0.9 m door's jambs
 // [m] People wait this far beyond the reach of a leaf that opens towards them: a wide body
 // (0.3 m) and a margin.
