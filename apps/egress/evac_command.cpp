@@ -4,12 +4,12 @@
 // (escorting), and every door propped open from the start (the upper bound). A trial ends when
 // every evacuee is out (at the assembly point beyond the exit) or at the time limit. Printed: a
 // table per condition (evacuation time median with its 95 % interval, people left behind,
-// robot-resident contacts and closest approach, time the robot stood in a doorway with a
-// resident within 2 m), per-door flow and queue time, and for the robot and the propped doors
-// the paired difference from no robot on the same seeds (median with its 95 % interval, seeds
-// faster and slower: what the condition buys, with the seeds' own spread taken out); written:
-// DIR/study.json, DIR/trials.csv, DIR/evacuated.png (people out vs time, median and 10-90 % band
-// per condition).
+// robot-resident contacts and closest approach, time the robot was in a doorway with a resident
+// within 2 m, and the part of it the robot stood there), per-door flow and queue time, and for the
+// robot and the propped doors the paired difference from no robot on the same seeds (median with
+// its 95 % interval, seeds faster and slower: what the condition buys, with the seeds' own spread
+// taken out); written: DIR/study.json, DIR/trials.csv, DIR/evacuated.png (people out vs time,
+// median and 10-90 % band per condition).
 //
 // A trial is a pure function of the scenario file, the condition and the seed, whatever --jobs.
 
@@ -28,6 +28,7 @@
 
 #include "brain_trial.h"
 #include "commands.h"
+#include "doorway_judge.h"
 #include "egress/hsr_interface/error.h"
 #include "egress/twin/sdf_world_loader.h"
 #include "egress/twin/twin_model.h"
@@ -40,10 +41,6 @@ namespace egress::apps {
 namespace {
 
 constexpr const char* kConditions[] = {"no_robot", "robot", "propped_open"};
-// A resident this near the robot while it stands in a doorway counts as blocked by it [m].
-constexpr double kDoorwayBlockRadiusM = 2.0;
-// The robot is in a doorway within this of the door line (and within its jambs) [m].
-constexpr double kInDoorwayM = 0.5;
 // Evacuation times this close under two conditions count as a tie: the same evacuation, seen a
 // control period or so apart [s].
 constexpr double kTieSec = 0.15;
@@ -111,7 +108,9 @@ nlohmann::json RunStudyTrial(const twin::Scenario& scenario, const twin::WorldDe
   std::map<std::string, std::vector<double>> crossings;  // per door
   std::map<std::string, double> queue;                   // per door: person-seconds waiting
   std::map<std::pair<std::string, std::string>, double> last_side;
-  double blocking = 0.0;
+  std::vector<twin::DoorwayFrame> doorways(lines.begin(), lines.end());
+  DoorwayBlockJudge doorway_judge(std::move(doorways));
+  std::vector<Eigen::Vector2d> p_WR;  // the residents still in the building
   const double period = brain ? 1.0 / config.control_rate_hz : 0.1;
   double last_t = 0.0;
   const auto all_out = [&] {
@@ -133,17 +132,10 @@ nlohmann::json RunStudyTrial(const twin::Scenario& scenario, const twin::WorldDe
         const double t = twin_world.time(), dt = t - last_t;
         last_t = t;
         const Eigen::Vector2d p_WB = twin_world.robot_pose().translation();
-        bool robot_in_doorway = false;
-        for (const auto& l : lines) {
-          const Eigen::Vector2d rel = p_WB - l.centre;
-          if (std::abs(rel.dot(l.normal)) < kInDoorwayM &&
-              std::abs(rel.dot(l.along)) < l.half_width)
-            robot_in_doorway = true;
-        }
-        bool resident_near = false;
+        p_WR.clear();
         for (const auto& p : twin_world.people()) {
           if (!IsEvacuee(p) || !p.started || p.out) continue;
-          resident_near = resident_near || (p.position - p_WB).norm() < kDoorwayBlockRadiusM;
+          p_WR.push_back(p.position);
           for (const auto& l : lines) {
             const Eigen::Vector2d rel = p.position - l.centre;
             const double side = rel.dot(l.normal);
@@ -158,7 +150,8 @@ nlohmann::json RunStudyTrial(const twin::Scenario& scenario, const twin::WorldDe
           if (p.phase == twin::PersonPhase::kWaitingForDoor && !p.waiting_for.empty())
             queue[p.waiting_for] += dt;
         }
-        if (robot_in_doorway && resident_near) blocking += dt;
+        const Twist2 V_B = twin_world.robot_velocity();
+        doorway_judge.Step(dt, p_WB, std::hypot(V_B.vx, V_B.vy), p_WR);
         return !all_out();
       },
       run);
@@ -197,7 +190,8 @@ nlohmann::json RunStudyTrial(const twin::Scenario& scenario, const twin::WorldDe
           {"contacts", m.contacts.count("person") ? m.contacts.at("person") : 0},
           {"closest", std::isfinite(m.min_person_distance) ? nlohmann::json(m.min_person_distance)
                                                            : nlohmann::json(nullptr)},
-          {"doorway_block_s", blocking},
+          {"doorway_block_s", doorway_judge.in_doorway_s()},
+          {"doorway_stand_s", doorway_judge.standing_s()},
           {"time", result.simulated_time}};
 }
 
@@ -318,8 +312,8 @@ void RunStudy(const StudyOptions& o) {
                           {"seed_base", o.seed_base},
                           {"crowd_social_rate_hz", twin_config.crowd_social_rate_hz},
                           {"conditions", nlohmann::json::array()}};
-  fmt::print("\n{:<14} {:>7} {:>24} {:>12} {:>9} {:>9} {:>12}\n", "condition", "trials",
-             "evacuation time [s]", "left behind", "contacts", "closest", "in doorway");
+  fmt::print("\n{:<14} {:>7} {:>24} {:>12} {:>9} {:>9} {:>22}\n", "condition", "trials",
+             "evacuation time [s]", "left behind", "contacts", "closest", "in doorway / standing");
   int residents = 0;
   // Per condition, each seed's evacuation time; people left behind count at the time limit
   // (censored, conservative).
@@ -332,7 +326,7 @@ void RunStudy(const StudyOptions& o) {
     const auto& trials = by_condition[c];
     std::vector<double> times;
     int left = 0, contacts = 0;
-    double closest = std::numeric_limits<double>::infinity(), blocking = 0.0;
+    double closest = std::numeric_limits<double>::infinity(), blocking = 0.0, standing = 0.0;
     std::map<std::string, std::vector<double>> flow, queue;
     for (const auto& t : trials) {
       residents = t.at("residents").get<int>();
@@ -341,17 +335,18 @@ void RunStudy(const StudyOptions& o) {
       contacts += t.at("contacts").get<int>();
       if (!t.at("closest").is_null()) closest = std::min(closest, t.at("closest").get<double>());
       blocking += t.at("doorway_block_s").get<double>();
+      standing += t.at("doorway_stand_s").get<double>();
       for (const auto& [door, d] : t.at("doors").items()) {
         if (d.at("flow").get<double>() > 0.0) flow[door].push_back(d.at("flow").get<double>());
         queue[door].push_back(d.at("queue_s").get<double>());
       }
     }
     const MedianCi ci = CalcMedianCi(times);
-    fmt::print("{:<14} {:>7} {:>9.1f} [{:6.1f}, {:6.1f}] {:>12} {:>9} {:>9} {:>10.1f} s\n", c,
+    fmt::print("{:<14} {:>7} {:>9.1f} [{:6.1f}, {:6.1f}] {:>12} {:>9} {:>9} {:>22}\n", c,
                trials.size(), ci.median, ci.low, ci.high, left,
                c == "robot" ? fmt::format("{}", contacts) : "-",
                c == "robot" && std::isfinite(closest) ? fmt::format("{:.2f} m", closest) : "-",
-               blocking);
+               fmt::format("{:.1f} / {:.1f} s", blocking, standing));
     nlohmann::json doors = nlohmann::json::object();
     for (const auto& [door, q] : queue) {
       const double f = flow[door].empty() ? 0.0 : CalcMedianCi(flow[door]).median;
@@ -382,12 +377,14 @@ void RunStudy(const StudyOptions& o) {
          {"contacts", contacts},
          {"closest_m", std::isfinite(closest) ? nlohmann::json(closest) : nlohmann::json(nullptr)},
          {"doorway_block_s", blocking},
+         {"doorway_stand_s", standing},
          {"doors", doors}});
   }
   std::filesystem::create_directories(dir);
   std::ofstream(dir / "study.json") << study.dump(2) << "\n";
   std::ofstream csv(dir / "trials.csv");
-  csv << "condition,seed,residents,out,left_behind,t_evac,contacts,closest,doorway_block_s\n";
+  csv << "condition,seed,residents,out,left_behind,t_evac,contacts,closest,doorway_block_s,"
+         "doorway_stand_s\n";
   for (const auto& r : results) {
     csv << r.at("condition").get<std::string>() << "," << r.at("seed").get<std::uint64_t>() << ","
         << r.at("residents").get<int>() << "," << r.at("out").get<int>() << ","
@@ -395,7 +392,8 @@ void RunStudy(const StudyOptions& o) {
         << (r.at("t_evac").is_null() ? "" : fmt::format("{:.2f}", r.at("t_evac").get<double>()))
         << "," << r.at("contacts").get<int>() << ","
         << (r.at("closest").is_null() ? "" : fmt::format("{:.3f}", r.at("closest").get<double>()))
-        << "," << fmt::format("{:.1f}", r.at("doorway_block_s").get<double>()) << "\n";
+        << "," << fmt::format("{:.1f}", r.at("doorway_block_s").get<double>()) << ","
+        << fmt::format("{:.1f}", r.at("doorway_stand_s").get<double>()) << "\n";
   }
   DrawEvacuated(by_condition, base.time_limit, residents, dir / "evacuated.png");
   fmt::print("wrote {}, {} and {}\n", (dir / "study.json").string(), (dir / "trials.csv").string(),
