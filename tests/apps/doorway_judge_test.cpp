@@ -24,7 +24,7 @@ TEST(DoorwayBlockJudgeTest, TheRobotIsInADoorwayWithinHalfAMetreOfItsLineBetween
   EXPECT_FALSE(judge.InDoorway({-3.0, 0.0}));  // along the wall
 }
 
-TEST(DoorwayBlockJudgeTest, InADoorwayWithAResidentNearCountsAndStandingThereIsTheStrictPart) {
+TEST(DoorwayBlockJudgeTest, InADoorwayWithAResidentNearCountsAndTheTimeStandingThereApart) {
   DoorwayBlockJudge judge({Doorway()});
   const std::vector<Eigen::Vector2d> near{{0.0, 1.5}}, far{{0.0, 2.5}};
   judge.Step(0.1, {0.0, 0.2}, 0.6, far);  // driving through, nobody within 2 m
