@@ -381,12 +381,16 @@ void TwinWorld::Impl::UpdatePeople() {
         // the route (clinic two wards seed 23: a north-ward resident walking the corridor, pressed
         // into door_d's doorway as it stood open for the south ward, went round its leaf into the
         // south ward and walked into the ward's wall to the time limit).
+        // The route's doors are looked up only for a leaf on the far side (every walker meets
+        // every door each step).
         const double next_side = (next - d.fixed->centre).dot(d.fixed->normal);
-        const bool on_route =
-            p.door == int(k) || std::any_of(p.doorway_waypoints.begin(), p.doorway_waypoints.end(),
-                                            [&](const auto& w) { return w.second == int(k); });
+        const auto on_route = [&] {
+          return p.door == int(k) ||
+                 std::any_of(p.doorway_waypoints.begin(), p.doorway_waypoints.end(),
+                             [&](const auto& w) { return w.second == int(k); });
+        };
         const bool back_out =
-            !on_route && next_side * (edge - d.fixed->centre).dot(d.fixed->normal) < 0.0;
+            next_side * (edge - d.fixed->centre).dot(d.fixed->normal) < 0.0 && !on_route();
         const Eigen::Vector2d round =
             back_out ? Eigen::Vector2d(d.fixed->centre + d.fixed->normal *
                                                              (next_side >= 0.0 ? 1.0 : -1.0) *
