@@ -86,11 +86,13 @@ constexpr double kAsideGainM = 0.1;
 // with people standing within `reach` of it, other than someone waiting by the doorway: a group
 // yet to set off may as it operates, and it would have to drive back through them. Once under
 // way, people found standing at a door with someone by its doorway are waiting for it, and it
-// opens it for them once per hold window, waiting aside in between.
-// SUCCESS: operate now. FAILURE: the hold is over — someone came and nobody (moving or not; a
-// resident who cannot open the door waits still) has been near for `clear_for` seconds of
-// watching, or nobody at all was near for `wait_for` (they went ahead, or are elsewhere), or it
-// has held `max_hold`. RUNNING: watching.
+// opens it for them once per hold window, waiting aside in between (never at the actuator: they
+// may be behind it, and its standoff may be before the doorway), and not again for nobody once
+// they are through.
+// SUCCESS: operate now. FAILURE: the hold is over — someone came (or it opened for someone
+// waiting) and nobody (moving or not; a resident who cannot open the door waits still) has been
+// near for `clear_for` seconds of watching, or nobody at all was near for `wait_for` (they went
+// ahead, or are elsewhere), or it has held `max_hold`. RUNNING: watching.
 class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
  public:
   using TaskNode::TaskNode;
@@ -193,7 +195,10 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     if (held > Input<double>("max_hold"))
       return Release(StrCat("held for ", std::round(held), " s"));
     if (!came_ && unseen_ > Input<double>("wait_for")) return Release("nobody about");
-    if (came_ && unseen_ > Input<double>("clear_for")) return Release("everyone is through");
+    // ... as once it has opened for someone waiting: they go through when it opens, and may not
+    // be seen to come (kComingForSec on end) as the robot turns from the actuator.
+    if ((came_ || opened_for_waiting_) && unseen_ > Input<double>("clear_for"))
+      return Release("everyone is through");
     // Someone too near: the robot steps away from them first, whatever it was doing (a crowd
     // funnelling into the doorway spreads along the wall it waits by). A step under way is
     // re-aimed when someone now comes at where it ends (clinic seed 4: a resident skirting the
@@ -302,15 +307,27 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     const double every = found_waiting || all_waiting
                              ? std::max(Input<double>("every"), task_.config.door_hold_window)
                              : Input<double>("every");
-    if (OperateDue(every) && actuator_clear && !OperationJustFailed()) {
+    // Having opened for someone waiting, and nobody about any more before anyone came: they went
+    // through, and there is nobody to open it for (clinic escort seed 26: the robot pressed door_e
+    // twice more after the wheelchair user it had opened for went through, and reached the exit
+    // door, where they waited, after the time limit). Not once people came: residents still
+    // coming from beyond its watch then find the door shut (two wards, 20 of 50 trials slower).
+    const bool for_someone = came_ || !opened_for_waiting_ || around.near;
+    if (OperateDue(every) && actuator_clear && for_someone && !OperationJustFailed()) {
       operate_asked_at_ = belief_.now;
+      if (found_waiting || all_waiting) opened_for_waiting_ = true;
       return NodeStatus::kSuccess;
     }
     // Not at the actuator with anyone near, moving or not: its standoff is beside the doorway's
     // way in, and with the leaf open towards them a wide resident waiting there cannot get
     // between the leaf and the robot (clinic seed 13: a wheelchair user waited through 80 s of
     // the robot's presses, the robot at the button between presses, until the time limit).
-    const Pose2& wait_at = came_ || around.near || !actuator_clear ? spot_ : standoff_;
+    // Nor once it has opened for someone waiting: they may be where the laser does not see,
+    // behind it as it faces the actuator (clinic escort seed 26: at door_e, whose standoff is
+    // before the doorway, the robot waited there after the press, and the resident it had
+    // opened for could not pass it while the door stood open).
+    const Pose2& wait_at =
+        came_ || around.near || !actuator_clear || opened_for_waiting_ ? spot_ : standoff_;
     // Only the spot and the last kSpotClearM of the way there: from far back, the straight line
     // to it passes people it will never meet on its path (clinic: a resident waiting at door_e
     // kept the robot 14 m back from its spot, and the door shut, until max_hold). On the way, the
@@ -318,8 +335,14 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // Past those waiting (standing still), the robot's room is enough: the planner keeps it
     // off them (a metre kept it at the actuator beside a wheelchair user it had opened for).
     const double spot_clear = found_waiting || all_waiting ? kStandoffFreeM : kSpotClearM;
+    // Nor to set off from their way in: staying there holds up whoever is near more than driving
+    // out past them (clinic escort seed 26: a resident 0.8 m from the way to the spot kept the
+    // robot before door_e's doorway, and so themselves behind it, through two openings). Out of
+    // the lane it stops short as ever if the spot is taken.
+    const double set_off_clear =
+        InTheLane(pass, belief_.X_MB.translation()) ? kStandoffFreeM : spot_clear;
     if ((wait_at.translation() - belief_.X_MB.translation()).norm() > kAtSpotM &&
-        WayClear(wait_at, spot_clear, kSpotClearM)) {
+        WayClear(wait_at, set_off_clear, kSpotClearM)) {
       // Square to the way it drives, turning to watch at the spot (below): the laser sees both
       // ahead and back along the way. From the last door the way there runs away from where the
       // residents come: facing them the robot drove backwards, the blind sector leading, into a
@@ -525,6 +548,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     moving_since_.reset();
     unseen_ = 0.0;
     stood_open_ = false;
+    opened_for_waiting_ = false;
   }
 
   NodeStatus Release(const std::string& why) {
@@ -639,6 +663,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   Eigen::Vector2d room_to_{0.0, 0.0};     // where that step ends
   Time room_since_{};                     // when it began
   bool stood_open_{false};  // the door stood open kStillForSec in this hold with nobody moving
+  bool opened_for_waiting_{false};  // it operated for someone found waiting, in this hold
   std::optional<Eigen::Vector2d> driving_to_;  // where a drive of this node's under way goes
   double drive_clear_{0.0};  // [m] the room round its end that drive set off with (WayClear)
   std::optional<Time> letting_pass_since_;  // stopped for someone walking up behind

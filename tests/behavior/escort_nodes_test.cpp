@@ -321,6 +321,99 @@ TEST_F(HoldForResidentsTest, BetweenOperationsForSomeoneWaitingItWaitsAsideNotAt
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);
 }
 
+// Once it has opened for someone found waiting, it waits aside, not at the actuator, even with
+// them out of view (behind it as it faces the button: clinic escort seed 26, where door_e's
+// standoff is before the doorway and the resident could not pass the robot waiting there).
+TEST_F(HoldForResidentsTest, AfterOpeningForSomeoneWaitingItWaitsAsideWithThemOutOfView) {
+  BeginFarFromAShutDoor();
+  belief_.off_map_returns = {{0.5, 2.2}};  // waiting by the doorway
+  belief_.now = At(6.5);
+  motion_.StopBase();
+  ASSERT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // found waiting: it goes to open it
+  // Pressed; facing the wall, the robot no longer sees them.
+  belief_.X_MB = Standoff();
+  belief_.off_map_returns.clear();
+  belief_.now = At(12.0);
+  OperatedAgo(0.5);
+  motion_.StopBase();
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(NotedText("driving to the spot beside the door"));
+  ASSERT_GE(motion_.path().size(), 2u);
+  EXPECT_NEAR(motion_.path().back().x, Standoff().x + 1.5, 1e-6);
+}
+
+// Standing in the residents' way in, it sets off for its spot with someone standing 0.7 m from
+// the way there: staying holds them up more (clinic escort seed 26: a resident beside the way
+// kept the robot before door_e's doorway, and themselves behind it, through two openings). Out
+// of the way in, the same person keeps it where it is.
+TEST_F(HoldForResidentsTest, InTheirWayInItLeavesPastSomeoneStandingNearTheWayOut) {
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);
+  belief_.now = At(1.5);
+  OperatedAgo(0.0);
+  const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
+  belief_.moving_returns = {{-1.5, 0.5}};
+  belief_.off_map_returns = belief_.moving_returns;
+  const double came = ComeFrom(2.0);  // they came
+  belief_.moving_returns.clear();
+  // Someone standing 0.7 m below the last metre of the way from before the doorway to the
+  // spot, more than a metre from the spot itself.
+  const Eigen::Vector2d in_lane(0.3, 2.4);
+  const Eigen::Vector2d last_metre =
+      spot.translation() + (in_lane - spot.translation()).normalized();
+  const Eigen::Vector2d standing = last_metre + Eigen::Vector2d(0.0, -0.7);
+  ASSERT_GT((standing - spot.translation()).norm(), 1.0);
+  belief_.off_map_returns = {standing};
+  belief_.X_MB = {in_lane.x(), in_lane.y(), 0.0};
+  belief_.now = At(came + 0.5);
+  motion_.StopBase();
+  log_.Take();
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(NotedText("driving to the spot beside the door"));
+  // From beside the actuator, out of the lane, on the same line: it stays.
+  tree_.HaltTree();
+  log_.Take();
+  const Eigen::Vector2d out_of_lane =
+      spot.translation() + 1.3 * (in_lane - spot.translation()).normalized();
+  belief_.X_MB = {out_of_lane.x(), out_of_lane.y(), 0.0};
+  ASSERT_GT(out_of_lane.x(), 1.1);  // beyond the lane's half width (1.02 m)
+  belief_.now = At(came + 1.0);
+  motion_.StopBase();
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_FALSE(NotedText("driving to the spot"));
+}
+
+// Having opened for someone found waiting, who then went through: it does not operate again for
+// nobody, and the hold is over once nobody has been near for clear_for (clinic escort seed 26:
+// two more presses at door_e after the resident it had opened for went through, and the robot
+// reached the exit door, where they waited, after the time limit).
+TEST_F(HoldForResidentsTest, OnceWhoeverItOpenedForWentThroughItReleasesTheDoor) {
+  BeginFarFromAShutDoor();
+  belief_.off_map_returns = {{0.5, 2.2}};  // waiting by the doorway
+  belief_.now = At(6.5);
+  motion_.StopBase();
+  ASSERT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // found waiting: it goes to open it
+  // Pressed at 7 s; they went through; the robot watches from its spot, facing the way in.
+  belief_.now = At(7.0);
+  OperatedAgo(0.0);
+  belief_.off_map_returns.clear();
+  const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
+  const Eigen::Vector2d way_in = Eigen::Vector2d(0.0, 2.0) - spot.translation();
+  belief_.X_MB = {spot.x, spot.y, std::atan2(way_in.y(), way_in.x())};
+  NodeStatus status = NodeStatus::kRunning;
+  double t = 7.0;
+  // Past `every` (6 s) and the door shut: it would operate again before the wait_for (10 s) of
+  // a hold nobody came to ran out.
+  while (status == NodeStatus::kRunning && t < 20.0) {
+    t += 0.5;
+    belief_.now = At(t);
+    motion_.StopBase();
+    status = tree_.TickOnce();
+  }
+  EXPECT_EQ(status, NodeStatus::kFailure) << "at " << t;
+  EXPECT_TRUE(NotedText("everyone is through"));
+  EXPECT_LT(t, 7.0 + 6.0);
+}
+
 TEST_F(HoldForResidentsTest, GoesAsideForSomeoneWaitingBesideTheWayThere) {
   // Someone came, and stopped 0.6 m beside the way from the actuator to the spot, waiting (a
   // wheelchair user held up there): past someone standing still, the robot's room is enough (a
