@@ -5,7 +5,8 @@
 // every evacuee is out (at the assembly point beyond the exit) or at the time limit. Printed: a
 // table per condition (evacuation time median with its 95 % interval, people left behind,
 // robot-resident contacts and closest approach, time the robot was in a doorway with a resident
-// within 2 m, and the part of it the robot stood there), per-door flow and queue time, and for the
+// within 2 m, and the part of it the robot stood there), per-door flow, queue time and how often
+// residents and the robot opened it, and for the
 // robot and the propped doors the paired difference from no robot on the same seeds (median with
 // its 95 % interval, seeds faster and slower: what the condition buys, with the seeds' own spread
 // taken out); written: DIR/study.json, DIR/trials.csv, DIR/evacuated.png (people out vs time,
@@ -167,11 +168,24 @@ nlohmann::json RunStudyTrial(const twin::Scenario& scenario, const twin::WorldDe
     }
   }
   std::sort(arrivals.begin(), arrivals.end());
+  // Who opened each door, and how often: a resident at its actuator, or the robot (a press or a
+  // wave). A door the robot keeps open is one the residents need not operate.
+  std::map<std::string, int> by_residents, by_robot;
+  for (const twin::TwinEvent& e : twin_world.events()) {
+    if (e.kind == "door_operated") ++by_residents[e.subject];
+    if (e.kind == "button_pressed") ++by_robot[e.subject];
+  }
+  int resident_operations = 0, robot_operations = 0;
   nlohmann::json doors = nlohmann::json::object();
   for (const auto& l : lines) {
     const auto& c = crossings[l.name];
-    if (c.empty() && queue[l.name] == 0.0) continue;
+    resident_operations += by_residents[l.name];
+    robot_operations += by_robot[l.name];
+    if (c.empty() && queue[l.name] == 0.0 && by_residents[l.name] == 0 && by_robot[l.name] == 0)
+      continue;
     doors[l.name] = {{"crossings", c.size()},
+                     {"operated_by_residents", by_residents[l.name]},
+                     {"operated_by_robot", by_robot[l.name]},
                      {"flow", c.size() >= 2 && c.back() > c.front()
                                   ? double(c.size() - 1) / (c.back() - c.front())
                                   : 0.0},
@@ -192,6 +206,8 @@ nlohmann::json RunStudyTrial(const twin::Scenario& scenario, const twin::WorldDe
                                                            : nlohmann::json(nullptr)},
           {"doorway_block_s", doorway_judge.in_doorway_s()},
           {"doorway_stand_s", doorway_judge.standing_s()},
+          {"resident_operations", resident_operations},
+          {"robot_operations", robot_operations},
           {"time", result.simulated_time}};
 }
 
@@ -327,7 +343,7 @@ void RunStudy(const StudyOptions& o) {
     std::vector<double> times;
     int left = 0, contacts = 0;
     double closest = std::numeric_limits<double>::infinity(), blocking = 0.0, standing = 0.0;
-    std::map<std::string, std::vector<double>> flow, queue;
+    std::map<std::string, std::vector<double>> flow, queue, by_residents, by_robot;
     for (const auto& t : trials) {
       residents = t.at("residents").get<int>();
       times.push_back(t_by_seed[c].at(t.at("seed").get<std::uint64_t>()));
@@ -339,6 +355,8 @@ void RunStudy(const StudyOptions& o) {
       for (const auto& [door, d] : t.at("doors").items()) {
         if (d.at("flow").get<double>() > 0.0) flow[door].push_back(d.at("flow").get<double>());
         queue[door].push_back(d.at("queue_s").get<double>());
+        by_residents[door].push_back(d.at("operated_by_residents").get<double>());
+        by_robot[door].push_back(d.at("operated_by_robot").get<double>());
       }
     }
     const MedianCi ci = CalcMedianCi(times);
@@ -350,9 +368,16 @@ void RunStudy(const StudyOptions& o) {
     nlohmann::json doors = nlohmann::json::object();
     for (const auto& [door, q] : queue) {
       const double f = flow[door].empty() ? 0.0 : CalcMedianCi(flow[door]).median;
-      doors[door] = {{"flow_median", f}, {"queue_s_median", CalcMedianCi(q).median}};
-      fmt::print("    {:<12} flow {:.2f} persons/s, queue {:.1f} s per person (medians)\n", door, f,
-                 CalcMedianCi(q).median);
+      const double residents_op = CalcMedianCi(by_residents[door]).median;
+      const double robot_op = CalcMedianCi(by_robot[door]).median;
+      doors[door] = {{"flow_median", f},
+                     {"queue_s_median", CalcMedianCi(q).median},
+                     {"operated_by_residents_median", residents_op},
+                     {"operated_by_robot_median", robot_op}};
+      fmt::print(
+          "    {:<12} flow {:.2f} persons/s, queue {:.1f} s per person, opened by residents {:g}, "
+          "by the robot {:g} (medians)\n",
+          door, f, CalcMedianCi(q).median, residents_op, robot_op);
     }
     nlohmann::json vs = nullptr;
     if (c != "no_robot" && t_by_seed.count("no_robot")) {
@@ -384,7 +409,7 @@ void RunStudy(const StudyOptions& o) {
   std::ofstream(dir / "study.json") << study.dump(2) << "\n";
   std::ofstream csv(dir / "trials.csv");
   csv << "condition,seed,residents,out,left_behind,t_evac,contacts,closest,doorway_block_s,"
-         "doorway_stand_s\n";
+         "doorway_stand_s,resident_operations,robot_operations\n";
   for (const auto& r : results) {
     csv << r.at("condition").get<std::string>() << "," << r.at("seed").get<std::uint64_t>() << ","
         << r.at("residents").get<int>() << "," << r.at("out").get<int>() << ","
@@ -393,7 +418,9 @@ void RunStudy(const StudyOptions& o) {
         << "," << r.at("contacts").get<int>() << ","
         << (r.at("closest").is_null() ? "" : fmt::format("{:.3f}", r.at("closest").get<double>()))
         << "," << fmt::format("{:.1f}", r.at("doorway_block_s").get<double>()) << ","
-        << fmt::format("{:.1f}", r.at("doorway_stand_s").get<double>()) << "\n";
+        << fmt::format("{:.1f}", r.at("doorway_stand_s").get<double>()) << ","
+        << r.at("resident_operations").get<int>() << "," << r.at("robot_operations").get<int>()
+        << "\n";
   }
   DrawEvacuated(by_condition, base.time_limit, residents, dir / "evacuated.png");
   fmt::print("wrote {}, {} and {}\n", (dir / "study.json").string(), (dir / "trials.csv").string(),

@@ -453,6 +453,16 @@ TEST(EgressCliTest, EvacStudyComparesTheThreeConditionsOnTheSameSeeds) {
     ASSERT_EQ(c.at("doors").size(), 1u) << name << ": " << c.at("doors").dump();
     EXPECT_TRUE(c.at("doors").contains("lab_door")) << name;
   }
+  // Who opened the door: without the robot, residents (it starts shut); escorting, the robot
+  // presses it on arriving; propped open, nobody.
+  const auto opened = [&](const std::string& c, const char* key) {
+    return by[c].at("doors").at("lab_door").at(key).get<double>();
+  };
+  EXPECT_GE(opened("no_robot", "operated_by_residents_median"), 1.0);
+  EXPECT_EQ(opened("no_robot", "operated_by_robot_median"), 0.0);
+  EXPECT_GE(opened("robot", "operated_by_robot_median"), 1.0);
+  EXPECT_EQ(opened("propped_open", "operated_by_residents_median"), 0.0);
+  EXPECT_EQ(opened("propped_open", "operated_by_robot_median"), 0.0);
   EXPECT_LE(by["propped_open"].at("t_evac_median_s").get<double>(),
             by["no_robot"].at("t_evac_median_s").get<double>());
   EXPECT_EQ(by["robot"].at("contacts").get<int>(), 0);
