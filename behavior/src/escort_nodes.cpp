@@ -1,6 +1,6 @@
 // The escort's task nodes (behavior/trees/evacuation_escort.xml): HoldForResidents keeps a door
 // open for the people being evacuated, from a spot beside the door out of their way;
-// IsNobodyComing breaks an operation off when they come.
+// IsNobodyComing (escort_guard.cpp) breaks an operation off when they come.
 
 #include "escort_watch.h"
 #include "task_node_support.h"
@@ -671,38 +671,11 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   bool aside_chosen_{false};                // the spot aside, while letting them pass
 };
 
-// IsNobodyComing: the guard of an operation during a hold (a ReactiveSequence above
-// ApproachButton and PressButton / WaveAtPlate): FAILURE as soon as someone moves near the door
-// on the robot's side (LookAround, as HoldForResidents sees them), so the robot breaks off
-// instead of standing at the actuator, beside the doorway, as the residents arrive.
-class IsNobodyComing final : public TaskNode<bt::ConditionNode> {
- public:
-  using TaskNode::TaskNode;
-  static PortsList ProvidedPorts() {
-    return {InputPort<std::string>("door", "door held open for the residents"),
-            InputPort<double>("near_door", 5.0,
-                              "laser returns off the map this close to the doorway, on the "
-                              "robot's side, are watched for motion [m]"),
-            InputPort<double>("watch_radius", 6.0,
-                              "tracked people this close to the doorway, on the robot's side, "
-                              "are watched [m]")};
-  }
-  NodeStatus Tick() override {
-    const std::string door = Door();
-    const DoorPass pass = CalcDoorPass(*task_.map, door, belief_.X_MB);
-    const Surroundings around =
-        LookAround(belief_, pass, Input<double>("watch_radius"), Input<double>("near_door"));
-    if (!around.moving) return NodeStatus::kSuccess;
-    Note(StrCat("someone coming to ", door, " (", around.mover, "): breaking off"));
-    return NodeStatus::kFailure;
-  }
-};
-
 }  // namespace
 
 void RegisterEscortNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services) {
   Register<HoldForResidents>(factory, "HoldForResidents", services);
-  Register<IsNobodyComing>(factory, "IsNobodyComing", services);
+  RegisterEscortGuard(factory, services);
 }
 
 }  // namespace egress::behavior::detail

@@ -404,5 +404,7 @@ void RegisterGraspNodes(bt::BehaviorTreeFactory& factory, const TaskServices* se
 void RegisterReleaseNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 void RegisterRouteNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 void RegisterEscortNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
+/// IsNobodyComing (escort_guard.cpp), registered by RegisterEscortNodes.
+void RegisterEscortGuard(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 
 }  // namespace egress::behavior::detail
