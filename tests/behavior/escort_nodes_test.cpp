@@ -88,6 +88,16 @@ class HoldForResidentsTest : public EscortNodesTest {
     EXPECT_TRUE(NotedText("everyone is through"));
     return t;
   }
+  // The robot comes from the far end of the room to a shut door; someone stands still by the
+  // doorway (0.6 m from the standoff) from the start. At 6.5 s they have waited long enough: the
+  // tick's status (SUCCESS: it goes to open the door for them).
+  NodeStatus OpenForSomeoneFoundWaiting() {
+    BeginFarFromAShutDoor();
+    belief_.off_map_returns = {{0.5, 2.2}};
+    belief_.now = At(6.5);
+    motion_.StopBase();
+    return tree_.TickOnce();
+  }
   // With residents coming and no operation due, the robot sets off to its spot at 2 s, from
   // `from(spot)`. Returns the spot.
   Pose2 DriveToTheSpotFrom(const std::function<Pose2(const Pose2&)>& from) {
@@ -325,11 +335,7 @@ TEST_F(HoldForResidentsTest, BetweenOperationsForSomeoneWaitingItWaitsAsideNotAt
 // them out of view (behind it as it faces the button: clinic escort seed 26, where door_e's
 // standoff is before the doorway and the resident could not pass the robot waiting there).
 TEST_F(HoldForResidentsTest, AfterOpeningForSomeoneWaitingItWaitsAsideWithThemOutOfView) {
-  BeginFarFromAShutDoor();
-  belief_.off_map_returns = {{0.5, 2.2}};  // waiting by the doorway
-  belief_.now = At(6.5);
-  motion_.StopBase();
-  ASSERT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // found waiting: it goes to open it
+  ASSERT_EQ(OpenForSomeoneFoundWaiting(), NodeStatus::kSuccess);
   // Pressed; facing the wall, the robot no longer sees them.
   belief_.X_MB = Standoff();
   belief_.off_map_returns.clear();
@@ -387,11 +393,7 @@ TEST_F(HoldForResidentsTest, InTheirWayInItLeavesPastSomeoneStandingNearTheWayOu
 // two more presses at door_e after the resident it had opened for went through, and the robot
 // reached the exit door, where they waited, after the time limit).
 TEST_F(HoldForResidentsTest, OnceWhoeverItOpenedForWentThroughItReleasesTheDoor) {
-  BeginFarFromAShutDoor();
-  belief_.off_map_returns = {{0.5, 2.2}};  // waiting by the doorway
-  belief_.now = At(6.5);
-  motion_.StopBase();
-  ASSERT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // found waiting: it goes to open it
+  ASSERT_EQ(OpenForSomeoneFoundWaiting(), NodeStatus::kSuccess);
   // Pressed at 7 s; they went through; the robot watches from its spot, facing the way in.
   belief_.now = At(7.0);
   OperatedAgo(0.0);
