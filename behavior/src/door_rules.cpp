@@ -104,7 +104,13 @@ bool IsPassageBusy(const TaskServices& task, const std::string& door, double hor
   for (const auto& entry : task.belief->world.people) {
     if (IsHoldingDoorAside(task, entry, door)) continue;
     const Eigen::Vector2d& p = entry.person.p_MP;
-    const Eigen::Vector2d later = p + entry.person.v_MP * std::max(horizon, 0.0);
+    // Someone standing stays where they are: a standing track's jitter (kWalkingMps) over the
+    // horizon of a pass reached the opening from metres away (S2 seed 2005: a crosser standing
+    // 2.9 m off at 0.15 m/s "would pass" over 6.5 s, and the robot waited at the entry until
+    // the door shut).
+    const Eigen::Vector2d later = entry.person.v_MP.norm() < detail::kWalkingMps
+                                      ? p
+                                      : p + entry.person.v_MP * std::max(horizon, 0.0);
     if ((ClosestPointOnSegment(pass.centre, p, later) - pass.centre).norm() <
         task.config.passage_clearance)
       return true;

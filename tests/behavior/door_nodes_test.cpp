@@ -12,6 +12,7 @@ using node_testing::At;
 
 class DoorNodesTest : public node_testing::TaskNodeFixture {
  protected:
+  double SlideOntoTheAxisAfterLookingThrough();
   // ApproachButton from (0, 1) puts its plan in the visit on `blackboard` (with `operated_at`, an
   // earlier press, if given); the leaf is last seen at `seen_at` [s], at `angle_deg` and
   // `motion`, and not since (from beside the actuator it is behind the jamb); then the robot
@@ -319,7 +320,9 @@ TEST_F(DoorNodesTest, APressRightAfterTheRobotsOwnOpeningPassesInThatOpeningsWin
   }
 }
 
-TEST_F(DoorNodesTest, TraverseDoorFromBesideTheLaneLooksThroughTheOpeningFromItsEdgeFirst) {
+// From the button's standoff beside the lane of the lab door (which opens away): to the lane's
+// edge, look through the opening, then slide onto the axis. Returns the slide's planned duration.
+double DoorNodesTest::SlideOntoTheAxisAfterLookingThrough() {
   auto blackboard = bt::Blackboard::Create();
   DoorVisit visit;
   visit.door = "lab_door";
@@ -331,8 +334,11 @@ TEST_F(DoorNodesTest, TraverseDoorFromBesideTheLaneLooksThroughTheOpeningFromIts
   belief_.world.doors[0].state.motion = perception::DoorMotion::kOpening;
   belief_.door_open_since.clear();
   belief_.now = At(1.0);
-  ASSERT_EQ(tree.TickOnce(), NodeStatus::kRunning);
-  ASSERT_GE(motion_.path().size(), 2u);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  if (motion_.path().size() < 2) {
+    ADD_FAILURE() << "no path";
+    return 0.0;
+  }
   // First to the lane's edge on the entry line: half the opening, the footprint and 5 cm out.
   const Pose2 edge = motion_.path().back();
   EXPECT_NEAR(edge.x, 0.475 + services_.config.footprint_radius + 0.05, 1e-6);
@@ -355,9 +361,29 @@ TEST_F(DoorNodesTest, TraverseDoorFromBesideTheLaneLooksThroughTheOpeningFromIts
   belief_.now = At(4.6);
   DoorSeenOpen(80.0, 0.5);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
-  ASSERT_TRUE(motion_.base_moving());
+  EXPECT_TRUE(motion_.base_moving());
   EXPECT_NEAR(motion_.path().back().x, 0.0, 1e-6);
   EXPECT_NEAR(motion_.path().back().y, edge.y, 1e-6);
+  return motion_.base_duration();
+}
+
+TEST_F(DoorNodesTest, TraverseDoorFromBesideTheLaneLooksThroughTheOpeningFromItsEdgeFirst) {
+  // The window from its press leaves time for the slide at the door speed only.
+  const planning::TrajectoryConfig& trajectory = motion_.trajectory_config();
+  const double slide = 0.475 + services_.config.footprint_radius + 0.05;
+  EXPECT_NEAR(SlideOntoTheAxisAfterLookingThrough(),
+              planning::SegmentDuration(slide, true, trajectory), 1e-6);
+}
+
+TEST_F(DoorNodesTest, TraverseDoorSlidesOntoTheAxisAtTheNominalSpeedWhenTheWindowLeavesTime) {
+  // A longer hold window: the slide across the lane, in front of an opening whose far side the
+  // robot may not see, goes at the nominal speed (it stops short of anyone stepping out).
+  services_.config.door_hold_window = 30.0;
+  const planning::TrajectoryConfig& trajectory = motion_.trajectory_config();
+  ASSERT_LT(trajectory.nominal_speed, trajectory.door_speed);
+  const double slide = 0.475 + services_.config.footprint_radius + 0.05;
+  EXPECT_NEAR(SlideOntoTheAxisAfterLookingThrough(),
+              planning::SegmentDuration(slide, false, trajectory), 1e-6);
 }
 
 TEST_F(DoorNodesTest, TraverseDoorOutOfViewOfTheLeafGivesItTheOperatorsOpeningTime) {

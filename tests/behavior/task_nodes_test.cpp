@@ -168,6 +168,15 @@ TEST_F(DoorZoneRulesTest, SomeoneWalkingPastTheFarSideMakesThePassageBusyOverThe
   passer.person.v_MP = {-1.0, 0.0};
   belief_.world.people = {passer};
   EXPECT_FALSE(IsPassageBusy(services_, "lab_door", 10.0));
+  // Standing 2.9 m from it, the track jittering 0.15 m/s towards it: standing (under
+  // kWalkingMps), so not busy however long the pass (S2 seed 2005); walking at that way, busy.
+  auto stander = StillPerson({-1.76, 0.74}, perception::PersonIntent::kStationary);
+  stander.person.v_MP = {0.04, 0.15};
+  belief_.world.people = {stander};
+  EXPECT_FALSE(IsPassageBusy(services_, "lab_door", 6.5));
+  stander.person.v_MP = {0.3, 0.6};
+  belief_.world.people = {stander};
+  EXPECT_TRUE(IsPassageBusy(services_, "lab_door", 6.5));
   // Standing 1.5 m from it: busy whatever the horizon; unless the rule is off.
   belief_.world.people = {StillPerson({1.5, 3.0}, perception::PersonIntent::kStationary)};
   EXPECT_TRUE(IsPassageBusy(services_, "lab_door", 0.0));

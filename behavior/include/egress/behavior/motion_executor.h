@@ -74,6 +74,10 @@ class MotionExecutor {
   Eigen::Vector2d planned_velocity() const {
     return base_active_ && !bug_ ? controller_.planned_velocity() : Eigen::Vector2d::Zero();
   }
+  /// How long the path being followed was planned to take (0 when idle or on a Bug2 detour) [s].
+  double base_duration() const {
+    return base_active_ && !bug_ ? controller_.trajectory_duration() : 0.0;
+  }
   /// Stops the base: zero velocity from the next control step.
   void StopBase();
   /// Moves the arm through `knots` (seconds from now, pose). Sent with the next control step.

@@ -11,7 +11,11 @@
 ///
 /// A track is *confirmed* (a person, not a table leg) once the camera has seen it, or the laser
 /// has seen it `confirm_laser_hits` times and it has moved `confirm_motion` within
-/// `confirm_window_s` (from where it was first seen, or where it was a window later, and so on):
+/// `confirm_window_s` (from where it was first seen, or where it was a window later, and so on),
+/// stepping on between each of its last three laser measurements (at confirm_motion /
+/// confirm_window_s or faster) and not back where it was before it went elsewhere (ComesBack): a
+/// track taking two table legs by turns jumps and stops, or jumps back, where a walker keeps
+/// going;
 /// a person walks that far in well under the window; the returns of a jamb or a box's edge creep
 /// as the robot's viewpoint changes, a few centimetres a second (the clinic's door_c jamb read
 /// as a person 0.3 m from its birth after 30 s, and held the robot off its door). A track is
@@ -103,6 +107,8 @@ struct FusedTrack {
   /// Per sensor (index PersonSource): its last measurement, for velocity from the same sensor
   /// (the camera's placement and the laser's leg midpoint disagree by a few centimetres).
   std::array<std::optional<std::pair<Time, Eigen::Vector2d>>, 2> last_by_source;
+  /// Until confirmed: its laser measurements (stamp, position) since its confirm window began.
+  std::vector<std::pair<Time, Eigen::Vector2d>> laser_path;
 };
 
 class FusedPersonTracker {

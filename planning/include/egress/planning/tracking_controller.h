@@ -59,6 +59,8 @@ class TrackingController {
   /// time scaling (zero when idle): which way the base is going.
   const Eigen::Vector2d& planned_velocity() const { return planned_v_M_; }
   const std::string& trip_reason() const { return trip_reason_; }
+  /// How long the trajectory being tracked was planned to take (0 when idle) [s].
+  double trajectory_duration() const { return trajectory_ ? trajectory_->duration() : 0.0; }
 
  private:
   ControllerConfig config_;
