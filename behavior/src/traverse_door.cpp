@@ -65,9 +65,13 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
         const double slide = (entry - belief_.X_MB.translation()).norm();
         const double slide_time =
             planning::SegmentDuration(slide, true, task_.motion->trajectory_config());
-        // Slowly if the window leaves time for that (slide_slowly_).
+        // Slowly if the window leaves time for that (slide_slowly_), with time to spare: the
+        // line-up ends a little after its trajectory (the base settling onto the pose; over DDS,
+        // odometry a step or two late), and an entry reached with the window spent is a failed
+        // pass and a second press (S1 across two processes: 24 s later than in-process).
         const double slow_slide_time =
-            planning::SegmentDuration(slide, false, task_.motion->trajectory_config());
+            planning::SegmentDuration(slide, false, task_.motion->trajectory_config()) +
+            kSlowSlideSpareTime;
         const double looked = ToSeconds(belief_.now - waiting_since_);
         // From beside the lane the leaf is often behind the jamb: its clearance is checked
         // again on the axis, where it is in view.
@@ -253,6 +257,9 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     return false;
   }
 
+  // What the window must leave beyond the slow slide's trajectory for the robot to take it [s]:
+  // in-process the line-up ends 0.05 s after its trajectory, over DDS 0.5 s and more.
+  static constexpr double kSlowSlideSpareTime = 1.0;
   // Off the opening's centre line by no more than this, the robot drives straight through [m].
   static constexpr double kSquareUpTolerance = 0.02;
   // Nearer the door line than this, a passage turned busy no longer stops the drive through: the
