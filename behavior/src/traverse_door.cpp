@@ -12,11 +12,11 @@ namespace {
 // Drives through a door in two legs: to the entry pose on the door's axis (the arm tucking on
 // the way), where the laser sees through the opening; then, once the leaf leaves room for the
 // footprint, through the doorway to the exit pose. Both legs run at the door speed (the ADA
-// hold window is short), but for the slide from the lane's edge when the window leaves time for
-// the nominal speed (slide_slowly_). Coming from beside the lane to a door that opens away, the
-// first leg stops at the lane's edge until the leaf is open and the robot has looked through the
-// opening (TaskConfig::door_peek_time): whoever waited on the far side is seen setting off before
-// the robot stands in their way.
+// hold window is short), but for the slide from the lane's edge, as slowly as the window leaves
+// time for, down to the nominal speed (slide_speed_). Coming from beside the lane to a door that
+// opens away, the first leg stops at the lane's edge until the leaf is open and the robot has
+// looked through the opening (TaskConfig::door_peek_time): whoever waited on the far side is seen
+// setting off before the robot stands in their way.
 class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
  public:
   using TaskNode::TaskNode;
@@ -65,13 +65,8 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
         const double slide = (entry - belief_.X_MB.translation()).norm();
         const double slide_time =
             planning::SegmentDuration(slide, true, task_.motion->trajectory_config());
-        // Slowly if the window leaves time for that (slide_slowly_), with time to spare: the
-        // line-up ends a little after its trajectory (the base settling onto the pose; over DDS,
-        // odometry a step or two late), and an entry reached with the window spent is a failed
-        // pass and a second press (S1 across two processes: 24 s later than in-process).
         const double slow_slide_time =
-            planning::SegmentDuration(slide, false, task_.motion->trajectory_config()) +
-            kSlowSlideSpareTime;
+            planning::SegmentDuration(slide, false, task_.motion->trajectory_config());
         const double looked = ToSeconds(belief_.now - waiting_since_);
         // From beside the lane the leaf is often behind the jamb: its clearance is checked
         // again on the axis, where it is in view.
@@ -88,7 +83,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
           }
           return NodeStatus::kRunning;
         }
-        slide_slowly_ = window_leaves(slow_slide_time);
+        slide_speed_ = SlideSpeed(slide, slide_time, slow_slide_time, window_leaves);
         if (const NodeStatus s = StartLineUp(); s != NodeStatus::kRunning) return s;
         return NodeStatus::kRunning;
       }
@@ -206,9 +201,10 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     const Pose2 X_MB_entry{entry.x(), entry.y(), yaw_};
     const std::vector<Pose2> line_up = LineUpPath(task_, door_, pass_, belief_.X_MB);
     if (task_.planner->IsPathValid(line_up)) {
-      const bool door_speed = phase_ != Phase::kPeeking || !slide_slowly_;
-      task_.motion->FollowPath(line_up, std::vector<bool>(line_up.size() - 1, door_speed),
-                               TuckedArm(*task_.model), belief_.now);
+      const std::optional<double> slide_speed =
+          phase_ == Phase::kPeeking ? slide_speed_ : std::nullopt;
+      task_.motion->FollowPath(line_up, std::vector<bool>(line_up.size() - 1, !slide_speed),
+                               TuckedArm(*task_.model), belief_.now, slide_speed);
       Note("lining up on the door's axis");
     } else {
       const NodeStatus s = StartPath(
@@ -257,9 +253,6 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     return false;
   }
 
-  // What the window must leave beyond the slow slide's trajectory for the robot to take it [s]:
-  // in-process the line-up ends 0.05 s after its trajectory, over DDS 0.5 s and more.
-  static constexpr double kSlowSlideSpareTime = 1.0;
   // Off the opening's centre line by no more than this, the robot drives straight through [m].
   static constexpr double kSquareUpTolerance = 0.02;
   // Nearer the door line than this, a passage turned busy no longer stops the drive through: the
@@ -274,7 +267,36 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
   // base needs ~0.35 m to stop (H12 seed 2093: someone stepping out from behind the leaf at
   // 2 m/s met the robot still sliding towards their way as it braked, 0.14 m off; at half the
   // speed it is still by the lane's edge when they come).
-  bool slide_slowly_{false};
+  // The slide's speed when slower than the door speed (nullopt: at the door speed) [m/s].
+  std::optional<double> slide_speed_;
+  // The slowest slide, no slower than the nominal speed, that the window leaves time for with
+  // kSlowSlideSpareTime to spare; nullopt for the door speed. `slide` [m] takes `fast_time` [s]
+  // at the door speed, `slow_time` at the nominal speed; `window_leaves(t)`: whether the window
+  // leaves time for the pass after a slide of t seconds.
+  template <class WindowLeaves>
+  std::optional<double> SlideSpeed(double slide, double fast_time, double slow_time,
+                                   const WindowLeaves& window_leaves) const {
+    if (slow_time <= fast_time || !window_leaves(fast_time + kSlowSlideSpareTime))
+      return std::nullopt;
+    double t = slow_time;
+    if (!window_leaves(slow_time + kSlowSlideSpareTime)) {
+      // The window's end is a threshold in the slide's time: halve the bracket [fast, slow].
+      double lo = fast_time, hi = slow_time;
+      for (int i = 0; i < 12; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (window_leaves(mid + kSlowSlideSpareTime) ? lo : hi) = mid;
+      }
+      t = lo;
+    }
+    const double min_duration = task_.motion->trajectory_config().min_duration;
+    if (t <= std::max(fast_time, min_duration) + 1e-3) return std::nullopt;
+    return slide / t;
+  }
+  // What the window must leave beyond the slide's trajectory for a slide slower than the door
+  // speed [s]: the line-up ends a little after its trajectory (in-process 0.05 s; over DDS, with
+  // odometry a step or two late, 0.5 s and more), and an entry reached with the window spent is
+  // a failed pass and a second press (S1 across two processes: 24 s later than in-process).
+  static constexpr double kSlowSlideSpareTime = 1.0;
   // Farther out than the ordinary entry distance by more than this, the pass stops there first
   // to look through (nearer, it sets off slowly enough as it is) [m].
   static constexpr double kLookThroughMinStep = 0.2;

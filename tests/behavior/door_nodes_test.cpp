@@ -370,7 +370,8 @@ double DoorNodesTest::SlideOntoTheAxisAfterLookingThrough(std::optional<bt::Tree
 }
 
 TEST_F(DoorNodesTest, TraverseDoorFromBesideTheLaneLooksThroughTheOpeningFromItsEdgeFirst) {
-  // The window from its press leaves time for the slide at the door speed only.
+  // A 9 s window from the press leaves time for the slide at the door speed only.
+  services_.config.door_hold_window = 9.0;
   const planning::TrajectoryConfig& trajectory = motion_.trajectory_config();
   const double slide = 0.475 + services_.config.footprint_radius + 0.05;
   EXPECT_NEAR(SlideOntoTheAxisAfterLookingThrough(),
@@ -388,27 +389,34 @@ TEST_F(DoorNodesTest, TraverseDoorSlidesOntoTheAxisAtTheNominalSpeedWhenTheWindo
               planning::SegmentDuration(slide, false, trajectory), 1e-6);
 }
 
-// The slow slide is taken only when the window leaves time to spare at the entry: a line-up that
-// ends a little late (the base settling; over DDS odometry a step or two late) still finds the
-// door passable. A slide taken slowly with the window just enough left the robot at the entry of
-// a door it no longer had time to pass: a failed pass and a second press (S1 over DDS, +24 s).
-TEST_F(DoorNodesTest, TraverseDoorSlidesSlowlyOnlyWithTimeToSpareAtTheEntry) {
+// The slide goes as slowly as the window leaves time for with time to spare at the entry, down to
+// the nominal speed: a line-up that ends a little late (the base settling; over DDS odometry a
+// step or two late) still finds the door passable. A slide at the nominal speed taken with the
+// window just enough left the robot at the entry of a door it no longer had time to pass: a
+// failed pass and a second press (S1 over DDS, +24 s).
+TEST_F(DoorNodesTest, TraverseDoorSlidesAsSlowlyAsTheWindowLeavesTimeForWithTimeToSpare) {
   const planning::TrajectoryConfig& trajectory = motion_.trajectory_config();
   const double slide = 0.475 + services_.config.footprint_radius + 0.05;
+  const double fast = planning::SegmentDuration(slide, true, trajectory);
   const double slow = planning::SegmentDuration(slide, false, trajectory);
-  int slow_slides = 0, fast_slides = 0;
-  for (double window = 10.0; window <= 20.0; window += 0.1) {
+  int at_door_speed = 0, between = 0, at_nominal_speed = 0;
+  double previous = 0.0;
+  for (double window = 9.0; window <= 13.0; window += 0.1) {
     SCOPED_TRACE(window);
     services_.config.door_hold_window = window;
     std::optional<bt::Tree> tree;
     log_.Take();
     const double duration = SlideOntoTheAxisAfterLookingThrough(&tree);
     ASSERT_TRUE(tree.has_value());
-    if (std::abs(duration - slow) > 1e-6) {
-      ++fast_slides;
+    EXPECT_GE(duration, previous - 1e-9) << "a longer window, a slide no faster";
+    EXPECT_GE(duration, fast - 1e-9);
+    EXPECT_LE(duration, slow + 1e-9);
+    previous = duration;
+    if (duration < fast + 1e-6) {
+      ++at_door_speed;
       continue;
     }
-    ++slow_slides;
+    ++(duration > slow - 1e-6 ? at_nominal_speed : between);
     // At the entry 0.9 s after the slide's trajectory, the leaf open and steady as before.
     const Pose2 entry = motion_.path().back();
     motion_.StopBase();
@@ -419,9 +427,11 @@ TEST_F(DoorNodesTest, TraverseDoorSlidesSlowlyOnlyWithTimeToSpareAtTheEntry) {
     EXPECT_EQ(tree->TickOnce(), NodeStatus::kRunning);
     EXPECT_TRUE(NotedText("driving through")) << "slid slowly, then found no time to pass";
   }
-  // The sweep crosses the boundary: the default 10 s slides at the door speed, long ones slowly.
-  EXPECT_GT(slow_slides, 0);
-  EXPECT_GT(fast_slides, 0);
+  // The sweep crosses the range: a 9 s window slides at the door speed, 13 s at the
+  // nominal speed, and those between as slowly as they leave time for.
+  EXPECT_GT(at_door_speed, 0);
+  EXPECT_GT(between, 0);
+  EXPECT_GT(at_nominal_speed, 0);
 }
 
 TEST_F(DoorNodesTest, TraverseDoorOutOfViewOfTheLeafGivesItTheOperatorsOpeningTime) {
