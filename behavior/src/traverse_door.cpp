@@ -261,13 +261,13 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
   // zone) [m].
   static constexpr double kPassageCommitDistance = 0.65;
   // The slide from the lane's edge (after the look through, PeekPose) onto the door's axis runs
-  // at the nominal speed, not the door speed, when the hold window leaves time for that: it
+  // as slowly as the hold window leaves time for, down to the nominal speed (SlideSpeed): it
   // crosses the lane in front of the opening, whose far side the robot may not see (behind the
   // leaf), and a rest-to-rest quintic at the door speed peaks at 1.875 x 0.4 m/s, from which the
   // base needs ~0.35 m to stop (H12 seed 2093: someone stepping out from behind the leaf at
   // 2 m/s met the robot still sliding towards their way as it braked, 0.14 m off; at half the
-  // speed it is still by the lane's edge when they come).
-  // The slide's speed when slower than the door speed (nullopt: at the door speed) [m/s].
+  // speed it is still by the lane's edge when they come). Its speed when slower than the door
+  // speed (nullopt: at the door speed) [m/s].
   std::optional<double> slide_speed_;
   // The slowest slide, no slower than the nominal speed, that the window leaves time for with
   // kSlowSlideSpareTime to spare; nullopt for the door speed. `slide` [m] takes `fast_time` [s]
