@@ -288,8 +288,8 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
       }
       t = lo;
     }
-    const double min_duration = task_.motion->trajectory_config().min_duration;
-    if (t <= std::max(fast_time, min_duration) + 1e-3) return std::nullopt;
+    // (fast_time is no shorter than the trajectory's min_duration: SegmentDuration.)
+    if (t <= fast_time + 1e-3) return std::nullopt;
     return slide / t;
   }
   // What the window must leave beyond the slide's trajectory for a slide slower than the door
