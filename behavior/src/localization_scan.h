@@ -4,8 +4,8 @@
 /// the floor plan (a doorway is a gap in it), so returns off a leaf, wherever it stands, would
 /// pull the estimate towards the jambs: passing an open exit with little else in view they
 /// turned it 0.4 rad, and pressing a button beside a shut door that opens away from the robot,
-/// its leaf filling half the view, they moved it 0.12 m and 3.5 deg (an L-shaped test building
-/// with 0.9 m doors, not committed).
+/// its leaf filling half the view, they moved it 0.12 m and 3.5 deg (the L-shaped school of
+/// worlds/tools/make_school.py, 0.9 m doors).
 
 #include "egress/behavior/mission_map.h"
 #include "egress/hsr_interface/geometry.h"
