@@ -6,6 +6,7 @@
 #include <numbers>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -28,20 +29,32 @@ perception::OccupancyGrid CorridorCorner(double turn) {
       {-2.0, -6.0}, {20.0, 8.0}, 0.05);
 }
 
+MissionMap MapOf(perception::OccupancyGrid grid) {
+  MissionMap map;
+  map.grid = std::move(grid);
+  return map;
+}
+
 class PathAheadTest : public ::testing::Test {
  protected:
-  explicit PathAheadTest(double turn = 0.0)
-      : model_(RobotModel::LoadDefault()),
+  PathAheadTest()
+      : map_(MapOf(CorridorCorner(0.0))),
+        model_(RobotModel::LoadDefault()),
         motion_(model_),
-        costmap_(CorridorCorner(turn)),
-        planner_(costmap_, nullptr),
-        turn_(turn) {
-    map_.grid = CorridorCorner(turn);
+        costmap_(map_.grid),
+        planner_(costmap_, nullptr) {
     services_.map = &map_;
     services_.model = &model_;
     services_.motion = &motion_;
     services_.planner = &planner_;
     services_.belief = &belief_;
+  }
+  // The building turned by `turn` instead.
+  void Turn(double turn) {
+    turn_ = turn;
+    map_.grid = CorridorCorner(turn);
+    costmap_ = perception::Costmap2D(map_.grid);
+    planner_ = planning::BasePlanner(costmap_, nullptr);
   }
   Pose2 InBuilding(double x, double y, double yaw) const {
     const Eigen::Vector2d p = Eigen::Rotation2Dd(turn_) * Eigen::Vector2d(x, y);
@@ -61,7 +74,7 @@ class PathAheadTest : public ::testing::Test {
   planning::BasePlanner planner_;
   Belief belief_;
   TaskServices services_;
-  double turn_;
+  double turn_{0.0};
 };
 
 TEST_F(PathAheadTest, APathJustPlannedIsNotBlocked) {
@@ -72,10 +85,7 @@ TEST_F(PathAheadTest, APathJustPlannedIsNotBlocked) {
       across(14.8, 15.6), yaw(-std::numbers::pi, std::numbers::pi);
   int planned = 0;
   for (const double turn : {0.0, 0.3}) {
-    turn_ = turn;
-    map_.grid = CorridorCorner(turn);
-    costmap_ = perception::Costmap2D(map_.grid);
-    planner_ = planning::BasePlanner(costmap_, nullptr);
+    Turn(turn);
     for (int k = 0; k < 40; ++k) {
       const Pose2 start = InBuilding(x(random), y(random), yaw(random));
       const Pose2 goal = InBuilding(across(random), down(random), yaw(random));
