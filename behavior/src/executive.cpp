@@ -435,8 +435,18 @@ bool Executive::Step(RobotPort& port) {
     }
     if (snapshot.scan) {
       m.localizer->Predict(*m.last_odometry, snapshot.odometry.X_OB);
+      const int recoveries = m.localizer->recover_count();
       m.localizer->Correct(
           WithoutDoorSweeps(*snapshot.scan, m.map, m.localizer->Estimate() * belief_.X_BL));
+      if (m.localizer->recover_count() != recoveries) {
+        const Pose2& jump = m.localizer->last_recovery();
+        decisions_.push_back(
+            {ToSeconds(now),
+             StrCat("localization: the scan fits a pose ",
+                    std::round(std::hypot(jump.x, jump.y) * 100), " cm and ",
+                    std::round(jump.yaw * 180.0 / M_PI), " deg away: relocalized there"),
+             DecisionEvent::kNote});
+      }
       m.last_odometry = snapshot.odometry.X_OB;
       m.X_MB_at_scan = m.localizer->Estimate();
     }

@@ -26,6 +26,23 @@ void LocalizerConfig::Validate() const {
               min_beams, ") must be in [1, max_beams].");
   ThrowUnless(resample_threshold > 0.0 && resample_threshold <= 1.0,
               "Invalid LocalizerConfig: resample_threshold must be in (0, 1].");
+  ThrowUnless(recover_below >= 0.0 && recover_below <= 1.0,
+              "Invalid LocalizerConfig: recover_below (", recover_below, ") must be in [0, 1].");
+  if (recover_below > 0.0) {
+    ThrowUnless(fit_distance > 0.0, "Invalid LocalizerConfig: fit_distance (", fit_distance,
+                ") must be > 0.");
+    ThrowUnless(recover_gain > 0.0 && recover_gain <= 1.0,
+                "Invalid LocalizerConfig: recover_gain (", recover_gain, ") must be in (0, 1].");
+    ThrowUnless(recover_step > 0.0 && recover_step_yaw > 0.0 && recover_window >= 0.0 &&
+                    recover_window_yaw >= 0.0,
+                "Invalid LocalizerConfig: recover_step and recover_step_yaw must be > 0, the "
+                "recover windows >= 0.");
+    ThrowUnless(
+        recover_window / recover_step <= 20.0 && recover_window_yaw / recover_step_yaw <= 20.0,
+        "Invalid LocalizerConfig: at most 20 recover steps each way (window / step).");
+    ThrowUnless(recover_check_scans >= 1, "Invalid LocalizerConfig: recover_check_scans (",
+                recover_check_scans, ") must be >= 1.");
+  }
 }
 
 ParticleFilterLocalizer::ParticleFilterLocalizer(const OccupancyGrid& map, const Pose2& X_BL,
@@ -153,27 +170,26 @@ bool ParticleFilterLocalizer::Correct(const LaserScan& scan) {
   ForgetSummary();
   scan.Validate();
   ThrowUnless(initialized(), "ParticleFilterLocalizer::Correct: call Initialize first.");
-  if (!moved_since_correction_) return false;
-  std::vector<Eigen::Vector2d> beams;  // end points in L
-  const std::size_t n = scan.ranges.size();
-  const std::size_t step = std::max<std::size_t>(1, n / std::size_t(config_.max_beams));
-  for (std::size_t i = 0; i < n; i += step) {
-    if (!scan.IsValidReturn(i) || scan.ranges[i] > config_.laser_max_range) continue;
-    const double angle = scan.AngleAt(i), range = scan.ranges[i];
-    beams.emplace_back(range * std::cos(angle), range * std::sin(angle));
+  ++scans_since_search_;
+  // Standing, nothing to correct — unless the robot was carried off (a kidnap): checked every
+  // recover_check_scans scans, as nothing else would ever move the cloud.
+  if (!moved_since_correction_ &&
+      (config_.recover_below <= 0.0 || scans_since_search_ < config_.recover_check_scans))
+    return false;
+  const std::vector<Eigen::Vector2d> beams = UsableBeams(scan);
+  if (beams.empty()) return false;
+  if (!moved_since_correction_) {
+    if (!MaybeRecover(beams)) {
+      scans_since_search_ = 0;
+      return false;
+    }
+  } else if (config_.recover_below > 0.0 && scans_since_search_ >= config_.recover_check_scans) {
+    MaybeRecover(beams);
   }
-  if (beams.empty() || beams.size() < std::size_t(config_.min_beams)) return false;
   std::vector<double> log_weights(particles_.size());
   for (std::size_t k = 0; k < particles_.size(); ++k) {
-    const Pose2 X_ML = particles_[k].X_MB * X_BL_;
-    const double c = std::cos(X_ML.yaw), s = std::sin(X_ML.yaw);
-    double log_w = 0.0;
-    for (const Eigen::Vector2d& p_LQ : beams) {
-      const double lx = p_LQ.x(), ly = p_LQ.y();
-      const Eigen::Vector2d p(X_ML.x + c * lx - s * ly, X_ML.y + s * lx + c * ly);
-      log_w += BeamLogLikelihood(LikelihoodFieldDistance(p));
-    }
-    log_weights[k] = std::log(particles_[k].weight) + log_w;
+    log_weights[k] =
+        std::log(particles_[k].weight) + CalcFit(particles_[k].X_MB, beams).log_likelihood;
   }
   const double max_log = *std::max_element(log_weights.begin(), log_weights.end());
   double total = 0.0;
@@ -190,6 +206,80 @@ bool ParticleFilterLocalizer::Correct(const LaserScan& scan) {
   if (n_eff < config_.resample_threshold * double(particles_.size())) Resample();
   moved_distance_ = moved_angle_ = 0.0;
   moved_since_correction_ = false;
+  return true;
+}
+
+std::vector<Eigen::Vector2d> ParticleFilterLocalizer::UsableBeams(const LaserScan& scan) const {
+  std::vector<Eigen::Vector2d> beams;  // end points in L
+  const std::size_t n = scan.ranges.size();
+  const std::size_t step = std::max<std::size_t>(1, n / std::size_t(config_.max_beams));
+  for (std::size_t i = 0; i < n; i += step) {
+    if (!scan.IsValidReturn(i) || scan.ranges[i] > config_.laser_max_range) continue;
+    const double angle = scan.AngleAt(i), range = scan.ranges[i];
+    beams.emplace_back(range * std::cos(angle), range * std::sin(angle));
+  }
+  if (beams.size() < std::size_t(config_.min_beams)) beams.clear();
+  return beams;
+}
+
+ParticleFilterLocalizer::Fit ParticleFilterLocalizer::CalcFit(
+    const Pose2& X_MB, const std::vector<Eigen::Vector2d>& beams) const {
+  const Pose2 X_ML = X_MB * X_BL_;
+  const double c = std::cos(X_ML.yaw), s = std::sin(X_ML.yaw);
+  Fit fit{0.0, 0};
+  for (const Eigen::Vector2d& p_LQ : beams) {
+    const Eigen::Vector2d p(X_ML.x + c * p_LQ.x() - s * p_LQ.y(),
+                            X_ML.y + s * p_LQ.x() + c * p_LQ.y());
+    const double d = LikelihoodFieldDistance(p);
+    fit.log_likelihood += BeamLogLikelihood(d);
+    if (d <= config_.fit_distance) ++fit.inliers;
+  }
+  return fit;
+}
+
+bool ParticleFilterLocalizer::MaybeRecover(const std::vector<Eigen::Vector2d>& beams) {
+  const Pose2 estimate = Estimate();
+  const Fit now = CalcFit(estimate, beams);
+  const double n = double(beams.size());
+  if (double(now.inliers) >= config_.recover_below * n) return false;
+  scans_since_search_ = 0;
+  // A coarse grid over the window, then a fine one (a quarter of the steps) round its best.
+  // Ranked by likelihood (smooth in the pose); ties go to the nearer pose, by the loop order.
+  Pose2 best = estimate;
+  Fit best_fit = now;
+  const auto search = [&](const Pose2& centre, double window, double window_yaw, double step,
+                          double step_yaw) {
+    const int k = int(std::floor(window / step + 1e-9));
+    const int k_yaw = int(std::floor(window_yaw / step_yaw + 1e-9));
+    for (int iyaw = 0; iyaw <= 2 * k_yaw; ++iyaw) {
+      // 0, +1, -1, +2, -2, ...: the nearer offsets first.
+      const int jyaw = (iyaw + 1) / 2 * (iyaw % 2 == 1 ? 1 : -1);
+      for (int ix = 0; ix <= 2 * k; ++ix) {
+        const int jx = (ix + 1) / 2 * (ix % 2 == 1 ? 1 : -1);
+        for (int iy = 0; iy <= 2 * k; ++iy) {
+          const int jy = (iy + 1) / 2 * (iy % 2 == 1 ? 1 : -1);
+          const Pose2 X_MB{centre.x + jx * step, centre.y + jy * step,
+                           WrapAngle(centre.yaw + jyaw * step_yaw)};
+          const Fit fit = CalcFit(X_MB, beams);
+          if (fit.log_likelihood > best_fit.log_likelihood) {
+            best = X_MB;
+            best_fit = fit;
+          }
+        }
+      }
+    }
+  };
+  search(estimate, config_.recover_window, config_.recover_window_yaw, config_.recover_step,
+         config_.recover_step_yaw);
+  search(best, config_.recover_step, config_.recover_step_yaw, config_.recover_step / 4.0,
+         config_.recover_step_yaw / 4.0);
+  if (double(best_fit.inliers - now.inliers) < config_.recover_gain * n) return false;
+  // Spread over what the fine grid cannot tell apart; the corrections that follow narrow it.
+  const double sigma = config_.recover_step / 8.0, sigma_yaw = config_.recover_step_yaw / 8.0;
+  Initialize(best,
+             Eigen::Vector3d(sigma * sigma, sigma * sigma, sigma_yaw * sigma_yaw).asDiagonal());
+  ++recover_count_;
+  last_recovery_ = estimate.Inverse() * best;
   return true;
 }
 

@@ -101,6 +101,77 @@ TEST(ParticleFilterLocalizerTest, AFewReturnsDoNotCorrectThePose) {
   EXPECT_THROW(ParticleFilterLocalizer(map, {}, config), InvalidArgument);
 }
 
+// A kidnap: the base is carried 0.36 m and 6 deg off without its odometry noticing, then stands.
+// The cloud, a few centimetres wide, cannot reach the true pose by resampling, and a standing
+// base does not correct at all: the relocalization check finds the pose the scan fits and
+// spreads the cloud there.
+TEST(ParticleFilterLocalizerTest, RelocalizesAfterAKidnapWhileStanding) {
+  const OccupancyGrid map = testing::TwoRoomMap();
+  const Pose2 X_BL{0.1675, 0.0, 0.0};
+  const Pose2 truth{2.0, 2.8, 0.3};
+  const Pose2 believed{truth.x - 0.3, truth.y + 0.2, truth.yaw - 0.1};
+  LaserScan scan = testing::MakeScan(181, 8.0);
+  testing::CastScan(map, truth * X_BL, &scan);
+  for (const bool recover : {false, true}) {
+    LocalizerConfig config;
+    if (!recover) config.recover_below = 0.0;
+    ParticleFilterLocalizer localizer(map, X_BL, config);
+    localizer.Initialize(believed, Eigen::Vector3d(1e-4, 1e-4, 1e-5).asDiagonal());
+    const Pose2 odometry{5.0, -1.0, 0.2};  // standing: the same odometry at every scan
+    for (int i = 0; i < 3 * config.recover_check_scans; ++i)
+      localizer.Update(odometry, scan);
+    const Pose2 estimate = localizer.Estimate();
+    const double error = std::hypot(estimate.x - truth.x, estimate.y - truth.y);
+    if (!recover) {
+      EXPECT_GT(error, 0.3);  // the old behaviour: stuck where it believed it was
+      EXPECT_EQ(localizer.recover_count(), 0);
+      continue;
+    }
+    EXPECT_EQ(localizer.recover_count(), 1);
+    EXPECT_LT(error, 0.02);
+    EXPECT_LT(std::abs(WrapAngle(estimate.yaw - truth.yaw)), 1 * kDeg);
+    // The jump reported is the one made, in the believed pose's frame.
+    const Pose2 jump = localizer.last_recovery();
+    EXPECT_NEAR(std::hypot(jump.x, jump.y), std::hypot(0.3, 0.2), 0.03);
+    EXPECT_NEAR(jump.yaw, 0.1, 1 * kDeg);
+  }
+}
+
+// People crowding the laser's view of a well-localized robot leave few returns on the map's
+// walls: the check searches, but nothing fits much better than where the robot is, and it
+// stays — standing, then driving past them.
+TEST(ParticleFilterLocalizerTest, PeopleCloseAroundDoNotPullThePoseAway) {
+  const OccupancyGrid map = testing::TwoRoomMap();
+  const Pose2 X_BL{0.1675, 0.0, 0.0};
+  Pose2 truth{2.0, 4.0, 0.0};
+  std::vector<testing::Disc> people;
+  for (int i = 0; i < 7; ++i) {
+    const double a = -1.2 + 0.4 * i;
+    people.push_back({truth.translation() + 0.9 * Eigen::Vector2d(std::cos(a), std::sin(a)), 0.2});
+  }
+  LaserScan scan = testing::MakeScan(181, 8.0);
+  ParticleFilterLocalizer localizer(map, X_BL);
+  localizer.Initialize(truth, Eigen::Vector3d(1e-4, 1e-4, 1e-5).asDiagonal());
+  Pose2 odometry;
+  int low_fit = 0;
+  for (int i = 0; i < 60; ++i) {
+    if (i >= 30) {  // sideways past them at 0.2 m/s
+      truth = truth * Pose2{0.0, -0.02, 0.0};
+      odometry = odometry * Pose2{0.0, -0.02, 0.0};
+    }
+    testing::CastScanAtDiscs(people, truth * X_BL, &scan, &map);
+    int on_people = 0;
+    for (float r : scan.ranges)
+      on_people += r < 1.0f ? 1 : 0;
+    low_fit += on_people > 181 * 0.4 ? 1 : 0;
+    localizer.Update(odometry, scan);
+    const Pose2 estimate = localizer.Estimate();
+    ASSERT_LT(std::hypot(estimate.x - truth.x, estimate.y - truth.y), 0.03) << "scan " << i;
+  }
+  EXPECT_GT(low_fit, 30);  // the check did have reason to search
+  EXPECT_EQ(localizer.recover_count(), 0);
+}
+
 TEST(ParticleFilterLocalizerTest, RejectsBadInput) {
   const OccupancyGrid map = testing::TwoRoomMap();
   ParticleFilterLocalizer localizer(map, {});
@@ -113,6 +184,14 @@ TEST(ParticleFilterLocalizerTest, RejectsBadInput) {
   empty.ranges.assign(2, std::numeric_limits<float>::infinity());
   EXPECT_FALSE(localizer.Correct(empty));  // no usable beam
   EXPECT_THROW(ParticleFilterLocalizer(map, {}, LocalizerConfig{5}), InvalidArgument);
+  LocalizerConfig config;
+  config.recover_below = 1.5;
+  EXPECT_THROW(ParticleFilterLocalizer(map, {}, config), InvalidArgument);
+  config.recover_below = 0.6;
+  config.recover_step = 0.0;
+  EXPECT_THROW(ParticleFilterLocalizer(map, {}, config), InvalidArgument);
+  config.recover_below = 0.0;  // disabled: its other fields are not used
+  EXPECT_NO_THROW(ParticleFilterLocalizer(map, {}, config));
 }
 
 }  // namespace

@@ -45,6 +45,22 @@ struct LocalizerConfig {
   double resample_threshold{0.5};    ///< Resample when N_eff < threshold * N.
   double update_min_distance{0.02};  ///< Skip a correction unless the base moved this far [m]…
   double update_min_angle{0.02};     ///< …or turned this much [rad].
+  /// Relocalization after a kidnap (the base pushed, or its wheels slipping, without odometry
+  /// knowing): the cloud, a few centimetres wide, cannot reach a pose decimetres away, and a
+  /// standing base does not correct at all. When fewer than `recover_below` of the usable beams
+  /// end within `fit_distance` of the map's obstacles at the estimate, poses on a grid around it
+  /// (±`recover_window`, ±`recover_window_yaw`, refined once at a quarter of the steps) are
+  /// scored; if the best of them fits `recover_gain` more of the beams, the cloud is spread
+  /// anew there. Checked at every correction and, standing, every `recover_check_scans`
+  /// scans; searched at most once per `recover_check_scans` scans. 0 disables it.
+  double recover_below{0.6};
+  double fit_distance{0.1};        ///< [m]
+  double recover_gain{0.25};       ///< fraction of the usable beams
+  double recover_window{0.5};      ///< [m]
+  double recover_window_yaw{0.2};  ///< [rad]
+  double recover_step{0.1};        ///< [m]
+  double recover_step_yaw{0.05};   ///< [rad]
+  int recover_check_scans{10};
   std::uint64_t seed{1};
   void Validate() const;
 };
@@ -71,6 +87,10 @@ class ParticleFilterLocalizer {
   Eigen::Matrix3d Covariance() const;
   bool initialized() const { return !particles_.empty(); }
   int resample_count() const { return resample_count_; }
+  /// How often the cloud was spread anew at a pose that fits the scan better (relocalized).
+  int recover_count() const { return recover_count_; }
+  /// The last relocalization's jump of the estimate (zero before any) [m, rad].
+  const Pose2& last_recovery() const { return last_recovery_; }
 
  private:
   struct Particle {
@@ -82,6 +102,15 @@ class ParticleFilterLocalizer {
   /// (an end point off the map: the uniform part only), from a table.
   double BeamLogLikelihood(double d) const;
   void Resample();
+  // The beam end points in L of the usable returns; empty if fewer than min_beams.
+  std::vector<Eigen::Vector2d> UsableBeams(const LaserScan& scan) const;
+  struct Fit {
+    double log_likelihood;  // summed over the beams
+    int inliers;            // beams ending within fit_distance of an obstacle
+  };
+  Fit CalcFit(const Pose2& X_MB, const std::vector<Eigen::Vector2d>& beams) const;
+  // The relocalization check (see LocalizerConfig::recover_below). True if it spread the cloud.
+  bool MaybeRecover(const std::vector<Eigen::Vector2d>& beams);
   Pose2 CalcEstimate() const;
   // Empties the cached Estimate and Covariance: the particles moved or were reweighed.
   void ForgetSummary();
@@ -100,6 +129,9 @@ class ParticleFilterLocalizer {
   double moved_angle_{0.0};
   bool moved_since_correction_{true};
   int resample_count_{0};
+  int recover_count_{0};
+  Pose2 last_recovery_;
+  int scans_since_search_{0};  // scans since the last relocalization search (or check, standing)
   // Estimate and Covariance of the particles as they are (the executive asks at its own rate,
   // 8x the scans'); emptied by whatever moves or reweighs a particle.
   mutable std::optional<Pose2> estimate_;
