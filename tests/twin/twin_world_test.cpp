@@ -138,6 +138,15 @@ TEST(TwinWorldTest, AShelfOverTheBaseAtTheArmsHeightTouchesTheArm) {
               ::testing::Contains(::testing::HasSubstr("hsrb_forearm")));
 }
 
+// The forearm runs from the arm roll link to the wrist flex link, which coincide in the shipped
+// model: a ball at the wrist (0.64-0.73 m tucked), not an upright capsule to 0.54 m below it
+// whatever the arm's pose (which touched what a level reach passed over).
+TEST(TwinWorldTest, AShelfJustUnderTheTuckedWristTouchesTheUpperArmOnly) {
+  const std::vector<std::string> parts = ContactsUnderAShelfAt(0.585);  // 0.56-0.61 m
+  EXPECT_THAT(parts, ::testing::Contains(::testing::HasSubstr("hsrb_upper_arm")));
+  EXPECT_THAT(parts, ::testing::Not(::testing::Contains(::testing::HasSubstr("hsrb_forearm"))));
+}
+
 TEST(TwinWorldTest, AShelfOverTheBaseAtBaseHeightTouchesTheBase) {
   // 0.20-0.25 m: the base's own top (0.01-0.25 m) is the footprint's full circle.
   EXPECT_THAT(ContactsUnderAShelfAt(0.225), ::testing::Contains(::testing::HasSubstr("by hsrb")));

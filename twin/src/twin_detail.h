@@ -109,6 +109,10 @@ inline bool IsTrunkLink(std::string_view link) {
          link == "head_tilt_link" || link == "arm_lift_link";
 }
 inline constexpr const char* kUpperArmLink = "arm_flex_link";
+// The forearm body runs from the first's origin to the second's (see BuildRobot).
+inline constexpr const char* kForearmLink = "arm_roll_link";
+inline constexpr const char* kWristLink = "wrist_flex_link";
+constexpr double kForearmRadius = 0.045;  // [m]
 
 // A robot description's collision primitive as a Bullet shape (centred on its frame S).
 inline std::unique_ptr<btCollisionShape> MakeRobotShape(const CollisionShape& s) {

@@ -61,9 +61,22 @@ void TwinWorld::Impl::BuildRobot() {
   const int he = AddEntity(EntityKind::kRobotArm, "hsrb_hand", -1);
   hand_body = AddBody(std::move(hand), Pose3(), 0.0, kGArm, kMaskArm, he);
   MakeKinematic(hand_body);
+  // The forearm: a capsule from the arm roll link's origin to the wrist flex link's, both on the
+  // arm roll link, so of a fixed length. In the shipped model they coincide, and it is a ball at
+  // the wrist: a fixed 0.2 m capsule there stood upright whatever the arm's pose, and reaching
+  // level over something low (H5's books) its lower end, 0.19 m under the wrist, touched what
+  // the arm cleared.
+  const double forearm_length = (model->CalcLinkPoseInBase(kWristLink, joints).translation() -
+                                 model->CalcLinkPoseInBase(kForearmLink, joints).translation())
+                                    .norm();
+  std::unique_ptr<btCollisionShape> forearm;
+  if (forearm_length > 1e-6) {
+    forearm = std::make_unique<btCapsuleShapeZ>(kForearmRadius, forearm_length);
+  } else {
+    forearm = std::make_unique<btSphereShape>(kForearmRadius);
+  }
   const int fe = AddEntity(EntityKind::kRobotArm, "hsrb_forearm", -1);
-  forearm_body =
-      AddBody(std::make_unique<btCapsuleShapeZ>(0.045, 0.2), Pose3(), 0.0, kGArm, kMaskArm, fe);
+  forearm_body = AddBody(std::move(forearm), Pose3(), 0.0, kGArm, kMaskArm, fe);
   MakeKinematic(forearm_body);
   // The upper arm: the arm flex link's own shapes, posed in W by its link frame.
   auto upper_arm = std::make_unique<btCompoundShape>();
@@ -232,8 +245,8 @@ void TwinWorld::Impl::UpdateArmBodies() {
   const Pose3 X_WB = Pose3::FromPose2(RobotPose());
   const std::vector<std::pair<std::string, double>> joints(arm_q.begin(), arm_q.end());
   if (!(arm_pose_cache_valid && joints == arm_pose_cache_q)) {
-    const Pose3 X_BR = model->CalcLinkPoseInBase("arm_roll_link", joints);
-    const Pose3 X_BW = model->CalcLinkPoseInBase("wrist_flex_link", joints);
+    const Pose3 X_BR = model->CalcLinkPoseInBase(kForearmLink, joints);
+    const Pose3 X_BW = model->CalcLinkPoseInBase(kWristLink, joints);
     X_BForearm_a = X_BR.translation();
     X_BForearm_b = X_BW.translation();
     X_BUpperArm = model->CalcLinkPoseInBase(kUpperArmLink, joints);
