@@ -68,14 +68,15 @@ double PayloadCentreHeight(std::string_view kind) {
   return 0.05;
 }
 
-std::optional<double> ClutterTopBeforeGrasp(const TaskServices& task, const Eigen::Vector3d& p_M,
-                                            const Eigen::Vector3d& approach_M,
-                                            double payload_radius, double surface_z) {
+std::optional<ClutterBeforeGrasp> FindClutterBeforeGrasp(const TaskServices& task,
+                                                         const Eigen::Vector3d& p_M,
+                                                         const Eigen::Vector3d& approach_M,
+                                                         double payload_radius, double surface_z) {
   if (!task.belief->depth) return std::nullopt;
   constexpr double kHandHalfWidth = 0.07;  // [m] fingers open, with a margin
   constexpr double kFlat = 0.02;           // [m] bumps lower than this are the surface
   const Eigen::Vector2d a = approach_M.head<2>().normalized();
-  std::optional<double> top;
+  std::optional<ClutterBeforeGrasp> clutter;
   ForEachDepthPointInMap(task, [&](const Eigen::Vector3d& p) {
     const Eigen::Vector2d d = p.head<2>() - p_M.head<2>();
     const double along = d.dot(a);
@@ -84,9 +85,14 @@ std::optional<double> ClutterTopBeforeGrasp(const TaskServices& task, const Eige
         lateral > kHandHalfWidth || p.z() < surface_z + kFlat) {
       return;
     }
-    top = top ? std::max(*top, p.z()) : p.z();
+    if (!clutter) {
+      clutter = ClutterBeforeGrasp{p.z(), -along};
+    } else {
+      clutter->top_z = std::max(clutter->top_z, p.z());
+      clutter->reach = std::max(clutter->reach, -along);
+    }
   });
-  return top;
+  return clutter;
 }
 
 std::optional<Eigen::Vector3d> LowPayloadCentre(const TaskServices& task,

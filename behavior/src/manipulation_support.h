@@ -39,13 +39,19 @@ Eigen::Vector3d HorizontalApproach(const Pose2& X_MB, const Eigen::Vector3d& p_M
 /// flashlight lying; unknown kinds get a middle value.
 double PayloadCentreHeight(std::string_view kind);
 
-/// The highest depth point standing out of the surface the payload rests on (`surface_z`) in
-/// the corridor the hand sweeps horizontally towards a grasp centre `p_M` along `approach_M`
-/// (from the pre-grasp to just before the payload, within a hand's width of the line), or
-/// nullopt if there is none.
-std::optional<double> ClutterTopBeforeGrasp(const TaskServices& task, const Eigen::Vector3d& p_M,
-                                            const Eigen::Vector3d& approach_M,
-                                            double payload_radius, double surface_z);
+/// Something low standing out of the surface the payload rests on (`surface_z`) in the corridor
+/// the hand sweeps horizontally towards a grasp centre `p_M` along `approach_M` (from the
+/// pre-grasp to just before the payload, within a hand's width of the line): the highest of its
+/// depth points, and how far back from p_M along the approach its nearest face is.
+struct ClutterBeforeGrasp {
+  double top_z;  ///< [m]
+  double reach;  ///< from p_M back to its face towards the robot [m]
+};
+/// The clutter before a grasp (see ClutterBeforeGrasp), or nullopt if there is none.
+std::optional<ClutterBeforeGrasp> FindClutterBeforeGrasp(const TaskServices& task,
+                                                         const Eigen::Vector3d& p_M,
+                                                         const Eigen::Vector3d& approach_M,
+                                                         double payload_radius, double surface_z);
 
 /// The centre of a low payload lying on a surface at `surface_z`, from the depth points that
 /// stand out of the surface within `radius` of the estimate `p_M` (the centroid of what the

@@ -195,6 +195,10 @@ struct GraspPlan {
   /// The arm there (whole-body IK); once ReachForPayload has solved it from where the base
   /// stopped, the arm at the grasp.
   ArmPose arm{};
+  /// The pre-grasp stands this far short of p_MC along approach_M [m]: beyond the default, in
+  /// front of something low before the payload, so that the hand, swinging up into it, does
+  /// not come up through that (it then goes in level, over it).
+  double pre_offset{0.12};
 };
 
 /// A release of the held payload (placing it, or handing it over), planned by PlanPlacement or
