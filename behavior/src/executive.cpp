@@ -12,6 +12,7 @@
 #include "egress/bt/tree.h"
 #include "egress/hsr_interface/error.h"
 #include "egress/perception/door_estimation.h"
+#include "localization_scan.h"
 #include "task_node_support.h"
 
 namespace egress::behavior {
@@ -42,11 +43,6 @@ void ExecutiveConfig::Validate() const {
 }
 
 namespace {
-
-// How far past a leaf's reach a return still counts as in its sweep [m].
-constexpr double kSweepMarginM = 0.1;
-// A return this near a mapped wall is the wall (kept for localization, in a sweep or not) [m].
-constexpr double kWallMatchM = 0.1;
 
 std::string_view StatusWord(bt::NodeStatus s) {
   switch (s) {
@@ -80,45 +76,6 @@ class ActionLog final : public bt::StatusObserver {
   std::vector<Decision>* out_;
   const bt::TreeNode* running_{nullptr};
 };
-
-// Whether p_M lies within kWallMatchM of an occupied cell of the building map.
-bool NearMappedWall(const perception::OccupancyGrid& grid, const Eigen::Vector2d& p_M) {
-  const auto& g = grid.geometry();
-  const int r = int(std::ceil(kWallMatchM / g.resolution));
-  const auto c = g.CellOf(p_M);
-  if (!c) return false;
-  for (int dy = -r; dy <= r; ++dy) {
-    for (int dx = -r; dx <= r; ++dx) {
-      if (g.Contains(c->x() + dx, c->y() + dy) &&
-          grid.at(c->x() + dx, c->y() + dy) == perception::kLethalCost)
-        return true;
-    }
-  }
-  return false;
-}
-
-// The scan without the returns that end inside a door's sweep (the quarter disc its leaf
-// turns through, on the side it opens into) away from the mapped walls: there a return is the
-// leaf at whatever angle it stands, or someone in the doorway, not the floor plan — and passing an
-// open exit, with little else in view, such returns pulled the estimate 0.4 rad round. X_ML: the
-// laser in M by the estimate before this scan.
-LaserScan WithoutDoorSweeps(const LaserScan& scan, const MissionMap& map, const Pose2& X_ML) {
-  LaserScan out = scan;
-  for (std::size_t i = 0; i < out.ranges.size(); ++i) {
-    if (!out.IsValidReturn(i)) continue;
-    const double a = out.AngleAt(i), r = out.ranges[i];
-    const Eigen::Vector2d p_M = X_ML * Eigen::Vector2d(r * std::cos(a), r * std::sin(a));
-    for (const auto& door : map.doors) {
-      const Eigen::Vector2d offset = p_M - door.p_MHinge;
-      if (offset.norm() <= door.width() + kSweepMarginM && offset.dot(door.SwingSide()) > 0.0 &&
-          !NearMappedWall(map.grid, p_M)) {
-        out.ranges[i] = std::numeric_limits<float>::infinity();
-        break;
-      }
-    }
-  }
-  return out;
-}
 
 }  // namespace
 
@@ -437,7 +394,7 @@ bool Executive::Step(RobotPort& port) {
       m.localizer->Predict(*m.last_odometry, snapshot.odometry.X_OB);
       const int recoveries = m.localizer->recover_count();
       m.localizer->Correct(
-          WithoutDoorSweeps(*snapshot.scan, m.map, m.localizer->Estimate() * belief_.X_BL));
+          detail::WithoutDoorSweeps(*snapshot.scan, m.map, m.localizer->Estimate() * belief_.X_BL));
       if (m.localizer->recover_count() != recoveries) {
         const Pose2& jump = m.localizer->last_recovery();
         decisions_.push_back(

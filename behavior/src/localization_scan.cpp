@@ -1,0 +1,41 @@
+#include "localization_scan.h"
+
+#include <cmath>
+#include <limits>
+
+namespace egress::behavior::detail {
+
+bool NearMappedWall(const perception::OccupancyGrid& grid, const Eigen::Vector2d& p_M) {
+  const auto& g = grid.geometry();
+  const int r = int(std::ceil(kWallMatchM / g.resolution));
+  const auto c = g.CellOf(p_M);
+  if (!c) return false;
+  for (int dy = -r; dy <= r; ++dy) {
+    for (int dx = -r; dx <= r; ++dx) {
+      if (g.Contains(c->x() + dx, c->y() + dy) &&
+          grid.at(c->x() + dx, c->y() + dy) == perception::kLethalCost)
+        return true;
+    }
+  }
+  return false;
+}
+
+LaserScan WithoutDoorSweeps(const LaserScan& scan, const MissionMap& map, const Pose2& X_ML) {
+  LaserScan out = scan;
+  for (std::size_t i = 0; i < out.ranges.size(); ++i) {
+    if (!out.IsValidReturn(i)) continue;
+    const double a = out.AngleAt(i), r = out.ranges[i];
+    const Eigen::Vector2d p_M = X_ML * Eigen::Vector2d(r * std::cos(a), r * std::sin(a));
+    for (const auto& door : map.doors) {
+      const Eigen::Vector2d offset = p_M - door.p_MHinge;
+      if (offset.norm() <= door.width() + kSweepMarginM && offset.dot(door.SwingSide()) > 0.0 &&
+          !NearMappedWall(map.grid, p_M)) {
+        out.ranges[i] = std::numeric_limits<float>::infinity();
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace egress::behavior::detail
