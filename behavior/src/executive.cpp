@@ -394,7 +394,7 @@ bool Executive::Step(RobotPort& port) {
       m.localizer->Predict(*m.last_odometry, snapshot.odometry.X_OB);
       const int recoveries = m.localizer->recover_count();
       m.localizer->Correct(
-          detail::WithoutDoorSweeps(*snapshot.scan, m.map, m.localizer->Estimate() * belief_.X_BL));
+          detail::WithoutDoorLeaves(*snapshot.scan, m.map, m.localizer->Estimate() * belief_.X_BL));
       if (m.localizer->recover_count() != recoveries) {
         const Pose2& jump = m.localizer->last_recovery();
         decisions_.push_back(

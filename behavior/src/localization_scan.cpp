@@ -20,7 +20,7 @@ bool NearMappedWall(const perception::OccupancyGrid& grid, const Eigen::Vector2d
   return false;
 }
 
-LaserScan WithoutDoorSweeps(const LaserScan& scan, const MissionMap& map, const Pose2& X_ML) {
+LaserScan WithoutDoorLeaves(const LaserScan& scan, const MissionMap& map, const Pose2& X_ML) {
   LaserScan out = scan;
   for (std::size_t i = 0; i < out.ranges.size(); ++i) {
     if (!out.IsValidReturn(i)) continue;
@@ -28,8 +28,10 @@ LaserScan WithoutDoorSweeps(const LaserScan& scan, const MissionMap& map, const 
     const Eigen::Vector2d p_M = X_ML * Eigen::Vector2d(r * std::cos(a), r * std::sin(a));
     for (const auto& door : map.doors) {
       const Eigen::Vector2d offset = p_M - door.p_MHinge;
-      if (offset.norm() <= door.width() + kSweepMarginM && offset.dot(door.SwingSide()) > 0.0 &&
-          !NearMappedWall(map.grid, p_M)) {
+      const bool in_sweep =
+          offset.norm() <= door.width() + kSweepMarginM && offset.dot(door.SwingSide()) > 0.0;
+      // The closed leaf reaches to within a few centimetres of the jambs: near a wall or not.
+      if ((in_sweep && !NearMappedWall(map.grid, p_M)) || door.OnDoorLine(p_M, kClosedLeafBandM)) {
         out.ranges[i] = std::numeric_limits<float>::infinity();
         break;
       }

@@ -26,6 +26,14 @@ bool DoorModel::InSweep(const Eigen::Vector2d& p_MQ, double margin) const {
   return offset.norm() <= width() + margin && offset.dot(SwingSide()) > -margin;
 }
 
+bool DoorModel::OnDoorLine(const Eigen::Vector2d& p_MQ, double margin) const {
+  const Eigen::Vector2d along = (p_MLatch - p_MHinge).normalized();
+  const Eigen::Vector2d offset = p_MQ - p_MHinge;
+  const double s = offset.dot(along);
+  return s >= 0.0 && s <= width() &&
+         std::abs(along.x() * offset.y() - along.y() * offset.x()) <= margin;
+}
+
 Eigen::Vector2d DoorModel::SwingSide() const {
   const Eigen::Vector2d along = (p_MLatch - p_MHinge).normalized();
   return swing_sign * Eigen::Vector2d(-along.y(), along.x());

@@ -65,6 +65,18 @@ TEST(DoorEstimationTest, TheSweepIsTheQuarterDiscOnTheSwingSideGrownByTheMargin)
   EXPECT_FALSE(door.InSweep({0.5, -0.3}, 0.2));
 }
 
+TEST(DoorEstimationTest, TheDoorLineIsBetweenTheJambsOnEitherSide) {
+  const DoorModel door = LabDoor();
+  EXPECT_TRUE(door.OnDoorLine({0.5, 0.0}, 0.1));
+  EXPECT_TRUE(door.OnDoorLine({0.5, 0.08}, 0.1));    // the swing side
+  EXPECT_TRUE(door.OnDoorLine({0.5, -0.08}, 0.1));   // the other side (a closed leaf's face)
+  EXPECT_TRUE(door.OnDoorLine({0.88, -0.05}, 0.1));  // by the latch
+  EXPECT_FALSE(door.OnDoorLine({0.5, -0.12}, 0.1));
+  EXPECT_FALSE(door.OnDoorLine({-0.05, 0.0}, 0.1));  // past the hinge jamb: the wall
+  EXPECT_FALSE(door.OnDoorLine({0.95, 0.0}, 0.1));   // past the latch jamb
+  EXPECT_FALSE(door.OnDoorLine({0.5, 0.5}, 0.1));    // under the opening leaf, not on the line
+}
+
 TEST(DoorEstimationTest, NoLeafSeenIsNoMeasurement) {
   EXPECT_FALSE(MeasureDoorAngle(LabDoor(), {{5.0, 5.0}, {-2.0, 0.0}}).has_value());
 }

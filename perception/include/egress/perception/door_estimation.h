@@ -36,6 +36,9 @@ struct DoorModel {
   /// Whether p_MQ lies in the quarter disc the leaf turns through (on the swing side, within
   /// width + margin of the hinge), grown by `margin` [m]: what a moving leaf can reach.
   bool InSweep(const Eigen::Vector2d& p_MQ, double margin) const;
+  /// Whether p_MQ lies between the jambs, within `margin` of the door line on either side [m]:
+  /// where the closed leaf stands (or someone in the doorway).
+  bool OnDoorLine(const Eigen::Vector2d& p_MQ, double margin) const;
   /// Where the leaf's free edge is at `angle` [m, in M].
   Eigen::Vector2d LeafTip(double angle) const;
   /// Clear width of the opening at `angle`: w·(1 − cos θ) up to 90°, w beyond [m].
