@@ -45,25 +45,17 @@ void TrajectoryConfig::Validate() const {
               "Invalid TrajectoryConfig: speeds must be > 0.");
   ThrowUnless(min_duration > 0.0, "Invalid TrajectoryConfig: min_duration must be > 0.");
   ThrowUnless(max_yaw_rate > 0.0, "Invalid TrajectoryConfig: max_yaw_rate must be > 0.");
-  ThrowUnless(std::isfinite(max_base_acceleration) && max_base_acceleration > 0.0,
-              "Invalid TrajectoryConfig: max_base_acceleration must be finite and > 0 (got ",
-              max_base_acceleration, ").");
 }
-
-// Peak speed / average speed of a rest-to-rest quintic.
-constexpr double kQuinticPeakFactor = 1.875;
-// Peak acceleration of a rest-to-rest quintic over L in T, as a multiple of L / T² (10 / √3).
-constexpr double kQuinticPeakAccelFactor = 5.773502691896258;
 
 double SegmentDuration(double base_distance, bool through_door, const TrajectoryConfig& config) {
   ThrowUnless(std::isfinite(base_distance) && base_distance >= 0.0,
               "Invalid segment: base distance (", base_distance, ") must be finite and >= 0.");
-  const double paper =
-      std::max(base_distance / (through_door ? config.door_speed : config.nominal_speed),
-               config.min_duration);
-  return std::max(
-      paper, std::sqrt(kQuinticPeakAccelFactor * base_distance / config.max_base_acceleration));
+  return std::max(base_distance / (through_door ? config.door_speed : config.nominal_speed),
+                  config.min_duration);
 }
+
+// Peak speed / average speed of a rest-to-rest quintic.
+constexpr double kQuinticPeakFactor = 1.875;
 
 double SegmentDuration(double base_distance, double base_turn, bool through_door,
                        const TrajectoryConfig& config) {

@@ -1,6 +1,5 @@
 #include "egress/planning/trajectory.h"
 
-#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -35,37 +34,6 @@ TEST(TrajectoryTest, DurationRule) {
   EXPECT_DOUBLE_EQ(SegmentDuration(2.0, true, config), 5.0);    // through a door, 0.4 m/s
   EXPECT_DOUBLE_EQ(SegmentDuration(0.05, false, config), 1.5);  // T_min
   EXPECT_THROW(SegmentDuration(-1.0, false, config), InvalidArgument);
-}
-
-// The paper's rule at door speed asks 5.77 * 0.6 / 1.5² = 1.54 m/s² of a 0.6 m step, more than
-// the base's 1 m/s²: the segment is stretched until its peak acceleration is the base's.
-TEST(TrajectoryTest, ShortDoorSpeedSegmentsPeakWithinTheBaseAcceleration) {
-  const RobotModel model = RobotModel::LoadDefault();
-  const TrajectoryConfig config;
-  for (const double length : {0.2, 0.4, 0.6, 0.8, 1.2}) {
-    WholeBodyVector a = WholeBodyVector::Zero(), b = a;
-    b[kBaseX] = length;
-    const WholeBodyTrajectory trajectory = WholeBodyTrajectory::Plan({a, b}, model, config, {true});
-    double peak = 0.0;
-    for (double t = 0.0; t <= trajectory.duration(); t += 1e-3)
-      peak = std::max(peak, std::abs(trajectory.Sample(t).qdd[kBaseX]));
-    EXPECT_LE(peak, config.max_base_acceleration + 1e-6) << length << " m";
-    // Never shorter than the paper's rule.
-    EXPECT_GE(trajectory.duration(), std::max(length / config.door_speed, config.min_duration));
-  }
-  // 0.6 m: sqrt(5.77 * 0.6 / 1.0) = 1.86 s instead of the paper's 1.5 s.
-  EXPECT_NEAR(SegmentDuration(0.6, true, config), std::sqrt(10.0 / std::sqrt(3.0) * 0.6), 1e-12);
-  // A gentler base takes longer still; a stronger one gets the paper's time back.
-  TrajectoryConfig gentle = config, strong = config;
-  gentle.max_base_acceleration = 0.5;
-  strong.max_base_acceleration = 10.0;
-  EXPECT_GT(SegmentDuration(0.6, true, gentle), SegmentDuration(0.6, true, config));
-  EXPECT_DOUBLE_EQ(SegmentDuration(0.6, true, strong), 1.5);
-  for (const double bad : {0.0, -1.0, std::nan("")}) {
-    TrajectoryConfig invalid = config;
-    invalid.max_base_acceleration = bad;
-    EXPECT_THROW(invalid.Validate(), InvalidArgument) << bad;
-  }
 }
 
 // A base that turns far takes longer than its distance says: its yaw peaks at max_yaw_rate (a

@@ -5,10 +5,8 @@
 ///   T = max(L / v_target, T_min)  (v_target 0.2 m/s nominal, 0.4 m/s through a door,
 ///                                  T_min 1.5 s),
 /// lengthened where needed so that no joint's peak speed (1.875·Δq/T for a quintic) exceeds
-/// its limit, and the base's peak acceleration (5.77·L/T²) not the base's own: at door speed
-/// the paper's rule asks up to 1.5 m/s² of a base that gives 1 m/s² (0.4-0.9 m segments), and
-/// the lagging base then overshoots the segment's end. Multi-waypoint motions are a sequence of
-/// such segments. Base yaw is unwrapped so that a segment always turns the short way.
+/// its limit. Multi-waypoint motions are a sequence of such segments. Base yaw is unwrapped so
+/// that a segment always turns the short way.
 
 #include <vector>
 
@@ -39,14 +37,10 @@ struct TrajectoryConfig {
   /// Peak base yaw rate [rad/s]: a segment that turns further takes longer (half the tracking
   /// controller's 1.2 rad/s limit, leaving it room to correct).
   double max_yaw_rate{0.6};
-  /// Peak base acceleration [m/s²]: a segment whose quintic would ask for more takes longer
-  /// (the tracking controller's and HSR base's limit, ControllerConfig::max_linear_accel).
-  double max_base_acceleration{1.0};
   void Validate() const;
 };
 
-/// The paper's duration rule for a segment whose base travels `base_distance` metres, stretched
-/// so that the base's acceleration peaks at no more than config.max_base_acceleration [s].
+/// The paper's duration rule for a segment whose base travels `base_distance` metres.
 double SegmentDuration(double base_distance, bool through_door, const TrajectoryConfig& config);
 /// The same, stretched so that a base turning `base_turn` radians (either way) peaks at no more
 /// than config.max_yaw_rate: what WholeBodyTrajectory::Plan gives a base-only segment [s].
