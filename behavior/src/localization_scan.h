@@ -24,10 +24,11 @@ constexpr double kClosedLeafBandM = 0.1;
 /// Whether p_M lies within kWallMatchM of an occupied cell of the building map.
 bool NearMappedWall(const perception::OccupancyGrid& grid, const Eigen::Vector2d& p_M);
 
-/// `scan` with every return that ends on a door's leaf set to no return (+inf): inside the
-/// quarter disc the leaf turns through (away from the mapped walls), where it stands at whatever
-/// angle, or someone in the doorway; and on the door's line between its jambs, where the closed
-/// leaf stands, seen from either side. X_ML: the laser in M by the estimate before this scan.
+/// `scan` with every return that ends on a door's leaf set to no return (+inf): within
+/// kSweepMarginM of the quarter disc the leaf turns through, where it stands at whatever angle;
+/// elsewhere on its swing side within its reach but away from the mapped walls (someone in the
+/// doorway); and on the door's line between its jambs, where the closed leaf stands, seen from
+/// either side. X_ML: the laser in M by the estimate before this scan.
 LaserScan WithoutDoorLeaves(const LaserScan& scan, const MissionMap& map, const Pose2& X_ML);
 
 }  // namespace egress::behavior::detail

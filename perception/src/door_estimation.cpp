@@ -26,6 +26,18 @@ bool DoorModel::InSweep(const Eigen::Vector2d& p_MQ, double margin) const {
   return offset.norm() <= width() + margin && offset.dot(SwingSide()) > -margin;
 }
 
+bool DoorModel::InLeafReach(const Eigen::Vector2d& p_MQ, double margin) const {
+  const Eigen::Vector2d offset = p_MQ - p_MHinge;
+  const double r = offset.norm();
+  if (r > width() + margin) return false;
+  if (r <= margin) return true;
+  // The angle from the closed leaf towards the swing side, and the angle `margin` spans at r.
+  const Eigen::Vector2d along = (p_MLatch - p_MHinge).normalized();
+  const double angle = std::atan2(offset.dot(SwingSide()), offset.dot(along));
+  const double slack = std::asin(margin / r);
+  return angle >= -slack && angle <= max_open_angle + slack;
+}
+
 bool DoorModel::OnDoorLine(const Eigen::Vector2d& p_MQ, double margin) const {
   const Eigen::Vector2d along = (p_MLatch - p_MHinge).normalized();
   const Eigen::Vector2d offset = p_MQ - p_MHinge;

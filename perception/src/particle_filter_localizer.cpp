@@ -42,6 +42,9 @@ void LocalizerConfig::Validate() const {
         "Invalid LocalizerConfig: at most 20 recover steps each way (window / step).");
     ThrowUnless(recover_check_scans >= 1, "Invalid LocalizerConfig: recover_check_scans (",
                 recover_check_scans, ") must be >= 1.");
+    ThrowUnless(recover_min_returns >= 0.0 && recover_min_returns <= 1.0,
+                "Invalid LocalizerConfig: recover_min_returns (", recover_min_returns,
+                ") must be in [0, 1].");
   }
 }
 
@@ -176,15 +179,16 @@ bool ParticleFilterLocalizer::Correct(const LaserScan& scan) {
   if (!moved_since_correction_ &&
       (config_.recover_below <= 0.0 || scans_since_search_ < config_.recover_check_scans))
     return false;
-  const std::vector<Eigen::Vector2d> beams = UsableBeams(scan);
+  std::size_t considered = 0;
+  const std::vector<Eigen::Vector2d> beams = UsableBeams(scan, &considered);
   if (beams.empty()) return false;
   if (!moved_since_correction_) {
-    if (!MaybeRecover(beams)) {
+    if (!MaybeRecover(beams, considered)) {
       scans_since_search_ = 0;
       return false;
     }
   } else if (config_.recover_below > 0.0 && scans_since_search_ >= config_.recover_check_scans) {
-    MaybeRecover(beams);
+    MaybeRecover(beams, considered);
   }
   std::vector<double> log_weights(particles_.size());
   for (std::size_t k = 0; k < particles_.size(); ++k) {
@@ -209,10 +213,12 @@ bool ParticleFilterLocalizer::Correct(const LaserScan& scan) {
   return true;
 }
 
-std::vector<Eigen::Vector2d> ParticleFilterLocalizer::UsableBeams(const LaserScan& scan) const {
+std::vector<Eigen::Vector2d> ParticleFilterLocalizer::UsableBeams(const LaserScan& scan,
+                                                                  std::size_t* considered) const {
   std::vector<Eigen::Vector2d> beams;  // end points in L
   const std::size_t n = scan.ranges.size();
   const std::size_t step = std::max<std::size_t>(1, n / std::size_t(config_.max_beams));
+  *considered = (n + step - 1) / step;
   for (std::size_t i = 0; i < n; i += step) {
     if (!scan.IsValidReturn(i) || scan.ranges[i] > config_.laser_max_range) continue;
     const double angle = scan.AngleAt(i), range = scan.ranges[i];
@@ -237,7 +243,9 @@ ParticleFilterLocalizer::Fit ParticleFilterLocalizer::CalcFit(
   return fit;
 }
 
-bool ParticleFilterLocalizer::MaybeRecover(const std::vector<Eigen::Vector2d>& beams) {
+bool ParticleFilterLocalizer::MaybeRecover(const std::vector<Eigen::Vector2d>& beams,
+                                           std::size_t considered) {
+  if (double(beams.size()) < config_.recover_min_returns * double(considered)) return false;
   const Pose2 estimate = Estimate();
   const Fit now = CalcFit(estimate, beams);
   const double n = double(beams.size());

@@ -118,6 +118,41 @@ TEST(LocalizationScanTest, InTheSweepOnlyTheMappedWallsAreKept) {
   EXPECT_EQ(wall_kept.ranges[2], at_wall.ranges[2]);
 }
 
+TEST(LocalizationScanTest, AnOpenLeafIsLeftOutRightUpToItsHingeBesideTheWall) {
+  // The clinic's exit: the robot past the door line, the leaf open 90 degrees along +y from the
+  // hinge, its face at x = 0.02. By the hinge its returns lie within kWallMatchM of the wall's
+  // end: matched to it, they pulled the estimate back and round.
+  const MissionMap map = WallWithDoor();
+  const Pose2 X_ML{0.6, 0.8, std::numbers::pi / 2};
+  const std::vector<Eigen::Vector2d> points = {
+      {0.6, 3.0},     // ahead: open floor, kept
+      {0.02, 0.08},   // the leaf 8 cm from the hinge
+      {0.02, 0.14},   // and 14 cm
+      {0.02, 0.5},    // and mid-leaf
+      {-1.2, 0.05}};  // the wall's face past the hinge: the floor plan, kept
+  ASSERT_TRUE(NearMappedWall(map.grid, points[1]));
+  // 3600 beams, a return only on the beam nearest each point (within 2 mm of it here).
+  LaserScan scan;
+  scan.angle_min = -std::numbers::pi;
+  scan.angle_increment = 2 * std::numbers::pi / 3600.0;
+  scan.range_min = 0.05;
+  scan.range_max = 20.0;
+  scan.ranges.assign(3600, std::numeric_limits<float>::infinity());
+  std::vector<std::size_t> beam;
+  for (const Eigen::Vector2d& p_M : points) {
+    const Eigen::Vector2d p_L = X_ML.Inverse() * p_M;
+    const double a = std::atan2(p_L.y(), p_L.x());
+    beam.push_back(std::size_t(std::lround((a - scan.angle_min) / scan.angle_increment)) % 3600);
+    scan.ranges[beam.back()] = float(p_L.norm());
+  }
+  const LaserScan kept = WithoutDoorLeaves(scan, map, X_ML);
+  EXPECT_EQ(kept.ranges[beam[0]], scan.ranges[beam[0]]);
+  EXPECT_TRUE(std::isinf(kept.ranges[beam[1]]));
+  EXPECT_TRUE(std::isinf(kept.ranges[beam[2]]));
+  EXPECT_TRUE(std::isinf(kept.ranges[beam[3]]));
+  EXPECT_EQ(kept.ranges[beam[4]], scan.ranges[beam[4]]);
+}
+
 TEST(LocalizationScanTest, ReturnsBesideADoorwayAreTheWall) {
   const MissionMap map = WallWithDoor();
   EXPECT_TRUE(NearMappedWall(map.grid, {-0.5, 0.06}));

@@ -55,7 +55,24 @@ TEST(DoorEstimationTest, AngleOpenFractionAndClearanceAtKeyAngles) {
   EXPECT_GT(half.state().clearance_width, 0.25);
 }
 
-TEST(DoorEstimationTest, TheSweepIsTheQuarterDiscOnTheSwingSideGrownByTheMargin) {
+TEST(DoorEstimationTest, TheLeafReachIsTheQuarterDiscItTurnsThroughGrownByTheMargin) {
+  const DoorModel door = LabDoor();  // hinge at the origin, latch at (0.9, 0), opening to +y
+  EXPECT_TRUE(door.InLeafReach({0.5, 0.5}, 0.0));     // under the opening leaf
+  EXPECT_TRUE(door.InLeafReach({0.02, 0.1}, 0.1));    // the open leaf by its hinge
+  EXPECT_TRUE(door.InLeafReach({-0.05, 0.5}, 0.1));   // the open leaf's far face
+  EXPECT_FALSE(door.InLeafReach({-0.2, 0.5}, 0.1));   // past the open leaf
+  EXPECT_FALSE(door.InLeafReach({-0.3, 0.05}, 0.1));  // the wall's face beside the hinge
+  EXPECT_TRUE(door.InLeafReach({0.5, -0.05}, 0.1));   // the closed leaf's other face
+  EXPECT_FALSE(door.InLeafReach({0.5, -0.2}, 0.1));   // behind the door line
+  EXPECT_FALSE(door.InLeafReach({0.8, 0.8}, 0.1));    // 1.13 m from the hinge
+  EXPECT_TRUE(door.InLeafReach({0.05, 0.0}, 0.1));    // at the hinge
+  DoorModel narrow = door;
+  narrow.max_open_angle = std::numbers::pi / 4;  // a leaf that opens only 45 degrees
+  EXPECT_TRUE(narrow.InLeafReach({0.5, 0.4}, 0.0));
+  EXPECT_FALSE(narrow.InLeafReach({0.2, 0.5}, 0.0));
+}
+
+TEST(DoorEstimationTest, TheSweepIsTheHalfDiscOnTheSwingSideGrownByTheMargin) {
   const DoorModel door = LabDoor();
   EXPECT_TRUE(door.InSweep({0.5, 0.5}, 0.0));    // under the opening leaf
   EXPECT_FALSE(door.InSweep({0.5, -0.5}, 0.0));  // behind the door line

@@ -1,6 +1,7 @@
 #include "egress/perception/particle_filter_localizer.h"
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include <gtest/gtest.h>
@@ -137,6 +138,33 @@ TEST(ParticleFilterLocalizerTest, RelocalizesAfterAKidnapWhileStanding) {
   }
 }
 
+// Out in the open (past an exit) most beams have no return: the few left cannot tell where the
+// base is along the wall they hit, so the check does not search — though the same returns show
+// a kidnap the search would act on.
+TEST(ParticleFilterLocalizerTest, AFewReturnsDoNotRelocalize) {
+  const OccupancyGrid map = testing::TwoRoomMap();
+  const Pose2 X_BL{0.1675, 0.0, 0.0};
+  const Pose2 truth{2.0, 2.8, 0.3};
+  const Pose2 believed{truth.x - 0.3, truth.y + 0.2, truth.yaw - 0.1};
+  LaserScan scan = testing::MakeScan(181, 8.0);
+  testing::CastScan(map, truth * X_BL, &scan);
+  int returns = 0;
+  for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
+    if (i % 5 != 0) scan.ranges[i] = std::numeric_limits<float>::infinity();  // 1 in 5 left
+    returns += std::isfinite(scan.ranges[i]) ? 1 : 0;
+  }
+  ASSERT_GE(returns, 12);  // enough to correct, too few to search
+  for (const double min_returns : {0.3, 0.0}) {
+    LocalizerConfig config;
+    config.recover_min_returns = min_returns;
+    ParticleFilterLocalizer localizer(map, X_BL, config);
+    localizer.Initialize(believed, Eigen::Vector3d(1e-4, 1e-4, 1e-5).asDiagonal());
+    for (int i = 0; i < 3 * config.recover_check_scans; ++i)
+      localizer.Update({5.0, -1.0, 0.2}, scan);
+    EXPECT_EQ(localizer.recover_count(), min_returns > 0.0 ? 0 : 1) << min_returns;
+  }
+}
+
 // People crowding the laser's view of a well-localized robot leave few returns on the map's
 // walls: the check searches, but nothing fits much better than where the robot is, and it
 // stays — standing, then driving past them.
@@ -190,6 +218,11 @@ TEST(ParticleFilterLocalizerTest, RejectsBadInput) {
   config.recover_below = 0.6;
   config.recover_step = 0.0;
   EXPECT_THROW(ParticleFilterLocalizer(map, {}, config), InvalidArgument);
+  config.recover_step = 0.1;
+  config.recover_min_returns = 1.5;
+  EXPECT_THROW(ParticleFilterLocalizer(map, {}, config), InvalidArgument);
+  config.recover_min_returns = 0.3;
+  EXPECT_NO_THROW(ParticleFilterLocalizer(map, {}, config));
   config.recover_below = 0.0;  // disabled: its other fields are not used
   EXPECT_NO_THROW(ParticleFilterLocalizer(map, {}, config));
 }

@@ -33,9 +33,14 @@ struct DoorModel {
   double closed_yaw() const;
   /// Unit normal of the door line pointing into the room the leaf opens into.
   Eigen::Vector2d SwingSide() const;
-  /// Whether p_MQ lies in the quarter disc the leaf turns through (on the swing side, within
-  /// width + margin of the hinge), grown by `margin` [m]: what a moving leaf can reach.
+  /// Whether p_MQ lies on the swing side of the door line (or within `margin` behind it) and
+  /// within width + margin of the hinge [m]: the half disc round the quarter disc the leaf turns
+  /// through — what a moving leaf, or someone passing it, can reach.
   bool InSweep(const Eigen::Vector2d& p_MQ, double margin) const;
+  /// Whether p_MQ lies within `margin` of the quarter disc the leaf itself turns through, from
+  /// closed to max_open_angle [m]: wherever the leaf stands, its returns fall here, a wall at the
+  /// hinge or not.
+  bool InLeafReach(const Eigen::Vector2d& p_MQ, double margin) const;
   /// Whether p_MQ lies between the jambs, within `margin` of the door line on either side [m]:
   /// where the closed leaf stands (or someone in the doorway).
   bool OnDoorLine(const Eigen::Vector2d& p_MQ, double margin) const;
