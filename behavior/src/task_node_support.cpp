@@ -425,19 +425,18 @@ double PeopleRoom::Predicted(const Eigen::Vector2d& q) const {
 double PeopleRoom::RoomOnTheWay(const std::vector<Eigen::Vector2d>& corners) const {
   planning::TrajectoryConfig timing = task_.motion->trajectory_config();
   timing.nominal_speed = task_.config.retreat_speed;
-  // Each leg's start time and its quintic progress 0 -> 1.
+  // Each leg's start time and its progress 0 -> 1, as the trajectory will time it.
   std::vector<double> starts{0.0};
-  std::vector<planning::QuinticPolynomial> legs;
+  std::vector<planning::SegmentTimeScaling> legs;
   for (std::size_t i = 0; i + 1 < corners.size(); ++i) {
     const double length = (corners[i + 1] - corners[i]).norm();
-    legs.emplace_back(0.0, 0.0, 0.0, 1.0, 0.0, 0.0,
-                      planning::SegmentDuration(length, false, timing));
+    legs.emplace_back(length, planning::SegmentDuration(length, false, timing), timing);
     starts.push_back(starts.back() + legs.back().duration());
   }
   const auto base_at = [&](double t) -> Eigen::Vector2d {
     for (std::size_t i = 0; i < legs.size(); ++i)
       if (t < starts[i + 1])
-        return corners[i] + (corners[i + 1] - corners[i]) * legs[i].Position(t - starts[i]);
+        return corners[i] + (corners[i + 1] - corners[i]) * legs[i].Progress(t - starts[i]);
     return corners.back();
   };
   double room = std::numeric_limits<double>::infinity();
