@@ -23,6 +23,14 @@ void ProxemicsConfig::Validate() const {
               "ProxemicsConfig: space_horizon must be >= 0 and space_step > 0 (s)");
 }
 
+bool IsWhomTheRobotGoesTo(const Eigen::Vector2d& p_MP, const Eigen::Vector2d& p_MB,
+                          const Eigen::Vector2d& p_MGoal, double goal_radius) {
+  // The nearness to the robot matters too: with the end's radius alone, a resident queueing by
+  // the button the robot went to press was "whom it goes to", and the robot drove past them at
+  // 0.2 m/s and 6 cm (two wards seed 8).
+  return (p_MP - p_MGoal).norm() < goal_radius && (p_MP - p_MB).norm() >= (p_MGoal - p_MB).norm();
+}
+
 double ApproachSpeedScale(const Pose2& X_MB, const Eigen::Vector2d& v_M,
                           const std::optional<Eigen::Vector2d>& p_MGoal,
                           const std::vector<perception::TrackedPersonWithIntent>& people,
@@ -34,7 +42,9 @@ double ApproachSpeedScale(const Pose2& X_MB, const Eigen::Vector2d& v_M,
   double scale = 1.0;
   for (const auto& entry : people) {
     const auto& person = entry.person;
-    if (p_MGoal && (person.p_MP - *p_MGoal).norm() < config.goal_radius) continue;
+    if (p_MGoal &&
+        IsWhomTheRobotGoesTo(person.p_MP, X_MB.translation(), *p_MGoal, config.goal_radius))
+      continue;
     for (const Eigen::Vector2d& p_MP :
          {person.p_MP, Eigen::Vector2d(person.p_MP + person.v_MP * config.horizon)}) {
       const Eigen::Vector2d d = p_MP - X_MB.translation();

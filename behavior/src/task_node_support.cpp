@@ -550,7 +550,9 @@ std::vector<std::pair<const perception::TrackedPerson*, double>> PeopleComing(
   const Eigen::Vector2d at = belief.X_MB.translation();
   std::vector<std::pair<const perception::TrackedPerson*, double>> coming;
   for (const auto& entry : belief.world.people) {
-    if (goal && (entry.person.p_MP - goal->translation()).norm() < kGoalPersonRadiusM) continue;
+    if (goal &&
+        IsWhomTheRobotGoesTo(entry.person.p_MP, at, goal->translation(), kGoalPersonRadiusM))
+      continue;
     if (const auto t_pass = OncomingPassTime(
             entry.person, at, task.config.footprint_radius, task.config.person_radius,
             task.config.comfort_distance, task.config.give_way_horizon, kWalkingMps))

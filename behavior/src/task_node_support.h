@@ -351,7 +351,8 @@ inline constexpr double kMakeWayMinGainM = 0.1;
 inline constexpr double kGoalPersonRadiusM = 1.5;
 /// The people the robot standing where it is should make way for (TaskConfig::give_way): walking
 /// at it to pass within comfort_distance within give_way_horizon (OncomingPassTime), each with
-/// when they pass nearest [s from now]; anyone within kGoalPersonRadiusM of `goal` excepted.
+/// when they pass nearest [s from now]; whom the robot goes to (IsWhomTheRobotGoesTo, within
+/// kGoalPersonRadiusM of `goal`) excepted.
 std::vector<std::pair<const perception::TrackedPerson*, double>> PeopleComing(
     const TaskServices& task, const std::optional<Pose2>& goal);
 

@@ -100,7 +100,8 @@ TEST_F(NavigationNodesTest, NavigateToMakesWayOnlyForPeopleComingAtTheRobot) {
   auto elsewhere = Person({-1.0, 2.5}, perception::PersonIntent::kUnknown);
   elsewhere.person.v_MP = {-1.2, 0.0};
   EXPECT_FALSE(makes_way_for(elsewhere, true));
-  auto at_goal = Person({2.2, 0.6}, perception::PersonIntent::kUnknown);
+  // Beyond where the path ends (IsWhomTheRobotGoesTo; proxemics_test has the near side).
+  auto at_goal = Person({2.8, 0.6}, perception::PersonIntent::kUnknown);
   at_goal.person.v_MP = {-1.0, 0.0};
   EXPECT_FALSE(makes_way_for(at_goal, true)) << "whom the robot goes to";
   auto coming = Person({0.5, 0.6}, perception::PersonIntent::kUnknown);

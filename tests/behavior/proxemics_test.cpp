@@ -56,6 +56,28 @@ TEST(ProxemicsTest, SomeoneWhereThePathEndsIsWhomTheRobotGoesTo) {
                    0.0);
 }
 
+// Someone near where the path ends but between the robot and the end is in its way, not whom it
+// goes to: a resident queueing by the button the robot drives to (the path ends 1.3 m ahead, the
+// resident stands 0.9 m ahead, 0.4 m from the robot's edge).
+TEST(ProxemicsTest, SomeoneOnTheRobotsSideOfThePathsEndIsInItsWay) {
+  const std::vector people = {At({0.515 + 0.4, 0.0})};
+  EXPECT_DOUBLE_EQ(ApproachSpeedScale({0.0, 0.0, 0.0}, {0.2, 0.0}, Eigen::Vector2d(1.3, 0.0),
+                                      people, kRobotRadius, kPersonRadius, {}),
+                   0.0);
+  // The same person with the path ending before them: whom the robot goes to.
+  EXPECT_DOUBLE_EQ(ApproachSpeedScale({0.0, 0.0, 0.0}, {0.2, 0.0}, Eigen::Vector2d(0.9, 0.0),
+                                      people, kRobotRadius, kPersonRadius, {}),
+                   1.0);
+}
+
+TEST(ProxemicsTest, WhomTheRobotGoesToIsNearThePathsEndAndBeyondIt) {
+  const Eigen::Vector2d p_MB(0.0, 0.0), p_MGoal(2.0, 0.0);
+  EXPECT_TRUE(IsWhomTheRobotGoesTo({2.6, 0.2}, p_MB, p_MGoal, 1.5));   // beyond the end
+  EXPECT_TRUE(IsWhomTheRobotGoesTo({2.0, 1.0}, p_MB, p_MGoal, 1.5));   // beside it
+  EXPECT_FALSE(IsWhomTheRobotGoesTo({1.5, 0.0}, p_MB, p_MGoal, 1.5));  // on the robot's side
+  EXPECT_FALSE(IsWhomTheRobotGoesTo({4.0, 0.0}, p_MB, p_MGoal, 1.5));  // too far beyond
+}
+
 // Oncoming: walking towards the robot and passing within the gap (0.8 m) within the horizon.
 TEST(ProxemicsTest, SomeoneWalkingAtTheRobotIsOncomingUntilTheyPass) {
   const auto pass = [](const Eigen::Vector2d& p, const Eigen::Vector2d& v) {

@@ -22,8 +22,8 @@ struct ProxemicsConfig {
   double stop_gap{0.45};        ///< ... and reaches a standstill this near [m].
   double horizon{1.0};          ///< People's positions this far ahead count too [s].
   double cone_deg{60.0};        ///< Within this of the way the robot goes, it goes to them.
-  /// Someone this near where the path ends is whom the robot goes to (a hand-over, a
-  /// responder): not slowed for [m].
+  /// Someone this near where the path ends, and no nearer the robot than the end, is whom the
+  /// robot goes to (a hand-over, a responder): not slowed for [m].
   double goal_radius{1.5};
   /// The costmap's proxemic layer, which the base planner weighs (paths round people): each
   /// tracked person's personal space, full from stop_gap beyond both bodies and fading out at
@@ -36,8 +36,15 @@ struct ProxemicsConfig {
   void Validate() const;
 };
 
+/// Whether a person at p_MP is whom the robot at p_MB goes to, its path ending at p_MGoal: within
+/// `goal_radius` [m] of the end and no nearer the robot than the end (the path stops short of
+/// them). Someone near the end but on the robot's side of it is in its way.
+bool IsWhomTheRobotGoesTo(const Eigen::Vector2d& p_MP, const Eigen::Vector2d& p_MB,
+                          const Eigen::Vector2d& p_MGoal, double goal_radius);
+
 /// The fraction of its planned pace the robot may go at (in [0, 1]) heading along v_M from
-/// X_MB to p_MGoal (where its path ends, if it has one), with `people` around. Radii: the
+/// X_MB to p_MGoal (where its path ends, if it has one), with `people` around (whom the robot
+/// goes to excepted: IsWhomTheRobotGoesTo). Radii: the
 /// robot's footprint and a person's [m].
 double ApproachSpeedScale(const Pose2& X_MB, const Eigen::Vector2d& v_M,
                           const std::optional<Eigen::Vector2d>& p_MGoal,
