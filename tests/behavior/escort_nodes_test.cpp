@@ -654,6 +654,33 @@ TEST_F(HoldForResidentsTest, GoesToItsSpotPastSomeoneFarFromItOnTheStraightLine)
   EXPECT_FALSE(NotedText("driving to the spot"));
 }
 
+// Someone standing behind it as it sets off for its spot does not keep it where it stands: the
+// drive takes it away from them. Stopped 0.9 m in front of a group yet to set off, between them
+// and the door, the robot counted the nearest as on its way and stood in their way in until
+// they walked past it at 0.09 m (office escort seed 3). Someone as near ahead, on the way, does.
+TEST_F(HoldForResidentsTest, SetsOffForItsSpotAwayFromSomeoneStandingBehindIt) {
+  BeginFarFromAShutDoor();
+  OperatedAgo(1.0);  // not due
+  const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
+  belief_.X_MB = {spot.x - 0.15, spot.y - 0.85, M_PI / 2};  // into the room, out of the lane
+  const Eigen::Vector2d at = belief_.X_MB.translation();
+  const Eigen::Vector2d to_spot = (spot.translation() - at).normalized();
+  belief_.now = At(2.0);
+  belief_.moving_returns = {{-0.5, 1.5}};  // they come
+  belief_.off_map_returns = {{-0.5, 1.5}, at - 0.8 * to_spot};
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(NotedText("driving to the spot beside the door"));
+  ASSERT_GE(motion_.path().size(), 2u);
+  EXPECT_LT((motion_.path().back().translation() - spot.translation()).norm(), 1e-6);
+  // The same person as near ahead, on its way there: it stays.
+  motion_.StopBase();
+  log_.Take();
+  belief_.now = At(2.5);
+  belief_.off_map_returns = {{-0.5, 1.5}, at + 0.8 * to_spot};
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_FALSE(NotedText("driving to the spot"));
+}
+
 // From far off, it drives to its spot square to the way it goes, the same side all the way, so
 // the laser (270 degrees) sees ahead along the way and back along it: its blind sector behind it,
 // facing the way the residents come it drove backwards 14 m into someone queued on its way
