@@ -342,7 +342,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     const double set_off_clear =
         InTheLane(pass, belief_.X_MB.translation()) ? kStandoffFreeM : spot_clear;
     if ((wait_at.translation() - belief_.X_MB.translation()).norm() > kAtSpotM &&
-        WayClear(wait_at, set_off_clear, kSpotClearM, true)) {
+        WayClear(wait_at, set_off_clear, kSpotClearM, /*ahead_only=*/true)) {
       // Square to the way it drives, turning to watch at the spot (below): the laser sees both
       // ahead and back along the way. From the last door the way there runs away from where the
       // residents come: facing them the robot drove backwards, the blind sector leading, into a
@@ -633,10 +633,10 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   // person, no laser return off the map. With `only_within`, only the last `only_within` metres
   // of the way count (a far robot's straight line says nothing of the path it will take). With
   // `ahead_only`, someone behind the robot (as it sets off towards `goal`) and not near `goal`
-  // does not count: the drive takes it away from them. Standing 0.9 m in front of a group it
-  // had stopped short of, the robot counted the nearest of them as on its way to the spot
-  // beside the door behind it, and stayed in their way in until they set off and walked past
-  // it at 0.09 m (office escort seed 3, 44 s).
+  // does not count: the drive takes it away from them. Stopped 0.9 m in front of a standing
+  // group, between them and the door, the robot counted the nearest of them (behind it) as on
+  // its way to its spot, and stayed in their way in for 44 s until they set off and walked past
+  // it at 0.09 m (office escort seed 3).
   bool WayClear(const Pose2& goal, double radius, double only_within = -1.0,
                 bool ahead_only = false) const {
     const Eigen::Vector2d from = belief_.X_MB.translation();

@@ -127,6 +127,26 @@ class HoldForResidentsTest : public EscortNodesTest {
     }
     return -1.0;
   }
+  // A tick at `t` with `returns` off the map (residents coming: moving returns by the doorway)
+  // sets the robot off on a path that ends at `spot`.
+  void ExpectSetsOffFor(const Pose2& spot, double t, std::vector<Eigen::Vector2d> returns) {
+    belief_.now = At(t);
+    belief_.moving_returns = {{-0.5, 1.5}};  // they come
+    belief_.off_map_returns = std::move(returns);
+    EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+    EXPECT_TRUE(NotedText("driving to the spot beside the door"));
+    ASSERT_GE(motion_.path().size(), 2u);
+    EXPECT_LT((motion_.path().back().translation() - spot.translation()).norm(), 1e-6);
+  }
+  // The robot stopped, a tick at `t` with `returns` off the map does not set it off.
+  void ExpectStaysWith(double t, std::vector<Eigen::Vector2d> returns) {
+    motion_.StopBase();
+    log_.Take();
+    belief_.now = At(t);
+    belief_.off_map_returns = std::move(returns);
+    EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+    EXPECT_FALSE(NotedText("driving to the spot"));
+  }
   static constexpr double kTickSec = 0.25;  // under kStirGapSec
   bool NotedText(const std::string& text) const {
     for (const auto& note : log_.pending())
@@ -637,21 +657,10 @@ TEST_F(HoldForResidentsTest, GoesToItsSpotPastSomeoneFarFromItOnTheStraightLine)
   const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
   const Eigen::Vector2d robot = belief_.X_MB.translation();
   const Eigen::Vector2d on_the_line = robot + 0.3 * (spot.translation() - robot);
-  belief_.now = At(2.0);
-  belief_.moving_returns = {{-0.5, 1.5}};  // they come
-  belief_.off_map_returns = {{-0.5, 1.5}, on_the_line};
-  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
-  EXPECT_TRUE(NotedText("driving to the spot beside the door"));
-  ASSERT_GE(motion_.path().size(), 2u);
-  EXPECT_LT((motion_.path().back().translation() - spot.translation()).norm(), 1e-6);
+  ExpectSetsOffFor(spot, 2.0, {{-0.5, 1.5}, on_the_line});
   // Someone standing 0.5 m from the spot: it waits where it is.
-  motion_.StopBase();
-  log_.Take();
-  belief_.now = At(2.5);
   belief_.moving_returns.clear();
-  belief_.off_map_returns = {{spot.x - 0.5, spot.y}};
-  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
-  EXPECT_FALSE(NotedText("driving to the spot"));
+  ExpectStaysWith(2.5, {{spot.x - 0.5, spot.y}});
 }
 
 // Someone standing behind it as it sets off for its spot does not keep it where it stands: the
@@ -665,20 +674,9 @@ TEST_F(HoldForResidentsTest, SetsOffForItsSpotAwayFromSomeoneStandingBehindIt) {
   belief_.X_MB = {spot.x - 0.15, spot.y - 0.85, M_PI / 2};  // into the room, out of the lane
   const Eigen::Vector2d at = belief_.X_MB.translation();
   const Eigen::Vector2d to_spot = (spot.translation() - at).normalized();
-  belief_.now = At(2.0);
-  belief_.moving_returns = {{-0.5, 1.5}};  // they come
-  belief_.off_map_returns = {{-0.5, 1.5}, at - 0.8 * to_spot};
-  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
-  EXPECT_TRUE(NotedText("driving to the spot beside the door"));
-  ASSERT_GE(motion_.path().size(), 2u);
-  EXPECT_LT((motion_.path().back().translation() - spot.translation()).norm(), 1e-6);
+  ExpectSetsOffFor(spot, 2.0, {{-0.5, 1.5}, at - 0.8 * to_spot});
   // The same person as near ahead, on its way there: it stays.
-  motion_.StopBase();
-  log_.Take();
-  belief_.now = At(2.5);
-  belief_.off_map_returns = {{-0.5, 1.5}, at + 0.8 * to_spot};
-  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
-  EXPECT_FALSE(NotedText("driving to the spot"));
+  ExpectStaysWith(2.5, {{-0.5, 1.5}, at + 0.8 * to_spot});
 }
 
 // From far off, it drives to its spot square to the way it goes, the same side all the way, so
