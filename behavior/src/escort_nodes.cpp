@@ -55,9 +55,6 @@ constexpr double kRoomHorizonSec = 2.0;
 constexpr double kRoomHorizonStepSec = 0.2;
 // [m] A step that gains less room than this is not worth taking.
 constexpr double kRoomGainM = 0.1;
-// [s] A step under way is re-aimed (someone now comes at where it ends) only this long after it
-// began: a step starts from rest, and one re-aimed every tick hardly moves the robot.
-constexpr double kReAimAfterSec = 1.0;
 // [m] A step ends at least this much beyond the footprint from the building's walls.
 constexpr double kRoomWallMarginM = 0.1;
 // [m] ... and at least this far from every door's line, across its opening: not in a doorway

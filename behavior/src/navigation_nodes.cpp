@@ -391,11 +391,17 @@ class WaitForClear final : public TaskNode<bt::StatefulActionNode> {
   // [s] After a step aside (or finding none better), who is coming is looked at again after this.
   static constexpr double kMakeWayPeriodSec = 1.0;
 
+  // A step under way is re-aimed, kReAimAfterSec into it, when a spot now leaves more room than
+  // where it ends: who comes is often seen only once the step has begun (as HoldForResidents'
+  // steps; two wards seed 25, a resident caught the robot up along the corridor at a step's end).
   void MakeWay() {
     if (stepping_) {
       if (task_.motion->base_failed()) task_.motion->StopBase();  // blocked: stay where it is
-      if (task_.motion->base_moving()) return;
-      stepping_ = false;
+      if (!task_.motion->base_moving()) {
+        stepping_ = false;
+      } else if (ToSeconds(belief_.now - step_since_) < kReAimAfterSec) {
+        return;
+      }
     }
     if (!task_.config.give_way || belief_.now < next_make_way_) return;
     const double horizon = 2.0 * task_.config.give_way_horizon;  // as MakeWaySpot's
@@ -403,19 +409,28 @@ class WaitForClear final : public TaskNode<bt::StatefulActionNode> {
     const bool through =
         RoomAt(ThroughDoorWays(task_, Door(), horizon), belief_.X_MB.translation()) <
         task_.config.footprint_radius + task_.config.comfort_distance;
-    if ((!coming && !through) || !StoppedOrStopTimedOut(task_, started_)) return;
+    // Stepping, the way to where it ends is judged by MakeWaySpot, whoever comes.
+    if (!stepping_ && ((!coming && !through) || !StoppedOrStopTimedOut(task_, started_))) return;
     next_make_way_ = belief_.now + SecondsToDuration(kMakeWayPeriodSec);
-    const auto spot = MakeWaySpot(task_, kMakeWayMinGainM, {.through_door = Door()});
+    const auto spot = MakeWaySpot(task_, kMakeWayMinGainM, {.through_door = Door()},
+                                  stepping_ ? std::optional(step_to_) : std::nullopt);
     if (!spot) return;
     StepAsideTo(task_, *spot);
+    Note(StrCat(stepping_ ? "making way: re-aiming the step aside"
+                          : StrCat("making way for ",
+                                   coming ? "someone coming" : "whoever comes through the doorway",
+                                   ": stepping aside"),
+                " to (", PoseText(*spot), ")"));
     stepping_ = true;
-    Note(StrCat("making way for ", coming ? "someone coming" : "whoever comes through the doorway",
-                ": stepping aside to (", PoseText(*spot), ")"));
+    step_to_ = spot->translation();
+    step_since_ = belief_.now;
   }
 
   Time started_{};
   Time next_make_way_{};
   bool stepping_{false};
+  Eigen::Vector2d step_to_{Eigen::Vector2d::Zero()};  ///< where the step under way ends
+  Time step_since_{};                                 ///< when it began
 };
 
 }  // namespace

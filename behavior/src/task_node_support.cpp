@@ -537,11 +537,14 @@ bool StoppedOrStopTimedOut(const TaskServices& task, Time since) {
 }
 
 std::optional<Pose2> MakeWaySpot(const TaskServices& task, double min_gain,
-                                 PeopleHypotheses hypotheses) {
+                                 PeopleHypotheses hypotheses,
+                                 const std::optional<Eigen::Vector2d>& stepping_to) {
   hypotheses.sidestep = true;
   const PeopleRoom room(task, 2.0 * task.config.give_way_horizon, std::move(hypotheses));
   const Pose2& X_MB = task.belief->X_MB;
-  return room.BestSpotAround({X_MB}, room.Score({X_MB.translation()}) + min_gain);
+  std::vector<Eigen::Vector2d> staying{X_MB.translation()};
+  if (stepping_to) staying.push_back(*stepping_to);
+  return room.BestSpotAround({X_MB}, room.Score(staying) + min_gain);
 }
 
 std::vector<std::pair<const perception::TrackedPerson*, double>> PeopleComing(

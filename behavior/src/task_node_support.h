@@ -339,13 +339,18 @@ bool StoppedOrStopTimedOut(const TaskServices& task, Time since);
 /// (PeopleRoom::BestSpotAround, with sidesteps), their ways predicted twice the give-way horizon
 /// — on past the robot: to the horizon alone they may stop short of it, and every spot would
 /// look as good as standing in their way — if it leaves `min_gain` [m] more room than standing.
-/// `hypotheses` beyond the sidestep (always on).
+/// `hypotheses` beyond the sidestep (always on). With `stepping_to` (a step aside under way ends
+/// there), the spot must leave that much more room than going on to it: the step is re-aimed.
 std::optional<Pose2> MakeWaySpot(const TaskServices& task, double min_gain,
-                                 PeopleHypotheses hypotheses = {});
+                                 PeopleHypotheses hypotheses = {},
+                                 const std::optional<Eigen::Vector2d>& stepping_to = std::nullopt);
 /// Starts the step to `spot` at retreat_speed, the arm held where it is going.
 void StepAsideTo(const TaskServices& task, const Pose2& spot);
 /// [m] A spot aside must give this much more room than standing where the robot is.
 inline constexpr double kMakeWayMinGainM = 0.1;
+/// [s] A step aside under way is re-aimed (someone now comes at where it ends) only this long
+/// after it began: a step starts from rest, and one re-aimed every tick hardly moves the robot.
+inline constexpr double kReAimAfterSec = 1.0;
 /// [m] Someone this near the robot's goal is whom it goes to, not someone to make way for (as
 /// ProxemicsConfig::goal_radius).
 inline constexpr double kGoalPersonRadiusM = 1.5;

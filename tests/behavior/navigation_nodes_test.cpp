@@ -204,6 +204,48 @@ TEST_F(NavigationNodesTest, WaitForClearStepsOutOfTheWayOfWhoeverMayComeThroughT
   EXPECT_FALSE(motion_.base_moving());
 }
 
+// A step aside under way is re-aimed when someone now walks at where it ends: not sooner than
+// kReAimAfterSec into it, and not when its end is still the best.
+TEST_F(NavigationNodesTest, WaitForClearReAimsAStepAsideWhenSomeoneComesAtWhereItEnds) {
+  services_.config.give_way = true;
+  belief_.X_MB = {0.9, 2.3, M_PI / 2};
+  belief_.now = At(1.0);
+  bt::Tree tree = Tree(R"(<WaitForClear door="lab_door" timeout="30" clear_for="1.0"/>)");
+  auto dawdler = Person({-0.1, 3.4}, perception::PersonIntent::kUnknown);
+  dawdler.person.v_MP = {0.0, -0.2};
+  See({dawdler});
+  ASSERT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  ASSERT_TRUE(motion_.base_moving());
+  const Eigen::Vector2d end = motion_.path().back().translation();
+  const Eigen::Vector2d p_MB0 = belief_.X_MB.translation();
+  // Half way there; someone walks along the wall straight at where the step ends.
+  auto walker = Person(end + Eigen::Vector2d(1.8, 0.0), perception::PersonIntent::kUnknown);
+  walker.person.v_MP = {-1.0, 0.0};
+  const auto half_way = [&](double t) {
+    belief_.X_MB = {0.5 * (p_MB0.x() + end.x()), 0.5 * (p_MB0.y() + end.y()), M_PI / 2};
+    belief_.V_B = {0.2, 0.0, 0.0};
+    belief_.now = At(t);
+  };
+  half_way(1.5);
+  See({dawdler, walker});
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_LT((motion_.path().back().translation() - end).norm(), 1e-9) << "too early to re-aim";
+  half_way(2.1);
+  See({dawdler});
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_LT((motion_.path().back().translation() - end).norm(), 1e-9) << "nobody comes at it";
+  EXPECT_FALSE(NotedText("re-aiming"));
+  half_way(3.2);
+  See({dawdler, walker});
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  ASSERT_TRUE(motion_.base_moving());
+  EXPECT_TRUE(NotedText("re-aiming"));
+  const Eigen::Vector2d re_aimed = motion_.path().back().translation();
+  EXPECT_GT(std::abs(re_aimed.y() - end.y()), 0.4)
+      << "off the walker's way (y = " << end.y() << "): " << re_aimed.transpose();
+  EXPECT_FALSE(IsInAnyDoorZone(services_, re_aimed));
+}
+
 // A retreat begun while the base still rolls the other way would leave its reference behind
 // and trip the watchdog (H2 seed 2002): it starts once the base has stopped.
 TEST_F(NavigationNodesTest, RetractToSafeWaitsForTheBaseToStopBeforeBackingOff) {
