@@ -393,7 +393,8 @@ class WaitForClear final : public TaskNode<bt::StatefulActionNode> {
 
   // A step under way is re-aimed, kReAimAfterSec into it, when a spot now leaves more room than
   // where it ends: who comes is often seen only once the step has begun (as HoldForResidents'
-  // steps; two wards seed 25, a resident caught the robot up along the corridor at a step's end).
+  // steps). Two wards seed 25 is not spared by it: the resident who caught the robot up along
+  // the corridor at a step's end was tracked at a third of their speed.
   void MakeWay() {
     if (stepping_) {
       if (task_.motion->base_failed()) task_.motion->StopBase();  // blocked: stay where it is

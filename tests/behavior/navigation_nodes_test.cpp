@@ -204,8 +204,8 @@ TEST_F(NavigationNodesTest, WaitForClearStepsOutOfTheWayOfWhoeverMayComeThroughT
   EXPECT_FALSE(motion_.base_moving());
 }
 
-// A step aside under way is re-aimed when someone now walks at where it ends: not sooner than
-// kReAimAfterSec into it, and not when its end is still the best.
+// A step aside under way is re-aimed when someone now walks at where it ends: not within a
+// second of its start, and not when its end is still the best.
 TEST_F(NavigationNodesTest, WaitForClearReAimsAStepAsideWhenSomeoneComesAtWhereItEnds) {
   services_.config.give_way = true;
   belief_.X_MB = {0.9, 2.3, M_PI / 2};
@@ -218,7 +218,7 @@ TEST_F(NavigationNodesTest, WaitForClearReAimsAStepAsideWhenSomeoneComesAtWhereI
   ASSERT_TRUE(motion_.base_moving());
   const Eigen::Vector2d end = motion_.path().back().translation();
   const Eigen::Vector2d p_MB0 = belief_.X_MB.translation();
-  // Half way there; someone walks along the wall straight at where the step ends.
+  // Half way there; someone walks straight at where the step ends.
   auto walker = Person(end + Eigen::Vector2d(1.8, 0.0), perception::PersonIntent::kUnknown);
   walker.person.v_MP = {-1.0, 0.0};
   const auto half_way = [&](double t) {
