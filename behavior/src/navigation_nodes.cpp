@@ -405,13 +405,16 @@ class WaitForClear final : public TaskNode<bt::StatefulActionNode> {
       }
     }
     if (!task_.config.give_way || belief_.now < next_make_way_) return;
-    const double horizon = 2.0 * task_.config.give_way_horizon;  // as MakeWaySpot's
-    const bool coming = !PeopleComing(task_, std::nullopt).empty();
-    const bool through =
-        RoomAt(ThroughDoorWays(task_, Door(), horizon), belief_.X_MB.translation()) <
-        task_.config.footprint_radius + task_.config.comfort_distance;
     // Stepping, the way to where it ends is judged by MakeWaySpot, whoever comes.
-    if (!stepping_ && ((!coming && !through) || !StoppedOrStopTimedOut(task_, started_))) return;
+    bool coming = false;
+    if (!stepping_) {
+      const double horizon = 2.0 * task_.config.give_way_horizon;  // as MakeWaySpot's
+      coming = !PeopleComing(task_, std::nullopt).empty();
+      const bool through =
+          RoomAt(ThroughDoorWays(task_, Door(), horizon), belief_.X_MB.translation()) <
+          task_.config.footprint_radius + task_.config.comfort_distance;
+      if ((!coming && !through) || !StoppedOrStopTimedOut(task_, started_)) return;
+    }
     next_make_way_ = belief_.now + SecondsToDuration(kMakeWayPeriodSec);
     const auto spot = MakeWaySpot(task_, kMakeWayMinGainM, {.through_door = Door()},
                                   stepping_ ? std::optional(step_to_) : std::nullopt);
