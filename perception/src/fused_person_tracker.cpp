@@ -20,6 +20,8 @@ void FusedPersonTrackerConfig::Validate() const {
   positive(drop_unseen_s, "drop_unseen_s");
   positive(max_latency_s, "max_latency_s");
   positive(min_velocity_dt, "min_velocity_dt");
+  positive(reacquire_after_s, "reacquire_after_s");
+  positive(reacquire_velocity_s, "reacquire_velocity_s");
   positive(forecast_dt, "forecast_dt");
   positive(confirm_window_s, "confirm_window_s");
   positive(static_radius, "static_radius");
@@ -153,15 +155,29 @@ void FusedPersonTracker::Update(const std::vector<PersonObservation>& observatio
     const bool jumped =
         o.source == PersonSource::kLaser && last && stamp > last->first &&
         (o.p_MP - last->second).norm() > config_.max_person_speed * ToSeconds(stamp - last->first);
-    if (last && stamp > last->first) {
+    const bool reacquired = ToSeconds(stamp - track.last_measured) > config_.reacquire_after_s;
+    if (reacquired) {
+      // Coasted: the old velocity is kept until the new one is measured, not differenced across
+      // the gap (from whoever the track followed before it).
+      track.reacquired = FusedTrack::VelocityAnchor{stamp, o.p_MP, o.source};
+      track.last_by_source = {};
+    } else if (track.reacquired) {
+      const FusedTrack::VelocityAnchor& anchor = *track.reacquired;
+      const double dt = ToSeconds(stamp - anchor.stamp);
+      if (o.source == anchor.source && dt >= config_.min_velocity_dt)
+        track.person.v_MP = (o.p_MP - anchor.p_MP) / dt;
+      if (dt >= config_.reacquire_velocity_s) track.reacquired.reset();
+    } else if (last && stamp > last->first) {
       const double dt = ToSeconds(stamp - last->first);
       if (dt >= config_.min_velocity_dt) {
         track.person.v_MP = a * (o.p_MP - last->second) / dt + (1.0 - a) * track.person.v_MP;
       }
     }
     if (!last || stamp >= last->first) last = std::make_pair(stamp, o.p_MP);
-    // Fused where the person is now: the observation moved on by the (new) velocity.
-    track.person.p_MP = a * (o.p_MP + track.person.v_MP * lag) + (1.0 - a) * track.person.p_MP;
+    // Fused where the person is now: the observation moved on by the (new) velocity; outright
+    // after coasting, when the prediction is the guess.
+    const double a_p = reacquired ? 1.0 : a;
+    track.person.p_MP = a_p * (o.p_MP + track.person.v_MP * lag) + (1.0 - a_p) * track.person.p_MP;
     ++track.person.hits;
     track.person.misses = 0;
     track.last_measured = std::max(track.last_measured, stamp);

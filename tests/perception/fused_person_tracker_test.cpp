@@ -250,6 +250,41 @@ TEST(FusedPersonTrackerTest, ASliverAtTheLasersEdgeKeepsATrackWithoutDraggingIt)
   EXPECT_NEAR(tracker.ConfirmedPeople()[0].v_MP.y(), 1.0, 0.2);
 }
 
+// A walker at 1 m/s goes out of the laser's view (its blind sector) and the track coasts on;
+// 0.6 s later the walker behind, 0.6 m short of the track's prediction and walking 1.4 m/s, is
+// the nearest and the track takes her up (two wards seed 25). Her velocity is measured afresh:
+// differenced across the gap and smoothed, it read 1.06 m/s 0.2 s later, and she was placed
+// 0.4 m ahead of where she was. A walker merely hidden for a frame is tracked on as before.
+TEST(FusedPersonTrackerTest, ATrackTakenUpAfterCoastingMeasuresItsVelocityAfresh) {
+  FusedPersonTracker tracker;
+  for (int i = 0; i <= 20; ++i) {
+    const double t = 0.1 * i;
+    tracker.Update({{Eigen::Vector2d(t, 0.0), PersonSource::kLaser}}, At(t));
+  }
+  for (int i = 21; i <= 25; ++i)
+    tracker.Update({}, At(0.1 * i), [](const Eigen::Vector2d&) { return false; });
+  const auto behind = [](double t) { return Eigen::Vector2d(2.0 + 1.4 * (t - 2.6), 0.05); };
+  for (int i = 26; i <= 28; ++i) {
+    const double t = 0.1 * i;
+    tracker.Update({{behind(t), PersonSource::kLaser}}, At(t));
+  }
+  ASSERT_EQ(tracker.ConfirmedPeople().size(), 1u);
+  const TrackedPerson taken_up = tracker.ConfirmedPeople()[0];
+  EXPECT_NEAR(taken_up.v_MP.x(), 1.4, 0.1);
+  EXPECT_LT((taken_up.p_MP - behind(2.8)).norm(), 0.05);
+
+  // Hidden for one frame (0.2 s between measurements): smoothing goes on, no fresh start.
+  FusedPersonTracker hidden;
+  for (int i = 0; i <= 30; ++i) {
+    const double t = 0.1 * i;
+    if (i == 25) continue;
+    hidden.Update({{Eigen::Vector2d(t, 0.0), PersonSource::kLaser}}, At(t));
+  }
+  ASSERT_EQ(hidden.tracks().size(), 1u);
+  EXPECT_FALSE(hidden.tracks()[0].reacquired.has_value());
+  EXPECT_NEAR(hidden.tracks()[0].person.v_MP.x(), 1.0, 0.05);
+}
+
 TEST(FusedPersonTrackerTest, BadInputIsRefusedNamingIt) {
   FusedPersonTracker tracker;
   tracker.Update({}, At(1.0));
@@ -265,6 +300,9 @@ TEST(FusedPersonTrackerTest, BadInputIsRefusedNamingIt) {
   EXPECT_THROW(FusedPersonTracker{config}, InvalidArgument);
   config = {};
   config.edge_gate = 0.0;
+  EXPECT_THROW(FusedPersonTracker{config}, InvalidArgument);
+  config = {};
+  config.reacquire_after_s = -1.0;
   EXPECT_THROW(FusedPersonTracker{config}, InvalidArgument);
 }
 

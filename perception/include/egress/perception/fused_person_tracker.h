@@ -71,6 +71,15 @@ struct FusedPersonTrackerConfig {
   double confirm_window_s{2.0};  ///< ... within this [s].
   double max_latency_s{0.5};     ///< Oldest a frame may be against the tracks' time [s].
   double min_velocity_dt{0.05};  ///< Measurements closer in time than this update no velocity [s].
+  /// A track no sensor has measured for this long has coasted on its velocity: its next
+  /// measurement places it outright, and its velocity is measured afresh from there (differenced
+  /// from that measurement, not smoothed into the old velocity) for `reacquire_velocity_s`. The
+  /// one it followed may have gone out of view and the track taken up someone else: two wards
+  /// seed 25's track coasted 0.6 s after a walker into the laser's blind sector, took the walker
+  /// behind her 0.6 m short of its prediction, differenced that as -0.6 m/s, and read her at
+  /// 0.5 m/s 0.1 s later while she walked at 1.4 [s].
+  double reacquire_after_s{0.4};
+  double reacquire_velocity_s{0.3};  ///< See reacquire_after_s [s].
   int forecast_steps{4};
   double forecast_dt{0.2};  ///< [s]
   /// An unconfirmed track whose laser observation jumped faster than this since the last one
@@ -107,6 +116,14 @@ struct FusedTrack {
   /// Per sensor (index PersonSource): its last measurement, for velocity from the same sensor
   /// (the camera's placement and the laser's leg midpoint disagree by a few centimetres).
   std::array<std::optional<std::pair<Time, Eigen::Vector2d>>, 2> last_by_source;
+  /// Since it was reacquired (FusedPersonTrackerConfig::reacquire_after_s), for
+  /// reacquire_velocity_s: that measurement (stamp, position, sensor), its velocity's origin.
+  struct VelocityAnchor {
+    Time stamp{};
+    Eigen::Vector2d p_MP{Eigen::Vector2d::Zero()};
+    PersonSource source{PersonSource::kLaser};
+  };
+  std::optional<VelocityAnchor> reacquired;
   /// Until confirmed: its laser measurements (stamp, position) since its confirm window began.
   std::vector<std::pair<Time, Eigen::Vector2d>> laser_path;
 };
