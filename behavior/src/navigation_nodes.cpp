@@ -393,8 +393,9 @@ class WaitForClear final : public TaskNode<bt::StatefulActionNode> {
 
   // A step under way is re-aimed, kReAimAfterSec into it, when a spot now leaves more room than
   // where it ends: who comes is often seen only once the step has begun (as HoldForResidents'
-  // steps). Two wards seed 25 is not spared by it: the resident who caught the robot up along
-  // the corridor at a step's end was tracked at a third of their speed.
+  // steps). It is only as good as people's tracked velocities: two wards seed 25's resident,
+  // catching the robot up along the corridor at a step's end, read a third of their speed
+  // until FusedPersonTracker measured a track's velocity afresh after it coasted.
   void MakeWay() {
     if (stepping_) {
       if (task_.motion->base_failed()) task_.motion->StopBase();  // blocked: stay where it is
