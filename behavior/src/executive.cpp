@@ -115,6 +115,7 @@ struct Executive::Impl {
   std::map<std::string, bool> zone_occupied;  // per door, at the last control step
   std::optional<double> occupied_known_at;    // when perception first showed a person there
   HeadGaze gaze;
+  ApproachPace pace;  // the paths' pace near people, with patience
 
   Impl(std::shared_ptr<const RobotModel> m, MissionMap mp, ExecutiveConfig c)
       : model(std::move(m)),
@@ -123,7 +124,8 @@ struct Executive::Impl {
         perception(map.doors, config.perception),
         motion(*model, config.trajectory, config.controller, config.arm),
         grasp(config.grasp),
-        gaze(config.head) {}
+        gaze(config.head),
+        pace(config.proxemics) {}
 };
 
 Executive::Executive(std::shared_ptr<const RobotModel> model, MissionMap map, MissionTree tree,
@@ -586,9 +588,16 @@ bool Executive::Step(RobotPort& port) {
   }
   std::optional<Eigen::Vector2d> p_MGoal;
   if (!m.motion.path().empty()) p_MGoal = m.motion.path().back().translation();
-  m.motion.SetSpeedScale(ApproachSpeedScale(belief_.X_MB, m.motion.planned_velocity(), p_MGoal,
-                                            belief_.world.people, m.config.tasks.footprint_radius,
-                                            m.config.tasks.person_radius, m.config.proxemics));
+  const bool was_squeezing = m.pace.squeezing();
+  m.motion.SetSpeedScale(m.pace.Update(
+      ToSeconds(now), belief_.X_MB, m.motion.planned_velocity(), p_MGoal, belief_.world.people,
+      m.config.tasks.footprint_radius, m.config.tasks.person_radius));
+  if (m.pace.squeezing() && !was_squeezing) {
+    decisions_.push_back({ToSeconds(now),
+                          StrCat("held back ", m.config.proxemics.patience_s,
+                                 " s by people standing in the way: edging past them"),
+                          DecisionEvent::kNote});
+  }
   Twist2 V_B = m.motion.Update(now, belief_.X_MB, snapshot.odometry.V_B);
   if (scan_silence > m.config.scan_hold_after_s) {
     V_B = Twist2{};  // blind: stand still until scans come again

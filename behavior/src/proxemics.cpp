@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "egress/hsr_interface/error.h"
 
@@ -21,6 +22,12 @@ void ProxemicsConfig::Validate() const {
   ThrowUnless(std::isfinite(space_horizon) && space_horizon >= 0 && std::isfinite(space_step) &&
                   space_step > 0,
               "ProxemicsConfig: space_horizon must be >= 0 and space_step > 0 (s)");
+  ThrowUnless(std::isfinite(patience_s) && patience_s >= 0,
+              "ProxemicsConfig: patience_s must be >= 0 (s)");
+  ThrowUnless(std::isfinite(squeeze_gap) && squeeze_gap >= 0 && squeeze_gap < stop_gap,
+              "ProxemicsConfig: need 0 <= squeeze_gap < stop_gap (m)");
+  ThrowUnless(std::isfinite(standing_speed) && standing_speed >= 0,
+              "ProxemicsConfig: standing_speed must be >= 0 (m/s)");
 }
 
 bool IsWhomTheRobotGoesTo(const Eigen::Vector2d& p_MP, const Eigen::Vector2d& p_MB,
@@ -34,8 +41,8 @@ bool IsWhomTheRobotGoesTo(const Eigen::Vector2d& p_MP, const Eigen::Vector2d& p_
 double ApproachSpeedScale(const Pose2& X_MB, const Eigen::Vector2d& v_M,
                           const std::optional<Eigen::Vector2d>& p_MGoal,
                           const std::vector<perception::TrackedPersonWithIntent>& people,
-                          double robot_radius, double person_radius,
-                          const ProxemicsConfig& config) {
+                          double robot_radius, double person_radius, const ProxemicsConfig& config,
+                          bool squeeze) {
   if (!config.slow_near_people || v_M.norm() < kMovingMps) return 1.0;
   const Eigen::Vector2d way = v_M.normalized();
   const double cos_cone = std::cos(config.cone_deg * M_PI / 180.0);
@@ -45,19 +52,56 @@ double ApproachSpeedScale(const Pose2& X_MB, const Eigen::Vector2d& v_M,
     if (p_MGoal &&
         IsWhomTheRobotGoesTo(person.p_MP, X_MB.translation(), *p_MGoal, config.goal_radius))
       continue;
+    const bool edge_past = squeeze && person.v_MP.norm() < config.standing_speed;
+    const double slow_gap = edge_past ? config.stop_gap : config.slow_gap;
+    const double stop_gap = edge_past ? config.squeeze_gap : config.stop_gap;
     for (const Eigen::Vector2d& p_MP :
          {person.p_MP, Eigen::Vector2d(person.p_MP + person.v_MP * config.horizon)}) {
       const Eigen::Vector2d d = p_MP - X_MB.translation();
       const double distance = d.norm();
       const double gap = distance - robot_radius - person_radius;
-      if (gap >= config.slow_gap) continue;
-      if (distance > 1e-9 && way.dot(d / distance) < cos_cone) continue;  // not towards them
-      scale = std::min(
-          scale,
-          std::clamp((gap - config.stop_gap) / (config.slow_gap - config.stop_gap), 0.0, 1.0));
+      if (gap >= slow_gap) continue;
+      // Not towards them. Edging past someone standing, going by them counts too (the path may
+      // pass them closer than it heads at them), at a crawl that ends short of touching.
+      if (distance > 1e-9 && way.dot(d / distance) < (edge_past ? 0.0 : cos_cone)) continue;
+      scale = std::min(scale, std::clamp((gap - stop_gap) / (slow_gap - stop_gap), 0.0, 1.0));
     }
   }
   return scale;
+}
+
+ApproachPace::ApproachPace(ProxemicsConfig config) : config_(std::move(config)) {
+  config_.Validate();
+}
+
+double ApproachPace::Update(double now_s, const Pose2& X_MB, const Eigen::Vector2d& v_M,
+                            const std::optional<Eigen::Vector2d>& p_MGoal,
+                            const std::vector<perception::TrackedPersonWithIntent>& people,
+                            double robot_radius, double person_radius) {
+  const double scale =
+      ApproachSpeedScale(X_MB, v_M, p_MGoal, people, robot_radius, person_radius, config_);
+  // Going nowhere tells nothing: held to a standstill at a path's start, the planned pace
+  // itself hovers there, and a step in which it is below kMovingMps is no step free.
+  if (v_M.norm() < kMovingMps) return scale;
+  squeezing_ = false;
+  if (config_.patience_s <= 0.0 || scale >= kHeldScale) {
+    held_since_.reset();
+    return scale;
+  }
+  // Held by people standing still: edging past them would go faster. Held by someone walking
+  // (who will be gone), the patience starts afresh.
+  const double edging = ApproachSpeedScale(X_MB, v_M, p_MGoal, people, robot_radius, person_radius,
+                                           config_, /*squeeze=*/true);
+  if (!(edging > scale)) {
+    held_since_.reset();
+    return scale;
+  }
+  // Held again after a while with no path (a pause to let people by): patience afresh.
+  if (!held_since_ || now_s - last_held_s_ > kHeldGapSec) held_since_ = now_s;
+  last_held_s_ = now_s;
+  if (now_s - *held_since_ < config_.patience_s) return scale;
+  squeezing_ = true;
+  return edging;
 }
 
 std::optional<double> OncomingPassTime(const perception::TrackedPerson& person,

@@ -1,5 +1,7 @@
 #include "egress/behavior/proxemics.h"
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "egress/hsr_interface/error.h"
@@ -109,6 +111,91 @@ TEST(ProxemicsTest, BadConfigsAreRefusedNamingTheField) {
   c = {};
   c.horizon = -1.0;
   EXPECT_THROW(c.Validate(), InvalidArgument);
+  c = {};
+  c.squeeze_gap = c.stop_gap;  // must be below it
+  EXPECT_THROW(c.Validate(), InvalidArgument);
+  c = {};
+  c.patience_s = std::nan("");
+  EXPECT_THROW(c.Validate(), InvalidArgument);
+  c = {};
+  c.standing_speed = -0.1;
+  EXPECT_THROW(c.Validate(), InvalidArgument);
+  c = {};
+  c.patience_s = -1.0;
+  EXPECT_THROW(ApproachPace{c}, InvalidArgument);
+}
+
+// Edging past: someone standing 0.3 m from the robot's edge ahead holds it still; with `squeeze`
+// it goes on at a crawl down to squeeze_gap (0.2 m), and someone it goes by (abeam-ahead, out
+// of the 60-degree cone) slows it too. Someone walking is never squeezed past.
+TEST(ProxemicsTest, SqueezingPastSomeoneStandingCrawlsDownToTheSqueezeGap) {
+  const ProxemicsConfig c;
+  const auto scale = [&](const Eigen::Vector2d& p, const Eigen::Vector2d& v, bool squeeze) {
+    return ApproachSpeedScale({0.0, 0.0, 0.0}, {0.2, 0.0}, std::nullopt, {At(p, v)}, kRobotRadius,
+                              kPersonRadius, c, squeeze);
+  };
+  const Eigen::Vector2d still = Eigen::Vector2d::Zero();
+  EXPECT_DOUBLE_EQ(scale({0.515 + 0.3, 0.0}, still, false), 0.0);
+  EXPECT_NEAR(scale({0.515 + 0.3, 0.0}, still, true), (0.3 - 0.2) / (0.45 - 0.2), 1e-9);
+  EXPECT_DOUBLE_EQ(scale({0.515 + 0.15, 0.0}, still, true), 0.0);  // inside the squeeze gap
+  // Going by, 70 degrees off the way at 0.25 m: not slowed at all, unless squeezing.
+  const Eigen::Vector2d beside = (0.515 + 0.25) * Eigen::Vector2d(std::cos(1.22), std::sin(1.22));
+  EXPECT_DOUBLE_EQ(scale(beside, still, false), 1.0);
+  EXPECT_NEAR(scale(beside, still, true), (0.25 - 0.2) / (0.45 - 0.2), 1e-9);
+  // Behind abeam: going away, never slowed.
+  EXPECT_DOUBLE_EQ(scale({-0.1, 0.515 + 0.25}, still, true), 1.0);
+  // Walking (0.5 m/s across, faster than standing_speed): the normal rule, squeeze or not.
+  EXPECT_DOUBLE_EQ(scale({0.515 + 0.3, 0.0}, {0.0, 0.5}, true),
+                   scale({0.515 + 0.3, 0.0}, {0.0, 0.5}, false));
+}
+
+// Patience: held to a crawl by someone standing for patience_s (5 s) in a row, the robot edges
+// past; a spell with no path longer than kHeldGapSec, or someone walking, starts it afresh.
+TEST(ProxemicsTest, ApproachPaceEdgesPastSomeoneStandingOnlyOncePatienceIsSpent) {
+  ApproachPace pace{ProxemicsConfig{}};
+  const std::vector standing = {At({0.515 + 0.3, 0.0})};
+  const Eigen::Vector2d v(0.2, 0.0), none = Eigen::Vector2d::Zero();
+  const auto update = [&](double t, const Eigen::Vector2d& v_M,
+                          const std::vector<perception::TrackedPersonWithIntent>& people) {
+    return pace.Update(t, {0.0, 0.0, 0.0}, v_M, std::nullopt, people, kRobotRadius, kPersonRadius);
+  };
+  const double edging = (0.3 - 0.2) / (0.45 - 0.2);
+  double t = 0.0;
+  for (; t < 4.95; t += 0.1) {
+    EXPECT_DOUBLE_EQ(update(t, v, standing), 0.0) << t;
+    // Steps where the planned pace is nil (held at a path's start) do not break the patience.
+    EXPECT_DOUBLE_EQ(update(t + 0.05, none, standing), 1.0);
+  }
+  EXPECT_FALSE(pace.squeezing());
+  EXPECT_NEAR(update(5.0, v, standing), edging, 1e-9);
+  EXPECT_TRUE(pace.squeezing());
+  EXPECT_NEAR(update(5.1, v, standing), edging, 1e-9);
+  // Past them (nobody near): no longer held, and the patience is spent again next time.
+  EXPECT_DOUBLE_EQ(update(5.2, v, {}), 1.0);
+  EXPECT_FALSE(pace.squeezing());
+  EXPECT_DOUBLE_EQ(update(5.3, v, standing), 0.0);
+  // No path for 2 s (longer than kHeldGapSec), then held again: patience afresh.
+  ApproachPace paused{ProxemicsConfig{}};
+  for (double s = 0.0; s < 4.0; s += 0.1)
+    paused.Update(s, {0.0, 0.0, 0.0}, v, std::nullopt, standing, kRobotRadius, kPersonRadius);
+  EXPECT_DOUBLE_EQ(
+      paused.Update(6.0, {0.0, 0.0, 0.0}, v, std::nullopt, standing, kRobotRadius, kPersonRadius),
+      0.0);
+  EXPECT_FALSE(paused.squeezing());
+  // Someone walking at the robot holds it however long: they will be gone.
+  ApproachPace walking{ProxemicsConfig{}};
+  const std::vector coming = {At({0.515 + 1.0, 0.0}, {-0.5, 0.0})};
+  for (double s = 0.0; s < 20.0; s += 0.1)
+    walking.Update(s, {0.0, 0.0, 0.0}, v, std::nullopt, coming, kRobotRadius, kPersonRadius);
+  EXPECT_FALSE(walking.squeezing());
+  // patience_s 0: it waits for them however long.
+  ProxemicsConfig never;
+  never.patience_s = 0.0;
+  ApproachPace waits{never};
+  for (double s = 0.0; s < 20.0; s += 0.1)
+    EXPECT_DOUBLE_EQ(
+        waits.Update(s, {0.0, 0.0, 0.0}, v, std::nullopt, standing, kRobotRadius, kPersonRadius),
+        0.0);
 }
 
 }  // namespace

@@ -4,6 +4,9 @@
 /// (Hall); the robot slows its paths when it heads towards someone within `slow_gap` of its
 /// edge (where they are, or will be within `horizon` at their velocity), down to a stop at
 /// `stop_gap`. Moving away from or past someone is never slowed: a retreat must be quick.
+/// Held back for `patience_s` by people who stand still (a resident waiting at the door the
+/// robot goes to open, beside the only way to its button: they will not move until it opens),
+/// the robot edges past them at a crawl instead of waiting for good (ApproachPace).
 /// Gaps are surface to surface, as the judge measures them.
 
 #include <optional>
@@ -32,6 +35,12 @@ struct ProxemicsConfig {
   bool personal_space_layer{true};
   double space_horizon{2.0};  ///< [s]
   double space_step{0.5};     ///< [s]
+  /// Held back this long [s] by people standing still, the robot edges past them: towards them
+  /// or going by them, it slows from stop_gap and stops at squeeze_gap. 0: it waits for them
+  /// however long.
+  double patience_s{5.0};
+  double squeeze_gap{0.2};      ///< [m], below stop_gap
+  double standing_speed{0.25};  ///< Tracked people slower than this stand still [m/s].
   /// @throws InvalidArgument naming the field.
   void Validate() const;
 };
@@ -46,10 +55,42 @@ bool IsWhomTheRobotGoesTo(const Eigen::Vector2d& p_MP, const Eigen::Vector2d& p_
 /// X_MB to p_MGoal (where its path ends, if it has one), with `people` around (whom the robot
 /// goes to excepted: IsWhomTheRobotGoesTo). Radii: the
 /// robot's footprint and a person's [m].
+/// `squeeze`: people standing still (slower than `standing_speed`) slow it from `stop_gap` to a
+/// stop at `squeeze_gap` instead, heading at them or going by them (anywhere ahead of abeam),
+/// where they stand (ApproachPace, once patience is spent).
 double ApproachSpeedScale(const Pose2& X_MB, const Eigen::Vector2d& v_M,
                           const std::optional<Eigen::Vector2d>& p_MGoal,
                           const std::vector<perception::TrackedPersonWithIntent>& people,
-                          double robot_radius, double person_radius, const ProxemicsConfig& config);
+                          double robot_radius, double person_radius, const ProxemicsConfig& config,
+                          bool squeeze = false);
+
+/// The robot's pace near people over time: ApproachSpeedScale, and patience. While the robot
+/// is held to a crawl (below kHeldScale) by people who stand still, for `patience_s` in a row,
+/// it edges past them (ApproachSpeedScale with `squeeze`) until it is no longer held. Without
+/// it a resident waiting at a door, beside the way to its button, and the robot waiting for
+/// them to move, waited for each other to the time limit (two wards seed 33: 340 s).
+class ApproachPace {
+ public:
+  /// A scale below this holds the robot to a crawl (a fifth of its pace).
+  static constexpr double kHeldScale = 0.2;
+  /// Held again after this long with no path [s], the robot's patience starts afresh.
+  static constexpr double kHeldGapSec = 1.0;
+
+  explicit ApproachPace(ProxemicsConfig config);
+  /// The scale at `now_s` [s] (monotonic across calls); arguments as ApproachSpeedScale's.
+  double Update(double now_s, const Pose2& X_MB, const Eigen::Vector2d& v_M,
+                const std::optional<Eigen::Vector2d>& p_MGoal,
+                const std::vector<perception::TrackedPersonWithIntent>& people, double robot_radius,
+                double person_radius);
+  /// Whether the last Update edged past people standing still.
+  bool squeezing() const { return squeezing_; }
+
+ private:
+  ProxemicsConfig config_;
+  std::optional<double> held_since_;  // [s] held by people standing still since
+  double last_held_s_{0.0};           // [s] when last held so
+  bool squeezing_{false};
+};
 
 /// Whether `person` walks (faster than `walking_speed` [m/s]) towards a robot standing at
 /// p_MB and, going straight on at their velocity, will pass within `gap` of its edge (surface
