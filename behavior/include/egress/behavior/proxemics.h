@@ -82,7 +82,7 @@ class ApproachPace {
                 const std::optional<Eigen::Vector2d>& p_MGoal,
                 const std::vector<perception::TrackedPersonWithIntent>& people, double robot_radius,
                 double person_radius);
-  /// Whether the last Update edged past people standing still.
+  /// Whether it edges past people standing still (as of the last Update with a pace planned).
   bool squeezing() const { return squeezing_; }
 
  private:
