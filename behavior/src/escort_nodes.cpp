@@ -169,7 +169,11 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
       if (!moving_since_ || !last_moving_ || ToSeconds(belief_.now - *last_moving_) > kStirGapSec)
         moving_since_ = belief_.now;
     }
-    if (around.moving && !came_ && ToSeconds(belief_.now - *moving_since_) >= kComingForSec) {
+    // And a tracked person among them nearer the doorway by kComingCloserM (ApproachWatch): a
+    // standing person's track creeps, now and then for seconds on end, but stays by them.
+    const bool closing = approach_.Update(belief_, pass, Input<double>("watch_radius"));
+    if (around.moving && !came_ && ToSeconds(belief_.now - *moving_since_) >= kComingForSec &&
+        (closing || !around.person_moving)) {
       Note(StrCat("residents coming (", around.mover, "): stepping aside"));
       came_ = true;
       under_way_ = true;
@@ -541,6 +545,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     last_tick_.reset();
     nobody_at_last_watch_ = false;
     came_ = false;
+    approach_.Reset();
     last_moving_.reset();
     moving_since_.reset();
     unseen_ = 0.0;
@@ -663,6 +668,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   bool under_way_{false};                 // someone came during any hold so far
   std::optional<Time> last_moving_;       // when someone near was last seen on the move
   std::optional<Time> moving_since_;      // since when, with no gap over kStirGapSec
+  ApproachWatch approach_;                // who walks up to the doorway, for came_
   double unseen_{0.0};                    // [s] of watching since anyone was near
   bool making_room_{false};               // stepping away from someone too near
   Eigen::Vector2d room_to_{0.0, 0.0};     // where that step ends

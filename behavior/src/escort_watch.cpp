@@ -19,6 +19,36 @@ constexpr double kSameBodyM = 0.15;
 constexpr double kHuggingWallM = 0.3;
 }  // namespace
 
+bool SeenWalking(const Belief& belief, const perception::TrackedPerson& person) {
+  // Walking off, not a tracker's wobble: away from where they stood as well as fast, and seen so
+  // now (a standing person's track that lost them at the edge of the laser's view, or behind
+  // someone, coasts on a step's worth of wobble and walks off on its own).
+  return person.v_MP.norm() > kMovingMps && (person.p_MP - person.p_MRest).norm() > kWalkedOffM &&
+         ToSeconds(belief.now - person.last_seen) <= kSeenMovingWithinSec;
+}
+
+bool ApproachWatch::Update(const Belief& belief, const DoorPass& pass, double watch_radius) {
+  bool closed = false;
+  for (const auto& entry : belief.world.people) {
+    const auto& person = entry.person;
+    const Eigen::Vector2d d = person.p_MP - pass.centre;
+    if (d.dot(pass.n_M) <= -kThroughM || d.norm() >= watch_radius || !SeenWalking(belief, person))
+      continue;
+    const double distance = d.norm();
+    auto it = walks_.find(person.id);
+    if (it == walks_.end() || ToSeconds(belief.now - it->second.last) > kStirGapSec)
+      it = walks_.insert_or_assign(person.id, Walk{belief.now, distance}).first;
+    Walk& walk = it->second;
+    walk.last = belief.now;
+    walk.farthest = std::max(walk.farthest, distance);
+    closed = closed || walk.farthest - distance >= kComingCloserM;
+  }
+  // Walks over (or tracks gone) are forgotten: a track that walks again starts afresh.
+  std::erase_if(walks_,
+                [&](const auto& w) { return ToSeconds(belief.now - w.second.last) > kStirGapSec; });
+  return closed;
+}
+
 Surroundings LookAround(const Belief& belief, const DoorPass& pass, double watch_radius,
                         double near_door) {
   const auto this_side = [&](const Eigen::Vector2d& p, double radius) {
@@ -29,15 +59,10 @@ Surroundings LookAround(const Belief& belief, const DoorPass& pass, double watch
   for (const auto& entry : belief.world.people) {
     if (!this_side(entry.person.p_MP, watch_radius)) continue;
     s.near = true;
-    // Walking off, not a tracker's wobble: away from where they stood as well as fast, and seen
-    // so now (a standing person's track that lost them at the edge of the laser's view, or behind
-    // someone, coasts on a step's worth of wobble and walks off on its own).
     const auto& person = entry.person;
-    if (s.moving || person.v_MP.norm() <= kMovingMps ||
-        (person.p_MP - person.p_MRest).norm() <= kWalkedOffM ||
-        ToSeconds(belief.now - person.last_seen) > kSeenMovingWithinSec)
-      continue;
+    if (s.moving || !SeenWalking(belief, person)) continue;
     s.moving = true;
+    s.person_moving = true;
     s.mover = StrCat("person ", person.id, " at ", PoseText({person.p_MP.x(), person.p_MP.y(), 0}),
                      ", ", std::round(person.v_MP.norm() * 10) / 10, " m/s");
   }

@@ -1,6 +1,8 @@
 // What the escort sees round a door it holds (behavior/src/escort_watch.h): who is near, and
 // whether anyone is coming.
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "escort_watch.h"
@@ -124,6 +126,39 @@ TEST(EscortWatchTest, OnlyThisSideWithinReachCounts) {
   EXPECT_TRUE(s.near);
   EXPECT_TRUE(s.moving);
   EXPECT_NE(s.mover.find("laser returns"), std::string::npos) << s.mover;
+}
+
+// Someone walking up to the doorway comes nearer it; a standing person's track that creeps (fast
+// enough, and off where it stood, for seconds on end) stays by them (office seed 45). Only a walk
+// that closes kComingCloserM on the doorway counts, from its farthest; a walk broken off for over
+// kStirGapSec starts afresh.
+TEST(EscortWatchTest, ApproachWatchCountsOnlyAWalkThatClosesOnTheDoorway) {
+  Belief belief;
+  ApproachWatch watch;
+  const auto tick = [&](double t, const Eigen::Vector2d& p) {
+    belief.now = Time{} + SecondsToDuration(t);
+    perception::TrackedPersonWithIntent walker = Person(7, {4.0, 0.0}, p, {-0.4, 0.0});
+    walker.person.last_seen = belief.now;
+    belief.world.people = {walker};
+    return watch.Update(belief, Pass(), kWatchM);
+  };
+  // Creeping back and forth between 3.6 and 3.2 m for 4 s: never.
+  for (int k = 0; k <= 40; ++k) {
+    const double x = 3.4 + 0.2 * std::sin(k * 0.3);
+    EXPECT_FALSE(tick(0.1 * k, {x, 0.0})) << k;
+  }
+  // Walking on from 3.6 m: coming once 0.6 m nearer than the farthest it was.
+  EXPECT_FALSE(tick(4.1, {3.3, 0.0}));
+  EXPECT_FALSE(tick(4.2, {3.1, 0.0}));
+  EXPECT_TRUE(tick(4.3, {2.95, 0.0}));
+  // A gap over kStirGapSec: a new walk, from where it is now.
+  EXPECT_FALSE(tick(4.3 + 2 * kStirGapSec, {2.9, 0.0}));
+  EXPECT_FALSE(tick(4.4 + 2 * kStirGapSec, {2.6, 0.0}));
+  EXPECT_TRUE(tick(4.5 + 2 * kStirGapSec, {2.25, 0.0}));
+  // Standing (not SeenWalking) is no walk; through the door is not this side.
+  watch.Reset();
+  belief.world.people = {Person(7, {2.0, 0.0}, {2.0, 0.0}, {0.0, 0.0})};
+  EXPECT_FALSE(watch.Update(belief, Pass(), kWatchM));
 }
 
 }  // namespace
