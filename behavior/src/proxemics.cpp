@@ -17,6 +17,8 @@ void ProxemicsConfig::Validate() const {
       "ProxemicsConfig: need 0 <= stop_gap < slow_gap (m)");
   ThrowUnless(std::isfinite(horizon) && horizon >= 0, "ProxemicsConfig: horizon must be >= 0");
   ThrowUnless(cone_deg > 0 && cone_deg <= 180, "ProxemicsConfig: cone_deg must be in (0, 180]");
+  ThrowUnless(std::isfinite(pass_gap) && pass_gap >= 0,
+              "ProxemicsConfig: pass_gap must be >= 0 (m)");
   ThrowUnless(std::isfinite(goal_radius) && goal_radius >= 0,
               "ProxemicsConfig: goal_radius must be >= 0");
   ThrowUnless(std::isfinite(space_horizon) && space_horizon >= 0 && std::isfinite(space_step) &&
@@ -38,6 +40,17 @@ bool IsWhomTheRobotGoesTo(const Eigen::Vector2d& p_MP, const Eigen::Vector2d& p_
   return (p_MP - p_MGoal).norm() < goal_radius && (p_MP - p_MB).norm() >= (p_MGoal - p_MB).norm();
 }
 
+bool IsPassedOnTheWay(const Eigen::Vector2d& p_MP, const Eigen::Vector2d& p_MB,
+                      const Eigen::Vector2d& p_MGoal, double reach) {
+  const Eigen::Vector2d way = p_MGoal - p_MB;
+  const double length = way.norm();
+  if (length < 1e-9) return false;
+  const Eigen::Vector2d d = p_MP - p_MB;
+  const double along = way.dot(d) / length;
+  return along > 0.0 && along < length &&
+         std::abs(way.x() * d.y() - way.y() * d.x()) / length < reach;
+}
+
 double ApproachSpeedScale(const Pose2& X_MB, const Eigen::Vector2d& v_M,
                           const std::optional<Eigen::Vector2d>& p_MGoal,
                           const std::vector<perception::TrackedPersonWithIntent>& people,
@@ -49,8 +62,14 @@ double ApproachSpeedScale(const Pose2& X_MB, const Eigen::Vector2d& v_M,
   double scale = 1.0;
   for (const auto& entry : people) {
     const auto& person = entry.person;
-    if (p_MGoal &&
-        IsWhomTheRobotGoesTo(person.p_MP, X_MB.translation(), *p_MGoal, config.goal_radius))
+    // Whom it goes to stands there waiting, and not beside its straight way there (within
+    // pass_gap): someone walking up, or passed on the way, is not (atrium seed 71: a step making
+    // room, ending 0.5 m past where a resident walking up to queue stopped, took the robot into
+    // her at 0.5 m/s).
+    if (p_MGoal && person.v_MP.norm() < config.standing_speed &&
+        IsWhomTheRobotGoesTo(person.p_MP, X_MB.translation(), *p_MGoal, config.goal_radius) &&
+        !IsPassedOnTheWay(person.p_MP, X_MB.translation(), *p_MGoal,
+                          robot_radius + person_radius + config.pass_gap))
       continue;
     const bool edge_past = squeeze && person.v_MP.norm() < config.standing_speed;
     const double slow_gap = edge_past ? config.stop_gap : config.slow_gap;
@@ -62,8 +81,14 @@ double ApproachSpeedScale(const Pose2& X_MB, const Eigen::Vector2d& v_M,
       const double gap = distance - robot_radius - person_radius;
       if (gap >= slow_gap) continue;
       // Not towards them. Edging past someone standing, going by them counts too (the path may
-      // pass them closer than it heads at them), at a crawl that ends short of touching.
-      if (distance > 1e-9 && way.dot(d / distance) < (edge_past ? 0.0 : cos_cone)) continue;
+      // pass them closer than it heads at them), at a crawl that ends short of touching. So does
+      // going by anyone ahead of abeam within pass_gap (atrium seed 71: she was 61 degrees off).
+      if (distance > 1e-9) {
+        const double along = way.dot(d);
+        const double pass = std::abs(way.x() * d.y() - way.y() * d.x());
+        const bool grazing = along > 0.0 && pass - robot_radius - person_radius < config.pass_gap;
+        if (along < (edge_past ? 0.0 : cos_cone) * distance && !grazing) continue;
+      }
       scale = std::min(scale, std::clamp((gap - stop_gap) / (slow_gap - stop_gap), 0.0, 1.0));
     }
   }

@@ -47,6 +47,45 @@ TEST(ProxemicsTest, MovingAwayOrPastSomeoneIsNeverSlowed) {
   EXPECT_DOUBLE_EQ(Scale({At({0.515 + 0.2, 0.0})}, {0.2, 0.0}, off), 1.0);
 }
 
+// Going by someone ahead of abeam, outside the cone, slows for them as heading at them would when
+// the straight way passes them within pass_gap (surface to surface); with room to spare it does
+// not (atrium seed 71).
+TEST(ProxemicsTest, GoingBySomeoneWithinThePassGapSlows) {
+  const auto grazed = At({0.3, 0.6});  // 63 degrees off, passed 0.6 - 0.515 = 0.085 m off
+  EXPECT_DOUBLE_EQ(Scale({grazed}), 0.0);
+  EXPECT_DOUBLE_EQ(Scale({At({0.3, 0.8})}), 1.0);  // passed 0.285 m off
+  ProxemicsConfig no_pass;
+  no_pass.pass_gap = 0.0;
+  EXPECT_DOUBLE_EQ(Scale({grazed}, {0.2, 0.0}, no_pass), 1.0);
+  // Abeam or behind, going away: never (a retreat must be quick).
+  EXPECT_DOUBLE_EQ(Scale({At({-0.1, 0.6})}), 1.0);
+}
+
+TEST(ProxemicsTest, PassedOnTheWayIsBesideTheWayNotAtItsEnds) {
+  const Eigen::Vector2d p_MB(0.0, 0.0), p_MGoal(2.0, 0.0);
+  EXPECT_TRUE(IsPassedOnTheWay({1.0, 0.5}, p_MB, p_MGoal, 0.6));
+  EXPECT_FALSE(IsPassedOnTheWay({1.0, 0.7}, p_MB, p_MGoal, 0.6));   // beyond reach
+  EXPECT_FALSE(IsPassedOnTheWay({2.3, 0.1}, p_MB, p_MGoal, 0.6));   // beyond the end
+  EXPECT_FALSE(IsPassedOnTheWay({-0.3, 0.1}, p_MB, p_MGoal, 0.6));  // behind the start
+  EXPECT_FALSE(IsPassedOnTheWay({1.0, 0.5}, p_MB, p_MB, 0.6));      // no way at all
+}
+
+// Near the path's end and no nearer than it, but walking, or beside the way there: not whom the
+// robot goes to (atrium seed 71: a step making room ended 0.5 m past a resident walking up).
+TEST(ProxemicsTest, SomeoneWalkingUpOrPassedOnTheWayIsNotWhomTheRobotGoesTo) {
+  const Eigen::Vector2d end(0.3, 0.0);
+  EXPECT_DOUBLE_EQ(ApproachSpeedScale({0.0, 0.0, 0.0}, {0.2, 0.0}, end, {At({0.915, 0.0})},
+                                      kRobotRadius, kPersonRadius, {}),
+                   1.0);  // standing beyond the end: whom it goes to
+  EXPECT_DOUBLE_EQ(
+      ApproachSpeedScale({0.0, 0.0, 0.0}, {0.2, 0.0}, end, {At({0.915, 0.0}, {-0.5, 0.0})},
+                         kRobotRadius, kPersonRadius, {}),
+      0.0);  // walking up
+  EXPECT_DOUBLE_EQ(ApproachSpeedScale({0.0, 0.0, 0.0}, {0.2, 0.0}, Eigen::Vector2d(0.6, 0.0),
+                                      {At({0.5, 0.6})}, kRobotRadius, kPersonRadius, {}),
+                   0.0);  // standing beside the way, 0.085 m from the robot's edge as it passes
+}
+
 // Going to someone on purpose (a hand-over: the path ends at reach of the responder).
 TEST(ProxemicsTest, SomeoneWhereThePathEndsIsWhomTheRobotGoesTo) {
   const std::vector people = {At({0.515 + 0.4, 0.0})};
@@ -119,6 +158,9 @@ TEST(ProxemicsTest, BadConfigsAreRefusedNamingTheField) {
   EXPECT_THROW(c.Validate(), InvalidArgument);
   c = {};
   c.standing_speed = -0.1;
+  EXPECT_THROW(c.Validate(), InvalidArgument);
+  c = {};
+  c.pass_gap = -0.1;
   EXPECT_THROW(c.Validate(), InvalidArgument);
   c = {};
   c.patience_s = -1.0;

@@ -3,7 +3,8 @@
 /// Proxemics: how close the robot lets itself come to people. Personal space is 0.45-1.2 m
 /// (Hall); the robot slows its paths when it heads towards someone within `slow_gap` of its
 /// edge (where they are, or will be within `horizon` at their velocity), down to a stop at
-/// `stop_gap`. Moving away from or past someone is never slowed: a retreat must be quick.
+/// `stop_gap`. Moving away from someone, or past them with room (`pass_gap`), is never slowed:
+/// a retreat must be quick.
 /// Held back for `patience_s` by people who stand still (a resident waiting at the door the
 /// robot goes to open, beside the only way to its button: they will not move until it opens),
 /// the robot edges past them at a crawl instead of waiting for good (ApproachPace).
@@ -25,6 +26,9 @@ struct ProxemicsConfig {
   double stop_gap{0.45};        ///< ... and reaches a standstill this near [m].
   double horizon{1.0};          ///< People's positions this far ahead count too [s].
   double cone_deg{60.0};        ///< Within this of the way the robot goes, it goes to them.
+  /// Someone ahead of abeam whom the robot's straight way would pass nearer than this [m] is
+  /// slowed for as if it went to them: going by at a hand's breadth is no way past anyone.
+  double pass_gap{0.2};
   /// Someone this near where the path ends, and no nearer the robot than the end, is whom the
   /// robot goes to (a hand-over, a responder): not slowed for [m].
   double goal_radius{1.5};
@@ -51,9 +55,15 @@ struct ProxemicsConfig {
 bool IsWhomTheRobotGoesTo(const Eigen::Vector2d& p_MP, const Eigen::Vector2d& p_MB,
                           const Eigen::Vector2d& p_MGoal, double goal_radius);
 
+/// Whether the straight way from p_MB to p_MGoal goes by p_MP within `reach` [m] (centre to
+/// centre) on the way, not at its ends: someone it passes, whom it does not go to.
+bool IsPassedOnTheWay(const Eigen::Vector2d& p_MP, const Eigen::Vector2d& p_MB,
+                      const Eigen::Vector2d& p_MGoal, double reach);
+
 /// The fraction of its planned pace the robot may go at (in [0, 1]) heading along v_M from
 /// X_MB to p_MGoal (where its path ends, if it has one), with `people` around (whom the robot
-/// goes to excepted: IsWhomTheRobotGoesTo). Radii: the
+/// goes to excepted: IsWhomTheRobotGoesTo, standing still, and not passed within `pass_gap` on
+/// the way there, IsPassedOnTheWay). Radii: the
 /// robot's footprint and a person's [m].
 /// `squeeze`: people standing still (slower than `standing_speed`) slow it from `stop_gap` to a
 /// stop at `squeeze_gap` instead, heading at them or going by them (anywhere ahead of abeam),
