@@ -17,6 +17,13 @@ constexpr double kSameBodyM = 0.15;
 // [m] A laser return this near a mapped wall or leaf is the wall's, seen off, rather than a
 // body's near side.
 constexpr double kHuggingWallM = 0.3;
+
+// p_M within `radius` [m] of the doorway's centre, on the robot's side of the door line (or
+// less than kThroughM beyond it).
+bool OnThisSideWithin(const DoorPass& pass, const Eigen::Vector2d& p_M, double radius) {
+  const Eigen::Vector2d d = p_M - pass.centre;
+  return d.dot(pass.n_M) > -kThroughM && d.norm() < radius;
+}
 }  // namespace
 
 bool SeenWalking(const Belief& belief, const perception::TrackedPerson& person) {
@@ -31,10 +38,9 @@ bool ApproachWatch::Update(const Belief& belief, const DoorPass& pass, double wa
   bool closed = false;
   for (const auto& entry : belief.world.people) {
     const auto& person = entry.person;
-    const Eigen::Vector2d d = person.p_MP - pass.centre;
-    if (d.dot(pass.n_M) <= -kThroughM || d.norm() >= watch_radius || !SeenWalking(belief, person))
+    if (!OnThisSideWithin(pass, person.p_MP, watch_radius) || !SeenWalking(belief, person))
       continue;
-    const double distance = d.norm();
+    const double distance = (person.p_MP - pass.centre).norm();
     auto it = walks_.find(person.id);
     if (it == walks_.end() || ToSeconds(belief.now - it->second.last) > kStirGapSec)
       it = walks_.insert_or_assign(person.id, Walk{belief.now, distance}).first;
@@ -52,8 +58,7 @@ bool ApproachWatch::Update(const Belief& belief, const DoorPass& pass, double wa
 Surroundings LookAround(const Belief& belief, const DoorPass& pass, double watch_radius,
                         double near_door) {
   const auto this_side = [&](const Eigen::Vector2d& p, double radius) {
-    const Eigen::Vector2d d = p - pass.centre;
-    return d.dot(pass.n_M) > -kThroughM && d.norm() < radius;
+    return OnThisSideWithin(pass, p, radius);
   };
   Surroundings s;
   for (const auto& entry : belief.world.people) {
@@ -92,8 +97,7 @@ Surroundings LookAround(const Belief& belief, const DoorPass& pass, double watch
 AtTheDoorway ByTheDoorway(const Belief& belief, const DoorPass& pass, const Eigen::Vector2d& p_MS,
                           double radius, double person_radius) {
   const auto by_doorway = [&](const Eigen::Vector2d& p, double within) {
-    const Eigen::Vector2d d = p - pass.centre;
-    return d.norm() < within && d.dot(pass.n_M) > -kThroughM;  // on the robot's side
+    return OnThisSideWithin(pass, p, within);
   };
   // Tracked people by the doorway.
   const auto& people = belief.world.people;
