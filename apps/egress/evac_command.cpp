@@ -186,9 +186,10 @@ nlohmann::json RunStudyTrial(const twin::Scenario& scenario, const twin::WorldDe
     doors[l.name] = {{"crossings", c.size()},
                      {"operated_by_residents", by_residents[l.name]},
                      {"operated_by_robot", by_robot[l.name]},
+                     // A rate needs two crossings: one resident through is no flow of 0.
                      {"flow", c.size() >= 2 && c.back() > c.front()
-                                  ? double(c.size() - 1) / (c.back() - c.front())
-                                  : 0.0},
+                                  ? nlohmann::json(double(c.size() - 1) / (c.back() - c.front()))
+                                  : nlohmann::json(nullptr)},
                      {"queue_s", c.empty() ? queue[l.name] : queue[l.name] / double(c.size())}};
   }
   const auto& m = result.verdict.metrics;
@@ -353,7 +354,7 @@ void RunStudy(const StudyOptions& o) {
       blocking += t.at("doorway_block_s").get<double>();
       standing += t.at("doorway_stand_s").get<double>();
       for (const auto& [door, d] : t.at("doors").items()) {
-        if (d.at("flow").get<double>() > 0.0) flow[door].push_back(d.at("flow").get<double>());
+        if (!d.at("flow").is_null()) flow[door].push_back(d.at("flow").get<double>());
         queue[door].push_back(d.at("queue_s").get<double>());
         by_residents[door].push_back(d.at("operated_by_residents").get<double>());
         by_robot[door].push_back(d.at("operated_by_robot").get<double>());
@@ -367,17 +368,23 @@ void RunStudy(const StudyOptions& o) {
                fmt::format("{:.1f} / {:.1f} s", blocking, standing));
     nlohmann::json doors = nlohmann::json::object();
     for (const auto& [door, q] : queue) {
-      const double f = flow[door].empty() ? 0.0 : CalcMedianCi(flow[door]).median;
+      // Null (and "n/a") where no trial saw two residents through: no rate to give.
+      nlohmann::json flow_median = nullptr;
+      std::string flow_text = "n/a (under two through)";
+      if (!flow[door].empty()) {
+        flow_median = CalcMedianCi(flow[door]).median;
+        flow_text = fmt::format("{:.2f} persons/s", flow_median.get<double>());
+      }
       const double residents_op = CalcMedianCi(by_residents[door]).median;
       const double robot_op = CalcMedianCi(by_robot[door]).median;
-      doors[door] = {{"flow_median", f},
+      doors[door] = {{"flow_median", flow_median},
                      {"queue_s_median", CalcMedianCi(q).median},
                      {"operated_by_residents_median", residents_op},
                      {"operated_by_robot_median", robot_op}};
       fmt::print(
-          "    {:<12} flow {:.2f} persons/s, queue {:.1f} s per person, opened by residents {:g}, "
+          "    {:<12} flow {}, queue {:.1f} s per person, opened by residents {:g}, "
           "by the robot {:g} (medians)\n",
-          door, f, CalcMedianCi(q).median, residents_op, robot_op);
+          door, flow_text, CalcMedianCi(q).median, residents_op, robot_op);
     }
     nlohmann::json vs = nullptr;
     if (c != "no_robot" && t_by_seed.count("no_robot")) {

@@ -517,6 +517,42 @@ TEST(EgressCliTest, EvacStudyComparesTheThreeConditionsOnTheSameSeeds) {
   std::filesystem::remove_all(dir);
 }
 
+// A door's flow is a rate: two residents through at least. One resident alone gives none (null,
+// "n/a"), not a flow of 0 persons/s; their queue time and who opened the door are still given.
+TEST(EgressCliTest, EvacStudyGivesNoFlowThroughADoorOnlyOneResidentPassed) {
+  const auto dir = egress::testing::TestTempPath("study_one");
+  const std::string scenario = WriteTemp("one_resident.yaml", R"(name: lab, one resident
+world: )" + kWorldsDir + R"(/lab/lab.sdf
+seed: 1
+time_limit: 120
+robot:
+  start: {x: 1.6, y: 1.9, yaw_deg: 90}
+  goal: {x: 1.8, y: 5.2}
+doors:
+  - door: lab_door
+    operator: push
+people:
+  - name: resident
+    behavior: evacuate
+    route: [lab_door]
+    start: {x: -1.5, y: 0.4}
+    goal: {x: -1.5, y: 6.0}
+    trigger: {at: 1.0}
+mission:
+  tree: )" + kWorldsDir + R"(/../behavior/trees/evacuation_escort.xml
+)");
+  Result run = RunEgress("evac study " + scenario + " --trials 1 -q --conditions no_robot --out " +
+                         (dir / "out").string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("lab_door     flow n/a (under two through)"));
+  const auto study = nlohmann::json::parse(std::ifstream(dir / "out" / "study.json"));
+  const auto& door = study.at("conditions").at(0).at("doors").at("lab_door");
+  EXPECT_TRUE(door.at("flow_median").is_null()) << door.dump();
+  EXPECT_GE(door.at("operated_by_residents_median").get<double>(), 1.0);  // they opened it
+  EXPECT_EQ(study.at("conditions").at(0).at("left_behind").get<int>(), 0);
+  std::filesystem::remove_all(dir);
+}
+
 // Issue 21's figures: closest approach per trial with the robot's speed then, median and worst
 // per scenario; the preemption latency of people the base laser saw; brain settings in the plan.
 TEST(EgressCliTest, SimBatchReportsClosestApproachesAndTheLaserPeopleSetting) {
