@@ -574,8 +574,8 @@ std::string ToString(const PredicateSpec& p) {
 
 void Scenario::ValidateAgainst(const WorldDescription& world) const {
   const std::string where = source.string();
-  if (!robot_off_scene) CheckRobotPose(world, where, "robot.start", start_place, robot_start);
-  if (goal) CheckRobotPose(world, where, "robot.goal", goal_place, *goal);
+  if (!robot_off_scene) CheckOnTheFloor(world, where, "robot.start", start_place, robot_start);
+  if (goal) CheckOnTheFloor(world, where, "robot.goal", goal_place, *goal);
   for (std::size_t i = 0; i < doors.size(); ++i) {
     const auto& op = doors[i];
     const std::string f = StrCat(where, ": field 'doors[", i, "]");
@@ -609,6 +609,17 @@ void Scenario::ValidateAgainst(const WorldDescription& world) const {
     }
   }
   for (std::size_t i = 0; i < people.size(); ++i) {
+    // Where they start and walk: a person placed inside a wall or 100 m off stands there, or is
+    // "left behind", until the time limit, and nothing says why.
+    const PersonSpec& person = people[i];
+    const auto on_floor = [&](const std::string& field, const Eigen::Vector2d& p_W) {
+      CheckOnTheFloor(world, where, StrCat("people[", i, "].", field), "", {p_W.x(), p_W.y(), 0.0});
+    };
+    on_floor("start", person.start);
+    on_floor("goal", person.goal);
+    for (std::size_t k = 0; k < person.via.size(); ++k)
+      on_floor(StrCat("via[", k, "]"), person.via[k]);
+    if (person.leave) on_floor("leave", *person.leave);
     if (!people[i].door.empty() && !known_door(people[i].door)) {
       throw LoadError(StrCat(where, ": field 'people[", i, "].door': world has no door '",
                              people[i].door, "'"));

@@ -10,8 +10,9 @@
 namespace egress::twin {
 namespace {
 
-// A robot pose may lie outside the walls' bounds by at most this [m] (a goal outside the exit
-// door is fine; one 50 m off is a typo, and the run would only find out at its time limit).
+// A robot's or person's place may lie outside the walls' bounds by at most this [m] (a goal
+// outside the exit door is fine; one 50 m off is a typo, and the run would only find out at its
+// time limit).
 constexpr double kPoseOutsideWallsMaxM = 5.0;
 
 // The static box or upright cylinder whose floor outline holds p, or null. Meshes are skipped:
@@ -33,9 +34,9 @@ const ShapeDescription* ShapeHolding(const WorldDescription& world, const Eigen:
 
 }  // namespace
 
-// The robot's start or goal: on the floor, not inside a wall, not far outside the building.
-void CheckRobotPose(const WorldDescription& world, const std::string& where,
-                    const std::string& field, const std::string& place, const Pose2& X_WB) {
+// A start, goal or waypoint: on the floor, not inside a wall, not far outside the building.
+void CheckOnTheFloor(const WorldDescription& world, const std::string& where,
+                     const std::string& field, const std::string& place, const Pose2& X_WB) {
   const std::string what =
       StrCat(where, ": field '", field, "'", place.empty() ? "" : " (place '" + place + "')", ": (",
              X_WB.x, ", ", X_WB.y, ")");

@@ -64,15 +64,15 @@ void TwinWorld::Impl::ApplyFaults() {
           const int steps = int(std::ceil(length / kKidnapPathStepM));
           for (int k = 1; k <= steps; ++k) {
             const double u = double(k) / steps;
-            CheckRobotPose(world, "kidnap", "offset", "",
-                           {X_WB.x + u * f.spec->offset.x, X_WB.y + u * f.spec->offset.y, 0.0});
+            CheckOnTheFloor(world, "kidnap", "offset", "",
+                            {X_WB.x + u * f.spec->offset.x, X_WB.y + u * f.spec->offset.y, 0.0});
           }
-          CheckRobotPose(world, "kidnap", "offset", "", target);
+          CheckOnTheFloor(world, "kidnap", "offset", "", target);
           for (int k = 0; k < kFootprintSamples; ++k) {
             const double a = 2.0 * M_PI * k / kFootprintSamples;
-            CheckRobotPose(world, "kidnap", "offset", "",
-                           {target.x + robot_radius * std::cos(a),
-                            target.y + robot_radius * std::sin(a), target.yaw});
+            CheckOnTheFloor(world, "kidnap", "offset", "",
+                            {target.x + robot_radius * std::cos(a),
+                             target.y + robot_radius * std::sin(a), target.yaw});
           }
         } catch (const LoadError&) {
           free = false;
