@@ -31,6 +31,7 @@
 #include "commands.h"
 #include "egress/hsr_interface/error.h"
 #include "egress/hsr_interface/text_file.h"
+#include "egress/twin/scenario.h"
 #include "egress/twin/sdf_world_loader.h"
 #include "egress/twin/twin_run.h"
 #include "workers.h"
@@ -525,6 +526,10 @@ void RunBatch(const BatchOptions& o) {
     }
     scenarios.emplace_back(file, trials);
   }
+  int most_trials = 0;
+  for (const auto& [file, trials] : scenarios)
+    most_trials = std::max(most_trials, trials);
+  CheckSeedBase(o.seed_base, most_trials, twin::kMaxScenarioSeed);
   const nlohmann::json plan = PlanJson(scenarios, o.seed_base, shard, o.laser_people);
   const bool laser_people = o.laser_people;
   const auto all = WorkList(plan);

@@ -31,6 +31,7 @@
 #include "commands.h"
 #include "doorway_judge.h"
 #include "egress/hsr_interface/error.h"
+#include "egress/twin/scenario.h"
 #include "egress/twin/sdf_world_loader.h"
 #include "egress/twin/twin_model.h"
 #include "egress/twin/twin_robot.h"
@@ -304,6 +305,7 @@ void RunStudy(const StudyOptions& o) {
   std::map<std::string, twin::Scenario> scenarios;
   for (const std::string& c : conditions)
     scenarios[c] = ConditionScenario(base, world, c);
+  CheckSeedBase(o.seed_base, o.trials, twin::kMaxScenarioSeed);
   std::vector<std::pair<std::string, std::uint64_t>> work;
   for (int i = 0; i < o.trials; ++i) {
     for (const std::string& c : conditions)

@@ -24,6 +24,7 @@
 #include "egress/hsr_interface/error.h"
 #include "egress/ros2/robot_port_server.h"
 #include "egress/ros2/ros2_robot_port.h"
+#include "egress/twin/scenario.h"
 #include "egress/twin/scenario_judge.h"
 #include "egress/twin/sdf_world_loader.h"
 #include "egress/twin/twin_run.h"
@@ -315,7 +316,8 @@ void AddRos2Commands(CLI::App& app) {
   serve->add_option("--start", o->start, "With a world: the robot's start (place or x;y;yaw)");
   serve->add_option("--goal", o->goal, "With a world: the goal (place or x;y;yaw)");
   serve->add_option("--tree", o->tree, "With a world: the mission tree")->check(CLI::ExistingFile);
-  serve->add_option("--seed", o->seed, "Seed (default: the scenario's)");
+  serve->add_option("--seed", o->seed, "Seed (default: the scenario's)")
+      ->check(CLI::Range(std::uint64_t{0}, twin::kMaxScenarioSeed));
   serve->add_option("--domain", o->domain, "ROS_DOMAIN_ID")->check(CLI::Range(0, 232));
   serve->add_option("--topics", o->topics, "Topic map YAML (default: the HSR's ROS 2 names)")
       ->check(CLI::ExistingFile);
@@ -342,7 +344,8 @@ void AddRos2Commands(CLI::App& app) {
   robot->add_option("--goal", o->goal, "With --map: the goal (place or x;y;yaw)");
   robot->add_option("--tree,--mission", o->tree, "With --map: the mission tree (default go_to.xml)")
       ->check(CLI::ExistingFile);
-  robot->add_option("--seed", o->seed, "The scenario's seed (its start pose and variant)");
+  robot->add_option("--seed", o->seed, "The scenario's seed (its start pose and variant)")
+      ->check(CLI::Range(std::uint64_t{0}, twin::kMaxScenarioSeed));
   robot->add_option("--domain", o->domain, "ROS_DOMAIN_ID")->check(CLI::Range(0, 232));
   robot->add_option("--topics", o->topics, "Topic map YAML (default: the HSR's ROS 2 names)")
       ->check(CLI::ExistingFile);

@@ -26,6 +26,7 @@
 #include "egress/bt/groot2_publisher.h"
 #include "egress/bt/loggers.h"
 #include "egress/hsr_interface/error.h"
+#include "egress/twin/scenario.h"
 #include "egress/twin/sdf_world_loader.h"
 #include "egress/twin/twin_model.h"
 #include "egress/twin/twin_run.h"
@@ -345,7 +346,8 @@ void AddSimCommand(CLI::App& app) {
   sim->add_option("--tree", o->tree, "with a world file: the mission tree (goal on {goal})")
       ->capture_default_str()
       ->check(CLI::ExistingFile);
-  sim->add_option("--seed", o->seed, "seed (default: the scenario's)");
+  sim->add_option("--seed", o->seed, "seed (default: the scenario's)")
+      ->check(CLI::Range(std::uint64_t{0}, twin::kMaxScenarioSeed));
   sim->add_option("--duration", o->duration,
                   "simulated seconds (default: the scenario's time limit)")
       ->check(FiniteIn(1e-3, 1e7));

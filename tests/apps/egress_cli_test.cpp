@@ -517,6 +517,39 @@ TEST(EgressCliTest, EvacStudyComparesTheThreeConditionsOnTheSameSeeds) {
   std::filesystem::remove_all(dir);
 }
 
+// Trial seeds are seed-base + i: the last must be a seed a scenario may have (2^53), not wrap past
+// 2^64 to 0 (it did: trials 18446744073709551615 and 0).
+TEST(EgressCliTest, BatchesRefuseASeedBaseWhoseLastTrialIsPastTheLargestSeed) {
+  const auto dir = egress::testing::TestTempPath("seed_base");
+  const std::string lab = kWorldsDir + "/scenarios/evacuation/lab_escort.yaml";
+  const std::string s1 = kWorldsDir + "/scenarios/s1_nominal.yaml";
+  const std::string top = "9007199254740992";  // 2^53
+  for (const std::string& command :
+       {"sim batch " + s1 + " --trials 2 --seed-base " + top,
+        "sim batch " + s1 + ":3 --seed-base 9007199254740991",
+        "sim batch " + s1 + " --trials 1 --seed-base 18446744073709551615",
+        "evac study " + lab + " --conditions no_robot --trials 2 --seed-base " + top}) {
+    const Result bad = RunEgress(command + " -q --out " + (dir / "bad").string());
+    EXPECT_EQ(bad.exit_code, 1) << command;
+    EXPECT_THAT(bad.output, HasSubstr("--seed-base")) << command;
+    EXPECT_THAT(bad.output, HasSubstr(top)) << command;
+    EXPECT_FALSE(std::filesystem::exists(dir / "bad" / "trials.csv")) << command;
+  }
+  // One run's seed alike: a seed a scenario file may hold, so the run can be written down.
+  const Result run = RunEgress("sim run " + s1 + " -q --seed 9007199254740993");
+  EXPECT_NE(run.exit_code, 0);
+  EXPECT_THAT(run.output, HasSubstr("--seed"));
+  EXPECT_THAT(run.output, HasSubstr(top));
+  // The largest seed itself is a trial's.
+  const Result last = RunEgress("sim batch " + s1 + " --trials 1 -q --seed-base " + top +
+                                " --out " + (dir / "last").string());
+  ASSERT_EQ(last.exit_code, 0) << last.output;
+  std::ifstream csv(dir / "last" / "trials.csv");
+  const std::string rows((std::istreambuf_iterator<char>(csv)), {});
+  EXPECT_THAT(rows, HasSubstr("," + top + ","));
+  std::filesystem::remove_all(dir);
+}
+
 // A door's flow is a rate: two residents through at least. One resident alone gives none (null,
 // "n/a"), not a flow of 0 persons/s; their queue time and who opened the door are still given.
 TEST(EgressCliTest, EvacStudyGivesNoFlowThroughADoorOnlyOneResidentPassed) {

@@ -22,7 +22,6 @@
 
 namespace egress::twin {
 namespace {
-constexpr double kMaxExactSeed = 9007199254740992.0;  // 2^53
 // A simulated run is bounded: a day of simulated time is far past any scenario's need.
 constexpr double kMaxTimeLimitSec = 86400.0;
 }  // namespace
@@ -197,7 +196,7 @@ Scenario Parse(const YAML::Node& root, const FieldReader& r,
     if (seed != std::floor(seed)) r.Fail(root["seed"], "seed", "must be a whole number");
     // Seeds are read as doubles: above 2^53 they are no longer exact (and past 2^64 the
     // conversion was undefined).
-    if (seed > kMaxExactSeed) r.Fail(root["seed"], "seed", "must be at most 2^53");
+    if (seed > double(kMaxScenarioSeed)) r.Fail(root["seed"], "seed", "must be at most 2^53");
     s.seed = std::uint64_t(seed);
   }
   if (root["time_limit"]) {

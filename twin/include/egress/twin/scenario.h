@@ -221,6 +221,10 @@ struct MissionSpec {
   int tree_line{0};  ///< Line of `mission.tree` in the scenario file (for error messages).
 };
 
+/// The largest seed a scenario (or a batch's trial) may have: 2^53, the last integer a double
+/// (YAML, JSON) holds exactly.
+inline constexpr std::uint64_t kMaxScenarioSeed = std::uint64_t{1} << 53;
+
 struct Scenario {
   std::string name;
   std::filesystem::path source;      ///< The YAML file.
@@ -232,7 +236,7 @@ struct Scenario {
   /// resolved into robot_start / goal by ApplyBuildingDefaults.
   std::string start_place;
   std::string goal_place;
-  std::uint64_t seed{1};
+  std::uint64_t seed{1};     ///< At most kMaxScenarioSeed.
   double time_limit{120.0};  ///< [s]
   Pose2 robot_start;
   /// The robot takes no part (`robot: {off_scene: true}`): it stands kOffSceneDistanceM beyond
