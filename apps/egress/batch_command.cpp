@@ -20,6 +20,7 @@
 #include <limits>
 #include <map>
 #include <numeric>
+#include <ranges>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -526,10 +527,8 @@ void RunBatch(const BatchOptions& o) {
     }
     scenarios.emplace_back(file, trials);
   }
-  int most_trials = 0;
-  for (const auto& [file, trials] : scenarios)
-    most_trials = std::max(most_trials, trials);
-  CheckSeedBase(o.seed_base, most_trials, twin::kMaxScenarioSeed);
+  CheckSeedBase(o.seed_base, std::ranges::max(scenarios | std::views::values),
+                twin::kMaxScenarioSeed);
   const nlohmann::json plan = PlanJson(scenarios, o.seed_base, shard, o.laser_people);
   const bool laser_people = o.laser_people;
   const auto all = WorkList(plan);

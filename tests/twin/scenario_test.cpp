@@ -87,16 +87,21 @@ TEST(ScenarioTest, ErrorsNameFileLineAndField) {
 
 // A start or goal inside a wall, or far outside the building, is refused by field at load (it
 // was found only at the run's time limit, 42 s and more of simulation later).
+// The error ValidateAgainst gives a scenario of the lab (empty: none).
+std::string LabValidationError(const std::string& yaml) {
+  const Scenario s =
+      LoadScenarioFromString("world: lab.sdf\n" + yaml, "v.yaml", WorldsDir() / "lab");
+  try {
+    s.ValidateAgainst(LoadSdfWorld(s.world_file));
+  } catch (const LoadError& e) {
+    return e.what();
+  }
+  return {};
+}
+
 TEST(ScenarioTest, StartAndGoalMustBeOnTheFloorOfTheBuilding) {
   const auto error_of = [](const std::string& robot) {
-    const Scenario s = LoadScenarioFromString("world: lab.sdf\nrobot: " + robot + "\n", "v.yaml",
-                                              WorldsDir() / "lab");
-    try {
-      s.ValidateAgainst(LoadSdfWorld(s.world_file));
-    } catch (const LoadError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
+    return LabValidationError("robot: " + robot + "\n");
   };
   EXPECT_EQ(error_of("{start: {x: 0, y: 1}, goal: {x: 0, y: 5}}"), "");
   // The lab's south wall is a 6.2 x 0.1 m box centred at (0, -1.05).
@@ -116,15 +121,7 @@ TEST(ScenarioTest, StartAndGoalMustBeOnTheFloorOfTheBuilding) {
 // stood there and was "left behind" at the time limit, nothing saying why).
 TEST(ScenarioTest, PeoplesStartsGoalsAndWaypointsMustBeOnTheFloor) {
   const auto error_of = [](const std::string& person) {
-    const Scenario s = LoadScenarioFromString(
-        "world: lab.sdf\nrobot: {start: {x: 0, y: 1}}\npeople:\n  - " + person + "\n", "v.yaml",
-        WorldsDir() / "lab");
-    try {
-      s.ValidateAgainst(LoadSdfWorld(s.world_file));
-    } catch (const LoadError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
+    return LabValidationError("robot: {start: {x: 0, y: 1}}\npeople:\n  - " + person + "\n");
   };
   const std::string walker = "{name: w, behavior: walk_past, speed: [1.0, 1.2], ";
   EXPECT_EQ(error_of(walker + "start: {x: -2, y: 1}, goal: {x: 2, y: 1}}"), "");
