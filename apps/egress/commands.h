@@ -43,14 +43,14 @@ inline constexpr int kMaxTrials = 1'000'000;
 inline constexpr int kMaxJobs = 256;
 
 /// --seed-base of a batch of `trials` trials: the last trial's seed (seed-base + trials - 1)
-/// must be at most `max_seed` (the scenarios' own bound, 2^53), not wrap past 2^64 to 0.
+/// must be at most `max_seed` (the scenarios' own bound), not wrap past 2^64 to 0.
 /// @throws CommandFailed naming --seed-base and both numbers.
 inline void CheckSeedBase(std::uint64_t seed_base, int trials, std::uint64_t max_seed) {
   const std::uint64_t span = trials > 0 ? std::uint64_t(trials) - 1 : 0;
   if (seed_base > max_seed || max_seed - seed_base < span)
     throw CommandFailed("--seed-base " + std::to_string(seed_base) + " with " +
                         std::to_string(trials) + " trials: the last trial's seed must be at most " +
-                        std::to_string(max_seed) + " (2^53, as a scenario's seed)");
+                        std::to_string(max_seed) + " (a scenario's largest seed)");
 }
 
 /// `egress --version`: the text printed (egress version, git revision, library versions).

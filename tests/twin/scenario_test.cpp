@@ -85,8 +85,6 @@ TEST(ScenarioTest, ErrorsNameFileLineAndField) {
               "mission.blackboard", "plain name");
 }
 
-// A start or goal inside a wall, or far outside the building, is refused by field at load (it
-// was found only at the run's time limit, 42 s and more of simulation later).
 // The error ValidateAgainst gives a scenario of the lab (empty: none).
 std::string LabValidationError(const std::string& yaml) {
   const Scenario s =
@@ -99,6 +97,8 @@ std::string LabValidationError(const std::string& yaml) {
   return {};
 }
 
+// A start or goal inside a wall, or far outside the building, is refused by field at load (it
+// was found only at the run's time limit, 42 s and more of simulation later).
 TEST(ScenarioTest, StartAndGoalMustBeOnTheFloorOfTheBuilding) {
   const auto error_of = [](const std::string& robot) {
     return LabValidationError("robot: " + robot + "\n");
