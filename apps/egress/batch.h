@@ -12,6 +12,7 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
 namespace egress::apps {
 
@@ -76,6 +77,11 @@ struct ScenarioSummary {
   std::vector<std::uint64_t> failed_seeds;
   std::vector<double> times;
 };
+
+/// A trial's result as a line of the journal and of batch.json, and back (fields a batch of an
+/// earlier stop did not write take their defaults).
+nlohmann::json ToJson(const TrialResult& r);
+TrialResult TrialFromJson(const nlohmann::json& j);
 
 /// Per scenario, in the order first seen.
 std::vector<ScenarioSummary> Summarize(const std::vector<TrialResult>& trials);
