@@ -14,6 +14,8 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "track_judge.h"
+
 namespace egress::apps {
 
 /// A binomial proportion's confidence interval (Wilson score), in [0, 1].
@@ -41,6 +43,8 @@ struct TrialResult {
   std::vector<double> preemption_total_latencies;  ///< [s] person in the zone (truth) -> stop.
   /// The total latencies of the events whose person was in the base laser's view on entering.
   std::vector<double> preemption_laser_view_latencies;
+  /// Track samples of people standing still, and those read as walking (StandingTrackJudge).
+  StandingReadWalking standing_tracks;
   double wall_time{0.0};  ///< [s]
   std::string error;      ///< The run threw this.
   bool crashed{false};    ///< The worker process died running it (`error` says how).

@@ -93,7 +93,17 @@ TrialResult RunBrainTrial(const std::string& scenario_path, std::uint64_t seed,
   };
   std::vector<Occupied> occupied;
   bool inside_before = false;
+  StandingTrackJudge standing;
   options.after_step = [&](const twin::TwinWorld& world, const behavior::Executive& brain) {
+    {
+      std::vector<PersonSample> tracks, people;
+      for (const auto& entry : brain.belief().world.people)
+        tracks.push_back({entry.person.p_MP, entry.person.v_MP});
+      for (const auto& person : world.people())  // those out too: the same index every step
+        people.push_back({person.position, person.velocity});
+      const Twist2 V = world.robot_velocity();
+      standing.Step(world.time(), std::hypot(V.vx, V.vy), V.wz, tracks, people);
+    }
     bool inside = false, seen = false;
     for (const auto& door : brain.services().map->doors) {
       const perception::DoorZone zone{door, brain.services().config.zone_depth,
@@ -131,6 +141,7 @@ TrialResult RunBrainTrial(const std::string& scenario_path, std::uint64_t seed,
   for (const auto& [door, n] : m.button_presses)
     r.presses += n;
   r.relocalizations = brain->relocalizations();
+  r.standing_tracks = standing.counts();
   for (const auto& [known, commanded] : brain->preemptions()) {
     r.preemption_latencies.push_back(commanded - known);
     // The true entry of whoever was in a zone when this stop was commanded, or had left it
@@ -264,6 +275,18 @@ void ReportBatch(const std::filesystem::path& dir, const nlohmann::json& plan,
          &TrialResult::preemption_total_latencies);
   report("total, the person in the base laser's view on entering",
          &TrialResult::preemption_laser_view_latencies);
+  StandingReadWalking standing;
+  for (const auto& r : results)
+    standing += r.standing_tracks;
+  const auto share = [](int k, int n) {
+    return n == 0 ? std::string("-") : fmt::format("{:.1f} %", 100.0 * k / n);
+  };
+  if (standing.moving_samples + standing.still_samples > 0)
+    fmt::print(
+        "standing people read walking (tracks on someone standing, ground truth): {} of {} "
+        "samples with the robot moving, {} of {} with it still\n",
+        share(standing.moving_walking, standing.moving_samples), standing.moving_samples,
+        share(standing.still_walking, standing.still_samples), standing.still_samples);
   fmt::print("wall time {:.1f} s for {} trials ({} jobs)\n", wall, results.size(), jobs);
   for (const auto& r : results) {
     if (r.success) continue;

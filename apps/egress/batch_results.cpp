@@ -47,6 +47,13 @@ nlohmann::json ToJson(const TrialResult& r) {
           {"preemption_total_latencies", r.preemption_total_latencies},
           {"preemption_laser_view_latencies", r.preemption_laser_view_latencies},
           {"closest_robot_speed", r.closest_robot_speed},
+          {"standing_tracks",
+           {{"robot_moving",
+             {{"samples", r.standing_tracks.moving_samples},
+              {"walking", r.standing_tracks.moving_walking}}},
+            {"robot_still",
+             {{"samples", r.standing_tracks.still_samples},
+              {"walking", r.standing_tracks.still_walking}}}}},
           {"wall_time", r.wall_time},
           {"error", r.error},
           {"crashed", r.crashed},
@@ -74,6 +81,13 @@ TrialResult TrialFromJson(const nlohmann::json& j) {
   r.preemption_laser_view_latencies =
       j.value("preemption_laser_view_latencies", std::vector<double>());
   r.closest_robot_speed = j.value("closest_robot_speed", 0.0);
+  if (j.contains("standing_tracks")) {
+    const auto& s = j.at("standing_tracks");
+    r.standing_tracks = {s.at("robot_moving").at("samples").get<int>(),
+                         s.at("robot_moving").at("walking").get<int>(),
+                         s.at("robot_still").at("samples").get<int>(),
+                         s.at("robot_still").at("walking").get<int>()};
+  }
   r.wall_time = j.at("wall_time").get<double>();
   r.error = j.at("error").get<std::string>();
   r.crashed = j.value("crashed", false);

@@ -611,12 +611,22 @@ TEST(EgressCliTest, SimBatchReportsClosestApproachesAndTheLaserPeopleSetting) {
   const auto& summary = j.at("summary").at(0);
   double worst = 1e9;
   std::vector<double> closest;
+  // How often the brain read someone standing still as walking (StandingTrackJudge): the
+  // crosser waits for the door before crossing, and the robot drives and stands.
+  EXPECT_THAT(run.output, HasSubstr("standing people read walking"));
+  int samples = 0;
   for (const auto& t : j.at("trials")) {
     EXPECT_TRUE(t.contains("closest_robot_speed"));
     EXPECT_TRUE(t.contains("preemption_laser_view_latencies"));
+    for (const char* robot : {"robot_moving", "robot_still"}) {
+      const auto& c = t.at("standing_tracks").at(robot);
+      EXPECT_LE(c.at("walking").get<int>(), c.at("samples").get<int>()) << robot;
+      samples += c.at("samples").get<int>();
+    }
     closest.push_back(t.at("min_person_distance").get<double>());
     worst = std::min(worst, closest.back());
   }
+  EXPECT_GT(samples, 0);
   EXPECT_DOUBLE_EQ(summary.at("closest_worst_m").get<double>(), worst);
   // Of two, the median is the upper one (the same index rule as the times').
   EXPECT_DOUBLE_EQ(summary.at("closest_median_m").get<double>(), std::max(closest[0], closest[1]));
