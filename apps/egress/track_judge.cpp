@@ -35,7 +35,7 @@ void StandingTrackJudge::Step(double time, double robot_speed, double robot_yaw_
       }
     }
     if (nearest == people.size() || time - still_since_[nearest] < kStandingForSec) continue;
-    const bool walking = track.v.norm() > kWalkingMps;
+    const bool walking = track.v.norm() > kOnTheMoveMps;
     (moving ? counts_.moving_samples : counts_.still_samples) += 1;
     if (walking) (moving ? counts_.moving_walking : counts_.still_walking) += 1;
   }

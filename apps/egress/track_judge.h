@@ -37,8 +37,10 @@ class StandingTrackJudge {
   /// walk read into a standing person).
   static constexpr double kStandingMps = 0.05;
   static constexpr double kStandingForSec = 1.0;
-  /// [m/s] A track faster than this reads walking (the escort's "on the move").
-  static constexpr double kWalkingMps = 0.2;
+  /// [m/s] A track faster than this reads on the move: the escort's threshold for someone
+  /// coming (behavior/src/escort_watch.h, kMovingMps), not the give-way's walking speed
+  /// (kWalkingMps, 0.5 m/s).
+  static constexpr double kOnTheMoveMps = 0.2;
   /// The robot moves when faster than this [m/s] or turning faster than kTurningRadPerSec.
   static constexpr double kRobotMovingMps = 0.05;
   static constexpr double kTurningRadPerSec = 0.1;
