@@ -68,9 +68,11 @@ std::string ClinicCrowd(int n, bool sensors) {
     s += "sensors: {laser: {rate_hz: 0.000001}, depth: {rate_hz: 0.000001}, "
          "detector: {rate_hz: 0.000001}}\n";
   s += "people:\n";
-  // Groups of at most 25 in the south ward and in room_a.
-  const char* starts[] = {"[3.0, -3.0]", "[9.5, -3.0]", "[4.0, 5.0]", "[10.0, 5.0]",
-                          "[16.0, 5.0]", "[6.5, -3.0]", "[7.0, 5.0]", "[12.5, 5.0]"};
+  // Groups of at most 25 in the south ward and rooms a, b and c, two of them side by side in a
+  // room where it has room for their 5 x 5 grids, 1.8 m a side (a group is laid out only where
+  // the building has room for it: (7, 5) was inside wall_ab, and (12.5, 5) ran past wall_bc).
+  const char* starts[] = {"[3.0, -3.0]", "[9.5, -3.0]", "[4.0, 5.0]", "[8.5, 5.0]",
+                          "[16.0, 5.0]", "[6.5, -3.0]", "[1.5, 4.5]", "[11.5, 5.0]"};
   const char* routes[] = {"[door_d, door_e, exit_door]", "[door_d, door_e, exit_door]",
                           "[door_a, door_e, exit_door]", "[door_a, door_e, exit_door]",
                           "[door_a, door_e, exit_door]", "[door_d, door_e, exit_door]",

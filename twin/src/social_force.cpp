@@ -34,6 +34,16 @@ Eigen::Vector2d ClosestPointOnSegment(const Eigen::Vector2d& p, const WallSegmen
   return egress::ClosestPointOnSegment(p, s.a, s.b);
 }
 
+bool SegmentsCross(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
+                   const Eigen::Vector2d& d) {
+  const auto cross = [](const Eigen::Vector2d& u, const Eigen::Vector2d& v) {
+    return u.x() * v.y() - u.y() * v.x();
+  };
+  const double d1 = cross(b - a, c - a), d2 = cross(b - a, d - a);
+  const double d3 = cross(d - c, a - c), d4 = cross(d - c, b - c);
+  return d1 * d2 <= 0.0 && d3 * d4 <= 0.0;
+}
+
 // HFV00 contact: compression along the normal and sliding friction along the tangent, only
 // while the bodies overlap. Returns a force [N].
 Eigen::Vector2d SocialForceModel::BodyForce(const Walker& w, const Eigen::Vector2d& other_p,

@@ -1,3 +1,4 @@
+#include "group_layout.h"
 #include "people/person_behavior.h"
 #include "twin_world_impl.h"
 
@@ -36,17 +37,8 @@ constexpr double kSkipQueueSpotM = 2.5;
 constexpr double kWaypointReachedM = 0.4;
 // Where the body of a person who has left the scene is put (below the floor: no ray, no contact).
 constexpr double kOutOfSceneZ = -50.0;
-
-// Whether segments ab and cd cross (touching counts).
-bool SegmentsCross(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
-                   const Eigen::Vector2d& d) {
-  const auto cross = [](const Eigen::Vector2d& u, const Eigen::Vector2d& v) {
-    return u.x() * v.y() - u.y() * v.x();
-  };
-  const double d1 = cross(b - a, c - a), d2 = cross(b - a, d - a);
-  const double d3 = cross(d - c, a - c), d4 = cross(d - c, b - c);
-  return d1 * d2 <= 0.0 && d3 * d4 <= 0.0;
-}
+// A doorway's line, as a barrier to a group's layout, runs this far on into each jamb [m].
+constexpr double kDoorwayLineOverrunM = 0.1;
 
 }  // namespace
 
@@ -78,6 +70,22 @@ void TwinWorld::Impl::BuildPeople() {
     const auto& model = fixed.behavior_models.at(spec.behavior);
     const int count = model->GroupSize(spec);
     const int columns = int(std::ceil(std::sqrt(double(count))));
+    // A group stands in a grid around its start, 2.2 radii apart (a group of mixed sizes, 2.2
+    // of its largest radii), where the building leaves room (GroupLayout).
+    std::optional<world_detail::GroupLayout> layout;
+    if (count > 1) {
+      std::vector<Eigen::Vector2d> grid(std::size_t(count), spec.start);
+      for (int k = 0; k < count; ++k) {
+        const Eigen::Vector2d offset = Eigen::Vector2d((k % columns) - (columns - 1) / 2.0,
+                                                       (k / columns) - (columns - 1) / 2.0) *
+                                       2.2 * spec.radius;
+        grid[std::size_t(k)] = spec.mobility.empty() ? Eigen::Vector2d(spec.start + offset)
+                                                     : spec.start + offset / spec.radius * 0.45;
+      }
+      const auto [barriers, keep_off] = LayoutBarriers();
+      layout.emplace(spec.start, grid, 2.2 * (spec.mobility.empty() ? spec.radius : 0.45), barriers,
+                     keep_off);
+    }
     for (int k = 0; k < count; ++k) {
       Person p;
       p.state.name = count == 1 ? spec.name : spec.name + "_" + std::to_string(k);
@@ -85,14 +93,7 @@ void TwinWorld::Impl::BuildPeople() {
       p.state.radius = spec.radius;
       p.state.phase = PersonPhase::kWaiting;
       p.behavior = model.get();
-      // A group stands in a grid around its start, 2.2 radii apart.
-      Eigen::Vector2d offset = Eigen::Vector2d::Zero();
-      if (count > 1) {
-        offset = Eigen::Vector2d((k % columns) - (columns - 1) / 2.0,
-                                 (k / columns) - (columns - 1) / 2.0) *
-                 2.2 * spec.radius;
-      }
-      p.walker.position = spec.start + offset;
+      p.walker.position = spec.start;
       p.walker.radius = spec.radius;
       p.walker.desired_speed = 0.0;
       p.walker.target = p.walker.position;
@@ -132,8 +133,18 @@ void TwinWorld::Impl::BuildPeople() {
         p.walker.relaxation_time =
             sfm.params().relaxation_time * std::min(1.0, p.speed / kReferencePaceMps);
         p.walker.wall_scale = std::min(1.0, std::pow(kReferenceBodyRadiusM / cls->radius, 4));
-        // A group of mixed sizes stands 2.2 of its largest radii apart.
-        if (count > 1) p.walker.position = spec.start + offset / spec.radius * 0.45;
+      }
+      if (layout) {
+        const auto place = layout->Place(k, p.walker.radius);
+        if (!place) {
+          throw LoadError(StrCat("people '", spec.name, "': a group of ", count,
+                                 " does not fit around its start (", spec.start.x(), ", ",
+                                 spec.start.y(), "): no room for member ", k, " (", p.state.name,
+                                 ", radius ", p.walker.radius,
+                                 " m) on the start's side of the walls and doorways within ",
+                                 world_detail::kGroupLayoutExtraRings, " places of the group"));
+        }
+        p.walker.position = *place;
       }
       p.state.position = p.walker.position;
       p.state.can_operate = p.can_operate;
@@ -588,6 +599,27 @@ Eigen::Vector2d TwinWorld::Impl::ClearOfWalls(Eigen::Vector2d p, double clearanc
     }
   }
   return p;
+}
+
+std::pair<std::vector<WallSegment>, std::vector<WallSegment>> TwinWorld::Impl::LayoutBarriers()
+    const {
+  // The walls and furniture at body height; and what nobody starts on at all: each doorway's line
+  // (run on into its jambs, past the gaps the leaf leaves there) and a square round the robot.
+  std::vector<WallSegment> keep_off;
+  for (const auto& d : doors) {
+    const Eigen::Vector2d hinge = d.fixed->desc->p_WH.head<2>();
+    const Eigen::Vector2d& along = d.fixed->along;
+    keep_off.push_back({hinge - along * kDoorwayLineOverrunM,
+                        hinge + along * (d.fixed->reach + kDoorwayLineOverrunM), -1});
+  }
+  const Eigen::Vector2d p_WB = RobotPose().translation();
+  const Eigen::Vector2d corners[4] = {p_WB + Eigen::Vector2d(robot_radius, robot_radius),
+                                      p_WB + Eigen::Vector2d(-robot_radius, robot_radius),
+                                      p_WB + Eigen::Vector2d(-robot_radius, -robot_radius),
+                                      p_WB + Eigen::Vector2d(robot_radius, -robot_radius)};
+  for (int c = 0; c < 4; ++c)
+    keep_off.push_back({corners[c], corners[(c + 1) % 4], -1});
+  return {fixed.walls, keep_off};
 }
 
 std::optional<Eigen::Vector2d> TwinWorld::Impl::SpotBesideWall(const Eigen::Vector2d& p) const {

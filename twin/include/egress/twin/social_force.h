@@ -81,6 +81,10 @@ struct WallSegment {
 /// Closest point to p on segment ab.
 Eigen::Vector2d ClosestPointOnSegment(const Eigen::Vector2d& p, const WallSegment& s);
 
+/// Whether segments ab and cd cross; touching counts.
+bool SegmentsCross(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eigen::Vector2d& c,
+                   const Eigen::Vector2d& d);
+
 /// Walls binned in a uniform grid (a cell list) so that a walker meets only the segments within
 /// the model's wall reach. Built once for the walls that do not move (a building's).
 class WallCells {
