@@ -82,9 +82,8 @@ void TwinWorld::Impl::BuildPeople() {
         grid[std::size_t(k)] = spec.mobility.empty() ? Eigen::Vector2d(spec.start + offset)
                                                      : spec.start + offset / spec.radius * 0.45;
       }
-      const auto [barriers, keep_off] = LayoutBarriers();
-      layout.emplace(spec.start, grid, 2.2 * (spec.mobility.empty() ? spec.radius : 0.45), barriers,
-                     keep_off);
+      layout.emplace(spec.start, grid, 2.2 * (spec.mobility.empty() ? spec.radius : 0.45),
+                     fixed.walls, StartKeepOff());
     }
     for (int k = 0; k < count; ++k) {
       Person p;
@@ -601,10 +600,9 @@ Eigen::Vector2d TwinWorld::Impl::ClearOfWalls(Eigen::Vector2d p, double clearanc
   return p;
 }
 
-std::pair<std::vector<WallSegment>, std::vector<WallSegment>> TwinWorld::Impl::LayoutBarriers()
-    const {
-  // The walls and furniture at body height; and what nobody starts on at all: each doorway's line
-  // (run on into its jambs, past the gaps the leaf leaves there) and a square round the robot.
+std::vector<WallSegment> TwinWorld::Impl::StartKeepOff() const {
+  // Each doorway's line (run on into its jambs, past the gaps the leaf leaves there) and a square
+  // round the robot.
   std::vector<WallSegment> keep_off;
   for (const auto& d : doors) {
     const Eigen::Vector2d hinge = d.fixed->desc->p_WH.head<2>();
@@ -619,7 +617,7 @@ std::pair<std::vector<WallSegment>, std::vector<WallSegment>> TwinWorld::Impl::L
                                       p_WB + Eigen::Vector2d(robot_radius, -robot_radius)};
   for (int c = 0; c < 4; ++c)
     keep_off.push_back({corners[c], corners[(c + 1) % 4], -1});
-  return {fixed.walls, keep_off};
+  return keep_off;
 }
 
 std::optional<Eigen::Vector2d> TwinWorld::Impl::SpotBesideWall(const Eigen::Vector2d& p) const {

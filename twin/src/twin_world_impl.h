@@ -193,9 +193,9 @@ struct TwinWorld::Impl {
   std::optional<Eigen::Vector2d> SpotBesideWall(const Eigen::Vector2d& p) const;
   // p moved out of every wall it is nearer than `clearance` to [m].
   Eigen::Vector2d ClearOfWalls(Eigen::Vector2d p, double clearance) const;
-  // What a group's members may not start beyond, and what they may not start on either
-  // (GroupLayout's barriers and keep_off).
-  std::pair<std::vector<WallSegment>, std::vector<WallSegment>> LayoutBarriers() const;
+  // What a group's members may neither start on nor beyond, besides the walls (GroupLayout's
+  // keep_off): the doorways' lines and the robot.
+  std::vector<WallSegment> StartKeepOff() const;
 
   void UpdateRobot();
 
