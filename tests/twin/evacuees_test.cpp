@@ -150,7 +150,8 @@ TEST(EvacueesTest, AGroupTheRoomHasNoSpaceForIsAnErrorNamingIt) {
     TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
     FAIL() << "a group of 150 in room 1 was laid out";
   } catch (const LoadError& e) {
-    EXPECT_THAT(e.what(), HasSubstr("people 'e': a group of 150 does not fit around its start"));
+    EXPECT_THAT(e.what(), HasSubstr("test.yaml: field 'people[0].count' ('e'): a group of 150 "
+                                    "does not fit around its start"));
   }
 }
 

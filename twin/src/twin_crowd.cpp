@@ -66,7 +66,8 @@ void TwinWorld::Impl::BuildPeople() {
   std::mt19937_64 hold_rng(DeriveSeed(seed, 5));
   std::mt19937_64 mobility_rng(DeriveSeed(seed, 6));
   const auto& r = scenario.randomize;
-  for (const auto& spec : scenario.people) {
+  for (std::size_t i = 0; i < scenario.people.size(); ++i) {
+    const PersonSpec& spec = scenario.people[i];
     const auto& model = fixed.behavior_models.at(spec.behavior);
     const int count = model->GroupSize(spec);
     const int columns = int(std::ceil(std::sqrt(double(count))));
@@ -136,12 +137,12 @@ void TwinWorld::Impl::BuildPeople() {
       if (layout) {
         const auto place = layout->Place(k, p.walker.radius);
         if (!place) {
-          throw LoadError(StrCat("people '", spec.name, "': a group of ", count,
-                                 " does not fit around its start (", spec.start.x(), ", ",
-                                 spec.start.y(), "): no room for member ", k, " (", p.state.name,
-                                 ", radius ", p.walker.radius,
-                                 " m) on the start's side of the walls and doorways within ",
-                                 world_detail::kGroupLayoutExtraRings, " places of the group"));
+          throw LoadError(StrCat(
+              scenario.source.string(), ": field 'people[", i, "].count' ('", spec.name,
+              "'): a group of ", count, " does not fit around its start (", spec.start.x(), ", ",
+              spec.start.y(), "): no room for member ", k, " (", p.state.name, ", radius ",
+              p.walker.radius, " m) on the start's side of the walls and doorways within ",
+              world_detail::kGroupLayoutExtraRings, " places of the group"));
         }
         p.walker.position = *place;
       }
