@@ -3,7 +3,6 @@
 
 #include "group_layout.h"
 
-#include <cmath>
 #include <optional>
 #include <set>
 #include <utility>
@@ -17,12 +16,9 @@ namespace {
 
 // The grid TwinWorld lays a group of `count` out on around `start`, `spacing` apart.
 std::vector<Eigen::Vector2d> Grid(const Eigen::Vector2d& start, int count, double spacing) {
-  const int columns = int(std::ceil(std::sqrt(double(count))));
   std::vector<Eigen::Vector2d> grid;
   for (int k = 0; k < count; ++k)
-    grid.push_back(start + Eigen::Vector2d((k % columns) - (columns - 1) / 2.0,
-                                           (k / columns) - (columns - 1) / 2.0) *
-                               spacing);
+    grid.push_back(start + GroupLayout::GridUnit(k, count) * spacing);
   return grid;
 }
 
@@ -124,6 +120,15 @@ TEST(GroupLayoutTest, NobodyStartsInADoorwayEvenAtTheirGridPlace) {
       EXPECT_EQ(*place, grid[std::size_t(k)]) << k;
     }
   }
+}
+
+TEST(GroupLayoutTest, TheGridIsSquareRowByRowAroundTheStart) {
+  EXPECT_EQ(GroupLayout::Columns(12), 4);
+  EXPECT_EQ(GroupLayout::Columns(16), 4);
+  EXPECT_EQ(GroupLayout::Columns(17), 5);
+  EXPECT_EQ(GroupLayout::GridUnit(0, 12), Eigen::Vector2d(-1.5, -1.5));
+  EXPECT_EQ(GroupLayout::GridUnit(5, 12), Eigen::Vector2d(-0.5, -0.5));
+  EXPECT_EQ(GroupLayout::GridUnit(4, 9), Eigen::Vector2d(0.0, 0.0));
 }
 
 TEST(GroupLayoutTest, BadArgumentsAreRefused) {

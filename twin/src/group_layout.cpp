@@ -18,6 +18,15 @@ bool CrossesAny(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
 
 }  // namespace
 
+int GroupLayout::Columns(int count) {
+  return int(std::ceil(std::sqrt(double(count))));
+}
+
+Eigen::Vector2d GroupLayout::GridUnit(int k, int count) {
+  const int columns = Columns(count);
+  return Eigen::Vector2d((k % columns) - (columns - 1) / 2.0, (k / columns) - (columns - 1) / 2.0);
+}
+
 GroupLayout::GroupLayout(const Eigen::Vector2d& p_WS,
                          const std::vector<Eigen::Vector2d>& grid_places, double spacing,
                          const std::vector<WallSegment>& barriers,
@@ -25,7 +34,7 @@ GroupLayout::GroupLayout(const Eigen::Vector2d& p_WS,
     : p_WS_(p_WS), count_(int(grid_places.size())) {
   ThrowUnless(count_ >= 1 && std::isfinite(spacing) && spacing > 0.0 && p_WS.allFinite(),
               "GroupLayout: needs a member, a finite spacing > 0 and a finite start");
-  columns_ = int(std::ceil(std::sqrt(double(count_))));
+  columns_ = Columns(count_);
   lo_ = -kGroupLayoutExtraRings;
   side_ = columns_ + 2 * kGroupLayoutExtraRings;
   const double c = (columns_ - 1) / 2.0;

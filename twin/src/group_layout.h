@@ -38,6 +38,11 @@ class GroupLayout {
               double spacing, const std::vector<WallSegment>& barriers,
               const std::vector<WallSegment>& keep_off = {});
 
+  /// Places a row of a group of `count`: ceil(sqrt(count)).
+  static int Columns(int count);
+  /// Member k's grid place relative to the group's start, in units of the grid's spacing.
+  static Eigen::Vector2d GridUnit(int k, int count);
+
   /// Member k's place (0 ≤ k < count), for a body of `radius`: its grid place if that is fit
   /// (reached, not in a barrier, clear of keep_off by `radius`) and not taken, else the nearest
   /// place that clears both by `radius`, is no member's grid place and is not taken (ties: row,

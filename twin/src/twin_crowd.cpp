@@ -70,16 +70,14 @@ void TwinWorld::Impl::BuildPeople() {
     const PersonSpec& spec = scenario.people[i];
     const auto& model = fixed.behavior_models.at(spec.behavior);
     const int count = model->GroupSize(spec);
-    const int columns = int(std::ceil(std::sqrt(double(count))));
     // A group stands in a grid around its start, 2.2 radii apart (a group of mixed sizes, 2.2
     // of its largest radii), where the building leaves room (GroupLayout).
     std::optional<world_detail::GroupLayout> layout;
     if (count > 1) {
       std::vector<Eigen::Vector2d> grid(std::size_t(count), spec.start);
       for (int k = 0; k < count; ++k) {
-        const Eigen::Vector2d offset = Eigen::Vector2d((k % columns) - (columns - 1) / 2.0,
-                                                       (k / columns) - (columns - 1) / 2.0) *
-                                       2.2 * spec.radius;
+        const Eigen::Vector2d offset =
+            world_detail::GroupLayout::GridUnit(k, count) * 2.2 * spec.radius;
         grid[std::size_t(k)] = spec.mobility.empty() ? Eigen::Vector2d(spec.start + offset)
                                                      : spec.start + offset / spec.radius * 0.45;
       }
