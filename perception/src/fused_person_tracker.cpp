@@ -156,6 +156,7 @@ void FusedPersonTracker::Update(const std::vector<PersonObservation>& observatio
         o.source == PersonSource::kLaser && last && stamp > last->first &&
         (o.p_MP - last->second).norm() > config_.max_person_speed * ToSeconds(stamp - last->first);
     const bool reacquired = ToSeconds(stamp - track.last_measured) > config_.reacquire_after_s;
+    const bool still = o.motion == PlaceMotion::kStill;
     if (reacquired) {
       // Coasted: the old velocity is kept until the new one is measured, not differenced across
       // the gap (from whoever the track followed before it).
@@ -165,12 +166,15 @@ void FusedPersonTracker::Update(const std::vector<PersonObservation>& observatio
       const FusedTrack::VelocityAnchor& anchor = *track.reacquired;
       const double dt = ToSeconds(stamp - anchor.stamp);
       if (o.source == anchor.source && dt >= config_.min_velocity_dt)
-        track.person.v_MP = (o.p_MP - anchor.p_MP) / dt;
+        track.person.v_MP =
+            still ? Eigen::Vector2d::Zero() : Eigen::Vector2d((o.p_MP - anchor.p_MP) / dt);
       if (dt >= config_.reacquire_velocity_s) track.reacquired.reset();
     } else if (last && stamp > last->first) {
       const double dt = ToSeconds(stamp - last->first);
       if (dt >= config_.min_velocity_dt) {
-        track.person.v_MP = a * (o.p_MP - last->second) / dt + (1.0 - a) * track.person.v_MP;
+        const Eigen::Vector2d step_v =
+            still ? Eigen::Vector2d::Zero() : Eigen::Vector2d((o.p_MP - last->second) / dt);
+        track.person.v_MP = a * step_v + (1.0 - a) * track.person.v_MP;
       }
     }
     if (!last || stamp >= last->first) last = std::make_pair(stamp, o.p_MP);

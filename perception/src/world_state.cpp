@@ -14,7 +14,8 @@ PerceptionPipeline::PerceptionPipeline(std::vector<DoorModel> doors, PerceptionC
       objects_(config_.objects),
       people_(config_.people),
       laser_detector_(config_.laser_detector),
-      fused_(config_.fused_people) {
+      fused_(config_.fused_people),
+      laser_motion_(config_.laser_motion) {
   for (auto& door : doors)
     doors_.emplace_back(std::move(door), config_.door_state);
 }
@@ -139,8 +140,18 @@ void PerceptionPipeline::ProcessScan(
       }
       return false;
     };
+    laser_motion_.AddScan(scan, X_ML);
+    // Whether a detection moved is judged on the returns about it: its legs (or body section),
+    // a margin past them, and at least a stride round its centre, so that a walker's swinging
+    // leg counts when the detector took only the planted one (escorts, 6 trials each: walkers'
+    // detections read still in 3.1 % / 5.6 % of scans with the robot moving / still, against
+    // 4.1 % / 5.3 % judged on their own returns).
+    constexpr double kMotionPlaceMarginM = 0.1, kMotionPlaceMinRadiusM = 0.35;
     for (const auto& d : laser_detector_.Detect(scan, X_ML, is_background, is_leaf))
-      observations.push_back({d.p_MP, PersonSource::kLaser, d.at_edge});
+      observations.push_back(
+          {d.p_MP, PersonSource::kLaser, d.at_edge,
+           laser_motion_.Judge(d.p_MP,
+                               std::max(kMotionPlaceMinRadiusM, d.radius + kMotionPlaceMarginM))});
     // The laser covers its 270 degrees out to the detector's reach.
     const double reach = config_.laser_detector.max_range;
     fused_.Update(observations, scan.stamp, [&](const Eigen::Vector2d& p) {

@@ -285,6 +285,27 @@ TEST(FusedPersonTrackerTest, ATrackTakenUpAfterCoastingMeasuresItsVelocityAfresh
   EXPECT_NEAR(hidden.tracks()[0].person.v_MP.x(), 1.0, 0.05);
 }
 
+// Someone standing, seen by a laser driving past: their leg-pair midpoint slides 4 cm a scan as
+// the viewpoint changes (0.4 m/s). Judged still along the beams (FreeSpaceMotion), those steps
+// are no velocity; judged unknown, they are.
+TEST(FusedPersonTrackerTest, AStandingPersonsStepsJudgedStillAreNoVelocity) {
+  for (const PlaceMotion motion : {PlaceMotion::kStill, PlaceMotion::kUnknown}) {
+    FusedPersonTracker tracker;
+    tracker.Update({{{2.0, 1.0}, PersonSource::kCamera}}, At(0.0));  // confirmed by the camera
+    for (int k = 1; k <= 20; ++k) {
+      const Eigen::Vector2d seen(2.0 + 0.04 * (k % 5), 1.0);  // slides, jumps back, slides
+      tracker.Update({{seen, PersonSource::kLaser, false, motion}}, At(0.1 * k));
+    }
+    ASSERT_EQ(tracker.tracks().size(), 1u);
+    const double speed = tracker.tracks().front().person.v_MP.norm();
+    if (motion == PlaceMotion::kStill) {
+      EXPECT_LT(speed, 0.02);
+    } else {
+      EXPECT_GT(speed, 0.1);
+    }
+  }
+}
+
 TEST(FusedPersonTrackerTest, BadInputIsRefusedNamingIt) {
   FusedPersonTracker tracker;
   tracker.Update({}, At(1.0));

@@ -7,7 +7,10 @@
 /// forward by its velocity before it is fused. Association is greedy nearest-first within a gate;
 /// position and velocity are smoothed exponentially (the paper's alpha); velocity is taken from
 /// successive measurements of a track, whichever sensor made them, never from two frames a few
-/// milliseconds apart.
+/// milliseconds apart. A laser measurement whose returns did not move (PersonObservation::motion
+/// kStill, judged along the beams by FreeSpaceMotion) measures zero velocity: the step from the
+/// last one is the moving viewpoint's (a leg pair's visible arcs, legs in each other's shadow),
+/// which read people standing as walking at up to 3 m/s while the robot drove.
 ///
 /// A track is *confirmed* (a person, not a table leg) once the camera has seen it, or the laser
 /// has seen it `confirm_laser_hits` times and it has moved `confirm_motion` within
@@ -46,6 +49,7 @@
 #include <Eigen/Core>
 
 #include "egress/hsr_interface/time.h"
+#include "egress/perception/free_space_motion.h"
 #include "egress/perception/person_tracker.h"
 
 namespace egress::perception {
@@ -59,6 +63,9 @@ struct PersonObservation {
   /// a body's radius off it. It starts tracks and keeps them alive, but moves a confirmed track
   /// only within FusedPersonTrackerConfig::edge_gate of its prediction.
   bool at_edge{false};
+  /// Whether its returns moved, judged along the laser's beams (FreeSpaceMotion): kStill
+  /// measures no velocity (the step from its last measurement is the viewpoint's, not theirs).
+  PlaceMotion motion{PlaceMotion::kUnknown};
 };
 
 struct FusedPersonTrackerConfig {

@@ -15,6 +15,7 @@
 #include "egress/perception/costmap.h"
 #include "egress/perception/detection.h"
 #include "egress/perception/door_estimation.h"
+#include "egress/perception/free_space_motion.h"
 #include "egress/perception/fused_person_tracker.h"
 #include "egress/perception/laser_person_detector.h"
 #include "egress/perception/object_tracker.h"
@@ -79,6 +80,9 @@ struct PerceptionConfig {
   bool laser_people{true};
   LaserPersonDetectorConfig laser_detector;
   FusedPersonTrackerConfig fused_people;
+  /// Whether each laser person detection's returns moved, judged along the beams (a standing
+  /// person seen from the moving robot is still; FusedPersonTracker reads no velocity then).
+  FreeSpaceMotionConfig laser_motion;
   /// How far the camera's person detections reach, for which tracks it should have seen [m].
   double camera_people_range{8.0};
 };
@@ -129,6 +133,7 @@ class PerceptionPipeline {
   PersonTracker people_;
   LaserPersonDetector laser_detector_;
   FusedPersonTracker fused_;
+  FreeSpaceMotion laser_motion_;
   std::vector<Detection2D> glass_boxes_;
   int glass_image_width_{0};  ///< Width of the image those boxes are in [px].
   Pose3 glass_X_MC_;          ///< The camera when that image was taken.
