@@ -267,6 +267,24 @@ bool Costmap2D::IsNearMappedObstacle(const Eigen::Vector2d& p_MQ, double radius)
   return IsNearLethal(p_MQ, radius, {&static_, &leaves_});
 }
 
+bool Costmap2D::IsNearUnmappedMark(const Eigen::Vector2d& p_MQ, double radius,
+                                   double off_map) const {
+  const auto c = geometry_.CellOf(p_MQ);
+  if (!c || !(radius >= 0.0)) return false;
+  const int n = int(std::ceil(radius / geometry_.resolution));
+  const double r2 = std::pow(radius / geometry_.resolution, 2);
+  for (int dy = -n; dy <= n; ++dy) {
+    for (int dx = -n; dx <= n; ++dx) {
+      const int x = c->x() + dx, y = c->y() + dy;
+      if (dx * dx + dy * dy > r2 || !geometry_.Contains(x, y) ||
+          obstacle_[geometry_.Index(x, y)] != kLethalCost)
+        continue;
+      if (!IsNearMappedObstacle(geometry_.CellCenter(x, y), off_map)) return true;
+    }
+  }
+  return false;
+}
+
 bool Costmap2D::IsNearLethal(const Eigen::Vector2d& p_MQ, double radius,
                              std::initializer_list<const std::vector<std::uint8_t>*> layers) const {
   const auto c = geometry_.CellOf(p_MQ);

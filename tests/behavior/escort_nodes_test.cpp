@@ -976,6 +976,57 @@ TEST_F(HoldForResidentsTest, AStepToMakeRoomEndsClearOfTheWall) {
   EXPECT_GT((to.translation() - Eigen::Vector2d(spot.x, spot.y - 0.4)).norm(), 0.4 + 0.1);
 }
 
+// Not back into the laser's blind sector where it last saw someone (school seed 5: pressing the
+// button, the robot had the residents standing behind it; making room for a wheelchair user
+// beside it, it stepped straight back among them). The costmap's obstacle layer remembers them
+// where no ray has cleared them since.
+TEST_F(HoldForResidentsTest, AStepToMakeRoomDoesNotGoBackAmongThoseLastSeenBehindIt) {
+  tree_.TickOnce();
+  OperatedAgo(1.0);
+  const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
+  // Facing the wall (north), someone just west of it (the doorway's side), too near.
+  const Pose2 X_MB{spot.x, spot.y, M_PI / 2};
+  const Eigen::Vector2d them{spot.x - 0.4, spot.y};
+  // Where a step goes, with `behind` seen earlier south of the robot (from where it stands,
+  // facing south) and out of the laser's view now.
+  const auto step_with = [&](const std::vector<Eigen::Vector2d>& behind, double t) {
+    perception::Costmap2D costmap = LabWalls();
+    LaserScan earlier = node_testing::SweepScan();
+    earlier.ranges.assign(earlier.ranges.size(), std::numeric_limits<float>::infinity());
+    const Pose2 X_ML_earlier{spot.x, spot.y, -M_PI / 2};
+    for (const Eigen::Vector2d& p : behind) {
+      const Eigen::Vector2d p_L = X_ML_earlier.Inverse() * p;
+      const auto i = std::size_t(std::lround((std::atan2(p_L.y(), p_L.x()) - earlier.angle_min) /
+                                             earlier.angle_increment));
+      earlier.ranges[i] = float(p_L.norm());
+    }
+    costmap.UpdateWithScan(earlier, X_ML_earlier);
+    belief_.world.costmap = &costmap;
+    belief_.scan = node_testing::SweepScan();
+    belief_.X_MB = X_MB;
+    belief_.off_map_returns = {them};
+    belief_.now = At(t);
+    motion_.StopBase();
+    log_.Take();
+    EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+    EXPECT_TRUE(NotedText("making room"));
+    belief_.world.costmap = nullptr;
+    return motion_.path().empty() ? X_MB.translation() : motion_.path().back().translation();
+  };
+  // With nothing seen behind it, it steps back, out of the laser's view.
+  const Eigen::Vector2d clear = step_with({}, 2.0);
+  EXPECT_LT(clear.y(), spot.y - 0.2) << clear.transpose();
+  // With people seen standing there, it steps elsewhere, clear of them by a body.
+  std::vector<Eigen::Vector2d> group;
+  for (double x = spot.x - 1.2; x <= spot.x + 1.2; x += 0.3)
+    group.emplace_back(x, spot.y - 0.8);
+  const Eigen::Vector2d to = step_with(group, 3.0);
+  for (const Eigen::Vector2d& p : group)
+    EXPECT_GT((to - p).norm(), TaskConfig{}.footprint_radius + 0.25)
+        << "step to " << to.transpose() << ", someone at " << p.transpose();
+  EXPECT_GT((to - them).norm(), 0.4 + 0.1);
+}
+
 // Nor in another door's doorway, nor through it (two wards seed 24: past door_d, holding door_e,
 // the robot stepped back into door_d's doorway, making room for residents walking along the
 // corridor, as door_d closed).

@@ -173,6 +173,30 @@ TEST(CostmapTest, SensedObstaclesAreTheMapTheLaserAndLeavesNotTheProjection) {
   EXPECT_FALSE(costmap.IsNearSensedObstacle({-1.0, -1.0}, 0.1));  // outside the map
 }
 
+// What the laser marked off the map is remembered where no ray clears it: the making-room
+// steps into the robot's blind sector keep clear of it (HoldForResidents), but not of the
+// laser's marks on a wall, which the map explains.
+TEST(CostmapTest, UnmappedMarksAreWhatTheLaserSawOffTheMapAndStayOutOfView) {
+  const OccupancyGrid walls =
+      OccupancyGrid::FromBoxes({{{5.0, 2.25, 0.0}, {0.1, 4.5}}}, {0, 0}, {10, 10}, 0.05);
+  Costmap2D costmap(walls);
+  const Pose2 X_ML{3.0, 2.0, 0.0};
+  costmap.UpdateWithScan(SingleReturn(0.0, 1.95f), X_ML);           // the wall's face at (4.95, 2)
+  costmap.UpdateWithScan(SingleReturn(M_PI / 2, 1.0f), X_ML);       // someone at (3, 3)
+  EXPECT_TRUE(costmap.IsNearSensedObstacle({4.6, 2.0}, 0.4));       // the wall's mark, sensed ...
+  EXPECT_FALSE(costmap.IsNearUnmappedMark({4.6, 2.0}, 0.4, 0.15));  // ... but the map's
+  EXPECT_TRUE(costmap.IsNearUnmappedMark({3.0, 2.7}, 0.4, 0.15));
+  EXPECT_FALSE(costmap.IsNearUnmappedMark({3.0, 2.5}, 0.4, 0.15));  // beyond the radius
+  // The laser turned away (the mark in its rear blind sector), seeing nothing: the mark stays.
+  costmap.UpdateWithScan(SingleReturn(0.0, std::numeric_limits<float>::infinity()),
+                         {3.0, 2.0, -M_PI / 2});
+  EXPECT_TRUE(costmap.IsNearUnmappedMark({3.0, 2.7}, 0.4, 0.15));
+  // A ray through it clears it.
+  costmap.UpdateWithScan(SingleReturn(M_PI / 2, std::numeric_limits<float>::infinity()), X_ML);
+  EXPECT_FALSE(costmap.IsNearUnmappedMark({3.0, 2.7}, 0.4, 0.15));
+  EXPECT_FALSE(costmap.IsNearUnmappedMark({-1.0, -1.0}, 0.4, 0.15));  // outside the map
+}
+
 TEST(CostmapTest, MappedObstaclesAreTheMapAndLeavesNotWhatTheLaserSaw) {
   const OccupancyGrid walls =
       OccupancyGrid::FromBoxes({{{5.0, 2.25, 0.0}, {0.1, 4.5}}}, {0, 0}, {10, 10}, 0.05);

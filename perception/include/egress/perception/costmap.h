@@ -89,6 +89,11 @@ class Costmap2D {
   /// Whether a lethal cell of the static map or of a door leaf is within `radius` of p_MQ: what
   /// the building explains (a laser return beyond it is someone or something not on the map).
   bool IsNearMappedObstacle(const Eigen::Vector2d& p_MQ, double radius) const;
+  /// Whether a cell the laser marked (the obstacle layer) lies within `radius` of p_MQ and
+  /// farther than `off_map` from every lethal cell of the static map and the door leaves:
+  /// something the building does not explain, as a scan's returns off the map — remembered
+  /// where no ray has cleared it since (behind the robot, out of the laser's view).
+  bool IsNearUnmappedMark(const Eigen::Vector2d& p_MQ, double radius, double off_map) const;
   /// Replaces the proxemic layer with `spaces` (overlapping spaces keep the higher cost). The
   /// cells are filled when the layer is next read (a hundred people's spaces take milliseconds
   /// to paint, and most control ticks plan nothing).
