@@ -55,10 +55,9 @@ constexpr double kRoomHorizonSec = 2.0;
 constexpr double kRoomHorizonStepSec = 0.2;
 // [m] A step that gains less room than this is not worth taking.
 constexpr double kRoomGainM = 0.1;
-// [m] A step into the laser's blind sector keeps this clear of what it last saw there, checked
-// every kBlindSampleM along it.
+// [m] A step into the laser's blind sector keeps this clear of what it last saw there (school
+// seed 5: the robot at the button stepped straight back among residents standing behind it).
 constexpr double kBlindClearM = 0.25;
-constexpr double kBlindSampleM = 0.15;
 // [m] A step ends at least this much beyond the footprint from the building's walls.
 constexpr double kRoomWallMarginM = 0.1;
 // [m] ... and at least this far from every door's line, across its opening: not in a doorway
@@ -451,7 +450,8 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
             costmap->IsNearMappedObstacle(q, task_.config.footprint_radius + kRoomWallMarginM))
           continue;
         const double room = worth(q);
-        if (room <= best_room || !RememberedClear(at, q)) continue;
+        if (room <= best_room || !IsBlindWayClear(task_, belief_.X_MB, at, q, kBlindClearM))
+          continue;
         const Pose2 candidate{q.x(), q.y(), belief_.X_MB.yaw};
         // The straight step, not only where it ends: a free pose may lie beyond a wall.
         if (!task_.planner->IsPathValid({belief_.X_MB, candidate})) continue;
@@ -460,27 +460,6 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
       }
     }
     return best;
-  }
-
-  // A step's way where the laser cannot see now (its rear blind sector) keeps kBlindClearM
-  // beyond the footprint from whatever the laser last saw there off the map (the costmap's
-  // obstacle layer, kept where no ray clears it): school seed 5, the robot at the button stepped
-  // straight back from a wheelchair user beside it, among the residents standing behind it
-  // (seen as it drove up; its latest scan's returns, all the rest of FindRoom reads, cannot).
-  // Not the walls' marks: walls keep kRoomWallMarginM as anywhere (with them, atrium seed 46's
-  // robot, cornered, found only a step across a resident's way).
-  bool RememberedClear(const Eigen::Vector2d& from, const Eigen::Vector2d& to) const {
-    const perception::Costmap2D* costmap = belief_.world.costmap;
-    if (costmap == nullptr) return true;
-    const double length = (to - from).norm();
-    const int steps = std::max(1, int(std::ceil(length / kBlindSampleM)));
-    for (int k = 1; k <= steps; ++k) {
-      const Eigen::Vector2d p = from + (to - from) * (double(k) / steps);
-      if (!IsInLaserSweep(task_, belief_.X_MB, p) &&
-          costmap->IsNearUnmappedMark(p, task_.config.footprint_radius + kBlindClearM, kOffMapM))
-        return false;
-    }
-    return true;
   }
 
   // Someone walking up behind its drive (residents walk faster; two wards seed 3): it stops,

@@ -467,6 +467,21 @@ bool IsInLaserSweep(const TaskServices& task, const Pose2& X_MB, const Eigen::Ve
          bearing <= belief.scan->angle_max() - PeopleRoom::kSweepMarginRad;
 }
 
+bool IsBlindWayClear(const TaskServices& task, const Pose2& X_MB, const Eigen::Vector2d& p_MFrom,
+                     const Eigen::Vector2d& p_MTo, double clearance) {
+  const perception::Costmap2D* costmap = task.belief->world.costmap;
+  if (costmap == nullptr) return true;
+  constexpr double kSampleM = 0.15;  // the way is checked this often
+  const int steps = std::max(1, int(std::ceil((p_MTo - p_MFrom).norm() / kSampleM)));
+  for (int k = 1; k <= steps; ++k) {
+    const Eigen::Vector2d p = p_MFrom + (p_MTo - p_MFrom) * (double(k) / steps);
+    if (!IsInLaserSweep(task, X_MB, p) &&
+        costmap->IsNearUnmappedMark(p, task.config.footprint_radius + clearance, kOffMapM))
+      return false;
+  }
+  return true;
+}
+
 bool PeopleRoom::IsSeenFrom(const Pose2& X_MB, const Eigen::Vector2d& p) const {
   // Where the base just drove, facing that way: nobody stood there as it passed.
   for (const auto& [t, p_MB] : task_.belief->swept_p_MB)

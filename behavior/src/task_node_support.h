@@ -233,6 +233,15 @@ double RoomAt(const std::vector<Occupant>& near, const Eigen::Vector2d& q);
 /// base at X_MB, or under the robot; true without a scan (nothing to tell).
 bool IsInLaserSweep(const TaskServices& task, const Pose2& X_MB, const Eigen::Vector2d& p_M);
 
+/// The straight way from p_MFrom to p_MTo keeps `clearance` [m] beyond the footprint, where it
+/// leaves the laser's sweep (base at X_MB), from what the laser marked there off the map (the
+/// costmap's obstacle layer, kept where no ray clears it; Costmap2D::IsNearUnmappedMark): the
+/// latest scan's returns, all else a step is judged on, cannot see there. Not the walls' marks:
+/// walls are the map's (counted too, atrium seed 46's cornered robot found only a step across a
+/// resident's way). True without a costmap.
+bool IsBlindWayClear(const TaskServices& task, const Pose2& X_MB, const Eigen::Vector2d& p_MFrom,
+                     const Eigen::Vector2d& p_MTo, double clearance);
+
 /// What people may do beyond walking on at their tracked velocity.
 struct PeopleHypotheses {
   /// People walking past step round the robot (TaskConfig::person_sidestep): each predicted
