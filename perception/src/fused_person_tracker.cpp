@@ -30,6 +30,8 @@ void FusedPersonTrackerConfig::Validate() const {
   positive(static_after_s, "static_after_s");
   positive(static_gap_s, "static_gap_s");
   positive(static_forget_s, "static_forget_s");
+  ThrowUnless(std::isfinite(camera_velocity_after_laser_s) && camera_velocity_after_laser_s >= 0.0,
+              "FusedPersonTrackerConfig: camera_velocity_after_laser_s must be finite and >= 0");
   ThrowUnless(std::isfinite(confirm_motion) && confirm_motion >= 0.0,
               "FusedPersonTrackerConfig: confirm_motion must be finite and >= 0");
   ThrowUnless(confirm_laser_hits >= 1 && forecast_steps >= 0,
@@ -171,7 +173,11 @@ void FusedPersonTracker::Update(const std::vector<PersonObservation>& observatio
       if (dt >= config_.reacquire_velocity_s) track.reacquired.reset();
     } else if (last && stamp > last->first) {
       const double dt = ToSeconds(stamp - last->first);
-      if (dt >= config_.min_velocity_dt) {
+      const auto& by_laser = track.last_by_source[std::size_t(PersonSource::kLaser)];
+      const bool laser_measures =
+          o.source == PersonSource::kCamera && by_laser &&
+          std::abs(ToSeconds(stamp - by_laser->first)) < config_.camera_velocity_after_laser_s;
+      if (dt >= config_.min_velocity_dt && !laser_measures) {
         const Eigen::Vector2d step_v =
             still ? Eigen::Vector2d::Zero() : Eigen::Vector2d((o.p_MP - last->second) / dt);
         track.person.v_MP = a * step_v + (1.0 - a) * track.person.v_MP;

@@ -2,6 +2,7 @@
 
 #include "egress/perception/fused_person_tracker.h"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 #include <vector>
@@ -306,6 +307,42 @@ TEST(FusedPersonTrackerTest, AStandingPersonsStepsJudgedStillAreNoVelocity) {
   }
 }
 
+// Someone standing in a group, seen by both sensors: the camera's depth places them 0.7 m apart
+// in turn (its frames every 0.2 s, 150 ms late), the laser judges them still along its beams.
+// The camera's placements measure no velocity while the laser measures them; once out of the
+// laser's view, the camera's do again (a walker it alone sees).
+TEST(FusedPersonTrackerTest, TheCameraMeasuresNoVelocityForSomeoneTheLaserMeasures) {
+  const auto max_speed = [](double camera_after_laser_s) {
+    FusedPersonTrackerConfig config;
+    config.camera_velocity_after_laser_s = camera_after_laser_s;
+    FusedPersonTracker tracker(config);
+    double fastest = 0.0;
+    int frame = 0;
+    for (int k = 0; k <= 40; ++k) {
+      const double now = 0.1 * k;
+      tracker.Update({{{3.0, 1.0}, PersonSource::kLaser, false, PlaceMotion::kStill}}, At(now));
+      if (k % 2 == 0 && k >= 2) {
+        const Eigen::Vector2d placed(3.0 + (frame++ % 2 == 0 ? 0.35 : -0.35), 1.0);
+        tracker.Update({{placed, PersonSource::kCamera}}, At(now - 0.15));
+      }
+      if (tracker.tracks().size() == 1)
+        fastest = std::max(fastest, tracker.tracks().front().person.v_MP.norm());
+    }
+    return fastest;
+  };
+  EXPECT_LT(max_speed(FusedPersonTrackerConfig{}.camera_velocity_after_laser_s), 0.05);
+  EXPECT_GT(max_speed(0.0), 0.5);  // the rule off: the camera's placements read as steps
+
+  // Out of the laser's view, a walker at 1 m/s the camera alone sees.
+  FusedPersonTracker tracker;
+  for (int k = 0; k <= 10; ++k)
+    tracker.Update({{{3.0, 1.0}, PersonSource::kLaser, false, PlaceMotion::kStill}}, At(0.1 * k));
+  for (int k = 1; k <= 15; ++k)
+    tracker.Update({{{3.0 + 0.2 * k, 1.0}, PersonSource::kCamera}}, At(1.0 + 0.2 * k));
+  ASSERT_EQ(tracker.tracks().size(), 1u);
+  EXPECT_NEAR(tracker.tracks().front().person.v_MP.x(), 1.0, 0.15);
+}
+
 TEST(FusedPersonTrackerTest, BadInputIsRefusedNamingIt) {
   FusedPersonTracker tracker;
   tracker.Update({}, At(1.0));
@@ -324,6 +361,9 @@ TEST(FusedPersonTrackerTest, BadInputIsRefusedNamingIt) {
   EXPECT_THROW(FusedPersonTracker{config}, InvalidArgument);
   config = {};
   config.reacquire_after_s = -1.0;
+  EXPECT_THROW(FusedPersonTracker{config}, InvalidArgument);
+  config = {};
+  config.camera_velocity_after_laser_s = std::nan("");
   EXPECT_THROW(FusedPersonTracker{config}, InvalidArgument);
 }
 
