@@ -586,6 +586,44 @@ mission:
   std::filesystem::remove_all(dir);
 }
 
+// The seeds to look at are named: a resident who cannot be out in the time limit is left behind
+// in every seed, each named with the count, in the table and in study.json.
+TEST(EgressCliTest, EvacStudyNamesTheSeedsThatLeftPeopleBehind) {
+  const auto dir = egress::testing::TestTempPath("study_left");
+  const std::string scenario = WriteTemp("left_behind.yaml", R"(name: lab, too little time
+world: )" + kWorldsDir + R"(/lab/lab.sdf
+seed: 1
+time_limit: 3
+robot:
+  start: {x: 1.6, y: 1.9, yaw_deg: 90}
+  goal: {x: 1.8, y: 5.2}
+doors:
+  - door: lab_door
+    operator: push
+people:
+  - name: resident
+    behavior: evacuate
+    route: [lab_door]
+    start: {x: -1.5, y: 0.4}
+    goal: {x: -1.5, y: 6.0}
+    trigger: {at: 1.0}
+mission:
+  tree: )" + kWorldsDir + R"(/../behavior/trees/evacuation_escort.xml
+)");
+  Result run = RunEgress("evac study " + scenario +
+                         " --trials 2 --seed-base 7 -q --conditions no_robot --out " +
+                         (dir / "out").string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_THAT(run.output, HasSubstr("left behind in seeds 7 (1), 8 (1)"));
+  EXPECT_THAT(run.output, Not(HasSubstr("contacts in seeds")));
+  const auto study = nlohmann::json::parse(std::ifstream(dir / "out" / "study.json"));
+  const auto& c = study.at("conditions").at(0);
+  EXPECT_EQ(c.at("left_behind").get<int>(), 2);
+  EXPECT_EQ(c.at("left_behind_by_seed"), nlohmann::json({{"7", 1}, {"8", 1}}));
+  EXPECT_TRUE(c.at("contacts_by_seed").empty());
+  std::filesystem::remove_all(dir);
+}
+
 // Issue 21's figures: closest approach per trial with the robot's speed then, median and worst
 // per scenario; the preemption latency of people the base laser saw; brain settings in the plan.
 TEST(EgressCliTest, SimBatchReportsClosestApproachesAndTheLaserPeopleSetting) {
