@@ -387,6 +387,31 @@ TEST(EgressCliTest, SimRunsAScenarioWritesVerdictTraceAndPictures) {
 const std::string kWorldsDir =
     std::filesystem::path(EGRESS_OFFICE_MAP).parent_path().parent_path().string();
 
+// The lab with one evacuee, who sets off at 1 s to go out through lab_door, and the escort.
+std::string WriteOneResidentLab(const std::string& name, double time_limit) {
+  return WriteTemp(name, R"(name: lab, one resident
+world: )" + kWorldsDir + R"(/lab/lab.sdf
+seed: 1
+time_limit: )" + std::to_string(time_limit) +
+                             R"(
+robot:
+  start: {x: 1.6, y: 1.9, yaw_deg: 90}
+  goal: {x: 1.8, y: 5.2}
+doors:
+  - door: lab_door
+    operator: push
+people:
+  - name: resident
+    behavior: evacuate
+    route: [lab_door]
+    start: {x: -1.5, y: 0.4}
+    goal: {x: -1.5, y: 6.0}
+    trigger: {at: 1.0}
+mission:
+  tree: )" + kWorldsDir + R"(/../behavior/trees/evacuation_escort.xml
+)");
+}
+
 TEST(EgressCliTest, SimRunWithTheBrainPrintsDecisionsAndTracesTheRunningAction) {
   const auto dir = egress::testing::TestTempPath("brain");
   std::filesystem::create_directories(dir);
@@ -554,26 +579,7 @@ TEST(EgressCliTest, BatchesRefuseASeedBaseWhoseLastTrialIsPastTheLargestSeed) {
 // "n/a"), not a flow of 0 persons/s; their queue time and who opened the door are still given.
 TEST(EgressCliTest, EvacStudyGivesNoFlowThroughADoorOnlyOneResidentPassed) {
   const auto dir = egress::testing::TestTempPath("study_one");
-  const std::string scenario = WriteTemp("one_resident.yaml", R"(name: lab, one resident
-world: )" + kWorldsDir + R"(/lab/lab.sdf
-seed: 1
-time_limit: 120
-robot:
-  start: {x: 1.6, y: 1.9, yaw_deg: 90}
-  goal: {x: 1.8, y: 5.2}
-doors:
-  - door: lab_door
-    operator: push
-people:
-  - name: resident
-    behavior: evacuate
-    route: [lab_door]
-    start: {x: -1.5, y: 0.4}
-    goal: {x: -1.5, y: 6.0}
-    trigger: {at: 1.0}
-mission:
-  tree: )" + kWorldsDir + R"(/../behavior/trees/evacuation_escort.xml
-)");
+  const std::string scenario = WriteOneResidentLab("one_resident.yaml", 120.0);
   Result run = RunEgress("evac study " + scenario + " --trials 1 -q --conditions no_robot --out " +
                          (dir / "out").string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
@@ -590,26 +596,7 @@ mission:
 // in every seed, each named with the count, in the table and in study.json.
 TEST(EgressCliTest, EvacStudyNamesTheSeedsThatLeftPeopleBehind) {
   const auto dir = egress::testing::TestTempPath("study_left");
-  const std::string scenario = WriteTemp("left_behind.yaml", R"(name: lab, too little time
-world: )" + kWorldsDir + R"(/lab/lab.sdf
-seed: 1
-time_limit: 3
-robot:
-  start: {x: 1.6, y: 1.9, yaw_deg: 90}
-  goal: {x: 1.8, y: 5.2}
-doors:
-  - door: lab_door
-    operator: push
-people:
-  - name: resident
-    behavior: evacuate
-    route: [lab_door]
-    start: {x: -1.5, y: 0.4}
-    goal: {x: -1.5, y: 6.0}
-    trigger: {at: 1.0}
-mission:
-  tree: )" + kWorldsDir + R"(/../behavior/trees/evacuation_escort.xml
-)");
+  const std::string scenario = WriteOneResidentLab("left_behind.yaml", 3.0);
   Result run = RunEgress("evac study " + scenario +
                          " --trials 2 --seed-base 7 -q --conditions no_robot --out " +
                          (dir / "out").string());
