@@ -22,7 +22,6 @@
 #include <fstream>
 #include <map>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -349,14 +348,13 @@ void RunStudy(const StudyOptions& o) {
     std::vector<double> times;
     int left = 0, contacts = 0;
     // The seeds to look at: where someone was left behind, where the robot touched someone.
-    nlohmann::json left_by_seed = nlohmann::json::object(),
-                   contacts_by_seed = nlohmann::json::object();
+    std::map<std::uint64_t, int> left_by_seed, contacts_by_seed;
     double closest = std::numeric_limits<double>::infinity(), blocking = 0.0, standing = 0.0;
     std::map<std::string, std::vector<double>> flow, queue, by_residents, by_robot;
     for (const auto& t : trials) {
       residents = t.at("residents").get<int>();
       times.push_back(t_by_seed[c].at(t.at("seed").get<std::uint64_t>()));
-      const std::string seed = std::to_string(t.at("seed").get<std::uint64_t>());
+      const auto seed = t.at("seed").get<std::uint64_t>();
       if (const int k = t.at("left_behind").get<int>(); k > 0) left_by_seed[seed] = k;
       if (const int k = t.at("contacts").get<int>(); k > 0) contacts_by_seed[seed] = k;
       left += t.at("left_behind").get<int>();
@@ -377,19 +375,22 @@ void RunStudy(const StudyOptions& o) {
                c == "robot" ? fmt::format("{}", contacts) : "-",
                c == "robot" && std::isfinite(closest) ? fmt::format("{:.2f} m", closest) : "-",
                fmt::format("{:.1f} / {:.1f} s", blocking, standing));
-    const auto by_seed = [](const nlohmann::json& counts) {
-      std::vector<std::pair<std::uint64_t, int>> rows;
-      for (const auto& [seed, k] : counts.items())
-        rows.emplace_back(std::stoull(seed), k.get<int>());
-      std::sort(rows.begin(), rows.end());
+    const auto seeds_text = [](const std::map<std::uint64_t, int>& counts) {
       std::string text;
-      for (const auto& [seed, k] : rows)
+      for (const auto& [seed, k] : counts)
         text += fmt::format("{}{} ({})", text.empty() ? "" : ", ", seed, k);
       return text;
     };
-    if (!left_by_seed.empty()) fmt::print("    left behind in seeds {}\n", by_seed(left_by_seed));
+    const auto seeds_json = [](const std::map<std::uint64_t, int>& counts) {
+      nlohmann::json j = nlohmann::json::object();
+      for (const auto& [seed, k] : counts)
+        j[std::to_string(seed)] = k;
+      return j;
+    };
+    if (!left_by_seed.empty())
+      fmt::print("    left behind in seeds {}\n", seeds_text(left_by_seed));
     if (!contacts_by_seed.empty())
-      fmt::print("    contacts in seeds {}\n", by_seed(contacts_by_seed));
+      fmt::print("    contacts in seeds {}\n", seeds_text(contacts_by_seed));
     nlohmann::json doors = nlohmann::json::object();
     for (const auto& [door, q] : queue) {
       // Null (and "n/a") where no trial saw two residents through: no rate to give.
@@ -430,9 +431,9 @@ void RunStudy(const StudyOptions& o) {
          {"t_evac_median_s", ci.median},
          {"t_evac_ci_s", {ci.low, ci.high}},
          {"left_behind", left},
-         {"left_behind_by_seed", left_by_seed},
+         {"left_behind_by_seed", seeds_json(left_by_seed)},
          {"contacts", contacts},
-         {"contacts_by_seed", contacts_by_seed},
+         {"contacts_by_seed", seeds_json(contacts_by_seed)},
          {"closest_m", std::isfinite(closest) ? nlohmann::json(closest) : nlohmann::json(nullptr)},
          {"doorway_block_s", blocking},
          {"doorway_stand_s", standing},

@@ -88,11 +88,11 @@ struct FusedPersonTrackerConfig {
   double reacquire_after_s{0.4};
   double reacquire_velocity_s{0.3};  ///< See reacquire_after_s [s].
   /// A camera observation within this long of the track's last laser measurement (before or
-  /// after it: the camera's frames come later) measures no
-  /// velocity: the laser places people to centimetres and judges their motion along its beams,
-  /// the camera's depth places them to decimetres (school seed 19: a resident standing in a
-  /// group, placed by the camera 0.8 m apart in consecutive frames, read as walking at 0.8 m/s
-  /// at the robot, laser measurements judging them still in between) [s].
+  /// after it: the camera's frames come later) measures no velocity: the laser places people to
+  /// centimetres and judges their motion along its beams, the camera's depth places them to
+  /// decimetres (school seed 19: a resident standing in a group, placed by the camera 0.8 m
+  /// apart in consecutive frames, read as walking at 0.8 m/s at the robot, laser measurements
+  /// judging them still in between) [s].
   double camera_velocity_after_laser_s{0.5};
   int forecast_steps{4};
   double forecast_dt{0.2};  ///< [s]
