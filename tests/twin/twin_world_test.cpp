@@ -6,6 +6,7 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include "../test_paths.h"
 #include "egress/hsr_interface/error.h"
 #include "egress/planning/ik_solver.h"
 #include "egress/twin/trace.h"
@@ -108,6 +109,55 @@ TEST(TwinWorldTest, ABlockedLeafStopsAgainstTheRobot) {
   EXPECT_LT(world.door_angle(0), 60 * kDeg);
   EXPECT_GE(CountEvents(world, "contact", "lab_door"), 1);
   EXPECT_LT((world.robot_pose().translation() - Eigen::Vector2d(0.0, 3.55)).norm(), 0.1);
+}
+
+// A door on its own, its model turned `yaw` [rad] about its hinge, opening counter-clockwise,
+// and its button 0.4 m behind the hinge.
+std::string LoneDoorSdf(double yaw) {
+  return R"(<?xml version="1.0" ?>
+<sdf version="1.7"><world name="lone_door">
+  <model name="door">
+    <pose>0 0 1 0 0 )" +
+         std::to_string(yaw) + R"(</pose>
+    <link name="frame"/>
+    <link name="leaf">
+      <inertial><mass>40.0</mass><inertia><ixx>13.4</ixx><iyy>13.4</iyy><izz>12.0</izz></inertia></inertial>
+      <collision name="c"><pose>0 0.5 0 0 0 0</pose><geometry><box><size>0.04 1.0 2.0</size></box></geometry></collision>
+    </link>
+    <joint name="hinge" type="revolute"><parent>frame</parent><child>leaf</child>
+      <axis><xyz>0 0 1</xyz><limit><lower>0.0</lower><upper>1.57</upper></limit></axis></joint>
+    <joint name="fixed_to_world" type="fixed"><parent>world</parent><child>frame</child></joint>
+  </model>
+  <model name="door_button"><static>true</static>
+    <pose>)" +
+         std::to_string(0.4 * std::sin(yaw)) + " " + std::to_string(-0.4 * std::cos(yaw)) +
+         " 1 0 0 " + std::to_string(yaw) + R"(</pose>
+    <link name="link"><collision name="c"><geometry><box><size>0.02 0.1 0.1</size></box></geometry></collision></link>
+  </model>
+</world></sdf>
+)";
+}
+
+TEST(TwinWorldTest, ADoorOpensWhicheverWayItFaces) {
+  // Bullet reads a hinge's angle in [-pi, pi]: a leaf whose closed angle lies near pi (a door
+  // turned ~176 degrees, as in a building turned 86 degrees) opened the wrong way, into its
+  // stop, and never opened. Every heading, those next to pi among them, opens to the operator's
+  // angle.
+  const auto dir = egress::testing::TestTempPath("lone_door");
+  std::filesystem::create_directories(dir);
+  for (const double yaw : {0.0, 1.0, 2.0, 3.0, 3.076, M_PI, 3.2, 4.0, -3.05, -1.5}) {
+    SCOPED_TRACE(yaw);
+    std::ofstream(dir / "door.sdf") << LoneDoorSdf(yaw);
+    auto loaded = LoadText(
+        "world: door.sdf\nrobot: {start: {x: 3.0, y: 3.0}}\n"
+        "doors:\n  - {door: door, operator: push, open_at: [0.2], hold_open_s: 100}\n",
+        dir);
+    TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+    world.StepFor(6.0);
+    EXPECT_NEAR(world.door_angle(0), 80 * kDeg, 4 * kDeg);
+    EXPECT_EQ(world.door_phase(0), DoorPhase::kHeldOpen);
+  }
+  std::filesystem::remove_all(dir);
 }
 
 // The robot's body is its description's shapes: above the base it is a slim column (torso and

@@ -31,7 +31,10 @@ void TwinWorld::Impl::BuildDoors() {
     const btTransform fixed = hinge->getBFrame();
     const double a0 = hinge->getHingeAngle(closed * hinge->getAFrame(), fixed);
     const double a1 = hinge->getHingeAngle(probe * hinge->getAFrame(), fixed);
-    door.motor_sign = a1 > a0 ? 1.0 : -1.0;
+    // Bullet's hinge angle is in [-pi, pi]: a leaf closed near pi reads the probe's 0.1 rad
+    // opening across the wrap (a0 3.075, a1 -3.108: a door turned 86 degrees in a random
+    // building opened the wrong way, into its jamb, and never opened).
+    door.motor_sign = std::remainder(a1 - a0, 2 * M_PI) > 0.0 ? 1.0 : -1.0;
     if (door.motor_sign > 0)
       hinge->setLimit(a0, a0 + d.max_open_angle, 0.9, 0.3, 0.5);
     else
