@@ -30,6 +30,44 @@ std::string PosePortText(const Pose2& X) {
   return buffer;
 }
 
+double BlindTravel(const TaskServices& task, const std::vector<Pose2>& path) {
+  // Where the footprint's leading edge will be a little ahead: the space the base drives into.
+  const double look = task.config.footprint_radius + kBlindLookAheadM;
+  double blind = 0.0;
+  for (std::size_t i = 0; i + 1 < path.size(); ++i) {
+    const Eigen::Vector2d d = path[i + 1].translation() - path[i].translation();
+    const double length = d.norm();
+    if (length < 0.01) continue;
+    const Eigen::Vector2d ahead = d / length * look;
+    // The heading turns evenly along a segment: seen at both ends, the way is seen along it.
+    if (!IsInLaserSweep(task, path[i], path[i].translation() + ahead) ||
+        !IsInLaserSweep(task, {path[i + 1].x, path[i + 1].y, path[i + 1].yaw},
+                        path[i + 1].translation() + ahead))
+      blind += length;
+  }
+  return blind;
+}
+
+void FaceTravel(std::vector<Pose2>* path, double goal_yaw) {
+  std::vector<Pose2>& p = *path;
+  std::vector<Pose2> faced{p.front()};
+  double yaw = p.front().yaw;
+  for (std::size_t i = 0; i + 1 < p.size(); ++i) {
+    const Eigen::Vector2d d = p[i + 1].translation() - p[i].translation();
+    if (d.norm() < 0.01) continue;  // an escape step's end: the next segment's way
+    const double travel = std::atan2(d.y(), d.x());
+    // Turned on the spot where the way turns much, else the turn spread along the segment.
+    if (std::abs(std::remainder(travel - yaw, 2 * M_PI)) > kFaceTravelTurnFirstRad)
+      faced.push_back({p[i].x, p[i].y, yaw + std::remainder(travel - yaw, 2 * M_PI)});
+    yaw = faced.back().yaw + std::remainder(travel - faced.back().yaw, 2 * M_PI);
+    faced.push_back({p[i + 1].x, p[i + 1].y, yaw});
+  }
+  // At the goal, to its heading on the spot.
+  if (std::abs(std::remainder(goal_yaw - yaw, 2 * M_PI)) > 1e-3)
+    faced.push_back({p.back().x, p.back().y, yaw + std::remainder(goal_yaw - yaw, 2 * M_PI)});
+  p = std::move(faced);
+}
+
 // Starts a base motion along a planned path; RUNNING until it ends.
 // Plans from the robot to `goal` on the costmap and starts following the path; `door_speed`
 // runs every segment at the door speed (a door approach inside the hold window).
@@ -117,6 +155,7 @@ NodeStatus StartPath(const TaskServices& task, const Pose2& goal, const std::str
       path[i].yaw = task.belief->X_MB.yaw + turn * fraction;
     }
   }
+  if (BlindTravel(task, path) > kBlindTravelToleranceM) FaceTravel(&path, goal.yaw);
   const std::vector<bool> through(path.size() - 1, door_speed);
   task.motion->FollowPath(path, through, task.motion->arm_target(), task.belief->now);
   note(StrCat("driving to ", what, " (", PoseText(goal), ", ", std::round(plan.length * 100) / 100,

@@ -151,6 +151,25 @@ inline constexpr double kFaceTravelBeyondM = 2.0;
 /// turned on the spot before driving (within it, the turn is spread along the first segment).
 inline constexpr double kFaceTravelTurnFirstRad = M_PI / 3;
 
+/// A way is seen when the base laser sweeps, from the pose at each end of a segment, the point
+/// this far ahead of the footprint along it [m] (IsInLaserSweep): where the base drives next.
+inline constexpr double kBlindLookAheadM = 0.3;
+/// A path whose yaws (any PathHeading) would drive more than this into the laser's blind sector
+/// (backwards, or sideways past the sweep's edge) is driven facing the way of travel instead
+/// (FaceTravel) [m]: someone standing behind the robot is never seen there, and it drove into
+/// residents standing round it as an evacuation began (random buildings of
+/// worlds/tools/make_random_building.py, 6 of 18: an approach to the button behind the robot,
+/// planned through the group it stood in, backed into one of them at 0.06 m/s). Less than this
+/// (a square-up, an escape step) is driven as planned.
+inline constexpr double kBlindTravelToleranceM = 0.3;
+/// Metres of `path` (the robot's pose first, yaws as it will drive them) on which the way ahead
+/// is not in the base laser's sweep (kBlindLookAheadM).
+double BlindTravel(const TaskServices& task, const std::vector<Pose2>& path);
+/// Re-heads `path` to face along each segment (turning on the spot first where a segment turns
+/// more than kFaceTravelTurnFirstRad from the heading before it), then on the spot at its end to
+/// `goal_yaw`. Yaws stay continuous (no wrap between poses).
+void FaceTravel(std::vector<Pose2>* path, double goal_yaw);
+
 /// Plans from the robot to `goal` on the costmap and starts following the path; `door_speed`
 /// runs every segment at the door speed (a door approach inside the hold window); `heading`:
 /// how the base turns along it. RUNNING while the base moves, SUCCESS if already there, FAILURE

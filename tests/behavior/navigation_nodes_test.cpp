@@ -3,6 +3,7 @@
 #include <optional>
 
 #include "task_node_fixture.h"
+#include "task_node_support.h"
 
 namespace egress::behavior {
 namespace {
@@ -22,6 +23,48 @@ TEST_F(NavigationNodesTest, NavigateToPlansAndFollowsAPathToTheGoal) {
   // Halted (a reactive condition failed): the base stops in the same tick.
   tree.HaltTree();
   EXPECT_FALSE(motion_.base_moving());
+}
+
+// A goal behind the robot, keeping its heading: the even turn would back the whole way into the
+// base laser's blind sector, where someone standing behind it is never seen. It turns to face
+// the way first, drives facing it and turns back to the goal's heading there.
+TEST_F(NavigationNodesTest, NavigateToNeverBacksIntoTheLasersBlindSector) {
+  belief_.scan = node_testing::SweepScan();
+  belief_.X_MB = {0.0, 2.0, M_PI / 2};                                         // facing north
+  bt::Tree tree = Tree(R"(<NavigateTo goal="0.0;0.0;1.5707963267948966"/>)");  // 2 m south
+  belief_.now = At(1.0);
+  ASSERT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  const std::vector<Pose2>& path = motion_.path();
+  ASSERT_GE(path.size(), 3u);
+  EXPECT_DOUBLE_EQ(detail::BlindTravel(services_, path), 0.0);
+  // On the spot to face south, then along the way, then on the spot back to north.
+  EXPECT_LT((path[1].translation() - path[0].translation()).norm(), 1e-9);
+  EXPECT_NEAR(std::remainder(path[1].yaw + M_PI / 2, 2 * M_PI), 0.0, 0.2);
+  EXPECT_LT((path.back().translation() - Eigen::Vector2d(0.0, 0.0)).norm(), 1e-6);
+  EXPECT_NEAR(std::remainder(path.back().yaw - M_PI / 2, 2 * M_PI), 0.0, 1e-9);
+  for (std::size_t i = 1; i < path.size(); ++i)  // no jump of a turn between poses
+    EXPECT_LT(std::abs(path[i].yaw - path[i - 1].yaw), M_PI + 1e-9);
+}
+
+// A way the laser sees all along (to the side) is driven as planned: turning evenly to the
+// goal's heading, no turn on the spot.
+TEST_F(NavigationNodesTest, NavigateToASeenWayKeepsTheEvenTurn) {
+  belief_.scan = node_testing::SweepScan();
+  belief_.X_MB = {0.0, 1.0, M_PI / 2};
+  bt::Tree tree = Tree(R"(<NavigateTo goal="2.0;1.0;1.5707963267948966"/>)");  // 2 m east
+  belief_.now = At(1.0);
+  ASSERT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  const std::vector<Pose2>& path = motion_.path();
+  ASSERT_GE(path.size(), 2u);
+  for (std::size_t i = 1; i < path.size(); ++i) {
+    EXPECT_GT((path[i].translation() - path[i - 1].translation()).norm(), 1e-6);
+    EXPECT_NEAR(path[i].yaw, M_PI / 2, 1e-9);
+  }
+  // The same way driven backwards (facing west) would be blind from its start.
+  std::vector<Pose2> backwards = path;
+  for (Pose2& p : backwards)
+    p.yaw = M_PI;
+  EXPECT_GT(detail::BlindTravel(services_, backwards), 1.5);
 }
 
 TEST_F(NavigationNodesTest, NavigateToAGoalWhereTheRobotStandsSucceedsAtOnce) {

@@ -468,8 +468,7 @@ void TwinWorld::Impl::UpdatePeople() {
   }
   std::vector<WallSegment> leaves;
   for (const auto& d : doors) {
-    leaves.push_back(
-        {d.fixed->desc->p_WH.head<2>(), d.free_edge});
+    leaves.push_back({d.fixed->desc->p_WH.head<2>(), d.free_edge});
   }
   const Twist2 V_B = RobotVelocity();
   const Eigen::Vector2d v_W = X_WB.rotation() * Eigen::Vector2d(V_B.vx, V_B.vy);
