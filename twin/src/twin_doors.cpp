@@ -10,7 +10,6 @@ void TwinWorld::Impl::BuildDoors() {
     Door door;
     door.fixed = &fixed.doors[i];
     door.spec = door.fixed->spec;
-    door.free_edge = d.CalcFreeEdge(door.angle).head<2>();
     if (door.spec && scenario.randomize.hold_open_s.max > 0.0) {
       door.spec->timing.hold_open_s = hold_override;
     }
@@ -110,7 +109,7 @@ double TwinWorld::Impl::MeasureDoorAngle(const Door& d) const {
 
 bool TwinWorld::Impl::LeafSwingsIntoSomeone(const Door& d) const {
   const Eigen::Vector2d hinge = d.fixed->desc->p_WH.head<2>();
-  const Eigen::Vector2d& edge = d.free_edge;
+  const Eigen::Vector2d edge = d.fixed->desc->CalcFreeEdge(d.angle).head<2>();
   const double omega_z = d.leaf->getAngularVelocity().z();  // about W's z [rad/s]
   if (std::abs(omega_z) < 1e-9) return false;
   for (const auto& p : people) {
@@ -130,7 +129,6 @@ void TwinWorld::Impl::UpdateDoors() {
   for (std::size_t i = 0; i < doors.size(); ++i) {
     Door& d = doors[i];
     d.angle = MeasureDoorAngle(d);
-    d.free_edge = d.fixed->desc->CalcFreeEdge(d.angle).head<2>();
     const double stall_impulse = (d.spec ? d.spec->timing.stall_force : 67.0) * d.fixed->reach * dt;
     if (d.op) {
       const double rate = d.op->Update(time, d.angle);

@@ -23,9 +23,6 @@ struct Door {
   btHingeConstraint* hinge{nullptr};
   double motor_sign{1.0};
   double angle{0.0};
-  // The leaf's free edge at `angle` on the ground plane (W), set with it: every walker near an
-  // open leaf needs it every step.
-  Eigen::Vector2d free_edge{Eigen::Vector2d::Zero()};
   int presses{0};
   bool reported_open{false};
   bool reported_closed{true};
