@@ -186,11 +186,13 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // back to the door, the robot sees nobody there (two-wards seed 17: a resident waiting at
     // door_e, behind it, was "everyone through" after clear_for). The operation just done was
     // counted in OnStart. Nor while the way in is beyond where the laser knows people: driving
-    // to a door 17 m away, it saw nobody there for want of range.
+    // to a door 17 m away, it saw nobody there for want of range. Nor while something of the map
+    // stands between: stepped aside behind the office's table, the robot saw nobody at door_a
+    // for 5 s while a wheelchair user waited there, and left them behind (office seed 5).
     const Eigen::Vector2d way_in = pass.centre + pass.n_M;
     if (around.near) {
       unseen_ = 0.0;
-    } else if (last_tick_ && IsInLaserSweep(task_, belief_.X_MB, way_in) &&
+    } else if (last_tick_ && IsInLaserSight(task_, belief_.X_MB, way_in) &&
                (way_in - belief_.X_MB.translation()).norm() <= belief_.people_range) {
       unseen_ += ToSeconds(belief_.now - *last_tick_);
     }

@@ -506,6 +506,22 @@ bool IsInLaserSweep(const TaskServices& task, const Pose2& X_MB, const Eigen::Ve
          bearing <= belief.scan->angle_max() - PeopleRoom::kSweepMarginRad;
 }
 
+bool IsInLaserSight(const TaskServices& task, const Pose2& X_MB, const Eigen::Vector2d& p_M) {
+  if (!IsInLaserSweep(task, X_MB, p_M)) return false;
+  const perception::Costmap2D* costmap = task.belief->world.costmap;
+  if (costmap == nullptr) return true;
+  // Sampled finer than a wall is thick; a cell's half-diagonal catches the corners between.
+  constexpr double kSightSampleM = 0.05;
+  const Eigen::Vector2d p_ML = (X_MB * task.belief->X_BL).translation();
+  const double length = (p_M - p_ML).norm() - kSightShortM;
+  if (length <= 0.0) return true;
+  const Eigen::Vector2d u = (p_M - p_ML).normalized();
+  const double half_cell = 0.5 * std::sqrt(2.0) * costmap->geometry().resolution;
+  for (double s = 0.0; s <= length; s += kSightSampleM)
+    if (costmap->IsNearMappedObstacle(p_ML + s * u, half_cell)) return false;
+  return true;
+}
+
 bool IsBlindWayClear(const TaskServices& task, const Pose2& X_MB, const Eigen::Vector2d& p_MFrom,
                      const Eigen::Vector2d& p_MTo, double clearance) {
   const perception::Costmap2D* costmap = task.belief->world.costmap;

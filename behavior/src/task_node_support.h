@@ -252,6 +252,14 @@ double RoomAt(const std::vector<Occupant>& near, const Eigen::Vector2d& q);
 /// base at X_MB, or under the robot; true without a scan (nothing to tell).
 bool IsInLaserSweep(const TaskServices& task, const Pose2& X_MB, const Eigen::Vector2d& p_M);
 
+/// p_M is in the base laser's sight with the base at X_MB: inside its sweep (IsInLaserSweep) and
+/// with no wall, furniture or door leaf of the map (Costmap2D::IsNearMappedObstacle) on the
+/// straight line from the laser to within kSightShortM of p_M (what stands at p_M is not in the
+/// way). True without a costmap. A clear view of a place is what lets "nobody is there" be
+/// counted: a table between the robot and a doorway hides whoever waits there.
+inline constexpr double kSightShortM = 0.3;
+bool IsInLaserSight(const TaskServices& task, const Pose2& X_MB, const Eigen::Vector2d& p_M);
+
 /// The straight way from p_MFrom to p_MTo keeps `clearance` [m] beyond the footprint, where it
 /// leaves the laser's sweep (base at X_MB), from what the laser marked there off the map (the
 /// costmap's obstacle layer, kept where no ray clears it; Costmap2D::IsNearUnmappedMark): the

@@ -4,6 +4,7 @@
 #include "task_node_fixture.h"
 
 #include "escort_watch.h"
+#include "task_node_support.h"
 
 #include "egress/behavior/head_gaze.h"
 #include "egress/planning/ik_solver.h"
@@ -1112,6 +1113,54 @@ TEST_F(HoldForResidentsTest, ClearTimeCountsOnlyWhileTheWayInIsInTheLasersSweep)
     EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning) << "at " << t;
   }
   belief_.now = At(12.6);
+  OperatedAgo(0.5);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kFailure);
+  EXPECT_TRUE(NotedText("everyone is through"));
+}
+
+// ... and only while nothing of the map stands between the laser and the way in: aside behind
+// the office's table, the robot saw nobody at door_a for 5 s while a wheelchair user waited
+// there, and left them behind (office seed 5).
+TEST_F(HoldForResidentsTest, ClearTimeCountsOnlyWhileTheWayInIsInTheLasersSight) {
+  belief_.scan = node_testing::SweepScan();
+  tree_.TickOnce();
+  OperatedAgo(1.0);
+  belief_.moving_returns = {{-0.5, 1.5}};  // they come
+  belief_.off_map_returns = belief_.moving_returns;
+  const double came = ComeFrom(2.0);
+  belief_.moving_returns.clear();
+  belief_.off_map_returns.clear();
+  const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
+  const Eigen::Vector2d way_in(0.0, 2.0);
+  // A table halfway between the spot and the way in, facing which the robot watches.
+  const Eigen::Vector2d table = 0.5 * (spot.translation() + way_in);
+  const perception::Costmap2D with_table(
+      perception::OccupancyGrid::FromBoxes({{{1.75, 3.0, 0.0}, {2.5, 0.1}},
+                                            {{-1.75, 3.0, 0.0}, {2.5, 0.1}},
+                                            {{table.x(), table.y(), 0.0}, {0.3, 0.6}}},
+                                           {-3.0, -1.0}, {3.0, 7.0}, 0.05));
+  const perception::Costmap2D walls = LabWalls();
+  belief_.world.costmap = &with_table;
+  const Eigen::Vector2d to_way_in = way_in - spot.translation();
+  belief_.X_MB = {spot.x, spot.y, std::atan2(to_way_in.y(), to_way_in.x())};
+  EXPECT_TRUE(detail::IsInLaserSweep(services_, belief_.X_MB, way_in));
+  EXPECT_FALSE(detail::IsInLaserSight(services_, belief_.X_MB, way_in));
+  for (double t = came + 0.5; t < 12.0; t += 0.5) {
+    belief_.now = At(t);
+    motion_.StopBase();
+    OperatedAgo(0.5);
+    EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning) << "at " << t << ": the table hides it";
+  }
+  // The view clear (the table gone): clear_for (3 s) of watching, then the hold is over.
+  belief_.world.costmap = &walls;
+  EXPECT_TRUE(detail::IsInLaserSight(services_, belief_.X_MB, way_in));
+  for (double t = 12.0; t < 15.0; t += 0.5) {
+    belief_.now = At(t);
+    motion_.StopBase();
+    OperatedAgo(0.5);
+    EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning) << "at " << t;
+  }
+  belief_.now = At(15.6);
   OperatedAgo(0.5);
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kFailure);
   EXPECT_TRUE(NotedText("everyone is through"));
