@@ -70,6 +70,10 @@ constexpr double kOffDoorwayM = 0.6;
 constexpr double kFollowerGapM = 2.0, kClosingMps = 0.3;
 constexpr double kLetPassClearSec = 1.5, kLetPassMaxSec = 15.0;
 constexpr double kAsideGainM = 0.1;
+// The search for a wait spot beside the lane when none is free along the wall: this far out from
+// the wall at most, on a grid of this step [m].
+constexpr double kSpotSearchOutM = 1.0;
+constexpr double kSpotSearchStepM = 0.1;
 
 // HoldForResidents: the watch between operations while the robot keeps a door open for the
 // residents being evacuated. Until anyone comes it waits at the actuator's standoff and
@@ -332,8 +336,13 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // behind it as it faces the actuator (clinic escort seed 26: at door_e, whose standoff is
     // before the doorway, the robot waited there after the press, and the resident it had
     // opened for could not pass it while the door stood open).
+    // And not where the standoff is the residents' way in (a spot found only beside the lane):
+    // waiting there, it was what the first of them, setting off, walked into on their way to the
+    // actuator (random building seed 31).
     const Pose2& wait_at =
-        came_ || around.near || !actuator_clear || opened_for_waiting_ ? spot_ : standoff_;
+        came_ || around.near || !actuator_clear || opened_for_waiting_ || spot_beside_lane_
+            ? spot_
+            : standoff_;
     // Only the spot and the last kSpotClearM of the way there: from far back, the straight line
     // to it passes people it will never meet on its path (clinic: a resident waiting at door_e
     // kept the robot 14 m back from its spot, and the door shut, until max_hold). On the way, the
@@ -594,9 +603,31 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
       spot_ = candidate;
       found = true;
     }
+    spot_beside_lane_ = !found && SpotBesideTheLane(pass, t, n, aside);
+    if (spot_beside_lane_)
+      Note(StrCat("no free spot along the wall: waiting beside the lane at ", PoseText(spot_)));
+    found = found || spot_beside_lane_;
     if (!found) Note("no free spot beside the actuator: waiting at its standoff");
     this->SetOutput("spot", PosePortText(spot_));
     return true;
+  }
+
+  // No spot along the wall (a corner within a footprint of the standoff): the standoff lies in
+  // the residents' way in, where the crowd funnelling to the door pressed the standing robot into
+  // the corner (random building seed 31). The nearest spot, along the wall and out from it, beside
+  // the lane, clear of the leaves, and leaving a resident room to stand at the actuator between
+  // it and the standoff, reached straight from the standoff; written to spot_.
+  bool SpotBesideTheLane(const DoorPass& pass, const Eigen::Vector2d& along,
+                         const Eigen::Vector2d& out, double aside) {
+    const auto p = NearestOnGrid(
+        standoff_.translation(), along, aside, out, kSpotSearchOutM, kSpotSearchStepM,
+        task_.config.footprint_radius + 2 * task_.config.person_radius,
+        [&](const Eigen::Vector2d& q) {
+          return !InTheLane(pass, q) && !IntoADoorway(standoff_.translation(), q) &&
+                 task_.planner->IsPathValid({standoff_, {q.x(), q.y(), standoff_.yaw}});
+        });
+    if (p) spot_ = {p->x(), p->y(), standoff_.yaw};
+    return p.has_value();
   }
 
   // The operation asked for less than kOperateRetrySec ago did not happen (the approach found
@@ -681,6 +712,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   Time room_since_{};                     // when it began
   bool stood_open_{false};  // the door stood open kStillForSec in this hold with nobody moving
   bool opened_for_waiting_{false};  // it operated for someone found waiting, in this hold
+  bool spot_beside_lane_{false};    // no spot along the wall: spot_ is SpotBesideTheLane's
   std::optional<Eigen::Vector2d> driving_to_;  // where a drive of this node's under way goes
   double drive_clear_{0.0};  // [m] the room round its end that drive set off with (WayClear)
   std::optional<Time> letting_pass_since_;  // stopped for someone walking up behind

@@ -522,6 +522,23 @@ bool IsInLaserSight(const TaskServices& task, const Pose2& X_MB, const Eigen::Ve
   return true;
 }
 
+std::optional<Eigen::Vector2d> NearestOnGrid(
+    const Eigen::Vector2d& p_MFrom, const Eigen::Vector2d& along, double max_along,
+    const Eigen::Vector2d& out, double max_out, double step, double min_distance,
+    const std::function<bool(const Eigen::Vector2d&)>& ok) {
+  std::vector<Eigen::Vector2d> offsets;
+  for (int i = 0; i * step <= max_along + 1e-9; ++i)
+    for (int j = 0; j * step <= max_out + 1e-9; ++j)
+      offsets.push_back(along * i * step + out * j * step);
+  std::stable_sort(offsets.begin(), offsets.end(),
+                   [](const auto& l, const auto& r) { return l.norm() < r.norm(); });
+  for (const auto& offset : offsets) {
+    if (offset.norm() < min_distance - 1e-9) continue;
+    if (ok(p_MFrom + offset)) return p_MFrom + offset;
+  }
+  return std::nullopt;
+}
+
 bool IsBlindWayClear(const TaskServices& task, const Pose2& X_MB, const Eigen::Vector2d& p_MFrom,
                      const Eigen::Vector2d& p_MTo, double clearance) {
   const perception::Costmap2D* costmap = task.belief->world.costmap;

@@ -269,6 +269,15 @@ bool IsInLaserSight(const TaskServices& task, const Pose2& X_MB, const Eigen::Ve
 bool IsBlindWayClear(const TaskServices& task, const Pose2& X_MB, const Eigen::Vector2d& p_MFrom,
                      const Eigen::Vector2d& p_MTo, double clearance);
 
+/// The nearest point to p_MFrom of the grid p_MFrom + a * along + b * out (a in [0, max_along],
+/// b in [0, max_out], both every `step` [m]; `along`, `out`: unit vectors, M) at least
+/// `min_distance` [m] from it for which `ok` holds; nullopt if none. Ties: the smaller a, then b.
+std::optional<Eigen::Vector2d> NearestOnGrid(const Eigen::Vector2d& p_MFrom,
+                                             const Eigen::Vector2d& along, double max_along,
+                                             const Eigen::Vector2d& out, double max_out,
+                                             double step, double min_distance,
+                                             const std::function<bool(const Eigen::Vector2d&)>& ok);
+
 /// What people may do beyond walking on at their tracked velocity.
 struct PeopleHypotheses {
   /// People walking past step round the robot (TaskConfig::person_sidestep): each predicted

@@ -166,6 +166,60 @@ TEST_F(HoldForResidentsTest, OperatesFirstAndWritesTheSpotBesideTheDoor) {
   EXPECT_NEAR(spot.y, Standoff().y, 1e-6);
 }
 
+TEST(NearestOnGridTest, FindsTheNearestAcceptedPointAtLeastTheDistanceAway) {
+  const Eigen::Vector2d from(1.0, 2.0), along(1.0, 0.0), out(0.0, -1.0);
+  // Everything accepted: the nearest grid point 0.25 m away or more is two steps each way.
+  auto p = detail::NearestOnGrid(from, along, 1.0, out, 1.0, 0.1, 0.25,
+                                 [](const Eigen::Vector2d&) { return true; });
+  ASSERT_TRUE(p.has_value());
+  EXPECT_TRUE(p->isApprox(Eigen::Vector2d(1.2, 1.8), 1e-9)) << p->transpose();
+  // Nothing past x = 1.15 (a wall): the nearest is out from `from`, still 0.25 m away.
+  p = detail::NearestOnGrid(from, along, 1.0, out, 1.0, 0.1, 0.25,
+                            [](const Eigen::Vector2d& q) { return q.x() < 1.15; });
+  ASSERT_TRUE(p.has_value());
+  EXPECT_TRUE(p->isApprox(Eigen::Vector2d(1.0, 1.7), 1e-9)) << p->transpose();
+  // Nothing accepted, or nothing of the grid far enough: none.
+  EXPECT_FALSE(detail::NearestOnGrid(from, along, 1.0, out, 1.0, 0.1, 0.0,
+                                     [](const Eigen::Vector2d&) { return false; }));
+  EXPECT_FALSE(detail::NearestOnGrid(from, along, 0.2, out, 0.2, 0.1, 0.5,
+                                     [](const Eigen::Vector2d&) { return true; }));
+}
+
+// Where the actuator's wall runs into the room's corner within a footprint of the standoff, no
+// spot along the wall is free: the robot waits beside the lane, out from the wall, leaving room
+// for a resident at the actuator, and waits there, not at the standoff, before anyone comes
+// (random building seed 31: waiting at the standoff, in the way in, it was walked into by the
+// first resident making for the button).
+TEST_F(HoldForResidentsTest, WithTheWallsCornerBesideTheActuatorItWaitsBesideTheLane) {
+  constexpr double kPartitionX = 1.55;  // a wall running south from the lab wall's corner
+  map_.grid = perception::OccupancyGrid::FromBoxes({{{1.75, 3.0, 0.0}, {2.5, 0.1}},
+                                                    {{-1.75, 3.0, 0.0}, {2.5, 0.1}},
+                                                    {{kPartitionX, 1.5, 0.0}, {0.1, 3.0}}},
+                                                   {-3.0, -1.0}, {3.0, 7.0}, 0.05);
+  const perception::Costmap2D cornered(map_.grid);
+  planning::BasePlanner planner(cornered, nullptr);
+  services_.planner = &planner;
+  belief_.world.costmap = &cornered;
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // not operated in this hold yet
+  ASSERT_TRUE(NotedText("waiting beside the lane"));
+  const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
+  const TaskConfig config;
+  EXPECT_LT(spot.x, kPartitionX - 0.05 - config.footprint_radius + 1e-9);  // this side of it
+  const double lane = 0.475 + config.footprint_radius + config.person_radius;
+  EXPECT_GT(std::abs(spot.x), lane);  // beside the way in
+  EXPECT_GE((spot.translation() - Standoff().translation()).norm(),
+            config.footprint_radius + 2 * config.person_radius - 1e-9);
+  EXPECT_LT(spot.y, Standoff().y);  // out from the wall, into the room
+  // Operated, nobody about: it goes to wait at the spot.
+  OperatedAgo(1.0);
+  log_.Take();
+  belief_.now = At(2.0);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(NotedText("driving to the spot beside the door"));
+  ASSERT_GE(motion_.path().size(), 2u);
+  EXPECT_LT((motion_.path().back().translation() - spot.translation()).norm(), 1e-6);
+}
+
 TEST_F(HoldForResidentsTest, ResidentsComingSendTheRobotAsideAndItLetsThemPass) {
   tree_.TickOnce();
   OperatedAgo(1.0);
