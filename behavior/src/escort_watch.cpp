@@ -74,11 +74,14 @@ Surroundings LookAround(const Belief& belief, const DoorPass& pass, double watch
   // A leaf on the move is drawn in the costmap where the door estimate last put it, which lags
   // the leaf: its returns land off the map, and move (two wards seed 7: door_e's leaf, opening
   // towards the robot at its button, read as someone at the door after each press, and the hold
-  // never ran out with everyone through). Returns where a moving leaf sweeps are its own.
+  // never ran out with everyone through). Returns where a moving leaf sweeps are its own; so are
+  // those where a leaf not measured for a while sweeps, drawn where it was last seen (random
+  // building seed 7: door_n1, last seen held open, was seen again shut 12 s later, and its
+  // returns read as someone at the door each time the robot came back to its spot).
   const auto on_moving_leaf = [&](const Eigen::Vector2d& p) {
     for (const auto& d : belief.world.doors)
       if (d.state.observed &&
-          (d.state.motion == perception::DoorMotion::kOpening ||
+          (d.stale || d.state.motion == perception::DoorMotion::kOpening ||
            d.state.motion == perception::DoorMotion::kClosing) &&
           d.model.InSweep(p, kOffMapM))
         return true;

@@ -297,18 +297,21 @@ DoorStateTracker::DoorStateTracker(DoorModel door, DoorStateConfig config)
   door_.Validate();
   ThrowUnless(config_.smoothing > 0.0 && config_.smoothing <= 1.0,
               "Invalid DoorStateConfig: smoothing must be in (0, 1].");
+  ThrowUnless(config_.stale_after > 0.0,
+              "Invalid DoorStateConfig: stale_after must be positive [s].");
 }
 
 void DoorStateTracker::Update(double angle, Time stamp) {
   ThrowUnless(std::isfinite(angle), "Invalid door angle for '", door_.id, "': must be finite.");
   angle = std::clamp(angle, 0.0, door_.max_open_angle);
-  if (!state_.observed) {
+  if (state_.observed)
+    ThrowUnless(stamp >= state_.stamp, "Invalid door measurement for '", door_.id,
+                "': time went backwards.");
+  if (!state_.observed || ToSeconds(stamp - state_.stamp) > config_.stale_after) {
     state_.angle = angle;
     state_.rate = 0.0;
     state_.steady_for = 0.0;
   } else {
-    ThrowUnless(stamp >= state_.stamp, "Invalid door measurement for '", door_.id,
-                "': time went backwards.");
     const double dt = ToSeconds(stamp - state_.stamp);
     const double previous = state_.angle;
     state_.angle += config_.smoothing * (angle - state_.angle);

@@ -154,6 +154,34 @@ TEST(DoorStateTrackerTest, OpeningHeldAndClosing) {
   EXPECT_THROW(DoorStateTracker({"bad", {0, 0}, {0, 0}}), InvalidArgument);
 }
 
+// A leaf seen again after longer than stale_after is where it is seen, not a blend with where it
+// was seconds ago (random building seed 7: door_n1 last seen held open, seen shut 12 s later).
+// Its rate is unknown then; within stale_after, measurements blend as ever.
+TEST(DoorStateTrackerTest, ALeafSeenAgainAfterAGapIsWhereItIsSeen) {
+  DoorStateTracker tracker(LabDoor());
+  Time t{0};
+  for (int i = 0; i < 20; ++i) {
+    t += milliseconds(100);
+    tracker.Update(75 * kDeg, t);
+  }
+  ASSERT_EQ(tracker.state().motion, DoorMotion::kHeldOpen);
+  t += milliseconds(900);  // within stale_after (1 s): blended
+  tracker.Update(0.0, t);
+  EXPECT_NEAR(tracker.state().angle, 37.5 * kDeg, 1e-9);
+  for (int i = 0; i < 20; ++i) {
+    t += milliseconds(100);
+    tracker.Update(75 * kDeg, t);
+  }
+  t += milliseconds(12000);  // the operator has closed it meanwhile
+  tracker.Update(0.0, t);
+  EXPECT_DOUBLE_EQ(tracker.state().angle, 0.0);
+  EXPECT_DOUBLE_EQ(tracker.state().rate, 0.0);
+  EXPECT_EQ(tracker.state().motion, DoorMotion::kClosed);
+  DoorStateConfig bad;
+  bad.stale_after = 0.0;
+  EXPECT_THROW(DoorStateTracker(LabDoor(), bad), InvalidArgument);
+}
+
 TEST(DoorEstimationTest, ALineThatIsNotTheLeafGivesNoAngle) {
   const DoorModel door = LabDoor();
   const auto line_through = [](Eigen::Vector2d a, Eigen::Vector2d b) {

@@ -60,6 +60,25 @@ TEST(PerceptionPipelineTest, BuildsTheWorldState) {
   ASSERT_EQ(world.doors.size(), 1u);
   EXPECT_NEAR(world.doors[0].state.angle, std::numbers::pi / 4, 4 * std::numbers::pi / 180);
   EXPECT_EQ(world.door_zone_forecast.at("lab").size(), 5u);
+  EXPECT_FALSE(world.doors[0].stale);
+}
+
+// A door measured longer than stale_after before the snapshot is stale: where its leaf is now is
+// not known. One never measured is not (it is not observed).
+TEST(PerceptionPipelineTest, ADoorNotMeasuredForAWhileIsStale) {
+  const DoorModel door{"lab", {6.0, 3.5}, {6.0, 4.5}, -1.0, std::numbers::pi / 2};
+  const DoorModel other{"other", {1.0, 3.5}, {1.0, 4.5}, -1.0, std::numbers::pi / 2};
+  PerceptionPipeline pipeline({door, other});
+  SeeTheLeafOpenAt45Degrees(door, milliseconds(500), &pipeline);
+  const Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity() * 1e-4;
+  WorldState world = pipeline.Snapshot(milliseconds(1400), {4.0, 4.0, 0.0}, covariance);
+  ASSERT_EQ(world.doors.size(), 2u);
+  ASSERT_TRUE(world.doors[0].state.observed);
+  EXPECT_FALSE(world.doors[0].stale);
+  world = pipeline.Snapshot(milliseconds(1600), {4.0, 4.0, 0.0}, covariance);
+  EXPECT_TRUE(world.doors[0].stale);
+  EXPECT_FALSE(world.doors[1].state.observed);
+  EXPECT_FALSE(world.doors[1].stale);
 }
 
 // A person's box whose depth is far nearer than its height says (they stand behind a door leaf,

@@ -131,6 +131,13 @@ struct DoorStateConfig {
   double closed_angle{0.0873};  ///< Below this the door is closed [rad] (5°).
   double motion_rate{0.1};      ///< |rate| above this is moving [rad/s].
   double held_after{1.0};       ///< Open and steady this long: held open [s].
+  /// A measurement this long after the last one replaces the estimate rather than blending into
+  /// it, its rate and steadiness unknown [s]: an operator closes a leaf in ~5 s, and the leaf
+  /// drawn at an estimate blended with one from seconds ago lands its own returns off the map,
+  /// where they read as someone by the door (random building seed 7: door_n1 last seen held open
+  /// 12 s before, its leaf seen again shut read as a resident, and the robot held the door for
+  /// nobody until the time limit).
+  double stale_after{1.0};
 };
 
 class DoorStateTracker {
