@@ -322,7 +322,12 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // twice more after the wheelchair user it had opened for went through, and reached the exit
     // door, where they waited, after the time limit). Not once people came: residents still
     // coming from beyond its watch then find the door shut (two wards, 20 of 50 trials slower).
-    const bool for_someone = came_ || !opened_for_waiting_ || around.near;
+    // Nor, once people came, while the clear clock runs with nobody near: the hold either runs
+    // out or someone comes within clear_for. Due on arrival at its spot after a drive longer than
+    // `every`, the operation fell due before the clear time had run, and the robot pressed for
+    // nobody once per round trip until the time limit (random building seeds 7, 12).
+    const bool clock_running = came_ && unseen_ > 0.0 && !around.near;
+    const bool for_someone = (came_ || !opened_for_waiting_ || around.near) && !clock_running;
     if (OperateDue(every) && actuator_clear && for_someone && !OperationJustFailed()) {
       operate_asked_at_ = belief_.now;
       if (found_waiting || all_waiting) opened_for_waiting_ = true;

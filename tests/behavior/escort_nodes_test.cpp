@@ -68,6 +68,18 @@ class HoldForResidentsTest : public EscortNodesTest {
     }
     return t - kTickSec;
   }
+  // The hold's first tick, no operation due at 2 s, and residents coming by the doorway from
+  // then until they are seen coming, gone by the next tick. Returns the time of their last tick.
+  double ResidentsCame() {
+    tree_.TickOnce();
+    OperatedAgo(1.0);
+    belief_.moving_returns = {{-0.5, 1.5}};
+    belief_.off_map_returns = belief_.moving_returns;
+    const double came = ComeFrom(2.0);
+    belief_.moving_returns.clear();
+    belief_.off_map_returns.clear();
+    return came;
+  }
   // A hold from `from` through which residents came (laser returns moving by the doorway for
   // kComingForSec), to its end once they are through. Returns the time of its last tick.
   double HoldThroughWhichResidentsCame(double from) {
@@ -1141,13 +1153,7 @@ TEST_F(HoldForResidentsTest, AnOperationThatDidNotHappenIsNotAskedForAgainAtOnce
 // door (stepping aside, turning), nobody there is seen (two-wards seed 17).
 TEST_F(HoldForResidentsTest, ClearTimeCountsOnlyWhileTheWayInIsInTheLasersSweep) {
   belief_.scan = node_testing::SweepScan();
-  tree_.TickOnce();
-  OperatedAgo(1.0);
-  belief_.moving_returns = {{-0.5, 1.5}};  // they come
-  belief_.off_map_returns = belief_.moving_returns;
-  const double came = ComeFrom(2.0);
-  belief_.moving_returns.clear();
-  belief_.off_map_returns.clear();
+  const double came = ResidentsCame();
   // Aside, facing away from the doorway's way in (x = 0, y = 2 from the spot's east): the
   // laser's blind sector behind it.
   const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
@@ -1177,13 +1183,7 @@ TEST_F(HoldForResidentsTest, ClearTimeCountsOnlyWhileTheWayInIsInTheLasersSweep)
 // there, and left them behind (office seed 5).
 TEST_F(HoldForResidentsTest, ClearTimeCountsOnlyWhileTheWayInIsInTheLasersSight) {
   belief_.scan = node_testing::SweepScan();
-  tree_.TickOnce();
-  OperatedAgo(1.0);
-  belief_.moving_returns = {{-0.5, 1.5}};  // they come
-  belief_.off_map_returns = belief_.moving_returns;
-  const double came = ComeFrom(2.0);
-  belief_.moving_returns.clear();
-  belief_.off_map_returns.clear();
+  const double came = ResidentsCame();
   const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
   const Eigen::Vector2d way_in(0.0, 2.0);
   // A table halfway between the spot and the way in, facing which the robot watches.
@@ -1217,6 +1217,47 @@ TEST_F(HoldForResidentsTest, ClearTimeCountsOnlyWhileTheWayInIsInTheLasersSight)
   belief_.now = At(15.6);
   OperatedAgo(0.5);
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kFailure);
+  EXPECT_TRUE(NotedText("everyone is through"));
+}
+
+// Once people came, an operation that falls due while the clear clock runs with nobody near
+// waits: the hold runs out, or someone comes (random building seeds 7, 12: arriving at its spot
+// after a drive longer than `every`, the robot went back to press before clear_for had run, for
+// nobody, until the time limit). Someone by the doorway stops the clock, and it operates.
+TEST_F(HoldForResidentsTest, OnceTheyCameItDoesNotOperateForNobodyWhileTheClearClockRuns) {
+  const double came = ResidentsCame();
+  const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
+  const Eigen::Vector2d to_way_in = Eigen::Vector2d(0.0, 2.0) - spot.translation();
+  belief_.X_MB = {spot.x, spot.y, std::atan2(to_way_in.y(), to_way_in.x())};
+  double t = came + 0.5;
+  for (; t < came + 2.5; t += 0.5) {
+    belief_.now = At(t);
+    motion_.StopBase();
+    OperatedAgo(20.0);  // long due
+    EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning) << "at " << t << ": for nobody";
+  }
+  // Someone by the doorway, still: the clock stops, and once they have stood 4 s (kStillForSec) the
+  // robot opens for them.
+  belief_.off_map_returns = {{0.3, 1.6}};
+  NodeStatus status = NodeStatus::kRunning;
+  for (const double until = t + 6.0; status == NodeStatus::kRunning && t < until; t += 0.5) {
+    belief_.now = At(t);
+    motion_.StopBase();
+    OperatedAgo(20.0);
+    status = tree_.TickOnce();
+  }
+  EXPECT_EQ(status, NodeStatus::kSuccess);
+  // Nobody near again: the clock runs out with no operation.
+  belief_.off_map_returns.clear();
+  status = NodeStatus::kRunning;
+  for (const double until = t + 6.0; status == NodeStatus::kRunning && t < until; t += 0.5) {
+    belief_.now = At(t);
+    motion_.StopBase();
+    belief_.X_MB = {spot.x, spot.y, std::atan2(to_way_in.y(), to_way_in.x())};
+    OperatedAgo(20.0);
+    status = tree_.TickOnce();
+  }
+  EXPECT_EQ(status, NodeStatus::kFailure);
   EXPECT_TRUE(NotedText("everyone is through"));
 }
 
