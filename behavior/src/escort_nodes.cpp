@@ -17,8 +17,6 @@
 namespace egress::behavior::detail {
 namespace {
 
-// [m] How far out from the doorway, on the robot's side, the robot looks for people coming.
-constexpr double kLookOutM = 2.0;
 // [rad] Facing the people's way in within this, the robot does not turn again.
 constexpr double kFacingToleranceRad = 20.0 * M_PI / 180.0;
 // [rad] Waiting, the robot turns only as far as brings the people's way in within this of
@@ -238,8 +236,8 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // guard spare whoever it nears on its way out.
     if (driving_to_ && !letting_pass_since_ && task_.motion->base_moving() &&
         (*driving_to_ - belief_.X_MB.translation()).norm() > kAtSpotM &&
-        !InTheLane(pass, belief_.X_MB.translation()) &&
-        !WayClear({driving_to_->x(), driving_to_->y(), 0.0}, drive_clear_, 0.0)) {
+        !InTheLane(pass, belief_.X_MB.translation(), task_.config) &&
+        !WayClear(belief_, {driving_to_->x(), driving_to_->y(), 0.0}, drive_clear_, 0.0)) {
       task_.motion->StopBase();
       driving_to_.reset();
       Note("the spot is taken: stopping short");
@@ -309,8 +307,8 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     const bool group_within_reach = !came_ && !under_way_ && !at_door.alone;
     const bool actuator_clear =
         !around.moving && (!group_within_reach || found_waiting) &&
-        (found_waiting || all_waiting ? WayClear(standoff_, kStandoffFreeM, 0.0)
-                                      : WayClear(standoff_, Input<double>("keep_clear")));
+        (found_waiting || all_waiting ? WayClear(belief_, standoff_, kStandoffFreeM, 0.0)
+                                      : WayClear(belief_, standoff_, Input<double>("keep_clear")));
     // For those waiting, once per hold window, not every `every` seconds: between operations
     // the robot waits aside, out of their way in (at `every`, the press itself and the tuck
     // after it kept the robot at the actuator, beside the way in, for good: clinic seed 13).
@@ -360,9 +358,9 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // robot before door_e's doorway, and so themselves behind it, through two openings). Out of
     // the lane it stops short as ever if the spot is taken.
     const double set_off_clear =
-        InTheLane(pass, belief_.X_MB.translation()) ? kStandoffFreeM : spot_clear;
+        InTheLane(pass, belief_.X_MB.translation(), task_.config) ? kStandoffFreeM : spot_clear;
     if ((wait_at.translation() - belief_.X_MB.translation()).norm() > kAtSpotM &&
-        WayClear(wait_at, set_off_clear, kSpotClearM, /*ahead_only=*/true)) {
+        WayClear(belief_, wait_at, set_off_clear, kSpotClearM, /*ahead_only=*/true)) {
       // Square to the way it drives, turning to watch at the spot (below): the laser sees both
       // ahead and back along the way. From the last door the way there runs away from where the
       // residents come: facing them the robot drove backwards, the blind sector leading, into a
@@ -516,8 +514,8 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
 
   // A step from `at` to `q` into the residents' way in, nearer the doorway, or into a doorway.
   bool InTheirWay(const DoorPass& pass, const Eigen::Vector2d& at, const Eigen::Vector2d& q) const {
-    return InTheLane(pass, q) || (q - pass.centre).norm() < (at - pass.centre).norm() ||
-           IntoADoorway(at, q);
+    return InTheLane(pass, q, task_.config) ||
+           (q - pass.centre).norm() < (at - pass.centre).norm() || IntoADoorway(at, q);
   }
 
   // A tracked person behind the way `way` (unit, M), within kFollowerGapM, walking up to it.
@@ -628,7 +626,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
         standoff_.translation(), along, aside, out, kSpotSearchOutM, kSpotSearchStepM,
         task_.config.footprint_radius + 2 * task_.config.person_radius,
         [&](const Eigen::Vector2d& q) {
-          return !InTheLane(pass, q) && !IntoADoorway(standoff_.translation(), q) &&
+          return !InTheLane(pass, q, task_.config) && !IntoADoorway(standoff_.translation(), q) &&
                  task_.planner->IsPathValid({standoff_, {q.x(), q.y(), standoff_.yaw}});
         });
     if (p) spot_ = {p->x(), p->y(), standoff_.yaw};
@@ -660,43 +658,6 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
         return true;
     }
     return ToSeconds(belief_.now - *visit->operated_at) >= every;
-  }
-
-  // The residents' way in: the doorway and the lane before it, as wide as the opening plus the
-  // robot and a resident, kLookOutM out on the robot's side.
-  bool InTheLane(const DoorPass& pass, const Eigen::Vector2d& q) const {
-    const Eigen::Vector2d d = q - pass.centre;
-    const double out = d.dot(pass.n_M);
-    const Eigen::Vector2d t(-pass.n_M.y(), pass.n_M.x());
-    const double lane = pass.width / 2 + task_.config.footprint_radius + task_.config.person_radius;
-    return out > -(task_.config.footprint_radius + kThroughM) && out < kLookOutM &&
-           std::abs(d.dot(t)) < lane;
-  }
-
-  // Nobody within `radius` of `goal` or of the straight way from the robot to it: no tracked
-  // person, no laser return off the map. With `only_within`, only the last `only_within` metres
-  // of the way count (a far robot's straight line says nothing of the path it will take). With
-  // `ahead_only`, someone behind the robot (as it sets off towards `goal`) and not near `goal`
-  // does not count: the drive takes it away from them. Stopped 0.9 m in front of a standing
-  // group, between them and the door, the robot counted the nearest of them (behind it) as on
-  // its way to its spot, and stayed in their way in for 44 s until they set off and walked past
-  // it at 0.09 m (office escort seed 3).
-  bool WayClear(const Pose2& goal, double radius, double only_within = -1.0,
-                bool ahead_only = false) const {
-    const Eigen::Vector2d from = belief_.X_MB.translation();
-    Eigen::Vector2d a = from;
-    const Eigen::Vector2d b = goal.translation();
-    if (only_within >= 0.0 && (a - b).norm() > only_within)
-      a = b + (a - b).normalized() * only_within;
-    const auto near_way = [&](const Eigen::Vector2d& p) {
-      if (ahead_only && (p - from).dot(b - from) <= 0.0 && (p - b).norm() >= radius) return false;
-      return (p - ClosestPointOnSegment(p, a, b)).norm() < radius;
-    };
-    for (const auto& entry : belief_.world.people)
-      if (near_way(entry.person.p_MP)) return false;
-    for (const Eigen::Vector2d& p : belief_.off_map_returns)
-      if (near_way(p)) return false;
-    return true;
   }
 
   std::string door_;

@@ -163,4 +163,31 @@ AtTheDoorway ByTheDoorway(const Belief& belief, const DoorPass& pass, const Eige
   return {someone, alone, someone && alone};
 }
 
+bool WayClear(const Belief& belief, const Pose2& goal, double radius, double only_within,
+              bool ahead_only) {
+  const Eigen::Vector2d from = belief.X_MB.translation();
+  Eigen::Vector2d a = from;
+  const Eigen::Vector2d b = goal.translation();
+  if (only_within >= 0.0 && (a - b).norm() > only_within)
+    a = b + (a - b).normalized() * only_within;
+  const auto near_way = [&](const Eigen::Vector2d& p) {
+    if (ahead_only && (p - from).dot(b - from) <= 0.0 && (p - b).norm() >= radius) return false;
+    return (p - ClosestPointOnSegment(p, a, b)).norm() < radius;
+  };
+  for (const auto& entry : belief.world.people)
+    if (near_way(entry.person.p_MP)) return false;
+  for (const Eigen::Vector2d& p : belief.off_map_returns)
+    if (near_way(p)) return false;
+  return true;
+}
+
+bool InTheLane(const DoorPass& pass, const Eigen::Vector2d& q, const TaskConfig& config) {
+  const Eigen::Vector2d d = q - pass.centre;
+  const double out = d.dot(pass.n_M);
+  const Eigen::Vector2d t(-pass.n_M.y(), pass.n_M.x());
+  const double lane = pass.width / 2 + config.footprint_radius + config.person_radius;
+  return out > -(config.footprint_radius + kThroughM) && out < kLookOutM &&
+         std::abs(d.dot(t)) < lane;
+}
+
 }  // namespace egress::behavior::detail

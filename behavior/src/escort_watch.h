@@ -8,11 +8,14 @@
 
 #include "egress/behavior/belief.h"
 #include "egress/behavior/door_rules.h"
+#include "egress/behavior/task_services.h"
 
 namespace egress::behavior::detail {
 
 /// [m] A person on the far side of the door line by more than this is through.
 inline constexpr double kThroughM = 0.3;
+/// [m] How far out from the doorway, on the robot's side, the robot looks for people coming.
+inline constexpr double kLookOutM = 2.0;
 /// [m/s] A tracked person faster than this is on the move.
 inline constexpr double kMovingMps = 0.2;
 /// [m] A tracked person this far from where they last stood (and on the move) walked off.
@@ -93,5 +96,20 @@ struct AtTheDoorway {
 };
 AtTheDoorway ByTheDoorway(const Belief& belief, const DoorPass& pass, const Eigen::Vector2d& p_MS,
                           double radius, double person_radius);
+
+/// Nobody within `radius` [m] of `goal` or of the straight way from the robot (belief.X_MB) to
+/// it: no tracked person, no laser return off the map. With `only_within` >= 0, only the last
+/// `only_within` metres of the way count (a far robot's straight line says nothing of the path
+/// it will take). With `ahead_only`, someone behind the robot (as it sets off towards `goal`) and
+/// not near `goal` does not count: the drive takes it away from them (office escort seed 3:
+/// stopped 0.9 m before a standing group, the robot counted the nearest of them, behind it, as on
+/// its way to its spot, and stayed in their way in for 44 s).
+/// Whether q [M] is in the residents' way in to `pass`: the doorway and the lane before it, as
+/// wide as the opening plus the robot and a resident (config's footprint and person radii),
+/// kLookOutM out on the robot's side.
+bool InTheLane(const DoorPass& pass, const Eigen::Vector2d& q, const TaskConfig& config);
+
+bool WayClear(const Belief& belief, const Pose2& goal, double radius, double only_within = -1.0,
+              bool ahead_only = false);
 
 }  // namespace egress::behavior::detail
