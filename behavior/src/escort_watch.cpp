@@ -78,7 +78,7 @@ Surroundings LookAround(const Belief& belief, const DoorPass& pass, double watch
   // those where a leaf not measured for a while sweeps, drawn where it was last seen (random
   // building seed 7: door_n1, last seen held open, was seen again shut 12 s later, and its
   // returns read as someone at the door each time the robot came back to its spot).
-  const auto on_moving_leaf = [&](const Eigen::Vector2d& p) {
+  const auto on_unsettled_leaf = [&](const Eigen::Vector2d& p) {
     for (const auto& d : belief.world.doors)
       if (d.state.observed &&
           (d.stale || d.state.motion == perception::DoorMotion::kOpening ||
@@ -88,9 +88,9 @@ Surroundings LookAround(const Belief& belief, const DoorPass& pass, double watch
     return false;
   };
   for (const Eigen::Vector2d& p : belief.off_map_returns)
-    s.near = s.near || (this_side(p, near_door) && !on_moving_leaf(p));
+    s.near = s.near || (this_side(p, near_door) && !on_unsettled_leaf(p));
   for (const Eigen::Vector2d& p : belief.moving_returns) {
-    if (s.moving || !this_side(p, near_door) || on_moving_leaf(p)) continue;
+    if (s.moving || !this_side(p, near_door) || on_unsettled_leaf(p)) continue;
     s.moving = true;
     s.mover = StrCat("laser returns moving at ", PoseText({p.x(), p.y(), 0}));
   }

@@ -104,12 +104,12 @@ AtTheDoorway ByTheDoorway(const Belief& belief, const DoorPass& pass, const Eige
 /// not near `goal` does not count: the drive takes it away from them (office escort seed 3:
 /// stopped 0.9 m before a standing group, the robot counted the nearest of them, behind it, as on
 /// its way to its spot, and stayed in their way in for 44 s).
+bool WayClear(const Belief& belief, const Pose2& goal, double radius, double only_within = -1.0,
+              bool ahead_only = false);
+
 /// Whether q [M] is in the residents' way in to `pass`: the doorway and the lane before it, as
 /// wide as the opening plus the robot and a resident (config's footprint and person radii),
 /// kLookOutM out on the robot's side.
 bool InTheLane(const DoorPass& pass, const Eigen::Vector2d& q, const TaskConfig& config);
-
-bool WayClear(const Belief& belief, const Pose2& goal, double radius, double only_within = -1.0,
-              bool ahead_only = false);
 
 }  // namespace egress::behavior::detail

@@ -301,13 +301,17 @@ DoorStateTracker::DoorStateTracker(DoorModel door, DoorStateConfig config)
               "Invalid DoorStateConfig: stale_after must be positive [s].");
 }
 
+bool DoorStateTracker::IsStaleAt(Time now) const {
+  return state_.observed && ToSeconds(now - state_.stamp) > config_.stale_after;
+}
+
 void DoorStateTracker::Update(double angle, Time stamp) {
   ThrowUnless(std::isfinite(angle), "Invalid door angle for '", door_.id, "': must be finite.");
   angle = std::clamp(angle, 0.0, door_.max_open_angle);
   if (state_.observed)
     ThrowUnless(stamp >= state_.stamp, "Invalid door measurement for '", door_.id,
                 "': time went backwards.");
-  if (!state_.observed || ToSeconds(stamp - state_.stamp) > config_.stale_after) {
+  if (!state_.observed || IsStaleAt(stamp)) {
     state_.angle = angle;
     state_.rate = 0.0;
     state_.steady_for = 0.0;

@@ -245,10 +245,7 @@ WorldState PerceptionPipeline::Snapshot(Time stamp, const Pose2& X_MB,
   world.octree = std::move(octree);
   const std::vector<TrackedPerson> people = CurrentPeople();
   for (const auto& tracker : doors_) {
-    const DoorState& state = tracker.state();
-    world.doors.push_back(
-        {tracker.door(), state,
-         state.observed && ToSeconds(stamp - state.stamp) > config_.door_state.stale_after});
+    world.doors.push_back({tracker.door(), tracker.state(), tracker.IsStaleAt(stamp)});
     const DoorZone zone{tracker.door(), config_.door_zone_depth};
     world.door_zone_forecast[tracker.door().id] = ForecastZoneOccupancy(people, zone);
   }

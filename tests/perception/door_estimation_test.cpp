@@ -166,6 +166,7 @@ TEST(DoorStateTrackerTest, ALeafSeenAgainAfterAGapIsWhereItIsSeen) {
   }
   ASSERT_EQ(tracker.state().motion, DoorMotion::kHeldOpen);
   t += milliseconds(900);  // within stale_after (1 s): blended
+  EXPECT_FALSE(tracker.IsStaleAt(t));
   tracker.Update(0.0, t);
   EXPECT_NEAR(tracker.state().angle, 37.5 * kDeg, 1e-9);
   for (int i = 0; i < 20; ++i) {
@@ -173,7 +174,9 @@ TEST(DoorStateTrackerTest, ALeafSeenAgainAfterAGapIsWhereItIsSeen) {
     tracker.Update(75 * kDeg, t);
   }
   t += milliseconds(12000);  // the operator has closed it meanwhile
+  EXPECT_TRUE(tracker.IsStaleAt(t));
   tracker.Update(0.0, t);
+  EXPECT_FALSE(tracker.IsStaleAt(t));
   EXPECT_DOUBLE_EQ(tracker.state().angle, 0.0);
   EXPECT_DOUBLE_EQ(tracker.state().rate, 0.0);
   EXPECT_EQ(tracker.state().motion, DoorMotion::kClosed);

@@ -146,6 +146,9 @@ class DoorStateTracker {
   /// A new angle measurement at `stamp` (stamps must not decrease).
   void Update(double angle, Time stamp);
   const DoorState& state() const { return state_; }
+  /// Observed, but not measured for longer than config.stale_after at `now`: where the leaf is
+  /// then is not known (a measurement then replaces the estimate).
+  bool IsStaleAt(Time now) const;
   const DoorModel& door() const { return door_; }
 
  private:

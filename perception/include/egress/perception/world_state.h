@@ -37,8 +37,8 @@ inline constexpr std::string_view kFlashlight = "flashlight";
 struct TrackedDoor {
   DoorModel model;
   DoorState state;
-  /// Observed, but not measured within DoorStateConfig::stale_after of the snapshot: its leaf
-  /// (drawn at state.angle) may be anywhere on its sweep by now.
+  /// DoorStateTracker::IsStaleAt the snapshot: its leaf (drawn at state.angle) may be anywhere
+  /// on its sweep by now.
   bool stale{false};
 };
 
