@@ -190,4 +190,37 @@ bool InTheLane(const DoorPass& pass, const Eigen::Vector2d& q, const TaskConfig&
          std::abs(d.dot(t)) < lane;
 }
 
+bool IntoADoorway(const TaskServices& task, const Eigen::Vector2d& at, const Eigen::Vector2d& q) {
+  const double body = task.config.footprint_radius;
+  for (const auto& door : task.map->doors) {
+    // The normal towards the robot's side now: a step ending on the other side crosses.
+    const DoorPass pass = CalcDoorPass(*task.map, door.id, Pose2{at.x(), at.y(), 0.0});
+    const Eigen::Vector2d along(-pass.n_M.y(), pass.n_M.x());
+    const double half = pass.width / 2 + body;
+    const double from = (at - pass.centre).dot(pass.n_M), to = (q - pass.centre).dot(pass.n_M);
+    if (std::abs(to) < kOffDoorwayM && std::abs((q - pass.centre).dot(along)) < half) return true;
+    if (to < 0.0) {
+      const Eigen::Vector2d cross = at + (q - at) * (from / (from - to));
+      if (std::abs((cross - pass.centre).dot(along)) < half) return true;
+    }
+    if (door.InSweep(q, body + kLeafClearance)) return true;
+  }
+  return false;
+}
+
+bool SomeoneWalkingUpBehind(const TaskServices& task, const Eigen::Vector2d& way) {
+  const Eigen::Vector2d at = task.belief->X_MB.translation();
+  for (const auto& entry : task.belief->world.people) {
+    const auto& person = entry.person;
+    const Eigen::Vector2d d = person.p_MP - at;
+    const double distance = d.norm();
+    if (distance < 1e-6 || d.dot(way) >= 0.0) continue;  // ahead: the way's own yielding
+    if (distance - task.config.footprint_radius - task.config.person_radius > kFollowerGapM)
+      continue;
+    if (person.v_MP.norm() < kWalkingMps || -person.v_MP.dot(d / distance) < kClosingMps) continue;
+    return true;
+  }
+  return false;
+}
+
 }  // namespace egress::behavior::detail

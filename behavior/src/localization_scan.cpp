@@ -1,5 +1,6 @@
 #include "localization_scan.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -42,6 +43,15 @@ LaserScan WithoutDoorLeaves(const LaserScan& scan, const MissionMap& map, const 
     }
   }
   return out;
+}
+
+bool NearEstimatedLeaf(const perception::TrackedDoor& door, const Eigen::Vector2d& p_M,
+                       double margin) {
+  if (!door.state.observed) return false;
+  const Eigen::Vector2d hinge = door.model.p_MHinge;
+  const Eigen::Vector2d leaf = door.model.LeafTip(door.state.angle) - hinge;
+  const double s = std::clamp((p_M - hinge).dot(leaf) / leaf.squaredNorm(), 0.0, 1.0);
+  return (hinge + s * leaf - p_M).norm() <= margin;
 }
 
 }  // namespace egress::behavior::detail

@@ -10,6 +10,7 @@
 #include "egress/behavior/mission_map.h"
 #include "egress/hsr_interface/geometry.h"
 #include "egress/hsr_interface/sensor_types.h"
+#include "egress/perception/world_state.h"
 
 namespace egress::behavior::detail {
 
@@ -30,5 +31,10 @@ bool NearMappedWall(const perception::OccupancyGrid& grid, const Eigen::Vector2d
 /// doorway); and on the door's line between its jambs, where the closed leaf stands, seen from
 /// either side. X_ML: the laser in M by the estimate before this scan.
 LaserScan WithoutDoorLeaves(const LaserScan& scan, const MissionMap& map, const Pose2& X_ML);
+
+/// Whether p_M lies within `margin` of `door`'s leaf where it was last estimated (the segment
+/// from the hinge to the free edge at state.angle) [m]; false for a door never observed.
+bool NearEstimatedLeaf(const perception::TrackedDoor& door, const Eigen::Vector2d& p_M,
+                       double margin);
 
 }  // namespace egress::behavior::detail

@@ -416,13 +416,18 @@ double PositionSigma(const TaskServices& task);
 class RelocalizeGate {
  public:
   /// A new act: forget any earlier wait.
-  void Reset() { waiting_since_.reset(); }
+  void Reset() {
+    waiting_since_.reset();
+    gave_up_ = false;
+  }
   /// RUNNING while re-localizing; SUCCESS when the pose is good enough (or the wait timed out,
-  /// noted). Each wait is noted as a DecisionEvent::kRelocalizing (the executive counts them).
+  /// noted: then SUCCESS until the next Reset, as another wait would end the same way). Each wait
+  /// is noted as a DecisionEvent::kRelocalizing (the executive counts them).
   NodeStatus Check(const TaskServices& task, const std::string& act, const EventNoteFn& note);
 
  private:
   std::optional<Time> waiting_since_;
+  bool gave_up_{false};  // a wait timed out in this act
 };
 
 /// Registers node type T under `id` with its ports; its nodes act through `services`.

@@ -160,5 +160,22 @@ TEST(LocalizationScanTest, ReturnsBesideADoorwayAreTheWall) {
   EXPECT_FALSE(NearMappedWall(map.grid, {-0.5, 0.5}));
 }
 
+// The leaf where it was last estimated: the segment from the hinge to its free edge, not the
+// sweep round it (someone standing in a held-open leaf's sweep is no leaf).
+TEST(LocalizationScanTest, ReturnsOnALeafWhereItWasLastEstimatedAreNearIt) {
+  perception::TrackedDoor door;
+  door.model = WallWithDoor().doors.front();  // hinge (0, 0), 0.9 m, opening to +y
+  door.state.angle = std::numbers::pi / 2;    // the free edge at (0, 0.9)
+  EXPECT_FALSE(NearEstimatedLeaf(door, {0.05, 0.5}, 0.15)) << "never observed";
+  door.state.observed = true;
+  EXPECT_TRUE(NearEstimatedLeaf(door, {0.05, 0.5}, 0.15));
+  EXPECT_TRUE(NearEstimatedLeaf(door, {-0.1, 0.95}, 0.15));  // past the free edge, within margin
+  EXPECT_FALSE(NearEstimatedLeaf(door, {0.0, 1.1}, 0.15));
+  EXPECT_FALSE(NearEstimatedLeaf(door, {0.5, 0.5}, 0.15));  // in its sweep, off the leaf
+  door.state.angle = 0.0;                                   // shut: along the door line
+  EXPECT_TRUE(NearEstimatedLeaf(door, {0.5, 0.1}, 0.15));
+  EXPECT_FALSE(NearEstimatedLeaf(door, {0.05, 0.5}, 0.15));
+}
+
 }  // namespace
 }  // namespace egress::behavior::detail

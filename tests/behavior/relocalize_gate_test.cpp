@@ -61,6 +61,17 @@ TEST(RelocalizeGateTest, AnUncertainPoseIsSettledBeforeTheAct) {
   EXPECT_EQ(gate.Check(ctx, "grasping", note), bt::NodeStatus::kSuccess);
   EXPECT_NE(notes.back().find("grasping anyway"), std::string::npos) << notes.back();
   EXPECT_EQ(relocalizations, 2);
+  // Checked again in the same act (its other conditions held it a tick): no new wait — one
+  // would end the same way, and a traversal waited 3 s a time until the door's window had gone
+  // (random building seed 12).
+  belief.now = At(13.2);
+  EXPECT_EQ(gate.Check(ctx, "grasping", note), bt::NodeStatus::kSuccess);
+  EXPECT_EQ(relocalizations, 2);
+  // A new act waits again.
+  gate.Reset();
+  belief.now = At(14.0);
+  EXPECT_EQ(gate.Check(ctx, "grasping", note), bt::NodeStatus::kRunning);
+  EXPECT_EQ(relocalizations, 3);
 }
 
 }  // namespace
