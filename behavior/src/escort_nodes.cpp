@@ -180,6 +180,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
       under_way_ = true;
     }
     if (around.moving) last_moving_ = belief_.now;
+    if (around.moving && ToSeconds(belief_.now - *moving_since_) >= kComingForSec) walked_ = true;
     // Clear time counts only while the way in is in the laser's sweep: stepping aside with its
     // back to the door, the robot sees nobody there (two-wards seed 17: a resident waiting at
     // door_e, behind it, was "everyone through" after clear_for). The operation just done was
@@ -327,16 +328,17 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // nobody once per round trip until the time limit (random building seeds 7, 12).
     const bool clock_running = came_ && unseen_ > 0.0 && !around.near;
     const bool for_someone = (came_ || !opened_for_waiting_ || around.near) && !clock_running;
-    // Boxed in at the actuator (not on its way to its spot for kStillForSec), with people who
-    // moved near in this hold now standing still for kStillForSec, someone by the doorway: they
-    // wait at the shut door, and the robot stands where they would operate it. It operates from
-    // where it stands, once per hold window (random building seed 8: the group came while it
-    // pressed, the press was broken off, and nine residents and the robot waited at the exit door
-    // for 340 s, the group within `reach` keeping it from pressing). Not for a group yet to set
-    // off, who have not moved (seed 28: they set off as it reached for the button among them).
+    // Boxed in at the actuator (not on its way to its spot for kStillForSec), with someone near
+    // who walked in this hold (on the move kComingForSec on end: came, or milled about the door)
+    // and all still for kStillForSec since, someone by the doorway: they wait at the shut door,
+    // and the robot stands where they would operate it. It operates from where it stands, once
+    // per hold window (random building seed 8: the group came while it pressed, the press was
+    // broken off, and nine residents and the robot waited at the exit door for 340 s, the group
+    // within `reach` keeping it from pressing). Not for a group yet to set off, however it stirs
+    // (seed 28: a stir of theirs let it reach for the button among them as they set off).
     const bool boxed_in =
         (standoff_.translation() - belief_.X_MB.translation()).norm() <= kAtSpotM && stuck_since_ &&
-        ToSeconds(belief_.now - *stuck_since_) >= kStillForSec && at_door.someone && last_moving_ &&
+        ToSeconds(belief_.now - *stuck_since_) >= kStillForSec && at_door.someone && walked_ &&
         ToSeconds(belief_.now - *last_moving_) > kStillForSec && !clock_running;
     if (!OperationJustFailed() &&
         ((OperateDue(every) && actuator_clear && for_someone) ||
@@ -560,6 +562,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     last_tick_.reset();
     nobody_at_last_watch_ = false;
     came_ = false;
+    walked_ = false;
     approach_.Reset();
     last_moving_.reset();
     moving_since_.reset();
@@ -666,14 +669,15 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   std::optional<Time> last_tick_;         // the previous tick of an unbroken watch
   bool nobody_at_last_watch_{false};      // nobody was near at the last tick of the watch
   bool came_{false};                      // someone came during this hold
-  bool under_way_{false};                 // someone came during any hold so far
-  std::optional<Time> last_moving_;       // when someone near was last seen on the move
-  std::optional<Time> moving_since_;      // since when, with no gap over kStirGapSec
-  ApproachWatch approach_;                // who walks up to the doorway, for came_
-  double unseen_{0.0};                    // [s] of watching since anyone was near
-  bool making_room_{false};               // stepping away from someone too near
-  Eigen::Vector2d room_to_{0.0, 0.0};     // where that step ends
-  Time room_since_{};                     // when it began
+  bool walked_{false};     // someone near was on the move kComingForSec on end in this hold
+  bool under_way_{false};  // someone came during any hold so far
+  std::optional<Time> last_moving_;    // when someone near was last seen on the move
+  std::optional<Time> moving_since_;   // since when, with no gap over kStirGapSec
+  ApproachWatch approach_;             // who walks up to the doorway, for came_
+  double unseen_{0.0};                 // [s] of watching since anyone was near
+  bool making_room_{false};            // stepping away from someone too near
+  Eigen::Vector2d room_to_{0.0, 0.0};  // where that step ends
+  Time room_since_{};                  // when it began
   bool stood_open_{false};  // the door stood open kStillForSec in this hold with nobody moving
   bool opened_for_waiting_{false};  // it operated for someone found waiting, in this hold
   bool spot_beside_lane_{false};    // no spot along the wall: spot_ is SpotBesideTheLane's

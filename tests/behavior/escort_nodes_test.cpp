@@ -246,6 +246,8 @@ TEST_F(HoldForResidentsTest, BoxedInAtTheActuatorItOperatesForThoseWhoCameAndWai
   const auto first_operation = [&](double from, double until) {
     for (double t = from; t <= until; t += 0.5) {
       belief_.now = At(t);
+      for (auto& entry : belief_.world.people)
+        entry.person.last_seen = belief_.now;
       motion_.StopBase();
       const NodeStatus status = tree_.TickOnce();
       if (status == NodeStatus::kSuccess) return t;
@@ -268,17 +270,40 @@ TEST_F(HoldForResidentsTest, BoxedInAtTheActuatorItOperatesForThoseWhoCameAndWai
   motion_.StopBase();
   belief_.X_MB = Standoff();
   log_.Take();
-  // Nobody has moved: a group yet to set off.
-  EXPECT_LT(first_operation(2.0, 14.0), 0.0);
-  // They came up (moving by the doorway for a tick) and stand: once still for kStillForSec,
-  // and due (a hold window since the last operation), it operates.
+  // Nobody has walked — a group yet to set off, stirring (moving returns for a tick) — nor ever
+  // will it operate for them (seed 28).
+  EXPECT_LT(first_operation(2.0, 7.5), 0.0);
   belief_.moving_returns = {{0.2, 2.1}};
-  belief_.now = At(14.5);
+  belief_.now = At(8.0);
   EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
   belief_.moving_returns.clear();
-  const double operated = first_operation(15.0, 25.0);
-  EXPECT_GT(operated, 14.5 + detail::kStillForSec);
-  EXPECT_LE(operated, 14.5 + detail::kStillForSec + 1.0);
+  EXPECT_LT(first_operation(8.5, 16.0), 0.0);
+  // Someone walks (kComingForSec and more) along the doorway's front, 1.2 m out — about the
+  // door, not nearer it: not residents coming — and stands there. Once all have stood
+  // kStillForSec, it operates (due: a hold window since the last operation).
+  constexpr double kOutM = 1.2, kSpeedMps = 0.5, kWalkFrom = 16.5, kWalkTo = 20.5;
+  const auto on_arc = [&](double t) {
+    const double a = -2.8 + kSpeedMps / kOutM * (t - kWalkFrom);
+    return Eigen::Vector2d(kOutM * std::cos(a), 3.0 + kOutM * std::sin(a));
+  };
+  auto walker = node_testing::Person(on_arc(kWalkFrom), perception::PersonIntent::kUnknown);
+  walker.person.p_MRest = on_arc(kWalkFrom);
+  for (double t = kWalkFrom; t < kWalkTo; t += kTickSec) {
+    belief_.now = At(t);
+    walker.person.p_MP = on_arc(t);
+    walker.person.v_MP = (on_arc(t + 0.01) - on_arc(t)) / 0.01;
+    walker.person.last_seen = belief_.now;
+    See({walker});
+    motion_.StopBase();
+    EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning) << "at " << t;
+  }
+  EXPECT_FALSE(NotedText("residents coming"));
+  walker.person.v_MP.setZero();
+  walker.person.p_MRest = walker.person.p_MP;
+  See({walker});
+  const double operated = first_operation(kWalkTo, kWalkTo + 10.0);
+  EXPECT_GT(operated, kWalkTo - kTickSec + detail::kStillForSec);
+  EXPECT_LE(operated, kWalkTo + detail::kStillForSec + 1.0);
   int no_path_notes = 0;
   for (const auto& note : log_.pending())
     no_path_notes += note.text.find("no path to the spot") != std::string::npos;
