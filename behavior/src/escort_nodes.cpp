@@ -203,7 +203,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // sweep): the time counted while it operated ends facing the actuator's wall, the way in
     // behind it (random building seed 10: released "nobody about" on the first tick after a
     // press, with eight residents 3-4 m behind it walking to the door).
-    const bool looking = IsInLaserSweep(task_, belief_.X_MB, pass.centre + pass.n_M * kLookOutM);
+    const bool looking = IsInLaserSweep(task_, belief_.X_MB, WatchPoint(pass));
     if (!came_ && unseen_ > Input<double>("wait_for") && looking) return Release("nobody about");
     // ... as once it has opened for someone waiting: they go through when it opens, and may not
     // be seen to come (kComingForSec on end) as the robot turns from the actuator.
@@ -417,9 +417,8 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // robot faces the wall and the residents' way in is behind it; a whole turn there and back
     // took ~5 s each way (lab: back at the button after the door had shut, as the residents set
     // off). The head looks the rest of the way.
-    // With no path to where it would wait, it looks that way when the laser does not: what
-    // blocks it may be marks of someone long gone, behind it, that only a ray clears (seed 8: the
-    // spot, in the laser's blind sector, stayed "in collision" for 340 s after a resident left).
+    // With no path to where it would wait, it looks there (marks of someone long gone, behind
+    // it, only a ray clears: seed 8's spot stayed "in collision" 340 s in the blind sector).
     {
       const Eigen::Vector2d to_wait = wait_at.translation() - belief_.X_MB.translation();
       const double look =
@@ -431,7 +430,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
                              ? belief_.X_MB.yaw
                              : belief_.X_MB.yaw + off - std::copysign(kWatchWithinRad, off);
       if (task_.gaze != nullptr) {
-        const Eigen::Vector2d p = pass.centre + pass.n_M * kLookOutM;
+        const Eigen::Vector2d p = WatchPoint(pass);
         task_.gaze->RequestLook({p.x(), p.y(), belief_.X_MC.translation().z()},
                                 belief_.now + SecondsToDuration(kLookRequestSec));
       }
@@ -451,9 +450,9 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   }
 
  private:
-  // The heading from p_M to where the residents come from: kLookOutM out from the doorway.
+  // The heading from p_M to the watch point (WatchPoint).
   static double LookYaw(const DoorPass& pass, const Eigen::Vector2d& p_M) {
-    const Eigen::Vector2d look = pass.centre + pass.n_M * kLookOutM - p_M;
+    const Eigen::Vector2d look = WatchPoint(pass) - p_M;
     return std::atan2(look.y(), look.x());
   }
 

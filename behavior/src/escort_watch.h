@@ -16,6 +16,10 @@ namespace egress::behavior::detail {
 inline constexpr double kThroughM = 0.3;
 /// [m] How far out from the doorway, on the robot's side, the robot looks for people coming.
 inline constexpr double kLookOutM = 2.0;
+/// Where the residents come from, that a hold watches: kLookOutM out from `pass`'s doorway [M].
+inline Eigen::Vector2d WatchPoint(const DoorPass& pass) {
+  return pass.centre + pass.n_M * kLookOutM;
+}
 /// [m/s] A tracked person faster than this is on the move.
 inline constexpr double kMovingMps = 0.2;
 /// [m] A tracked person this far from where they last stood (and on the move) walked off.
