@@ -53,6 +53,8 @@ struct Person {
   std::optional<Eigen::Vector2d> aside_spot;  // where it then stands (held against the walls' push)
   double blocked_for{0.0};                    // [s] walking but not moving (any leg of the route)
   double slow_for{0.0};                       // [s] slower than kHeldUpMps (any phase)
+  double give_way_until{-1.0};  // [s] stepping back for someone nearer the bottleneck until then
+  Eigen::Vector2d give_way_spot{Eigen::Vector2d::Zero()};  // where it then steps back to
   double hold_angle{0.0};
   double hold_duration{0.0};
   double hold_started{-1.0};
@@ -169,6 +171,10 @@ struct TwinWorld::Impl {
   // doorway of their route they had passed (the crowd pushed them back through it), takes up
   // their route again from before that doorway.
   void RewindIfPushedBack(Person& p);
+  // Stuck in a jam, a walker touching someone nearer the bottleneck (the next doorway of its
+  // route, else its waypoint) steps back from it for kGiveWaySec: pressed on from behind and the
+  // sides, the one ahead could not move on.
+  void GiveWayIfJammed(Person& p);
   // The door whose doorway centre is the person's next waypoint, or -1. Also, for an evacuee
   // held up (slower than kHeldUpMps for kHeldUpSec) within kQueueNearSpotM of the spot before a
   // shut door's doorway, that door: they queue for it where the crowd lets them stand.
