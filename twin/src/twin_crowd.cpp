@@ -39,14 +39,6 @@ constexpr double kWaypointReachedM = 0.4;
 constexpr double kOutOfSceneZ = -50.0;
 // A doorway's line, as a barrier to a group's layout, runs this far on into each jamb [m].
 constexpr double kDoorwayLineOverrunM = 0.1;
-// A jammed walker gives way to someone nearer the bottleneck for this long [s]: long enough for
-// them to step clear (half a metre at a wheelchair's pace), short enough not to be overtaken by
-// the rest behind.
-constexpr double kGiveWaySec = 1.5;
-// Bodies this near (surface to surface) press on each other in a jam [m].
-constexpr double kPressingGapM = 0.05;
-// How far a walker who gives way steps back [m]: room for a wide body beside it to pass.
-constexpr double kGiveWayStepM = 0.3;
 
 }  // namespace
 
@@ -569,33 +561,6 @@ void TwinWorld::Impl::RewindIfPushedBack(Person& p) {
     p.round_leaf = -1;
     p.walker.target = p.route.front();
     AddEvent("person_rewinds_route", p.state.name, d.desc->name);
-    return;
-  }
-}
-
-void TwinWorld::Impl::GiveWayIfJammed(Person& p) {
-  // The jam's front is whoever is nearest the bottleneck (the next doorway of the route, else the
-  // waypoint): they keep their drive, and everyone pressing on them from behind or beside steps
-  // back a moment. One bottleneck for all who share it, so two never give way to each other. In
-  // an arch of wide bodies before a doorway (a pushed wheelchair on the axis, two more pressed
-  // into the corners beside the jambs heading for the spot it stands on), each held the others
-  // still for good: 22 residents left at the clinic's open exit (two wards seed 48).
-  if (p.state.phase != PersonPhase::kWalking || time < p.give_way_until) return;
-  Eigen::Vector2d bottleneck = p.walker.target;
-  const auto doorway = p.doorway_waypoints.lower_bound(p.reached);
-  if (doorway != p.doorway_waypoints.end())
-    bottleneck = doors[std::size_t(doorway->second)].fixed->centre;
-  const Eigen::Vector2d back = p.walker.position - bottleneck;
-  const double mine = back.norm();
-  if (mine < 1e-6) return;
-  for (const Person& o : people) {
-    if (&o == &p || o.state.out || !o.state.started) continue;
-    const double gap =
-        (o.walker.position - p.walker.position).norm() - o.walker.radius - p.walker.radius;
-    if (gap > kPressingGapM || (o.walker.position - bottleneck).norm() >= mine) continue;
-    p.give_way_spot = p.walker.position + back / mine * kGiveWayStepM;
-    p.give_way_until = time + kGiveWaySec;
-    AddEvent("person_gives_way", p.state.name, o.state.name);
     return;
   }
 }
