@@ -88,6 +88,45 @@ TEST(SocialForceModelTest, ARobotDiscIsAvoided) {
   EXPECT_GT(w[0].position.x(), 3.0);
 }
 
+// A walker's approach to the robot is capped so it could stop short of it: the cap takes away
+// only its own speed towards the disc (its sideways speed stays, and a disc driving at a
+// standing walker does not push it back: that contact is the disc's).
+TEST(SocialForceModelTest, AWalkerCanAlwaysStopShortOfTheRobot) {
+  const SocialForceModel sfm;
+  const auto& P = sfm.params();
+  std::vector<Walker> w(1);
+  w[0].radius = 0.25;
+  w[0].position = {-0.25 - 0.215 - 0.2, 0.0};  // a 0.2 m gap
+  w[0].velocity = {1.6, 0.5};
+  w[0].target = {5.0, 0.0};
+  const std::vector<DiscObstacle> robot = {{{0, 0}, {0, 0}, 0.215}};
+  sfm.Integrate(&w, {Eigen::Vector2d::Zero()}, 0.01, robot);
+  EXPECT_NEAR(w[0].velocity.x(),
+              std::sqrt(2.0 * P.disc_braking_deceleration * (0.2 - P.disc_keep_gap)), 1e-9);
+  EXPECT_EQ(w[0].velocity.y(), 0.5);
+  // Without the disc, nothing caps it.
+  std::vector<Walker> free = {w[0]};
+  free[0].velocity = {1.6, 0.5};
+  sfm.Integrate(&free, {Eigen::Vector2d::Zero()}, 0.01);
+  EXPECT_EQ(free[0].velocity.x(), 1.6);
+  // A disc coming at a walker standing still leaves it standing.
+  std::vector<Walker> still(1);
+  still[0].position = {-0.5, 0.0};
+  still[0].desired_speed = 0.0;
+  const std::vector<DiscObstacle> coming = {{{0, 0}, {-0.5, 0}, 0.215}};
+  sfm.Integrate(&still, {Eigen::Vector2d::Zero()}, 0.01, coming);
+  EXPECT_EQ(still[0].velocity, Eigen::Vector2d::Zero());
+  // Step caps as Integrate does: a walker running at the robot stops short of it.
+  std::vector<Walker> running = {w[0]};
+  running[0].velocity = {1.65, 0.0};
+  double min_gap = 1e9;
+  for (int i = 0; i < 100; ++i) {
+    sfm.Step(&running, robot, {}, 1.0 / 240);
+    min_gap = std::min(min_gap, running[0].position.norm() - 0.25 - 0.215);
+  }
+  EXPECT_GT(min_gap, P.disc_keep_gap - 1e-3);
+}
+
 // Step's cell lists (walkers within the social cutoff, walls within reach) give bit for bit
 // the accelerations of summing over every walker and every wall, so runs do not change with
 // the crowd's size or the building's.

@@ -287,7 +287,7 @@ void SocialForceModel::Step(std::vector<Walker>* walkers, const std::vector<Disc
 void SocialForceModel::Step(std::vector<Walker>* walkers, const std::vector<DiscObstacle>& discs,
                             const WallCells& fixed, const std::vector<WallSegment>& moving,
                             double dt) const {
-  Integrate(walkers, CalcAccelerations(*walkers, discs, fixed, moving), dt);
+  Integrate(walkers, CalcAccelerations(*walkers, discs, fixed, moving), dt, discs);
 }
 
 std::vector<Eigen::Vector2d> SocialForceModel::CalcAccelerations(
@@ -410,15 +410,32 @@ std::vector<Eigen::Vector2d> SocialForceModel::SumTerms(
   return accelerations;
 }
 
+Eigen::Vector2d SocialForceModel::CapApproach(const Walker& w, const DiscObstacle& d) const {
+  // The cap is the speed one can brake from over the gap left (from afar it is above any
+  // walker's top speed: the social terms keep walkers off the disc there).
+  const Eigen::Vector2d to_disc = d.position - w.position;
+  const double dist = to_disc.norm();
+  if (dist < 1e-9) return w.velocity;
+  const Eigen::Vector2d n = to_disc / dist;
+  const double gap = std::max(dist - w.radius - d.radius - params_.disc_keep_gap, 0.0);
+  const double cap = std::sqrt(2.0 * params_.disc_braking_deceleration * gap);
+  const double own = w.velocity.dot(n);  // the walker's own speed towards the disc
+  const double excess = std::min((w.velocity - d.velocity).dot(n) - cap, own);
+  // Only the walker's approach is taken away: it is not made to back off a disc coming at it.
+  return excess > 0.0 ? Eigen::Vector2d(w.velocity - excess * n) : w.velocity;
+}
+
 void SocialForceModel::Integrate(std::vector<Walker>* walkers,
-                                 const std::vector<Eigen::Vector2d>& accelerations,
-                                 double dt) const {
+                                 const std::vector<Eigen::Vector2d>& accelerations, double dt,
+                                 const std::vector<DiscObstacle>& discs) const {
   for (std::size_t i = 0; i < walkers->size(); ++i) {
     Walker& w = (*walkers)[i];
     if (w.held) continue;
     w.velocity += accelerations[i] * dt;
     const double v_max = params_.max_speed_factor * std::max(w.desired_speed, 0.3);
     if (w.velocity.norm() > v_max) w.velocity *= v_max / w.velocity.norm();
+    for (const DiscObstacle& d : discs)
+      w.velocity = CapApproach(w, d);
     if (w.desired_speed == 0.0 && w.velocity.norm() < 0.02) w.velocity.setZero();
     w.position += w.velocity * dt;
   }

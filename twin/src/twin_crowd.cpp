@@ -507,7 +507,7 @@ void TwinWorld::Impl::UpdatePeople() {
     accelerations =
         sfm.CalcAccelerationsWithSocial(social, walkers, discs, fixed.wall_cells, leaves);
   }
-  sfm.Integrate(&walkers, accelerations, dt);
+  sfm.Integrate(&walkers, accelerations, dt, discs);
   // Standing people do not integrate (they would drift under wall forces).
   for (std::size_t k = 0; k < walkers.size(); ++k) {
     Person& p = people[walker_of[k]];

@@ -36,9 +36,16 @@ struct SocialForceParams {
   double robot_strength{6.0};       ///< Repulsion from a disc obstacle (the robot) [m²/s²]:
                                     ///< people keep more room from a robot than HM95's 2.1
   double robot_range{0.4};          ///< [m]
-  double keep_right{0.3};           ///< Share of the social force turned to the walker's right
-                                    ///< to break head-on symmetry [–]
-  double max_acceleration{20.0};    ///< Clamp [m/s²] (the contact terms are stiff)
+  /// Deceleration [m/s²] a walker keeps in hand towards a disc (the robot): its speed towards
+  /// the disc, relative to the disc's, is capped at sqrt(2 · this · (gap − disc_keep_gap)), so
+  /// it could stop short of it (Tordeux et al. 2016's collision-free speed, along one
+  /// direction). People see a robot ahead and do not walk into it, whatever the crowd behind
+  /// them does; only their own approach is capped (a disc driving at them still touches).
+  double disc_braking_deceleration{2.0};
+  double disc_keep_gap{0.05};     ///< Surface gap [m] a walker stops short of a disc by
+  double keep_right{0.3};         ///< Share of the social force turned to the walker's right
+                                  ///< to break head-on symmetry [–]
+  double max_acceleration{20.0};  ///< Clamp [m/s²] (the contact terms are stiff)
 };
 
 /// One walker's state in W.
@@ -150,8 +157,9 @@ class SocialForceModel {
       const std::vector<WallSegment>& moving) const;
   /// Advances every walker by dt [s] under `accelerations` (one per walker), as Step does: a
   /// caller may hold accelerations over several steps (the forces are the costly part).
+  /// `discs`: the walkers' approach to each is capped (disc_braking_deceleration).
   void Integrate(std::vector<Walker>* walkers, const std::vector<Eigen::Vector2d>& accelerations,
-                 double dt) const;
+                 double dt, const std::vector<DiscObstacle>& discs = {}) const;
 
   const SocialForceParams& params() const { return params_; }
 
@@ -189,6 +197,8 @@ class SocialForceModel {
   // The drive towards the walker's target: (desired velocity - velocity) / τ, with its gain.
   Eigen::Vector2d CalcDriveAcceleration(const Walker& w) const;
   Eigen::Vector2d ClampAcceleration(const Eigen::Vector2d& a) const;
+  // w's velocity with its approach to d capped (disc_braking_deceleration).
+  Eigen::Vector2d CapApproach(const Walker& w, const DiscObstacle& d) const;
   // Every walker's `terms` through the cell lists; kContact adds the drive and `social`'s entry
   // and clamps (as kAll does).
   std::vector<Eigen::Vector2d> SumTerms(const std::vector<Walker>& walkers,
