@@ -396,6 +396,34 @@ TEST(EvacueesTest, SomeoneCarriedPastAWaypointGoesOnFromThere) {
   }
 }
 
+// Carried by the crowd through the doorway of a room off their route, an evacuee who finds a
+// wall between them and their way on goes back out through that doorway (clinic two wards seed
+// 1, doors propped open: a north-ward resident pressed through door_b into the room beyond
+// leaned on its wall, the corridor on the other side, to the time limit). They start where that
+// resident stood, in the room east of door_b (open, into the corridor), the exit route beyond
+// the room's south wall.
+TEST(EvacueesTest, SomeoneCarriedIntoARoomOffTheirRouteFindsTheWayBackOut) {
+  for (const char* mobility : {"walker", "wheelchair"}) {
+    auto loaded = LoadText(
+        std::string("world: clinic.sdf\nrobot: {off_scene: true}\n"
+                    "doors: [{door: door_b, operator: proximity, hold_open_s: 1000, open_at: [0.0]}]\n"
+                    "people:\n"
+                    "  - {name: e, behavior: evacuate, route: [door_e, exit_door], start: [10.9,"
+                    " 2.6], goal: [21.0, 11.5], mobility: {") +
+            mobility + ": 1}, trigger: {at: 3.0}}\n",
+        WorldsDir() / "clinic");
+    TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+    world.StepFor(90.0);
+    // On along the corridor to door_e and beyond (a wheelchair user then waits at the exit,
+    // whose button they cannot reach).
+    const auto& e = world.people().front();
+    EXPECT_TRUE(e.out || e.position.x() > 19.5) << mobility << " at " << e.position.transpose();
+    EXPECT_TRUE(std::any_of(world.events().begin(), world.events().end(),
+                            [](const TwinEvent& ev) { return ev.kind == "person_finds_way_back"; }))
+        << mobility;
+  }
+}
+
 // Pushed by the crowd into the doorway of a door not on their route, whose open leaf stands
 // across their way on, an evacuee steps back out into the corridor, not round the leaf into the
 // room beyond it (clinic two wards seed 23: a north-ward resident walking east along the

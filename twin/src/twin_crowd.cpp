@@ -360,6 +360,7 @@ void TwinWorld::Impl::UpdatePeople() {
     if (p.blocked_for > kStuckSec) {
       RewindIfPushedBack(p);
       GiveWayIfJammed(p);
+      FindWayBackThroughDoorway(p);
     }
     // Held off its last waypoint by the walls round it (a hold spot in a corner: the social
     // forces balance short of it), a walker who is near enough has arrived.
@@ -418,8 +419,13 @@ void TwinWorld::Impl::UpdatePeople() {
           // straight way on clears the leaf (by a body's width past its free edge), the detour
           // is done. Walking back to it would be against the crowd, in the doorway where they
           // stand (clinic two wards seed 22: 6 residents kept at door_e to the time limit).
-          if (p.route.size() > 1 && !SegmentsCross(p.walker.position, p.route[1], hinge,
-                                                   edge + along * p.walker.radius)) {
+          // Through a wall it is no way on: pressed into the doorway beside the hinge, the line
+          // on passed the hinge through the wall, and they walked into the room beyond (clinic
+          // two wards seed 7, doors propped open: door_b's leaf open into the corridor).
+          if (p.route.size() > 1 &&
+              !SegmentsCross(p.walker.position, p.route[1], hinge,
+                             edge + along * p.walker.radius) &&
+              !WallBetween(p.walker.position, p.route[1])) {
             SkipRouteTo(p, p.reached + 1);
             p.walker.target = p.route.front();
             p.walker.final_target = p.route.size() == 1;
@@ -429,6 +435,12 @@ void TwinWorld::Impl::UpdatePeople() {
         } else {
           if (!SegmentsCross(p.walker.position, p.route.front(), hinge, edge)) continue;
           if (SegmentsCross(p.walker.position, round, hinge, edge)) continue;
+          // A leaf seen through a wall is not in their way: standing in the doorway of a room
+          // beside the corridor, the straight way on ran along the wall's face past door_c's
+          // leaf, open into the next room, and the way round it led through that room's wall
+          // (clinic two wards seed 7, doors propped open: a resident walked into it to the time
+          // limit).
+          if (WallBetween(p.walker.position, round)) continue;
           if (p.round_leaf >= 0) continue;  // one leaf at a time
           // At the edge already: a detour there would be reached at once, and inserted again
           // the next step.
@@ -471,6 +483,15 @@ void TwinWorld::Impl::UpdatePeople() {
     if (people[i].state.out) continue;
     walkers.push_back(people[i].walker);
     walkers.back().held = !people[i].state.started;  // standing people do not integrate
+    auto& way_back = people[i].way_back;
+    if (people[i].state.phase != PersonPhase::kWalking) way_back.clear();
+    if (!way_back.empty() &&
+        (way_back.front() - walkers.back().position).norm() < kWaypointReachedM)
+      way_back.erase(way_back.begin());
+    if (!way_back.empty()) {
+      walkers.back().target = way_back.front();
+      walkers.back().final_target = false;
+    }
     if (time < people[i].give_way_until && people[i].state.phase == PersonPhase::kWalking) {
       walkers.back().target = people[i].give_way_spot;
       walkers.back().final_target = true;
@@ -534,17 +555,18 @@ bool TwinWorld::Impl::PassedWaypoint(const Person& p) const {
   const Eigen::Vector2d& waypoint = p.route[0];
   const Eigen::Vector2d& next = p.route[1];
   if ((at - waypoint).dot(next - waypoint) <= 0.0) return false;
-  return std::none_of(fixed.walls.begin(), fixed.walls.end(),
-                      [&](const WallSegment& w) { return SegmentsCross(at, next, w.a, w.b); });
+  return !WallBetween(at, next);
+}
+
+bool TwinWorld::Impl::WallBetween(const Eigen::Vector2d& a, const Eigen::Vector2d& b) const {
+  return std::any_of(fixed.walls.begin(), fixed.walls.end(),
+                     [&](const WallSegment& w) { return SegmentsCross(a, b, w.a, w.b); });
 }
 
 void TwinWorld::Impl::RewindIfPushedBack(Person& p) {
   if (p.planned_route.empty() || p.route.empty()) return;
   const Eigen::Vector2d& at = p.walker.position;
-  const auto wall_between = [&](const Eigen::Vector2d& to) {
-    return std::any_of(fixed.walls.begin(), fixed.walls.end(),
-                       [&](const WallSegment& w) { return SegmentsCross(at, to, w.a, w.b); });
-  };
+  const auto wall_between = [&](const Eigen::Vector2d& to) { return WallBetween(at, to); };
   if (!wall_between(p.route.front())) return;
   // The latest doorway already passed that they stand before again: on its waiting side, in
   // sight of the waypoint before it (the drive towards the next waypoint may have slid them

@@ -6,6 +6,7 @@
 #include "doorway_way.h"
 
 #include <cmath>
+#include <limits>
 #include <optional>
 
 namespace egress::twin {
@@ -39,6 +40,8 @@ constexpr double kOperateGiveUpSec = 12.0;
 // queues for it (GateDoor) [s], [m].
 constexpr double kHeldUpSec = 1.0;
 constexpr double kQueueNearSpotM = 1.5;
+// A stuck walker looks for a way back through doorways this near [m].
+constexpr double kWayBackReachM = 3.0;
 
 }  // namespace
 
@@ -226,6 +229,36 @@ void TwinWorld::Impl::GiveWayIfJammed(Person& p) {
     AddEvent("person_gives_way", p.state.name, o.state.name);
     return;
   }
+}
+
+void TwinWorld::Impl::FindWayBackThroughDoorway(Person& p) {
+  if (p.state.phase != PersonPhase::kWalking || !p.way_back.empty() || time < p.give_way_until)
+    return;
+  const Eigen::Vector2d& at = p.walker.position;
+  const Eigen::Vector2d& to = p.walker.target;
+  if (!WallBetween(at, to)) return;
+  // Each doorway open enough to pass, its centre within reach: out of it on this side, then on
+  // the waypoint's, each leg clear of walls; the shortest such way.
+  double best = std::numeric_limits<double>::infinity();
+  int best_door = -1;
+  for (std::size_t k = 0; k < doors.size(); ++k) {
+    if (doors[k].angle < config.door_crossed_open_angle_deg * kDegToRad) continue;
+    const DoorModel& d = *doors[k].fixed;
+    if ((at - d.centre).norm() > kWayBackReachM) continue;
+    const double mine = (at - d.centre).dot(d.normal), theirs = (to - d.centre).dot(d.normal);
+    if (mine * theirs >= 0.0) continue;  // the doorway does not lead to the waypoint's side
+    const Eigen::Vector2d near = d.centre + d.normal * std::copysign(kOutOfDoorwayM, mine);
+    const Eigen::Vector2d far = d.centre + d.normal * std::copysign(kOutOfDoorwayM, theirs);
+    const double length = (near - at).norm() + (to - far).norm();
+    if (length >= best || WallBetween(at, near) || WallBetween(near, far) || WallBetween(far, to))
+      continue;
+    best = length;
+    best_door = int(k);
+    p.way_back = {near, far};
+  }
+  if (best_door >= 0)
+    AddEvent("person_finds_way_back", p.state.name,
+             doors[std::size_t(best_door)].fixed->desc->name);
 }
 
 }  // namespace egress::twin

@@ -55,6 +55,9 @@ struct Person {
   double slow_for{0.0};                       // [s] slower than kHeldUpMps (any phase)
   double give_way_until{-1.0};  // [s] stepping back for someone nearer the bottleneck until then
   Eigen::Vector2d give_way_spot{Eigen::Vector2d::Zero()};  // where it then steps back to
+  // Through a doorway to where the waypoint is in sight (FindWayBackThroughDoorway): walked to
+  // front first, ahead of the route, each dropped once reached.
+  std::vector<Eigen::Vector2d> way_back;
   double hold_angle{0.0};
   double hold_duration{0.0};
   double hold_started{-1.0};
@@ -175,6 +178,10 @@ struct TwinWorld::Impl {
   // route, else its waypoint) steps back from it for kGiveWaySec: pressed on from behind and the
   // sides, the one ahead could not move on.
   void GiveWayIfJammed(Person& p);
+  // Stuck with a wall between them and their waypoint (carried by the crowd through the doorway
+  // of a room off their route), a walker goes back through the nearest open doorway in sight
+  // from whose far side the waypoint is in sight (Person::way_back).
+  void FindWayBackThroughDoorway(Person& p);
   // The door whose doorway centre is the person's next waypoint, or -1. Also, for an evacuee
   // held up (slower than kHeldUpMps for kHeldUpSec) within kQueueNearSpotM of the spot before a
   // shut door's doorway, that door: they queue for it where the crowd lets them stand.
@@ -199,6 +206,8 @@ struct TwinWorld::Impl {
   std::optional<Eigen::Vector2d> SpotBesideWall(const Eigen::Vector2d& p) const;
   // p moved out of every wall it is nearer than `clearance` to [m].
   Eigen::Vector2d ClearOfWalls(Eigen::Vector2d p, double clearance) const;
+  // Whether a building wall (not a door leaf) crosses the straight way from a to b in W.
+  bool WallBetween(const Eigen::Vector2d& a, const Eigen::Vector2d& b) const;
   // What a group's members may neither start on nor beyond, besides the walls (GroupLayout's
   // keep_off): the doorways' lines and the robot.
   std::vector<WallSegment> StartKeepOff() const;
