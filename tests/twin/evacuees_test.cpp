@@ -405,11 +405,12 @@ TEST(EvacueesTest, SomeoneCarriedPastAWaypointGoesOnFromThere) {
 TEST(EvacueesTest, SomeoneCarriedIntoARoomOffTheirRouteFindsTheWayBackOut) {
   for (const char* mobility : {"walker", "wheelchair"}) {
     auto loaded = LoadText(
-        std::string("world: clinic.sdf\nrobot: {off_scene: true}\n"
-                    "doors: [{door: door_b, operator: proximity, hold_open_s: 1000, open_at: [0.0]}]\n"
-                    "people:\n"
-                    "  - {name: e, behavior: evacuate, route: [door_e, exit_door], start: [10.9,"
-                    " 2.6], goal: [21.0, 11.5], mobility: {") +
+        std::string(
+            "world: clinic.sdf\nrobot: {off_scene: true}\n"
+            "doors: [{door: door_b, operator: proximity, hold_open_s: 1000, open_at: [0.0]}]\n"
+            "people:\n"
+            "  - {name: e, behavior: evacuate, route: [door_e, exit_door], start: [10.9,"
+            " 2.6], goal: [21.0, 11.5], mobility: {") +
             mobility + ": 1}, trigger: {at: 3.0}}\n",
         WorldsDir() / "clinic");
     TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
@@ -418,9 +419,9 @@ TEST(EvacueesTest, SomeoneCarriedIntoARoomOffTheirRouteFindsTheWayBackOut) {
     // whose button they cannot reach).
     const auto& e = world.people().front();
     EXPECT_TRUE(e.out || e.position.x() > 19.5) << mobility << " at " << e.position.transpose();
-    EXPECT_TRUE(std::any_of(world.events().begin(), world.events().end(),
-                            [](const TwinEvent& ev) { return ev.kind == "person_finds_way_back"; }))
-        << mobility;
+    EXPECT_TRUE(std::any_of(world.events().begin(), world.events().end(), [](const TwinEvent& ev) {
+      return ev.kind == "person_finds_way_back";
+    })) << mobility;
   }
 }
 
