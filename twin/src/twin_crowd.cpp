@@ -566,8 +566,7 @@ bool TwinWorld::Impl::WallBetween(const Eigen::Vector2d& a, const Eigen::Vector2
 void TwinWorld::Impl::RewindIfPushedBack(Person& p) {
   if (p.planned_route.empty() || p.route.empty()) return;
   const Eigen::Vector2d& at = p.walker.position;
-  const auto wall_between = [&](const Eigen::Vector2d& to) { return WallBetween(at, to); };
-  if (!wall_between(p.route.front())) return;
+  if (!WallBetween(at, p.route.front())) return;
   // The latest doorway already passed that they stand before again: on its waiting side, in
   // sight of the waypoint before it (the drive towards the next waypoint may have slid them
   // along the walls far from the doorway).
@@ -577,7 +576,7 @@ void TwinWorld::Impl::RewindIfPushedBack(Person& p) {
     const DoorModel& d = *doors[std::size_t(it->second)].fixed;
     const Eigen::Vector2d& before = p.planned_route[std::size_t(centre - 1)];
     if ((at - d.centre).dot(d.normal) * (before - d.centre).dot(d.normal) <= 0.0) continue;
-    if (wall_between(before)) continue;
+    if (WallBetween(at, before)) continue;
     p.route.assign(p.planned_route.begin() + (centre - 1), p.planned_route.end());
     p.reached = centre - 1;
     p.round_leaf = -1;
