@@ -61,10 +61,14 @@ ParticleFilterLocalizer::ParticleFilterLocalizer(const OccupancyGrid& map, const
   }
   cv::Mat distance;
   cv::distanceTransform(free_mask, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
-  distance_.resize(geometry_.size());
-  for (int iy = 0; iy < geometry_.height; ++iy) {
-    for (int ix = 0; ix < geometry_.width; ++ix) {
-      distance_[geometry_.Index(ix, iy)] = distance.at<float>(iy, ix) * float(geometry_.resolution);
+  distance_stride_ = geometry_.width + 2;
+  distance_.resize(std::size_t(distance_stride_) * std::size_t(geometry_.height + 2));
+  for (int iy = -1; iy <= geometry_.height; ++iy) {
+    for (int ix = -1; ix <= geometry_.width; ++ix) {
+      const int cx = std::clamp(ix, 0, geometry_.width - 1);
+      const int cy = std::clamp(iy, 0, geometry_.height - 1);
+      distance_[std::size_t((iy + 1) * distance_stride_ + ix + 1)] =
+          distance.at<float>(cy, cx) * float(geometry_.resolution);
     }
   }
   // exp and log per beam per particle cost more than the rest of the correction; beyond
@@ -159,13 +163,11 @@ double ParticleFilterLocalizer::LikelihoodFieldDistance(const Eigen::Vector2d& p
   const double v = gy - 0.5;
   const int i0 = int(std::floor(u)), j0 = int(std::floor(v));
   const double fu = u - i0, fv = v - j0;
-  const auto at = [&](int i, int j) {
-    i = std::clamp(i, 0, geometry_.width - 1);
-    j = std::clamp(j, 0, geometry_.height - 1);
-    return double(distance_[geometry_.Index(i, j)]);
-  };
-  const double d = (1 - fu) * (1 - fv) * at(i0, j0) + fu * (1 - fv) * at(i0 + 1, j0) +
-                   (1 - fu) * fv * at(i0, j0 + 1) + fu * fv * at(i0 + 1, j0 + 1);
+  // i0, j0 >= -1 and i0 + 1 <= width, j0 + 1 <= height: within the border.
+  const float* row = distance_.data() + std::ptrdiff_t(j0 + 1) * distance_stride_ + (i0 + 1);
+  const float* next_row = row + distance_stride_;
+  const double d = (1 - fu) * (1 - fv) * double(row[0]) + fu * (1 - fv) * double(row[1]) +
+                   (1 - fu) * fv * double(next_row[0]) + fu * fv * double(next_row[1]);
   return std::max(0.0, d - 0.5 * res);
 }
 

@@ -109,7 +109,7 @@ double TwinWorld::Impl::MeasureDoorAngle(const Door& d) const {
 
 bool TwinWorld::Impl::LeafSwingsIntoSomeone(const Door& d) const {
   const Eigen::Vector2d hinge = d.fixed->desc->p_WH.head<2>();
-  const Eigen::Vector2d edge = d.fixed->desc->CalcFreeEdge(d.angle).head<2>();
+  const Eigen::Vector2d edge = d.FreeEdge();
   const double omega_z = d.leaf->getAngularVelocity().z();  // about W's z [rad/s]
   if (std::abs(omega_z) < 1e-9) return false;
   for (const auto& p : people) {

@@ -6,6 +6,8 @@
 // twin_robot_body.cpp (base, arm, gripper, payloads), twin_rays.cpp (ray casting for the
 // sensors).
 
+#include <limits>
+
 #include "ray_convex.h"
 #include "twin_model_compiled.h"
 
@@ -27,6 +29,18 @@ struct Door {
   bool reported_open{false};
   bool reported_closed{true};
   DoorPhase last_phase{DoorPhase::kClosed};
+
+  // The leaf's free edge on the floor at `angle` (DoorDescription::CalcFreeEdge), kept while the
+  // angle stays the same: the people's rules ask for it per person and step.
+  Eigen::Vector2d FreeEdge() const {
+    if (!(free_edge_angle == angle)) {
+      free_edge = fixed->desc->CalcFreeEdge(angle).head<2>();
+      free_edge_angle = angle;
+    }
+    return free_edge;
+  }
+  mutable double free_edge_angle{std::numeric_limits<double>::quiet_NaN()};
+  mutable Eigen::Vector2d free_edge{Eigen::Vector2d::Zero()};
 };
 
 // A person in the run.

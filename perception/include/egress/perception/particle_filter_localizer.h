@@ -123,7 +123,10 @@ class ParticleFilterLocalizer {
 
   LocalizerConfig config_;
   GridGeometry geometry_;
-  std::vector<float> distance_;  // to the nearest occupied cell [m], per cell
+  // To the nearest occupied cell [m], per cell, with a border of one cell round the grid that
+  // repeats its edge: the bilinear lookup reads its four cells without clamping their indices.
+  std::vector<float> distance_;
+  int distance_stride_{0};  // cells per row of distance_ (the grid's width + 2)
   // BeamLogLikelihood at d = i·kBeamTableStep, out to where the hit term no longer counts.
   static constexpr double kBeamTableStep = 0.0005;  // [m]
   std::vector<double> beam_log_likelihood_;
