@@ -598,9 +598,12 @@ bool Executive::Step(RobotPort& port) {
   std::optional<Eigen::Vector2d> p_MGoal;
   if (!m.motion.path().empty()) p_MGoal = m.motion.path().back().translation();
   const bool was_squeezing = m.pace.squeezing();
+  const Eigen::Vector2d v_M = m.motion.planned_velocity();
   m.motion.SetSpeedScale(m.pace.Update(
-      ToSeconds(now), belief_.X_MB, m.motion.planned_velocity(), p_MGoal, belief_.world.people,
-      m.config.tasks.footprint_radius, m.config.tasks.person_radius));
+      ToSeconds(now), belief_.X_MB, v_M, p_MGoal, belief_.world.people,
+      m.config.tasks.footprint_radius, m.config.tasks.person_radius,
+      IsLeavingDoorway(belief_.X_MB, v_M, m.map.doors, m.config.proxemics.doorway_depth,
+                       m.config.tasks.footprint_radius)));
   if (m.pace.squeezing() && !was_squeezing) {
     decisions_.push_back({ToSeconds(now),
                           StrCat("held back ", m.config.proxemics.patience_s,

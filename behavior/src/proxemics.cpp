@@ -30,6 +30,8 @@ void ProxemicsConfig::Validate() const {
               "ProxemicsConfig: need 0 <= squeeze_gap < stop_gap (m)");
   ThrowUnless(std::isfinite(standing_speed) && standing_speed >= 0,
               "ProxemicsConfig: standing_speed must be >= 0 (m/s)");
+  ThrowUnless(std::isfinite(doorway_depth) && doorway_depth >= 0,
+              "ProxemicsConfig: doorway_depth must be >= 0 (m)");
 }
 
 bool IsWhomTheRobotGoesTo(const Eigen::Vector2d& p_MP, const Eigen::Vector2d& p_MB,
@@ -95,6 +97,25 @@ double ApproachSpeedScale(const Pose2& X_MB, const Eigen::Vector2d& v_M,
   return scale;
 }
 
+bool IsLeavingDoorway(const Pose2& X_MB, const Eigen::Vector2d& v_M,
+                      const std::vector<perception::DoorModel>& doors, double doorway_depth,
+                      double robot_radius) {
+  if (doorway_depth <= 0.0 || v_M.norm() < kMovingMps) return false;
+  for (const perception::DoorModel& door : doors) {
+    const double width = door.width();
+    if (!(width > 1e-9)) continue;
+    const Eigen::Vector2d along = (door.p_MLatch - door.p_MHinge) / width;
+    const Eigen::Vector2d normal(-along.y(), along.x());
+    const Eigen::Vector2d from_centre = X_MB.translation() - 0.5 * (door.p_MHinge + door.p_MLatch);
+    const double depth = from_centre.dot(normal);
+    if (std::abs(depth) < doorway_depth &&
+        std::abs(from_centre.dot(along)) < 0.5 * width + robot_radius &&
+        depth * v_M.dot(normal) > 0.0)
+      return true;
+  }
+  return false;
+}
+
 ApproachPace::ApproachPace(ProxemicsConfig config) : config_(std::move(config)) {
   config_.Validate();
 }
@@ -102,9 +123,19 @@ ApproachPace::ApproachPace(ProxemicsConfig config) : config_(std::move(config)) 
 double ApproachPace::Update(double now_s, const Pose2& X_MB, const Eigen::Vector2d& v_M,
                             const std::optional<Eigen::Vector2d>& p_MGoal,
                             const std::vector<perception::TrackedPersonWithIntent>& people,
-                            double robot_radius, double person_radius) {
-  const double scale =
+                            double robot_radius, double person_radius, bool leaving_doorway) {
+  double scale =
       ApproachSpeedScale(X_MB, v_M, p_MGoal, people, robot_radius, person_radius, config_);
+  if (leaving_doorway && scale < kHeldScale) {
+    // Out of the doorway at a crawl: slowed for anyone ahead from stop_gap, stopped at
+    // squeeze_gap (where standing would be a contact, not only a nuisance).
+    ProxemicsConfig out = config_;
+    out.slow_gap = config_.stop_gap;
+    out.stop_gap = config_.squeeze_gap;
+    scale =
+        std::max(scale, std::min(kHeldScale, ApproachSpeedScale(X_MB, v_M, p_MGoal, people,
+                                                                robot_radius, person_radius, out)));
+  }
   // Going nowhere tells nothing: held to a standstill at a path's start, the planned pace
   // itself hovers there, and a step in which it is below kMovingMps is no step free.
   if (v_M.norm() < kMovingMps) return scale;

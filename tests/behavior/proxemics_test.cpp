@@ -240,5 +240,59 @@ TEST(ProxemicsTest, ApproachPaceEdgesPastSomeoneStandingOnlyOncePatienceIsSpent)
         0.0);
 }
 
+// A door 1 m wide on the x axis, hinge at x = -0.5: its doorway spans |x| < 0.5 + the
+// footprint, within doorway_depth (0.6 m) of the line y = 0 on either side.
+perception::DoorModel DoorOnTheXAxis() {
+  perception::DoorModel door;
+  door.id = "door";
+  door.p_MHinge = {-0.5, 0.0};
+  door.p_MLatch = {0.5, 0.0};
+  return door;
+}
+
+TEST(ProxemicsTest, LeavingADoorwayIsGoingAwayFromItsLineBetweenItsJambs) {
+  const std::vector doors = {DoorOnTheXAxis()};
+  const double depth = ProxemicsConfig{}.doorway_depth;
+  const auto leaving = [&](const Eigen::Vector2d& p, const Eigen::Vector2d& v) {
+    return IsLeavingDoorway({p.x(), p.y(), 0.0}, v, doors, depth, kRobotRadius);
+  };
+  EXPECT_TRUE(leaving({0.0, 0.3}, {0.0, 0.4}));    // past the line, going on
+  EXPECT_TRUE(leaving({0.0, -0.3}, {0.0, -0.4}));  // either side
+  EXPECT_FALSE(leaving({0.0, -0.3}, {0.0, 0.4}));  // coming to the line
+  EXPECT_FALSE(leaving({0.0, 0.7}, {0.0, 0.4}));   // out of it already
+  EXPECT_FALSE(leaving({0.8, 0.3}, {0.0, 0.4}));   // beside the jamb
+  EXPECT_TRUE(leaving({0.6, 0.3}, {0.0, 0.4}));    // the footprint overlaps the opening
+  EXPECT_FALSE(leaving({0.0, 0.3}, {0.0, 0.0}));   // standing
+  EXPECT_FALSE(leaving({0.0, 0.3}, {0.4, 0.0}));   // along the line
+  EXPECT_FALSE(IsLeavingDoorway({0.0, 0.3, 0.0}, {0.0, 0.4}, doors, 0.0, kRobotRadius));
+}
+
+// Two wards seed 24: out of a doorway into a corridor, a resident walking the corridor towards
+// the robot's way held it to a stop 0.46 m past the line, in the way of whoever came through.
+TEST(ProxemicsTest, LeavingADoorwayTheRobotCrawlsOutUnlessSomeoneIsWithinTheSqueezeGap) {
+  const ProxemicsConfig config;
+  const Eigen::Vector2d v(0.0, 0.4);
+  const Pose2 X_MB{0.0, 0.4, M_PI / 2};
+  // Walking across ahead, 0.35 m from the robot's edge now (inside stop_gap: a stop).
+  const std::vector coming = {
+      At({0.0 + 0.9 * std::cos(1.0), 0.4 + 0.9 * std::sin(1.0)}, {-0.3, 0.0})};
+  const auto update = [&](ApproachPace* pace,
+                          const std::vector<perception::TrackedPersonWithIntent>& people,
+                          bool leaving) {
+    return pace->Update(0.0, X_MB, v, std::nullopt, people, kRobotRadius, kPersonRadius, leaving);
+  };
+  ApproachPace held{config}, out{config};
+  EXPECT_DOUBLE_EQ(update(&held, coming, false), 0.0);
+  EXPECT_DOUBLE_EQ(update(&out, coming, true), ApproachPace::kHeldScale);
+  // Nobody near: the planned pace, doorway or not.
+  EXPECT_DOUBLE_EQ(update(&out, {}, true), 1.0);
+  // Someone within the squeeze gap ahead stops it even there.
+  const std::vector touching = {At({0.0, 0.4 + kRobotRadius + kPersonRadius + 0.1})};
+  EXPECT_DOUBLE_EQ(update(&out, touching, true), 0.0);
+  // Just beyond the squeeze gap: slower than a crawl, not stopped.
+  const std::vector close = {At({0.0, 0.4 + kRobotRadius + kPersonRadius + 0.22})};
+  EXPECT_NEAR(update(&out, close, true), (0.22 - 0.2) / (0.45 - 0.2), 1e-9);
+}
+
 }  // namespace
 }  // namespace egress::behavior

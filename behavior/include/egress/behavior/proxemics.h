@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 
 #include "egress/hsr_interface/geometry.h"
+#include "egress/perception/door_estimation.h"
 #include "egress/perception/world_state.h"
 
 namespace egress::behavior {
@@ -45,6 +46,12 @@ struct ProxemicsConfig {
   double patience_s{5.0};
   double squeeze_gap{0.2};      ///< [m], below stop_gap
   double standing_speed{0.25};  ///< Tracked people slower than this stand still [m/s].
+  /// Within this of a door's line, between its jambs (grown by the footprint), the base is in
+  /// the doorway [m]. Going out of it, the pace holds the robot to no less than a crawl
+  /// (ApproachPace::kHeldScale) unless someone is within squeeze_gap ahead: stopped there for a
+  /// passer-by, it would stand in the way of everyone who comes through the door (two wards seed
+  /// 24: stopped 0.46 m past door_d's line for a resident walking the corridor). 0: no floor.
+  double doorway_depth{0.6};
   /// @throws InvalidArgument naming the field.
   void Validate() const;
 };
@@ -74,6 +81,13 @@ double ApproachSpeedScale(const Pose2& X_MB, const Eigen::Vector2d& v_M,
                           double robot_radius, double person_radius, const ProxemicsConfig& config,
                           bool squeeze = false);
 
+/// Whether a robot at X_MB going along v_M is in one of `doors`' doorways (within
+/// `doorway_depth` of its door line, and between its jambs grown by `robot_radius` [m]) and going
+/// out of it (away from the door line).
+bool IsLeavingDoorway(const Pose2& X_MB, const Eigen::Vector2d& v_M,
+                      const std::vector<perception::DoorModel>& doors, double doorway_depth,
+                      double robot_radius);
+
 /// The robot's pace near people over time: ApproachSpeedScale, and patience. While the robot
 /// is held to a crawl (below kHeldScale) by people who stand still, for `patience_s` in a row,
 /// it edges past them (ApproachSpeedScale with `squeeze`) until it is no longer held. Without
@@ -88,10 +102,12 @@ class ApproachPace {
 
   explicit ApproachPace(ProxemicsConfig config);
   /// The scale at `now_s` [s] (monotonic across calls); arguments as ApproachSpeedScale's.
+  /// `leaving_doorway` (IsLeavingDoorway): the scale is at least a crawl (kHeldScale), slowed
+  /// from stop_gap to a stop at squeeze_gap for anyone ahead (ProxemicsConfig::doorway_depth).
   double Update(double now_s, const Pose2& X_MB, const Eigen::Vector2d& v_M,
                 const std::optional<Eigen::Vector2d>& p_MGoal,
                 const std::vector<perception::TrackedPersonWithIntent>& people, double robot_radius,
-                double person_radius);
+                double person_radius, bool leaving_doorway = false);
   /// Whether it edges past people standing still (as of the last Update with a pace planned).
   bool squeezing() const { return squeezing_; }
 
