@@ -322,7 +322,7 @@ void TwinWorld::Impl::UpdatePeople() {
         // Behind the leaf (it stands between them and the doorway, in the pocket it makes with
         // the wall), out past its free edge: stepping straight back keeps them in the pocket,
         // leaning on the leaf that cannot open for them.
-        const Eigen::Vector2d edge = d.FreeEdge();
+        const Eigen::Vector2d edge = FreeEdge(d);
         const bool behind = SegmentsCross(p.walker.position, d.fixed->centre, hinge, edge);
         p.walker.target = hinge + (behind ? Eigen::Vector2d((edge - hinge).normalized())
                                           : from_hinge.normalized()) *
@@ -384,7 +384,7 @@ void TwinWorld::Impl::UpdatePeople() {
           continue;
         }
         const Eigen::Vector2d hinge = d.fixed->desc->p_WH.head<2>();
-        const Eigen::Vector2d edge = d.FreeEdge();
+        const Eigen::Vector2d edge = FreeEdge(d);
         // Past the free edge and a shoulder to the side of the leaf the waypoint is on: from
         // there the way on does not cross the leaf again.
         const Eigen::Vector2d along = (edge - hinge).normalized();
@@ -500,7 +500,7 @@ void TwinWorld::Impl::UpdatePeople() {
   }
   std::vector<WallSegment> leaves;
   for (const auto& d : doors) {
-    leaves.push_back({d.fixed->desc->p_WH.head<2>(), d.FreeEdge()});
+    leaves.push_back({d.fixed->desc->p_WH.head<2>(), FreeEdge(d)});
   }
   const Twist2 V_B = RobotVelocity();
   const Eigen::Vector2d v_W = X_WB.rotation() * Eigen::Vector2d(V_B.vx, V_B.vy);

@@ -1,5 +1,7 @@
 #include "twin_world_impl.h"
 
+#include <limits>
+
 namespace egress::twin {
 
 void TwinWorld::Impl::BuildDoors() {
@@ -109,7 +111,7 @@ double TwinWorld::Impl::MeasureDoorAngle(const Door& d) const {
 
 bool TwinWorld::Impl::LeafSwingsIntoSomeone(const Door& d) const {
   const Eigen::Vector2d hinge = d.fixed->desc->p_WH.head<2>();
-  const Eigen::Vector2d edge = d.FreeEdge();
+  const Eigen::Vector2d edge = FreeEdge(d);
   const double omega_z = d.leaf->getAngularVelocity().z();  // about W's z [rad/s]
   if (std::abs(omega_z) < 1e-9) return false;
   for (const auto& p : people) {
@@ -173,6 +175,19 @@ void TwinWorld::Impl::UpdateDoors() {
       AddEvent("door_closed", d.fixed->desc->name);
     }
   }
+}
+
+Eigen::Vector2d TwinWorld::Impl::FreeEdge(const Door& d) const {
+  const auto k = std::size_t(&d - doors.data());
+  if (free_edges.size() != doors.size())
+    free_edges.assign(doors.size(),
+                      {std::numeric_limits<double>::quiet_NaN(), Eigen::Vector2d::Zero()});
+  auto& [angle, edge] = free_edges[k];
+  if (!(angle == d.angle)) {
+    edge = d.fixed->desc->CalcFreeEdge(d.angle).head<2>();
+    angle = d.angle;
+  }
+  return edge;
 }
 
 }  // namespace egress::twin

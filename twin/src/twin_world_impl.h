@@ -6,8 +6,6 @@
 // twin_robot_body.cpp (base, arm, gripper, payloads), twin_rays.cpp (ray casting for the
 // sensors).
 
-#include <limits>
-
 #include "ray_convex.h"
 #include "twin_model_compiled.h"
 
@@ -29,18 +27,6 @@ struct Door {
   bool reported_open{false};
   bool reported_closed{true};
   DoorPhase last_phase{DoorPhase::kClosed};
-
-  // The leaf's free edge on the floor at `angle` (DoorDescription::CalcFreeEdge), kept while the
-  // angle stays the same: the people's rules ask for it per person and step.
-  Eigen::Vector2d FreeEdge() const {
-    if (!(free_edge_angle == angle)) {
-      free_edge = fixed->desc->CalcFreeEdge(angle).head<2>();
-      free_edge_angle = angle;
-    }
-    return free_edge;
-  }
-  mutable double free_edge_angle{std::numeric_limits<double>::quiet_NaN()};
-  mutable Eigen::Vector2d free_edge{Eigen::Vector2d::Zero()};
 };
 
 // A person in the run.
@@ -312,6 +298,12 @@ struct TwinWorld::Impl {
       [this](const btCollisionObject* o, int t) { return EntityOf(o, t); };
   std::vector<Entity> entities;
   std::vector<Door> doors;
+  // The leaves' free edges on the floor (DoorDescription::CalcFreeEdge), per door, with the angle
+  // each is at: the people's rules ask for them per person and step. Not in Door: GCC 12's
+  // sanitizer build reads a grown Door's copy as maybe-uninitialized.
+  mutable std::vector<std::pair<double, Eigen::Vector2d>> free_edges;
+  // The free edge of doors[k] at its angle now.
+  Eigen::Vector2d FreeEdge(const Door& d) const;
   std::vector<Person> people;
   std::vector<PersonState> states_cache;
   std::vector<Payload> payloads;
