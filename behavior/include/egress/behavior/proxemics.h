@@ -83,7 +83,8 @@ double ApproachSpeedScale(const Pose2& X_MB, const Eigen::Vector2d& v_M,
 
 /// Whether a robot at X_MB going along v_M is in one of `doors`' doorways (within
 /// `doorway_depth` of its door line, and between its jambs grown by `robot_radius` [m]) and going
-/// out of it (away from the door line).
+/// out of it (away from the door line). Unlike DoorModel::OnDoorLine (a point between the
+/// jambs), a footprint that still overlaps the opening counts.
 bool IsLeavingDoorway(const Pose2& X_MB, const Eigen::Vector2d& v_M,
                       const std::vector<perception::DoorModel>& doors, double doorway_depth,
                       double robot_radius);
