@@ -302,7 +302,7 @@ struct TwinWorld::Impl {
   // each is at: the people's rules ask for them per person and step. Not in Door: GCC 12's
   // sanitizer build reads a grown Door's copy as maybe-uninitialized.
   mutable std::vector<std::pair<double, Eigen::Vector2d>> free_edges;
-  // The free edge of doors[k] at its angle now.
+  // The free edge of `d` (an element of `doors`: its index keys the cache) at its angle now.
   Eigen::Vector2d FreeEdge(const Door& d) const;
   std::vector<Person> people;
   std::vector<PersonState> states_cache;
