@@ -58,7 +58,8 @@ struct StudyOptions {
   std::vector<std::string> conditions{std::begin(kConditions), std::end(kConditions)};
   bool overwrite{false};
   bool quiet{false};
-  double crowd_social_rate_hz{twin::TwinConfig{}.crowd_social_rate_hz};
+  double crowd_rate_hz{twin::TwinConfig{}.crowd_rate_hz};
+  double crowd_social_rate_hz{0.0};  ///< 0: every crowd step
 };
 
 bool IsEvacuee(const twin::PersonState& p) {
@@ -285,7 +286,9 @@ void RunStudy(const StudyOptions& o) {
           fmt::format("'{}' exists; pass --overwrite to replace it", (dir / f).string()));
   }
   twin::TwinConfig twin_config;
-  twin_config.crowd_social_rate_hz = o.crowd_social_rate_hz;  // checked by its option
+  twin_config.crowd_rate_hz = o.crowd_rate_hz;  // in range by its option; Validate: a divisor
+  twin_config.crowd_social_rate_hz =
+      o.crowd_social_rate_hz > 0.0 ? o.crowd_social_rate_hz : o.crowd_rate_hz;
   const twin::Scenario loaded = twin::LoadScenario(o.scenario);
   if (!loaded.mission)
     throw CommandFailed(fmt::format(
@@ -331,6 +334,7 @@ void RunStudy(const StudyOptions& o) {
   nlohmann::json study = {{"scenario", o.scenario},
                           {"trials", o.trials},
                           {"seed_base", o.seed_base},
+                          {"crowd_rate_hz", twin_config.crowd_rate_hz},
                           {"crowd_social_rate_hz", twin_config.crowd_social_rate_hz},
                           {"conditions", nlohmann::json::array()}};
   fmt::print("\n{:<14} {:>7} {:>24} {:>12} {:>9} {:>9} {:>22}\n", "condition", "trials",
@@ -485,10 +489,15 @@ void AddEvacCommand(CLI::App& app) {
       ->check(CLI::IsMember({"no_robot", "robot", "propped_open"}))
       ->capture_default_str();
   study
-      ->add_option("--crowd-social-rate", o->crowd_social_rate_hz,
-                   "Sum the people's social terms at this rate, held between [Hz] "
-                   "(TwinConfig::crowd_social_rate_hz)")
+      ->add_option("--crowd-rate", o->crowd_rate_hz,
+                   "Step the people at this rate, 240 Hz divided by a whole number [Hz] "
+                   "(TwinConfig::crowd_rate_hz)")
       ->capture_default_str()
+      ->check(FiniteIn(1.0, twin::TwinConfig{}.physics_rate_hz));
+  study
+      ->add_option("--crowd-social-rate", o->crowd_social_rate_hz,
+                   "Sum the people's social terms at this rate, held between [Hz] (default: "
+                   "every crowd step; TwinConfig::crowd_social_rate_hz)")
       ->check(FiniteIn(1.0, twin::TwinConfig{}.physics_rate_hz));
   study->add_flag("--overwrite", o->overwrite, "Replace existing output files");
   study->add_flag("-q,--quiet", o->quiet, "No progress bar");

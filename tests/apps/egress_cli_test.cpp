@@ -430,7 +430,7 @@ TEST(EgressCliTest, SimRunWithTheBrainPrintsDecisionsAndTracesTheRunningAction) 
   std::filesystem::remove_all(dir);
 }
 
-TEST(EgressCliTest, TheCrowdsSocialRateIsAnOptionOfSimRunAndEvacStudy) {
+TEST(EgressCliTest, TheCrowdsRatesAreOptionsOfSimRunAndEvacStudy) {
   const auto dir = egress::testing::TestTempPath("social_rate");
   std::filesystem::create_directories(dir);
   const std::string scenario = kWorldsDir + "/scenarios/evacuation/lab_escort.yaml";
@@ -445,6 +445,8 @@ TEST(EgressCliTest, TheCrowdsSocialRateIsAnOptionOfSimRunAndEvacStudy) {
   const std::string every = hash("", "every.jsonl");
   EXPECT_EQ(hash(" --crowd-social-rate 240", "every_again.jsonl"), every);  // the default
   EXPECT_NE(hash(" --crowd-social-rate 60", "held.jsonl"), every);
+  EXPECT_EQ(hash(" --crowd-rate 240", "crowd_every.jsonl"), every);  // the default
+  EXPECT_NE(hash(" --crowd-rate 120", "crowd_120.jsonl"), every);
   for (const std::string& command :
        {"sim run " + scenario + " -q",
         "evac study " + scenario + " -q --trials 1 --out " + (dir / "study").string()}) {
@@ -452,6 +454,12 @@ TEST(EgressCliTest, TheCrowdsSocialRateIsAnOptionOfSimRunAndEvacStudy) {
     EXPECT_NE(bad.exit_code, 0) << command;
     EXPECT_THAT(bad.output, HasSubstr("--crowd-social-rate")) << command;
     EXPECT_THAT(bad.output, HasSubstr("240")) << command;  // at most the physics rate
+    const Result not_a_divisor = RunEgress(command + " --crowd-rate 100");
+    EXPECT_NE(not_a_divisor.exit_code, 0) << command;
+    EXPECT_THAT(not_a_divisor.output, HasSubstr("crowd_rate_hz")) << command;
+    const Result above_crowd = RunEgress(command + " --crowd-rate 120 --crowd-social-rate 240");
+    EXPECT_NE(above_crowd.exit_code, 0) << command;
+    EXPECT_THAT(above_crowd.output, HasSubstr("crowd_social_rate_hz")) << command;
   }
   std::filesystem::remove_all(dir);
 }

@@ -97,6 +97,15 @@ TEST(EvacueesTest, WithSocialTermsHeldAt60HzTheDenseFlowStaysInTheHydraulicBand)
   ExpectDenseFlowInTheHydraulicBand(config);
 }
 
+TEST(EvacueesTest, WithThePeopleSteppedAt120HzTheDenseFlowStaysInTheHydraulicBand) {
+  // TwinConfig::crowd_rate_hz at half the physics rate: every person's decisions and forces every
+  // other physics step, their bodies carried on between.
+  TwinConfig config;
+  config.crowd_rate_hz = 120.0;
+  config.crowd_social_rate_hz = 120.0;
+  ExpectDenseFlowInTheHydraulicBand(config);
+}
+
 // The office: room 1 (x < 5), door_a (x = 5, push buttons), room 2, door_b (x = 9, glass,
 // proximity plates), room 3; both doors closed; the robot parked in room 1's corner.
 std::string OfficeExitRoute(int count, const std::string& mobility) {
@@ -121,6 +130,34 @@ TEST(EvacueesTest, AGroupFollowsItsExitRouteOperatingEachClosedDoor) {
   EXPECT_GE(CountEvents(world, "door_operated", "door_a"), 1);
   EXPECT_GE(CountEvents(world, "door_operated", "door_b"), 1);
   EXPECT_EQ(CountEvents(world, "button_pressed"), 0);  // the robot pressed nothing
+}
+
+TEST(EvacueesTest, SteppedBelowThePhysicsRateWalkersAreCarriedOnEveryPhysicsStep) {
+  auto loaded = LoadText(OfficeExitRoute(6, ""), WorldsDir() / "office");
+  TwinConfig config;
+  config.crowd_rate_hz = 80.0;  // every third physics step
+  config.crowd_social_rate_hz = 80.0;
+  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr(), config);
+  world.StepFor(2.0);
+  // Someone walking: over each of the next six physics steps they move by their velocity.
+  std::vector<PersonState> before = world.people();
+  int walking = 0;
+  for (int k = 0; k < 6; ++k) {
+    world.Step();
+    const std::vector<PersonState> after = world.people();
+    for (std::size_t i = 0; i < after.size(); ++i) {
+      if (before[i].velocity.norm() < 0.2) continue;
+      ++walking;
+      const Eigen::Vector2d moved = after[i].position - before[i].position;
+      EXPECT_GT(moved.norm(), 0.5 * before[i].velocity.norm() * world.step_size())
+          << after[i].name << " step " << k;
+    }
+    before = after;
+  }
+  EXPECT_GT(walking, 0);
+  world.StepFor(118.0);
+  for (const auto& p : world.people())
+    EXPECT_TRUE(p.out) << p.name << " at " << p.position.transpose();
 }
 
 // A group of 12 put 0.8 m from room 1's west wall (its face at x = 0.1): the 4 x 4 grid's

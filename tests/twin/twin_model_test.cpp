@@ -76,6 +76,21 @@ TEST_F(TwinModelTest, ABadConfigNamesTheField) {
   EXPECT_THAT(
       [&] { TwinModel(scenario_, world_, Hsr(), config); },
       ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("crowd_social_rate_hz")));
+  for (const double crowd_rate : {100.0, 480.0, 0.0, std::nan("")}) {  // 240 / k only
+    config = {};
+    config.crowd_rate_hz = crowd_rate;
+    config.crowd_social_rate_hz = 60.0;
+    EXPECT_THAT([&] { TwinModel(scenario_, world_, Hsr(), config); },
+                ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("crowd_rate_hz")))
+        << crowd_rate;
+  }
+  config = {};
+  config.crowd_rate_hz = 120.0;  // the social terms at most as often as the rest
+  EXPECT_THAT(
+      [&] { TwinModel(scenario_, world_, Hsr(), config); },
+      ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("crowd_social_rate_hz")));
+  config.crowd_social_rate_hz = 120.0;
+  EXPECT_NO_THROW(TwinModel(scenario_, world_, Hsr(), config));
   config = {};
   config.robot_mass = std::nan("");
   EXPECT_THAT([&] { TwinModel(scenario_, world_, Hsr(), config); },

@@ -338,7 +338,8 @@ void TwinWorld::Impl::UpdatePeople() {
     // Pushed against a jamb (a social-force local minimum, e.g. after making way for the
     // robot), a walker heading for the doorway steps back onto the door's axis and goes again.
     const bool heading_for_doorway = gate >= 0 && p.state.phase == PersonPhase::kWalking;
-    p.stuck_for = heading_for_doorway && p.walker.velocity.norm() < 0.05 ? p.stuck_for + dt : 0.0;
+    p.stuck_for =
+        heading_for_doorway && p.walker.velocity.norm() < 0.05 ? p.stuck_for + crowd_dt : 0.0;
     if (p.stuck_for > kStuckSec && !p.realigned) {
       const Door& d = doors[std::size_t(gate)];
       const double side =
@@ -354,9 +355,9 @@ void TwinWorld::Impl::UpdatePeople() {
     // wall to the social forces, and a wall between walker and goal is a local minimum), a
     // walker steps round the leaf's free edge, as people do.
     p.blocked_for = p.state.phase == PersonPhase::kWalking && p.walker.velocity.norm() < 0.05
-                        ? p.blocked_for + dt
+                        ? p.blocked_for + crowd_dt
                         : 0.0;
-    p.slow_for = p.walker.velocity.norm() < kHeldUpMps ? p.slow_for + dt : 0.0;
+    p.slow_for = p.walker.velocity.norm() < kHeldUpMps ? p.slow_for + crowd_dt : 0.0;
     if (p.blocked_for > kStuckSec) {
       RewindIfPushedBack(p);
       GiveWayIfJammed(p);
@@ -509,14 +510,14 @@ void TwinWorld::Impl::UpdatePeople() {
   // within a few metres are most of a crowd's cost); the drive and body contact, which are
   // stiff, every step, as is the integration, so bodies move smoothly.
   const auto social_every = std::max<std::uint64_t>(
-      1, std::uint64_t(std::lround(config.physics_rate_hz / config.crowd_social_rate_hz)));
+      1, std::uint64_t(std::lround(config.crowd_rate_hz / config.crowd_social_rate_hz)));
   std::vector<Eigen::Vector2d> accelerations;
   if (social_every == 1) {
     // Every term every step: one sum.
     accelerations = sfm.CalcAccelerations(walkers, discs, fixed.wall_cells, leaves);
   } else {
     std::vector<Eigen::Vector2d> social;
-    if (step % social_every == 0) {
+    if (step / crowd_every % social_every == 0) {
       social = sfm.CalcSocialAccelerations(walkers, discs, fixed.wall_cells, leaves);
       for (std::size_t k = 0; k < walkers.size(); ++k)
         people[walker_of[k]].social_acceleration = social[k];
@@ -527,6 +528,10 @@ void TwinWorld::Impl::UpdatePeople() {
     accelerations =
         sfm.CalcAccelerationsWithSocial(social, walkers, discs, fixed.wall_cells, leaves);
   }
+  // Velocities over the crowd step, positions over this physics step: CarryPeople moves them
+  // on over the rest (v += a crowd_dt, x += v dt).
+  for (auto& a : accelerations)
+    a *= double(crowd_every);
   sfm.Integrate(&walkers, accelerations, dt, discs);
   // Standing people do not integrate (they would drift under wall forces).
   for (std::size_t k = 0; k < walkers.size(); ++k) {
@@ -535,10 +540,7 @@ void TwinWorld::Impl::UpdatePeople() {
     p.walker = walkers[k];
     p.state.position = p.walker.position;
     p.state.velocity = p.walker.velocity;
-    const btTransform T(btQuaternion::getIdentity(),
-                        btVector3(p.walker.position.x(), p.walker.position.y(), kPersonHeight / 2));
-    p.body->getMotionState()->setWorldTransform(T);
-    p.body->setWorldTransform(T);
+    PlacePersonBody(p);
   }
 }
 

@@ -137,7 +137,7 @@ bool TwinWorld::Impl::OperateDoor(Person& p, int gate) {
   p.walker.final_target = true;
   p.walker.desired_speed = there ? 0.0 : p.speed;
   if (there) {
-    p.operate_elapsed += dt;
+    p.operate_elapsed += crowd_dt;
     p.operate_progress_at = time;
   }
   if (p.operate_elapsed >= p.operate_time) {

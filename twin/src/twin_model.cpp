@@ -1,5 +1,7 @@
 #include "egress/twin/twin_model.h"
 
+#include <cmath>
+
 #include "people/person_behavior.h"
 #include "twin_model_compiled.h"
 
@@ -10,10 +12,17 @@ using namespace world_detail;
 void TwinConfig::Validate() const {
   ThrowUnless(std::isfinite(physics_rate_hz) && physics_rate_hz >= 60.0,
               "TwinConfig: physics_rate_hz must be at least 60 (got ", physics_rate_hz, ")");
+  // A whole number of physics steps per crowd step (to a part in a million).
+  const double per_crowd_step = physics_rate_hz / crowd_rate_hz;
+  ThrowUnless(std::isfinite(crowd_rate_hz) && crowd_rate_hz > 0.0 &&
+                  crowd_rate_hz <= physics_rate_hz &&
+                  std::abs(per_crowd_step - std::round(per_crowd_step)) < 1e-6 * per_crowd_step,
+              "TwinConfig: crowd_rate_hz must be physics_rate_hz (", physics_rate_hz,
+              ") divided by a whole number (got ", crowd_rate_hz, ")");
   ThrowUnless(std::isfinite(crowd_social_rate_hz) && crowd_social_rate_hz > 0.0 &&
-                  crowd_social_rate_hz <= physics_rate_hz,
-              "TwinConfig: crowd_social_rate_hz must be positive and at most physics_rate_hz (got ",
-              crowd_social_rate_hz, ")");
+                  crowd_social_rate_hz <= crowd_rate_hz,
+              "TwinConfig: crowd_social_rate_hz must be positive and at most crowd_rate_hz (got ",
+              crowd_social_rate_hz, ", crowd_rate_hz ", crowd_rate_hz, ")");
   const std::pair<const char*, double> positive[] = {
       {"base_max_linear_acceleration", base_max_linear_acceleration},
       {"base_max_angular_acceleration", base_max_angular_acceleration},

@@ -31,7 +31,9 @@ TwinWorld::Impl::Impl(std::shared_ptr<const TwinModel> twin_model_in, std::uint6
       seed(seed_in),
       model(twin_model->robot_model()),
       config(twin_model->config()),
-      dt(twin_model->step_size()) {
+      dt(twin_model->step_size()),
+      crowd_every(std::uint64_t(std::lround(config.physics_rate_hz / config.crowd_rate_hz))),
+      crowd_dt(double(crowd_every) * dt) {
   entities = fixed.entities;
   collision_config = std::make_unique<btDefaultCollisionConfiguration>();
   dispatcher = std::make_unique<btCollisionDispatcher>(collision_config.get());
@@ -181,7 +183,11 @@ void TwinWorld::Impl::RecordContacts() {
 
 void TwinWorld::Impl::StepOnce() {
   ApplyFaults();
-  UpdatePeople();
+  if (step % crowd_every == 0) {
+    UpdatePeople();
+  } else {
+    CarryPeople();
+  }
   UpdateRobot();
   UpdateArmBodies();
   FollowHeldPayload();
@@ -196,6 +202,22 @@ void TwinWorld::Impl::StepOnce() {
   for (std::size_t i = 0; i < people.size(); ++i)
     states_cache[i] = people[i].state;
   ray_proxies_stale = true;  // re-posed before the next ray cast (sensors run at 5-40 Hz)
+}
+
+void TwinWorld::Impl::CarryPeople() {
+  for (auto& p : people) {
+    if (!p.state.started || p.state.out) continue;
+    p.walker.position += p.walker.velocity * dt;
+    p.state.position = p.walker.position;
+    PlacePersonBody(p);
+  }
+}
+
+void TwinWorld::Impl::PlacePersonBody(Person& p) {
+  const btTransform T(btQuaternion::getIdentity(),
+                      btVector3(p.walker.position.x(), p.walker.position.y(), kPersonHeight / 2));
+  p.body->getMotionState()->setWorldTransform(T);
+  p.body->setWorldTransform(T);
 }
 
 TwinWorld::TwinWorld(std::shared_ptr<const TwinModel> model, std::uint64_t seed) {

@@ -151,6 +151,10 @@ struct TwinWorld::Impl {
                 const std::string& detail = "");
 
   void UpdatePeople();
+  // Between the people's steps: each body moved on at its velocity for one physics step.
+  void CarryPeople();
+  // The person's Bullet body to where its walker stands.
+  void PlacePersonBody(Person& p);
 
   // Someone else is in the doorway: wait for them to come through (one at a time).
   bool DoorwayTaken(const Person& me, int door) const;
@@ -255,6 +259,10 @@ struct TwinWorld::Impl {
   std::shared_ptr<const RobotModel> model;
   const TwinConfig& config;
   double dt;
+  // The people are stepped every crowd_every physics steps, crowd_dt [s] apart
+  // (TwinConfig::crowd_rate_hz); between, CarryPeople moves their bodies on.
+  std::uint64_t crowd_every;
+  double crowd_dt;
   std::uint64_t step{0};
   double time{0.0};
 

@@ -32,6 +32,13 @@ struct TwinConfig {
   /// 8 with the robot in a doorway beside a resident against 2, one robot-resident contact
   /// against none), so by default every term is summed every step.
   double crowd_social_rate_hz{240.0};
+  /// The people (their decisions and the social force model's sums and velocities) are stepped
+  /// at this rate [Hz]: physics_rate_hz divided by a whole number, at least
+  /// crowd_social_rate_hz. Between their steps each body is carried on at its velocity every
+  /// physics step, so a person moves as smoothly as the robot (what Bullet's contacts and the
+  /// sensors see); over one crowd step the model integrates the same as at the lower rate. The
+  /// people are most of a crowd run's cost; by default they are stepped with the physics.
+  double crowd_rate_hz{240.0};
   double base_max_linear_acceleration{1.0};   ///< [m/s²]
   double base_max_angular_acceleration{2.0};  ///< [rad/s²]
   double base_max_linear_speed{0.8};          ///< [m/s] (HSR: ~3 km/h)
@@ -42,8 +49,9 @@ struct TwinConfig {
   double grasp_tolerance{0.02};               ///< Lateral centring error a grasp accepts [m]
   double person_hold_force{100.0};            ///< Force a person holds a door with [N]
   double door_crossed_open_angle_deg{60.0};   ///< "Open when crossed" threshold [deg]
-  /// @throws InvalidArgument naming the field for a physics rate below 60 Hz, a crowd social rate
-  /// above it, or a non-positive or non-finite limit.
+  /// @throws InvalidArgument naming the field for a physics rate below 60 Hz, a crowd rate that
+  /// does not divide it or a crowd social rate above the crowd rate, or a non-positive or
+  /// non-finite limit.
   void Validate() const;
 };
 
