@@ -508,7 +508,7 @@ void TwinWorld::Impl::UpdatePeople() {
   const std::vector<DiscObstacle> discs = {{X_WB.translation(), v_W, robot_radius}};
   // The social terms every few steps, held between (sums of every walker's neighbours and walls
   // within a few metres are most of a crowd's cost); the drive and body contact, which are
-  // stiff, every step, as is the integration, so bodies move smoothly.
+  // stiff, every crowd step, as is the integration, so bodies move smoothly.
   const auto social_every = std::max<std::uint64_t>(
       1, std::uint64_t(std::lround(config.crowd_rate_hz / config.crowd_social_rate_hz)));
   std::vector<Eigen::Vector2d> accelerations;
