@@ -116,6 +116,8 @@ nlohmann::json RunStudyTrial(const twin::Scenario& scenario, const twin::WorldDe
   std::vector<twin::DoorwayFrame> doorways(lines.begin(), lines.end());
   DoorwayBlockJudge doorway_judge(std::move(doorways));
   std::vector<Eigen::Vector2d> p_WR;  // the residents still in the building
+  // Since when each resident waiting for a door has waited there (for who is left behind).
+  std::map<std::string, double> waiting_since;
   const double period = brain ? 1.0 / config.control_rate_hz : 0.1;
   double last_t = 0.0;
   const auto all_out = [&] {
@@ -154,6 +156,10 @@ nlohmann::json RunStudyTrial(const twin::Scenario& scenario, const twin::WorldDe
           // another room, the nearest door may be one they never use).
           if (p.phase == twin::PersonPhase::kWaitingForDoor && !p.waiting_for.empty())
             queue[p.waiting_for] += dt;
+          if (p.phase == twin::PersonPhase::kWaitingForDoor)
+            waiting_since.try_emplace(p.name, t);
+          else
+            waiting_since.erase(p.name);
         }
         const Twist2 V_B = twin_world.robot_velocity();
         doorway_judge.Step(dt, p_WB, std::hypot(V_B.vx, V_B.vy), p_WR);
@@ -162,6 +168,8 @@ nlohmann::json RunStudyTrial(const twin::Scenario& scenario, const twin::WorldDe
       run);
   std::vector<double> arrivals;
   int residents = 0, left = 0;
+  // Who is left behind, and where: the seeds worth a look say which door kept whom.
+  nlohmann::json left_people = nlohmann::json::array();
   for (const auto& p : twin_world.people()) {
     if (!IsEvacuee(p)) continue;
     ++residents;
@@ -169,6 +177,17 @@ nlohmann::json RunStudyTrial(const twin::Scenario& scenario, const twin::WorldDe
       arrivals.push_back(p.arrived_at);
     } else {
       ++left;
+      const auto since = waiting_since.find(p.name);
+      left_people.push_back(
+          {{"name", p.name},
+           {"mobility", p.mobility},
+           {"can_operate", p.can_operate},
+           {"phase", std::string(twin::ToString(p.phase))},
+           {"waiting_for", p.waiting_for},
+           {"waiting_since_s", since != waiting_since.end() && !p.waiting_for.empty()
+                                   ? nlohmann::json(since->second)
+                                   : nlohmann::json(nullptr)},
+           {"position", {p.position.x(), p.position.y()}}});
     }
   }
   std::sort(arrivals.begin(), arrivals.end());
@@ -202,6 +221,7 @@ nlohmann::json RunStudyTrial(const twin::Scenario& scenario, const twin::WorldDe
           {"residents", residents},
           {"out", arrivals.size()},
           {"left_behind", left},
+          {"left_behind_people", left_people},
           {"t_evac", left == 0 && !arrivals.empty() ? nlohmann::json(arrivals.back())
                                                     : nlohmann::json(nullptr)},
           {"arrivals", arrivals},
@@ -214,6 +234,33 @@ nlohmann::json RunStudyTrial(const twin::Scenario& scenario, const twin::WorldDe
           {"resident_operations", resident_operations},
           {"robot_operations", robot_operations},
           {"time", result.simulated_time}};
+}
+
+// Who was left behind (trial JSON "left_behind_people", each with its seed), one line each, the
+// first kLeftBehindLines of them: mobility, whether they can operate a door, and the door they
+// wait at and since when.
+void PrintLeftBehind(const nlohmann::json& people) {
+  constexpr std::size_t kLeftBehindLines = 12;
+  for (std::size_t k = 0; k < people.size() && k < kLeftBehindLines; ++k) {
+    const auto& p = people[k];
+    const std::string mobility = p.at("mobility").get<std::string>();
+    const std::string waiting =
+        p.at("waiting_for").get<std::string>().empty()
+            ? p.at("phase").get<std::string>()
+            : fmt::format(
+                  "waiting for {}{}", p.at("waiting_for").get<std::string>(),
+                  p.at("waiting_since_s").is_null()
+                      ? ""
+                      : fmt::format(" since {:.1f} s", p.at("waiting_since_s").get<double>()));
+    fmt::print("      seed {}: {} ({}{}), {} at ({:.1f}, {:.1f})\n",
+               p.at("seed").get<std::uint64_t>(), p.at("name").get<std::string>(),
+               mobility.empty() ? "" : mobility + ", ",
+               p.at("can_operate").get<bool>() ? "operates doors" : "cannot operate doors", waiting,
+               p.at("position")[0].get<double>(), p.at("position")[1].get<double>());
+  }
+  if (people.size() > kLeftBehindLines)
+    fmt::print("      ... and {} more (study.json: left_behind_people)\n",
+               people.size() - kLeftBehindLines);
 }
 
 // People out vs time, one curve (median) and band (10-90 %) per condition.
@@ -353,6 +400,7 @@ void RunStudy(const StudyOptions& o) {
     int left = 0, contacts = 0;
     // The seeds to look at: where someone was left behind, where the robot touched someone.
     std::map<std::uint64_t, int> left_by_seed, contacts_by_seed;
+    nlohmann::json left_people = nlohmann::json::array();  // each with its seed
     double closest = std::numeric_limits<double>::infinity(), blocking = 0.0, standing = 0.0;
     std::map<std::string, std::vector<double>> flow, queue, by_residents, by_robot;
     for (const auto& t : trials) {
@@ -360,6 +408,10 @@ void RunStudy(const StudyOptions& o) {
       times.push_back(t_by_seed[c].at(t.at("seed").get<std::uint64_t>()));
       const auto seed = t.at("seed").get<std::uint64_t>();
       if (const int k = t.at("left_behind").get<int>(); k > 0) left_by_seed[seed] = k;
+      for (nlohmann::json p : t.at("left_behind_people")) {
+        p["seed"] = seed;
+        left_people.push_back(std::move(p));
+      }
       if (const int k = t.at("contacts").get<int>(); k > 0) contacts_by_seed[seed] = k;
       left += t.at("left_behind").get<int>();
       contacts += t.at("contacts").get<int>();
@@ -393,6 +445,7 @@ void RunStudy(const StudyOptions& o) {
     };
     if (!left_by_seed.empty())
       fmt::print("    left behind in seeds {}\n", seeds_text(left_by_seed));
+    PrintLeftBehind(left_people);
     if (!contacts_by_seed.empty())
       fmt::print("    contacts in seeds {}\n", seeds_text(contacts_by_seed));
     nlohmann::json doors = nlohmann::json::object();
@@ -436,6 +489,7 @@ void RunStudy(const StudyOptions& o) {
          {"t_evac_ci_s", {ci.low, ci.high}},
          {"left_behind", left},
          {"left_behind_by_seed", seeds_json(left_by_seed)},
+         {"left_behind_people", left_people},
          {"contacts", contacts},
          {"contacts_by_seed", seeds_json(contacts_by_seed)},
          {"closest_m", std::isfinite(closest) ? nlohmann::json(closest) : nlohmann::json(nullptr)},

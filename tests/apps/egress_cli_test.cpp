@@ -583,6 +583,58 @@ TEST(EgressCliTest, BatchesRefuseASeedBaseWhoseLastTrialIsPastTheLargestSeed) {
   std::filesystem::remove_all(dir);
 }
 
+// Who is left behind is named, with the door they wait at and since when (the seeds worth a
+// look): a wheelchair user who cannot operate the lab's shut door waits at it to the time limit
+// with no robot; one who can gets out.
+TEST(EgressCliTest, EvacStudyNamesWhoIsLeftBehindAndTheDoorTheyWaitAt) {
+  const auto dir = egress::testing::TestTempPath("study_left");
+  const std::string scenario = WriteTemp("wheelchair_lab.yaml", R"(name: lab, one wheelchair user
+world: )" + kWorldsDir + R"(/lab/lab.sdf
+seed: 1
+time_limit: 40
+robot:
+  start: {x: 1.6, y: 1.9, yaw_deg: 90}
+  goal: {x: 1.8, y: 5.2}
+doors:
+  - door: lab_door
+    operator: push
+people:
+  - name: resident
+    behavior: evacuate
+    route: [lab_door]
+    start: {x: -1.5, y: 0.4}
+    goal: {x: -1.5, y: 6.0}
+    mobility: {wheelchair: 1}
+    trigger: {at: 1.0}
+mission:
+  tree: )" + kWorldsDir + R"(/../behavior/trees/evacuation_escort.xml
+)");
+  Result run = RunEgress("evac study " + scenario + " --trials 6 -q --conditions no_robot --out " +
+                         (dir / "out").string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const auto study = nlohmann::json::parse(std::ifstream(dir / "out" / "study.json"));
+  const auto& c = study.at("conditions").at(0);
+  const auto& people = c.at("left_behind_people");
+  ASSERT_EQ(int(people.size()), c.at("left_behind").get<int>());
+  ASSERT_GT(people.size(), 0u) << "no seed of six drew someone who cannot operate the door";
+  ASSERT_LT(people.size(), 6u) << "no seed of six drew someone who can";
+  for (const auto& p : people) {
+    EXPECT_EQ(p.at("name"), "resident") << p.dump();
+    EXPECT_EQ(p.at("mobility"), "wheelchair");
+    EXPECT_FALSE(p.at("can_operate").get<bool>());
+    EXPECT_EQ(p.at("phase"), "waiting_for_door");
+    EXPECT_EQ(p.at("waiting_for"), "lab_door");
+    EXPECT_GT(p.at("waiting_since_s").get<double>(), 1.0);  // after they set off
+    EXPECT_LT(p.at("waiting_since_s").get<double>(), 40.0);
+    EXPECT_LT(p.at("position")[1].get<double>(), 3.0);  // on the room's side of the door
+    const std::string line =
+        "seed " + std::to_string(p.at("seed").get<std::uint64_t>()) +
+        ": resident (wheelchair, cannot operate doors), waiting for lab_door since";
+    EXPECT_THAT(run.output, HasSubstr(line));
+  }
+  std::filesystem::remove_all(dir);
+}
+
 // A door's flow is a rate: two residents through at least. One resident alone gives none (null,
 // "n/a"), not a flow of 0 persons/s; their queue time and who opened the door are still given.
 TEST(EgressCliTest, EvacStudyGivesNoFlowThroughADoorOnlyOneResidentPassed) {
