@@ -388,7 +388,9 @@ const std::string kWorldsDir =
     std::filesystem::path(EGRESS_OFFICE_MAP).parent_path().parent_path().string();
 
 // The lab with one evacuee, who sets off at 1 s to go out through lab_door, and the escort.
-std::string WriteOneResidentLab(const std::string& name, double time_limit) {
+// `mobility`: the evacuee's mobility mix (YAML flow map), if any.
+std::string WriteOneResidentLab(const std::string& name, double time_limit,
+                                const std::string& mobility = "") {
   return WriteTemp(name, R"(name: lab, one resident
 world: )" + kWorldsDir + R"(/lab/lab.sdf
 seed: 1
@@ -406,7 +408,8 @@ people:
     route: [lab_door]
     start: {x: -1.5, y: 0.4}
     goal: {x: -1.5, y: 6.0}
-    trigger: {at: 1.0}
+)" + (mobility.empty() ? "" : "    mobility: " + mobility + "\n") +
+                             R"(    trigger: {at: 1.0}
 mission:
   tree: )" + kWorldsDir + R"(/../behavior/trees/evacuation_escort.xml
 )");
@@ -588,27 +591,7 @@ TEST(EgressCliTest, BatchesRefuseASeedBaseWhoseLastTrialIsPastTheLargestSeed) {
 // with no robot; one who can gets out.
 TEST(EgressCliTest, EvacStudyNamesWhoIsLeftBehindAndTheDoorTheyWaitAt) {
   const auto dir = egress::testing::TestTempPath("study_left");
-  const std::string scenario = WriteTemp("wheelchair_lab.yaml", R"(name: lab, one wheelchair user
-world: )" + kWorldsDir + R"(/lab/lab.sdf
-seed: 1
-time_limit: 40
-robot:
-  start: {x: 1.6, y: 1.9, yaw_deg: 90}
-  goal: {x: 1.8, y: 5.2}
-doors:
-  - door: lab_door
-    operator: push
-people:
-  - name: resident
-    behavior: evacuate
-    route: [lab_door]
-    start: {x: -1.5, y: 0.4}
-    goal: {x: -1.5, y: 6.0}
-    mobility: {wheelchair: 1}
-    trigger: {at: 1.0}
-mission:
-  tree: )" + kWorldsDir + R"(/../behavior/trees/evacuation_escort.xml
-)");
+  const std::string scenario = WriteOneResidentLab("wheelchair_lab.yaml", 40.0, "{wheelchair: 1}");
   Result run = RunEgress("evac study " + scenario + " --trials 6 -q --conditions no_robot --out " +
                          (dir / "out").string());
   ASSERT_EQ(run.exit_code, 0) << run.output;
