@@ -31,6 +31,7 @@
 
 #include "brain_trial.h"
 #include "commands.h"
+#include "crowd_rate_options.h"
 #include "doorway_judge.h"
 #include "egress/hsr_interface/error.h"
 #include "egress/twin/scenario.h"
@@ -58,8 +59,7 @@ struct StudyOptions {
   std::vector<std::string> conditions{std::begin(kConditions), std::end(kConditions)};
   bool overwrite{false};
   bool quiet{false};
-  double crowd_rate_hz{twin::TwinConfig{}.crowd_rate_hz};
-  double crowd_social_rate_hz{0.0};  ///< 0: every crowd step
+  CrowdRateOptions crowd;
 };
 
 bool IsEvacuee(const twin::PersonState& p) {
@@ -333,9 +333,7 @@ void RunStudy(const StudyOptions& o) {
           fmt::format("'{}' exists; pass --overwrite to replace it", (dir / f).string()));
   }
   twin::TwinConfig twin_config;
-  twin_config.crowd_rate_hz = o.crowd_rate_hz;  // in range by its option; Validate: a divisor
-  twin_config.crowd_social_rate_hz =
-      o.crowd_social_rate_hz > 0.0 ? o.crowd_social_rate_hz : o.crowd_rate_hz;
+  o.crowd.ApplyTo(twin_config);
   const twin::Scenario loaded = twin::LoadScenario(o.scenario);
   if (!loaded.mission)
     throw CommandFailed(fmt::format(
@@ -542,17 +540,7 @@ void AddEvacCommand(CLI::App& app) {
                    "Conditions to run (no_robot, robot, propped_open; default: all three)")
       ->check(CLI::IsMember({"no_robot", "robot", "propped_open"}))
       ->capture_default_str();
-  study
-      ->add_option("--crowd-rate", o->crowd_rate_hz,
-                   "Step the people at this rate, 240 Hz divided by a whole number [Hz] "
-                   "(TwinConfig::crowd_rate_hz)")
-      ->capture_default_str()
-      ->check(FiniteIn(1.0, twin::TwinConfig{}.physics_rate_hz));
-  study
-      ->add_option("--crowd-social-rate", o->crowd_social_rate_hz,
-                   "Sum the people's social terms at this rate, held between [Hz] (default: "
-                   "every crowd step; TwinConfig::crowd_social_rate_hz)")
-      ->check(FiniteIn(1.0, twin::TwinConfig{}.physics_rate_hz));
+  o->crowd.AddTo(*study);
   study->add_flag("--overwrite", o->overwrite, "Replace existing output files");
   study->add_flag("-q,--quiet", o->quiet, "No progress bar");
   study->callback([o] { RunStudy(*o); });

@@ -22,6 +22,7 @@
 #include "batch.h"
 #include "brain_trial.h"
 #include "commands.h"
+#include "crowd_rate_options.h"
 #include "egress/behavior/task_nodes.h"
 #include "egress/bt/groot2_publisher.h"
 #include "egress/bt/loggers.h"
@@ -85,8 +86,7 @@ struct SimOptions {
   std::optional<std::uint16_t> groot2_port;
   std::string groot2_bind{"127.0.0.1"};
   double pace{0.0};  ///< Real-time factor to hold the run to (0: as fast as it goes).
-  double crowd_rate_hz{twin::TwinConfig{}.crowd_rate_hz};
-  double crowd_social_rate_hz{0.0};  ///< 0: every crowd step
+  CrowdRateOptions crowd;
 };
 
 void RefuseOverwrite(const std::string& path, bool overwrite) {
@@ -178,9 +178,7 @@ void RunSim(const SimOptions& o) {
     }
   }
   twin::TwinConfig twin_config;
-  twin_config.crowd_rate_hz = o.crowd_rate_hz;  // in range by its option; Validate: a divisor
-  twin_config.crowd_social_rate_hz =
-      o.crowd_social_rate_hz > 0.0 ? o.crowd_social_rate_hz : o.crowd_rate_hz;
+  o.crowd.ApplyTo(twin_config);
   twin::RunOptions options;
   options.duration = o.duration;
   // The trace only when something is made of it (recording it costs a few per cent of a run).
@@ -375,14 +373,7 @@ void AddSimCommand(CLI::App& app) {
   sim->add_option("--pace", o->pace,
                   "hold the run to this many times real time (e.g. 1 to watch it in Groot2)")
       ->check(CLI::NonNegativeNumber);
-  sim->add_option("--crowd-rate", o->crowd_rate_hz,
-                  "step the people at this rate, 240 Hz divided by a whole number [Hz] (default: "
-                  "every physics step, 240; TwinConfig::crowd_rate_hz)")
-      ->check(FiniteIn(1.0, twin::TwinConfig{}.physics_rate_hz));
-  sim->add_option("--crowd-social-rate", o->crowd_social_rate_hz,
-                  "sum the people's social terms at this rate, held between [Hz] (default: every "
-                  "crowd step; TwinConfig::crowd_social_rate_hz)")
-      ->check(FiniteIn(1.0, twin::TwinConfig{}.physics_rate_hz));
+  o->crowd.AddTo(*sim);
   sim->add_flag("--overwrite", o->overwrite, "replace existing output files");
   sim->add_flag("-q,--quiet", o->quiet, "print only the verdict");
   sim->add_flag("--laser-people,!--camera-people-only", o->laser_people,
