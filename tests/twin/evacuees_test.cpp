@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "egress/hsr_interface/error.h"
+#include "egress/hsr_interface/geometry.h"
 #include "egress/twin/mobility.h"
 #include "egress/twin/twin_model.h"
 #include "twin_test_util.h"
@@ -341,11 +342,13 @@ TEST(EvacueesTest, SomeoneWhoCannotOperateTheDoorWaitsAtItAndTheRestGoOn) {
 // For each seed 1..`seeds` of the clinic with `people` (YAML list items), 30 s on: the last
 // person, if they cannot operate a door, is waiting for `door` and passes `check`. The number
 // of seeds that drew such a person.
+// `robot`: the scenario's robot entry (off the scene unless given).
 int CheckWhoCannotOperateWaitingAt(const std::string& people, const std::string& door, int seeds,
-                                   const std::function<void(const PersonState&, int)>& check) {
+                                   const std::function<void(const PersonState&, int)>& check,
+                                   const std::string& robot = "{off_scene: true}") {
   int unable = 0;
   for (int seed = 1; seed <= seeds; ++seed) {
-    auto loaded = LoadText("world: clinic.sdf\nrobot: {off_scene: true}\npeople:\n" + people,
+    auto loaded = LoadText("world: clinic.sdf\nrobot: " + robot + "\npeople:\n" + people,
                            WorldsDir() / "clinic");
     TwinWorld world(loaded.scenario, loaded.world, std::uint64_t(seed), Hsr());
     world.StepFor(30.0);
@@ -406,6 +409,40 @@ TEST(EvacueesTest, SomeoneWhoCannotOperateTheDoorLeavesTheWayToItsActuatorClear)
             << "seed " << seed << ": still waiting at the door";
       });
   EXPECT_GT(unable, 0);
+}
+
+// Someone who cannot operate a door, waiting at it, steps out of the robot's straight way to
+// its actuator when the robot is near (kMakeWayForRobotM): two wheelchair users waiting across
+// the clinic's 2 m corridor before door_e left the robot, coming along the corridor, no way to
+// the button on the east wall; it stood 1.3 m from it for 390 s and both were left behind (two
+// wards seed 54). Here the robot stands in the corridor west of door_e, and a wheelchair user
+// who cannot press waits between it and the button; with the robot off the scene, the same
+// resident waits in that way on some seed (the rule is the robot's presence, not the lane's).
+TEST(EvacueesTest, SomeoneWhoCannotOperateTheDoorMakesWayForTheRobotComingToItsActuator) {
+  const Eigen::Vector2d p_WR(20.15, 1.6);  // the robot, facing the button
+  const Eigen::Vector2d stand_at = Eigen::Vector2d(21.99, 1.9) + Eigen::Vector2d(-0.45, 0.0);
+  const std::string resident =
+      "  - {name: w, behavior: evacuate, route: [door_e, exit_door], start: [20.95, 1.45],"
+      " goal: [21.0, 11.5], mobility: {wheelchair: 1}}\n";
+  const auto off_the_way = [&](const PersonState& p) {
+    const Eigen::Vector2d foot = egress::ClosestPointOnSegment(p.position, p_WR, stand_at);
+    return (p.position - foot).norm() - p.radius - 0.215;
+  };
+  double least_without_robot = 1e9;
+  CheckWhoCannotOperateWaitingAt(resident, "door_e", 8, [&](const PersonState& p, int) {
+    least_without_robot = std::min(least_without_robot, off_the_way(p));
+  });
+  const int unable = CheckWhoCannotOperateWaitingAt(
+      resident, "door_e", 8,
+      [&](const PersonState& p, int seed) {
+        // The robot's room beside them (the rule's margin, 0.3 m, less the walk's settling).
+        EXPECT_GT(off_the_way(p), 0.25) << "seed " << seed << " at " << p.position.transpose();
+        EXPECT_LT((p.position - Eigen::Vector2d(21.0, 2.65)).norm(), 2.5)
+            << "seed " << seed << ": still waiting at the door";
+      },
+      "{start: {x: 20.15, y: 1.6, yaw_deg: 0}}");
+  EXPECT_GT(unable, 0);
+  EXPECT_LT(least_without_robot, 0.25);
 }
 
 // Carried by the crowd past a via point of their route (here: started 1 m past it, along the

@@ -4,6 +4,7 @@
 #include "twin_world_impl.h"
 
 #include "doorway_way.h"
+#include "egress/hsr_interface/geometry.h"
 
 #include <cmath>
 #include <limits>
@@ -26,6 +27,11 @@ constexpr double kActuatorClearMarginM = 0.15;
 // waiting who cannot operate it keeps clear: room for a wheelchair or the robot (0.43 m) to come
 // by to it [m].
 constexpr double kActuatorLaneHalfM = 0.6;
+// Someone waiting who cannot operate the door steps out of the robot's straight way to the
+// actuator on their side once the robot is this near the actuator's spot [m], to this much more
+// than the two bodies' radii [m]: people make way for whoever comes to open the door for them.
+constexpr double kMakeWayForRobotM = 3.0;
+constexpr double kRobotWayMarginM = 0.3;
 // A jammed walker gives way to someone nearer the bottleneck for this long [s]: long enough for
 // them to step clear (half a metre at a wheelchair's pace), short enough not to be overtaken by
 // the rest behind.
@@ -171,6 +177,7 @@ std::optional<Eigen::Vector2d> TwinWorld::Impl::ClearOfActuator(const Person& p,
   const double side = (p.walker.position - d.centre).dot(d.normal) >= 0 ? 1 : -1;
   const auto spot = ActuatorSpot(gate, side, p.walker.position);
   if (!spot) return std::nullopt;
+  if (const auto aside = OutOfRobotsWayTo(p, gate, *spot, side)) return aside;
   const Eigen::Vector2d away = p.walker.position - *spot;
   const double keep = kPersonAtActuatorRadiusM + kActuatorClearMarginM + p.walker.radius;
   // The way to it as well, square to the door from the room: waiting in the middle of a 2 m
@@ -202,6 +209,33 @@ std::optional<Eigen::Vector2d> TwinWorld::Impl::ClearOfActuator(const Person& p,
   }
   if (away.norm() >= keep || away.norm() <= 1e-6) return std::nullopt;
   return ClearOfWalls(*spot + away.normalized() * keep, p.walker.radius);
+}
+
+std::optional<Eigen::Vector2d> TwinWorld::Impl::OutOfRobotsWayTo(const Person& p, int gate,
+                                                                 const Eigen::Vector2d& spot,
+                                                                 double side) const {
+  // Two who could not press door_e's button waited across the 2 m corridor before it, the
+  // button's lane (square to the door) kept clear, but not the robot's way along the corridor to
+  // it: the robot stood 1.3 m from the button for 390 s (clinic two wards seed 54).
+  const Eigen::Vector2d p_WB = RobotPose().translation();
+  const DoorModel& d = *doors[std::size_t(gate)].fixed;
+  if ((p_WB - spot).norm() > kMakeWayForRobotM || (p_WB - d.centre).dot(d.normal) * side <= 0.0)
+    return std::nullopt;
+  const Eigen::Vector2d& p_WP = p.walker.position;
+  const Eigen::Vector2d foot = egress::ClosestPointOnSegment(p_WP, p_WB, spot);
+  const double keep = robot_radius + p.walker.radius + kRobotWayMarginM;
+  const Eigen::Vector2d off = p_WP - foot;
+  if (off.norm() >= keep || (foot - p_WB).norm() < 1e-6) return std::nullopt;
+  // Aside, square to the robot's way, on the side they stand (the other if a wall is there).
+  const Eigen::Vector2d way = (spot - p_WB).normalized();
+  Eigen::Vector2d across(-way.y(), way.x());
+  if (across.dot(off) < 0.0) across = -across;
+  for (const double s : {1.0, -1.0}) {
+    const Eigen::Vector2d target = ClearOfWalls(foot + across * s * keep, p.walker.radius);
+    if ((target - egress::ClosestPointOnSegment(target, p_WB, spot)).norm() > keep - 0.02)
+      return target;
+  }
+  return std::nullopt;
 }
 
 void TwinWorld::Impl::GiveWayIfJammed(Person& p) {

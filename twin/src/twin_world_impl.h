@@ -194,6 +194,11 @@ struct TwinWorld::Impl {
   // actuator clear for whoever can (a resident, the robot); nullopt: they are clear of it (or
   // can operate it).
   std::optional<Eigen::Vector2d> ClearOfActuator(const Person& p, int gate) const;
+  // Where that person steps to be out of the robot's straight way to the actuator's `spot` on
+  // their `side` of door `gate`, when the robot is on that side within kMakeWayForRobotM of it
+  // and they stand in its way; nullopt otherwise.
+  std::optional<Eigen::Vector2d> OutOfRobotsWayTo(const Person& p, int gate,
+                                                  const Eigen::Vector2d& spot, double side) const;
   // Where a person on `side` (+1/-1 along the door's normal) stands to operate door `door`'s
   // actuator: in front of its free face, on their side of the door; nullopt if none is there.
   std::optional<Eigen::Vector2d> ActuatorSpot(int door, double side,
