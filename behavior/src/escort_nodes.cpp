@@ -2,6 +2,7 @@
 // open for the people being evacuated, from a spot beside the door out of their way;
 // IsNobodyComing (escort_guard.cpp) breaks an operation off when they come.
 
+#include "escort_room.h"
 #include "escort_watch.h"
 #include "task_node_support.h"
 
@@ -26,6 +27,8 @@ constexpr double kFacingToleranceRad = 20.0 * M_PI / 180.0;
 constexpr double kWatchWithinRad = M_PI / 2;
 // [m] The robot this near its wait spot is there.
 constexpr double kAtSpotM = 0.15;
+// [m] This near the actuator's standoff after an operation, the robot has not left it.
+constexpr double kStillAtActuatorM = 0.3;
 // An operation asked for that did not happen is not asked for again sooner than this [s].
 constexpr double kOperateRetrySec = 3.0;
 // [s] The head's look at the residents' way in lasts this long unless renewed (each tick).
@@ -38,25 +41,6 @@ constexpr double kSpotClearM = 1.0;
 // seed 13: a wheelchair user's side 0.36 m from the standoff; with 0.5 m the robot watched them
 // wait from its spot aside until the time limit).
 constexpr double kStandoffFreeM = 0.33;
-// [m] Someone (a laser return off the map, a tracked person) this near the robot's edge is too
-// near: it makes room. Inside personal space (0.45-1.2 m), beyond a crowd's elbow room.
-constexpr double kMakeRoomGapM = 0.35;
-// [m] How far it looks round for room, and the steps it considers.
-constexpr double kRoomLookM = 2.5;
-constexpr double kRoomStepsM[] = {0.3, 0.6, 1.0};
-constexpr int kRoomHeadings = 16;
-// [s] Making room keeps clear of where people will be up to this far ahead (their positions at
-// their velocity every kRoomHorizonStepSec; the tracker's own forecast is the first 0.8 s of
-// these): about the time a 0.6 m step takes.
-constexpr double kRoomHorizonSec = 2.0;
-constexpr double kRoomHorizonStepSec = 0.2;
-// [m] A step that gains less room than this is not worth taking.
-constexpr double kRoomGainM = 0.1;
-// [m] A step into the laser's blind sector keeps this clear of what it last saw there (school
-// seed 5: the robot at the button stepped straight back among residents standing behind it).
-constexpr double kBlindClearM = 0.25;
-// [m] A step ends at least this much beyond the footprint from the building's walls.
-constexpr double kRoomWallMarginM = 0.1;
 // Someone walking up behind (LettingFollowersPass, SomeoneWalkingUpBehind): it drives on
 // kLetPassClearSec after the last one, or after kLetPassMaxSec [s]; once stopped it stands aside
 // where kAsideGainM more room is (MakeWaySpot).
@@ -84,7 +68,9 @@ constexpr double kSpotSearchStepM = 0.1;
 // way, people found standing at a door with someone by its doorway are waiting for it, and it
 // opens it for them once per hold window, waiting aside in between (never at the actuator: they
 // may be behind it, and its standoff may be before the doorway), and not again for nobody once
-// they are through.
+// they are through. Right after an operation, the door open and someone near (or those it opened
+// for), still at the actuator in their way in, it first steps sideways along the door line away
+// from the opening, up to the wall (the way between the open leaf's edge and the robot is theirs).
 // SUCCESS: operate now. FAILURE: the hold is over — someone came (or it opened for someone
 // waiting) and nobody (moving or not; a resident who cannot open the door waits still) has been
 // near for `clear_for` seconds of watching, or nobody at all was near for `wait_for` (they went
@@ -209,6 +195,30 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // be seen to come (kComingForSec on end) as the robot turns from the actuator.
     if ((came_ || opened_for_waiting_) && unseen_ > Input<double>("clear_for") && looking)
       return Release("everyone is through");
+    // The door open for those waiting or anyone near, and the robot still at the actuator in
+    // their way in: first of all it steps sideways out of the way through, up to the wall (a drive
+    // to its spot may stall beside them, as the drive slows for whoever is near). Standing at the
+    // standoff, it is what they cannot pass (two wards seed 54, clinic seed 19: door_e's leaf
+    // opens towards them, its free edge 0.55 m from the robot at the standoff on the wall where
+    // its button is, and a wheelchair needs 0.66 m). With its way to the spot taken, it stays
+    // there while the door stands open, for a hold window at most (it may have shut unseen).
+    const bool door_open = belief_.door_open_since.count(door_) > 0;
+    if ((opened_for_waiting_ || around.near) && door_open && !squeezed_ &&
+        (standoff_.translation() - belief_.X_MB.translation()).norm() <= kStillAtActuatorM &&
+        InTheLane(pass, belief_.X_MB.translation(), task_.config)) {
+      if (const std::optional<Pose2> to = SqueezeAsidePose(task_, pass, door_)) {
+        task_.motion->FollowPath({belief_.X_MB, *to}, {true}, TuckedArm(*task_.model), belief_.now);
+        Note(StrCat("in the way in to the open door: squeezing aside to ", PoseText(*to)));
+        squeezed_ = true;
+        squeezed_at_ = belief_.now;
+        return NodeStatus::kRunning;
+      }
+    }
+    if (squeezed_ && door_open &&
+        ToSeconds(belief_.now - squeezed_at_) < task_.config.door_hold_window &&
+        (task_.motion->base_moving() ||
+         !WayClear(belief_, spot_, kStandoffFreeM, kSpotClearM, /*ahead_only=*/true)))
+      return NodeStatus::kRunning;
     // Someone too near: the robot steps away from them first, whatever it was doing (a crowd
     // funnelling into the doorway spreads along the wall it waits by). A step under way is
     // re-aimed when someone now comes at where it ends (clinic seed 4: a resident skirting the
@@ -218,7 +228,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // tick the robot hardly moved (clinic seed 124).
     const bool may_step = !making_room_ || ToSeconds(belief_.now - room_since_) >= kReAimAfterSec;
     if (const std::optional<Pose2> room =
-            may_step ? FindRoom(pass, making_room_ ? std::optional(room_to_) : std::nullopt)
+            may_step ? FindRoom(task_, pass, making_room_ ? std::optional(room_to_) : std::nullopt)
                      : std::nullopt) {
       // At the door speed (the quickest the trajectories go): a resident walks at 1 m/s.
       task_.motion->FollowPath({belief_.X_MB, *room}, {true}, task_.motion->arm_target(),
@@ -345,6 +355,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
          (boxed_in &&
           OperateDue(std::max(Input<double>("every"), task_.config.door_hold_window))))) {
       operate_asked_at_ = belief_.now;
+      squeezed_ = false;
       if (found_waiting || all_waiting || boxed_in) opened_for_waiting_ = true;
       return NodeStatus::kSuccess;
     }
@@ -450,69 +461,6 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   }
 
  private:
-  // The heading from p_M to the watch point (WatchPoint).
-  static double LookYaw(const DoorPass& pass, const Eigen::Vector2d& p_M) {
-    const Eigen::Vector2d look = WatchPoint(pass) - p_M;
-    return std::atan2(look.y(), look.x());
-  }
-
-  // Where to step to make room when someone is within kMakeRoomGapM of the robot's edge (or,
-  // during a step to `stepping_to`, of that step's end): of the poses a free straight step away
-  // (the same heading), not in the residents' way in, the one farthest from everyone near, if
-  // it gains kRoomGainM over staying (over the step's end) and is predicted to leave everyone
-  // room. nullopt: nobody that near, or no better place.
-  std::optional<Pose2> FindRoom(const DoorPass& pass,
-                                const std::optional<Eigen::Vector2d>& stepping_to) const {
-    const Eigen::Vector2d at = belief_.X_MB.translation();
-    // A tracked person where they are and where they will be at their velocity up to
-    // kRoomHorizonSec (someone walking at the robot is too near before they arrive, and a step
-    // that keeps clear of them for only the tracker's 0.8 s forecast is a step along their path
-    // — clinic seed 4, a resident pushed along the wall by the crowd caught up with the robot
-    // stepping ahead of them).
-    const std::vector<Occupant> near =
-        PeopleAround(task_, at, kRoomLookM, kRoomHorizonSec, kRoomHorizonStepSec);
-    const auto room_at = [&](const Eigen::Vector2d& q) { return RoomAt(near, q); };
-    if (room_at(stepping_to.value_or(at)) > task_.config.footprint_radius + kMakeRoomGapM)
-      return std::nullopt;
-    // A step is worth the least room it leaves anyone: where it ends (at any time of the
-    // horizon) and on the way there, the robot where the step has taken it when they are where
-    // they are predicted (clinic seed 62: a step to a spot beyond a resident's way, chosen for
-    // the room there, crossed in front of them).
-    const PeopleRoom people(task_, kRoomHorizonSec);
-    const auto worth = [&](const Eigen::Vector2d& q) {
-      return std::min(room_at(q), people.RoomOnTheWay({at, q}));
-    };
-    const double now = stepping_to ? worth(*stepping_to) : room_at(at);
-    const perception::Costmap2D* costmap = belief_.world.costmap;
-    std::optional<Pose2> best;  // never in their way (InTheirWay)
-    // Only a step predicted to leave them room: where every step still meets someone (a
-    // resident pushed at 1.5 m/s into the corner it stood in), the robot keeps its course, which
-    // they can see and avoid, rather than turn about into their way (atrium seed 32: a metre's
-    // step chosen at a predicted -0.16 m reversed the robot into them).
-    double best_room = std::max(now + kRoomGainM, 0.0);
-    for (const double step : kRoomStepsM) {
-      for (int k = 0; k < kRoomHeadings; ++k) {
-        const double a = 2 * M_PI * k / kRoomHeadings;
-        const Eigen::Vector2d q = at + step * Eigen::Vector2d(std::cos(a), std::sin(a));
-        if (room_at(q) <= best_room || InTheirWay(pass, at, q)) continue;
-        // Not up to a wall: a step's quintic settles up to a decimetre past its end (clinic
-        // seed 62: a step to 2.5 cm from the corridor's wall touched it).
-        if (costmap != nullptr &&
-            costmap->IsNearMappedObstacle(q, task_.config.footprint_radius + kRoomWallMarginM))
-          continue;
-        const double room = worth(q);
-        if (room <= best_room || !IsBlindWayClear(task_, belief_.X_MB, at, q, kBlindClearM))
-          continue;
-        const Pose2 candidate{q.x(), q.y(), belief_.X_MB.yaw};
-        // The straight step, not only where it ends: a free pose may lie beyond a wall.
-        if (!task_.planner->IsPathValid({belief_.X_MB, candidate})) continue;
-        best = candidate;
-        best_room = room;
-      }
-    }
-    return best;
-  }
-
   // Someone walking up behind its drive (residents walk faster; two wards seed 3): it stops,
   // stands where people leave it the most room (PeopleRoom, as NavigateTo's give-way) but never
   // in the way in, nearer the doorway or in one (lab seed 14), and drives on kLetPassClearSec
@@ -540,19 +488,13 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     if (!aside_chosen_ && StoppedOrStopTimedOut(task_, *letting_pass_since_)) {
       aside_chosen_ = true;
       const auto aside = MakeWaySpot(task_, kAsideGainM);
-      if (aside && !InTheirWay(pass, at, aside->translation())) {
+      if (aside && !InTheirWay(task_, pass, at, aside->translation())) {
         StepAsideTo(task_, *aside);
         Note(StrCat("stepping aside to ", PoseText(*aside)));
       }
     }
     if (task_.motion->base_failed()) task_.motion->StopBase();  // blocked: stay where it is
     return true;
-  }
-
-  // A step from `at` to `q` into the residents' way in, nearer the doorway, or into a doorway.
-  bool InTheirWay(const DoorPass& pass, const Eigen::Vector2d& at, const Eigen::Vector2d& q) const {
-    return InTheLane(pass, q, task_.config) ||
-           (q - pass.centre).norm() < (at - pass.centre).norm() || IntoADoorway(task_, at, q);
   }
 
   void ResetHold() {
@@ -568,6 +510,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     unseen_ = 0.0;
     stood_open_ = false;
     opened_for_waiting_ = false;
+    squeezed_ = false;
   }
 
   NodeStatus Release(const std::string& why) {
@@ -679,7 +622,9 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   Time room_since_{};                  // when it began
   bool stood_open_{false};  // the door stood open kStillForSec in this hold with nobody moving
   bool opened_for_waiting_{false};  // it operated for someone found waiting, in this hold
-  bool spot_beside_lane_{false};    // no spot along the wall: spot_ is SpotBesideTheLane's
+  bool squeezed_{false};  // stepped aside from the open door's way in since the last operation
+  Time squeezed_at_{};    // when
+  bool spot_beside_lane_{false};  // no spot along the wall: spot_ is SpotBesideTheLane's
   std::optional<Eigen::Vector2d> driving_to_;  // where a drive of this node's under way goes
   double drive_clear_{0.0};  // [m] the room round its end that drive set off with (WayClear)
   std::optional<Time> stuck_since_;         // since when it is not on its way to where it waits

@@ -3,6 +3,7 @@
 // hold for the residents being evacuated — who is near it on the robot's side, and whether anyone
 // is coming.
 
+#include <cmath>
 #include <map>
 #include <string>
 
@@ -19,6 +20,11 @@ inline constexpr double kLookOutM = 2.0;
 /// Where the residents come from, that a hold watches: kLookOutM out from `pass`'s doorway [M].
 inline Eigen::Vector2d WatchPoint(const DoorPass& pass) {
   return pass.centre + pass.n_M * kLookOutM;
+}
+/// The heading [rad] in M from p_M to `pass`'s watch point (WatchPoint).
+inline double LookYaw(const DoorPass& pass, const Eigen::Vector2d& p_M) {
+  const Eigen::Vector2d look = WatchPoint(pass) - p_M;
+  return std::atan2(look.y(), look.x());
 }
 /// [m/s] A tracked person faster than this is on the move.
 inline constexpr double kMovingMps = 0.2;

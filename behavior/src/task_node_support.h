@@ -204,6 +204,9 @@ const perception::TrackedDoor* FindTrackedDoor(const perception::WorldState& wor
                                                const std::string& door);
 /// Far enough past the door line that the closing leaf cannot reach the footprint [m].
 double ExitDistance(const TaskServices& task, const std::string& door);
+/// The middle of `door`'s clear opening [M], between its latch jamb and its leaf at the angle
+/// last estimated (a leaf never seen: square to the door line): the way through an open door.
+Eigen::Vector2d ClearOpeningCentre(const TaskServices& task, const std::string& door);
 /// How far before the door line the robot lines up and waits [m].
 double EntryDistance(const TaskServices& task, const std::string& door, const DoorPass& pass);
 /// The robot's way from X_MB_from onto `door`'s axis, at EntryDistance, facing through it:

@@ -110,7 +110,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
           return NodeStatus::kRunning;  // the leaf is still opening
         }
         // Through the middle of the clear opening, between the latch jamb and the leaf.
-        const Eigen::Vector2d centre = ClearOpeningCentre();
+        const Eigen::Vector2d centre = ClearOpeningCentre(task_, door_);
         const Eigen::Vector2d exit = centre - pass_.n_M * ExitDistance(task_, door_);
         const Eigen::Vector2d offset = belief_.X_MB.translation() - centre;
         std::vector<Pose2> path{belief_.X_MB};
@@ -321,19 +321,6 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
       return ToSeconds(belief_.now - *visit.operated_at) < kOperatorOpeningTime;
     return d->state.motion == perception::DoorMotion::kOpening &&
            ToSeconds(belief_.now - d->state.stamp) < kOperatorOpeningTime;
-  }
-
-  Eigen::Vector2d ClearOpeningCentre() const {
-    const perception::DoorModel& door = *task_.map->FindDoor(door_);
-    double angle = M_PI / 2;
-    for (const auto& d : belief_.world.doors) {
-      if (d.model.id == door_ && d.state.observed) angle = std::min(d.state.angle, M_PI / 2);
-    }
-    constexpr double kLeafHalfThickness = 0.03;  // [m] with a margin
-    const double w = door.width();
-    const double clear_from = std::min(w, w * std::cos(angle) + kLeafHalfThickness);
-    const Eigen::Vector2d along = (door.p_MLatch - door.p_MHinge) / w;
-    return door.p_MHinge + along * (clear_from + w) / 2;
   }
 
   enum class Phase { kToPeek, kPeeking, kToEntry, kWaiting, kThrough };

@@ -543,6 +543,62 @@ TEST_F(HoldForResidentsTest, AfterOpeningForSomeoneWaitingItWaitsAsideWithThemOu
   EXPECT_NEAR(motion_.path().back().x, Standoff().x + 1.5, 1e-6);
 }
 
+// The door open and someone near, the robot still at the actuator in their way in steps sideways
+// along the door line away from the opening, up to the wall (kSqueezeMaxM, 0.4 m), facing the way
+// they come, and waits there while the door stands open if its way to the spot is taken (two
+// wards seed 54, clinic seed 19: door_e's leaf opens towards those waiting, and its free edge
+// ended 0.55 m from the robot at the standoff; a wheelchair needs 0.66 m). Residents as wide as
+// a wheelchair (0.4 m) put the lab's standoff, 1.075 m from the doorway's middle, in their lane.
+TEST_F(HoldForResidentsTest, InTheWayInToTheOpenDoorItStepsAsideAlongTheDoorLine) {
+  services_.config.person_radius = 0.4;
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // operates first
+  // Pressed: the door open, someone by the doorway, the robot at the standoff.
+  belief_.now = At(3.0);
+  OperatedAgo(1.0);
+  DoorSeenOpen(90.0, 1.0);
+  belief_.off_map_returns = {{0.2, 2.2}};
+  belief_.X_MB = Standoff();
+  motion_.StopBase();
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(NotedText("squeezing aside"));
+  ASSERT_EQ(motion_.path().size(), 2u);
+  const Pose2 aside = motion_.path().back();
+  EXPECT_NEAR(aside.x, Standoff().x + 0.4, 1e-6);  // away from the doorway, along its line
+  EXPECT_NEAR(aside.y, Standoff().y, 1e-6);
+  // Facing the way they come (the watch point, 2 m out from the doorway's middle).
+  const Eigen::Vector2d look =
+      detail::WatchPoint(CalcDoorPass(map_, "lab_door", aside)) - aside.translation();
+  EXPECT_NEAR(aside.yaw, std::atan2(look.y(), look.x()), 1e-6);
+  // There, with someone on its way to the spot, it stays while the door stands open.
+  belief_.X_MB = aside;
+  motion_.StopBase();
+  log_.Take();
+  belief_.off_map_returns = {{0.2, 2.2}, {2.3, 2.4}};
+  belief_.now = At(4.0);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_FALSE(motion_.base_moving());
+  EXPECT_FALSE(NotedText("squeezing aside"));
+  EXPECT_FALSE(NotedText("driving to the spot"));
+  // The way there clear, it goes on to the spot.
+  belief_.off_map_returns = {{0.2, 2.2}};
+  belief_.now = At(4.5);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(NotedText("driving to the spot beside the door"));
+}
+
+// ... but not with the door shut: at the standoff beside someone waiting, it goes to its spot.
+TEST_F(HoldForResidentsTest, WithTheDoorShutItDoesNotStepAsideAlongTheDoorLine) {
+  services_.config.person_radius = 0.4;
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);
+  belief_.now = At(3.0);
+  OperatedAgo(1.0);
+  belief_.off_map_returns = {{0.2, 2.2}};
+  belief_.X_MB = Standoff();
+  motion_.StopBase();
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  EXPECT_FALSE(NotedText("squeezing aside"));
+}
+
 // Standing in the residents' way in, it sets off for its spot with someone standing 0.7 m from
 // the way there: staying holds them up more (clinic escort seed 26: a resident beside the way
 // kept the robot before door_e's doorway, and themselves behind it, through two openings). Out
