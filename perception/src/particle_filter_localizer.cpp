@@ -11,6 +11,14 @@
 #include "egress/hsr_interface/error.h"
 
 namespace egress::perception {
+namespace {
+
+// Less motion than this between two scans is the base at rest [m, rad]: 1 cm/s and 0.01 rad/s at
+// the laser's 10 Hz, below any speed the base drives at.
+constexpr double kAtRestTranslationM = 1e-3;
+constexpr double kAtRestRotation = 1e-3;
+
+}  // namespace
 
 void LocalizerConfig::Validate() const {
   ThrowUnless(num_particles >= 10, "Invalid LocalizerConfig: num_particles (", num_particles,
@@ -21,6 +29,13 @@ void LocalizerConfig::Validate() const {
   ThrowUnless(sigma_hit > 0.0, "Invalid LocalizerConfig: sigma_hit (", sigma_hit, ") must be > 0.");
   ThrowUnless(z_hit > 0.0 && z_hit <= 1.0, "Invalid LocalizerConfig: z_hit (", z_hit,
               ") must be in (0, 1].");
+  ThrowUnless(update_min_distance >= 0.0 && update_min_angle >= 0.0 &&
+                  moving_update_distance >= update_min_distance &&
+                  moving_update_angle >= update_min_angle,
+              "Invalid LocalizerConfig: update_min_distance (", update_min_distance,
+              ") and update_min_angle (", update_min_angle,
+              ") must be >= 0, moving_update_distance (", moving_update_distance,
+              ") and moving_update_angle (", moving_update_angle, ") at least as large.");
   ThrowUnless(max_beams >= 1, "Invalid LocalizerConfig: max_beams must be >= 1.");
   ThrowUnless(min_beams >= 1 && min_beams <= max_beams, "Invalid LocalizerConfig: min_beams (",
               min_beams, ") must be in [1, max_beams].");
@@ -144,9 +159,11 @@ void ParticleFilterLocalizer::Predict(const Pose2& X_OB_previous, const Pose2& X
     p.X_MB.y += t * std::sin(heading) + strafe * std::cos(heading);
     p.X_MB.yaw = WrapAngle(p.X_MB.yaw + r);
   }
-  if (moved_distance_ >= config_.update_min_distance || moved_angle_ >= config_.update_min_angle) {
-    moved_since_correction_ = true;
-  }
+  const bool at_rest = translation < kAtRestTranslationM && std::abs(rotation) < kAtRestRotation;
+  const double min_distance =
+      at_rest ? config_.update_min_distance : config_.moving_update_distance;
+  const double min_angle = at_rest ? config_.update_min_angle : config_.moving_update_angle;
+  if (moved_distance_ >= min_distance || moved_angle_ >= min_angle) moved_since_correction_ = true;
 }
 
 double ParticleFilterLocalizer::LikelihoodFieldDistance(const Eigen::Vector2d& p_MQ) const {

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -80,6 +82,54 @@ TEST(ParticleFilterLocalizerTest, IsDeterministicForASeed) {
   }
   EXPECT_EQ(a.x, b.x);
   EXPECT_EQ(a.yaw, b.yaw);
+}
+
+// AMCL's spacing of corrections: driving, one per moving_update_distance; coming to rest, one
+// as soon as the motion since the last passes update_min_distance; standing, none.
+TEST(ParticleFilterLocalizerTest, DrivingItCorrectsEachTenthOfAMetreAndOnceMoreAtRest) {
+  const OccupancyGrid map = testing::TwoRoomMap();
+  LocalizerConfig config;
+  config.recover_below = 0.0;  // no standing relocalization checks
+  ASSERT_EQ(config.moving_update_distance, 0.1);
+  ASSERT_EQ(config.update_min_distance, 0.02);
+  LaserScan scan = testing::MakeScan(121, 8.0);
+  for (const double moving_spacing : {config.moving_update_distance, config.update_min_distance}) {
+    config.moving_update_distance = moving_spacing;
+    ParticleFilterLocalizer localizer(map, {}, config);
+    Pose2 truth{2.0, 2.0, 0.0};
+    localizer.Initialize(truth, Eigen::Vector3d(1e-4, 1e-4, 1e-4).asDiagonal());
+    testing::CastScan(map, truth, &scan);
+    ASSERT_TRUE(localizer.Correct(scan));  // the first scan after Initialize
+    std::vector<bool> corrected;
+    // Six scans 0.04 m apart, driving; then two at rest.
+    for (const double step : {0.04, 0.04, 0.04, 0.04, 0.04, 0.04, 0.0, 0.0}) {
+      const Pose2 before = truth;
+      truth.x += step;
+      localizer.Predict(before, truth);
+      testing::CastScan(map, truth, &scan);
+      corrected.push_back(localizer.Correct(scan));
+    }
+    if (moving_spacing == 0.1) {
+      // 0.12 m at the third scan and again at the sixth; at rest after it, nothing to correct.
+      EXPECT_EQ(corrected,
+                (std::vector<bool>{false, false, true, false, false, true, false, false}));
+    } else {
+      EXPECT_EQ(corrected, (std::vector<bool>{true, true, true, true, true, true, false, false}));
+    }
+    const Pose2 estimate = localizer.Estimate();
+    EXPECT_NEAR(estimate.x, truth.x, 0.03);
+    EXPECT_NEAR(estimate.y, truth.y, 0.03);
+  }
+  // Stopping short of the spacing: the scan at rest corrects.
+  ParticleFilterLocalizer localizer(map, {}, config = LocalizerConfig{});
+  localizer.Initialize({2.0, 2.0, 0.0}, Eigen::Vector3d(1e-4, 1e-4, 1e-4).asDiagonal());
+  testing::CastScan(map, {2.0, 2.0, 0.0}, &scan);
+  ASSERT_TRUE(localizer.Correct(scan));
+  testing::CastScan(map, {2.05, 2.0, 0.0}, &scan);
+  localizer.Predict({2.0, 2.0, 0.0}, {2.05, 2.0, 0.0});
+  EXPECT_FALSE(localizer.Correct(scan));  // 5 cm, still moving
+  localizer.Predict({2.05, 2.0, 0.0}, {2.05, 2.0, 0.0});
+  EXPECT_TRUE(localizer.Correct(scan));  // at rest, 5 cm since the last correction
 }
 
 TEST(ParticleFilterLocalizerTest, AFewReturnsDoNotCorrectThePose) {
@@ -225,6 +275,17 @@ TEST(ParticleFilterLocalizerTest, RejectsBadInput) {
   EXPECT_NO_THROW(ParticleFilterLocalizer(map, {}, config));
   config.recover_below = 0.0;  // disabled: its other fields are not used
   EXPECT_NO_THROW(ParticleFilterLocalizer(map, {}, config));
+  // The spacing while moving is at least that at rest; none of them NaN.
+  config.moving_update_distance = 0.01;
+  EXPECT_THROW(ParticleFilterLocalizer(map, {}, config), InvalidArgument);
+  config.moving_update_distance = 0.1;
+  config.update_min_angle = std::nan("");
+  try {
+    ParticleFilterLocalizer(map, {}, config);
+    ADD_FAILURE() << "a NaN update_min_angle was accepted";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("update_min_angle"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
