@@ -446,10 +446,10 @@ TEST(EgressCliTest, TheCrowdsRatesAreOptionsOfSimRunAndEvacStudy) {
     return at == std::string::npos ? std::string() : run.output.substr(at, 21);
   };
   const std::string every = hash("", "every.jsonl");
-  EXPECT_EQ(hash(" --crowd-social-rate 240", "every_again.jsonl"), every);  // the default
+  EXPECT_EQ(hash(" --crowd-social-rate 120", "every_again.jsonl"), every);  // the default
   EXPECT_NE(hash(" --crowd-social-rate 60", "held.jsonl"), every);
-  EXPECT_EQ(hash(" --crowd-rate 240", "crowd_every.jsonl"), every);  // the default
-  EXPECT_NE(hash(" --crowd-rate 120", "crowd_120.jsonl"), every);
+  EXPECT_EQ(hash(" --crowd-rate 120", "crowd_default.jsonl"), every);  // the default
+  EXPECT_NE(hash(" --crowd-rate 240", "crowd_240.jsonl"), every);
   for (const std::string& command :
        {"sim run " + scenario + " -q",
         "evac study " + scenario + " -q --trials 1 --out " + (dir / "study").string()}) {
@@ -502,7 +502,7 @@ TEST(EgressCliTest, EvacStudyComparesTheThreeConditionsOnTheSameSeeds) {
   EXPECT_LE(by["propped_open"].at("t_evac_median_s").get<double>(),
             by["no_robot"].at("t_evac_median_s").get<double>());
   EXPECT_EQ(by["robot"].at("contacts").get<int>(), 0);
-  EXPECT_EQ(study.at("crowd_social_rate_hz").get<double>(), 240.0);  // every physics step
+  EXPECT_EQ(study.at("crowd_social_rate_hz").get<double>(), 120.0);  // every crowd step
   // What each buys over no robot, seed by seed: one seed, one pair, the difference of the times.
   EXPECT_TRUE(by["no_robot"].at("vs_no_robot").is_null());
   for (const char* c : {"robot", "propped_open"}) {

@@ -85,11 +85,11 @@ TEST_F(TwinModelTest, ABadConfigNamesTheField) {
         << crowd_rate;
   }
   config = {};
-  config.crowd_rate_hz = 120.0;  // the social terms at most as often as the rest
+  config.crowd_rate_hz = 60.0;  // the social terms at most as often as the rest
   EXPECT_THAT(
       [&] { TwinModel(scenario_, world_, Hsr(), config); },
       ::testing::ThrowsMessage<InvalidArgument>(::testing::HasSubstr("crowd_social_rate_hz")));
-  config.crowd_social_rate_hz = 120.0;
+  config.crowd_social_rate_hz = 60.0;
   EXPECT_NO_THROW(TwinModel(scenario_, world_, Hsr(), config));
   config = {};
   config.robot_mass = std::nan("");

@@ -24,21 +24,24 @@ namespace egress::twin {
 struct TwinConfig {
   double physics_rate_hz{240.0};
   /// The people's social terms (HM95's repulsion from each other, the robot and walls) are
-  /// summed at this rate and held between [Hz]; at most physics_rate_hz. Below it, the drive
-  /// and body contact are still summed every physics step (holding them too, at 120 Hz, jammed
-  /// the clinic's door_e for good: 11 residents left behind in 30 clinic runs against 0). The
-  /// social sums are most of a crowd's cost: at 60 Hz the 100-resident bench runs ~1.2x faster,
-  /// but the study's robot trials came out otherwise in ways not yet understood (505 trials:
-  /// 8 with the robot in a doorway beside a resident against 2, one robot-resident contact
-  /// against none), so by default every term is summed every step.
-  double crowd_social_rate_hz{240.0};
+  /// summed at this rate and held between [Hz]; at most crowd_rate_hz. Below it, the drive and
+  /// body contact are still summed every crowd step (holding them too, at 120 Hz with 240 Hz
+  /// steps, jammed the clinic's door_e for good: 11 residents left behind in 30 clinic runs
+  /// against 0). At 60 Hz the 100-resident bench ran ~1.2x faster, but the study's robot trials
+  /// came out otherwise in ways not yet understood (505 trials: 8 with the robot in a doorway
+  /// beside a resident against 2, one robot-resident contact against none), so by default
+  /// every term is summed every crowd step.
+  double crowd_social_rate_hz{120.0};
   /// The people (their decisions and the social force model's sums and velocities) are stepped
   /// at this rate [Hz]: physics_rate_hz divided by a whole number, at least
   /// crowd_social_rate_hz. Between their steps each body is carried on at its velocity every
   /// physics step, so a person moves as smoothly as the robot (what Bullet's contacts and the
   /// sensors see); over one crowd step the model integrates the same as at the lower rate. The
-  /// people are most of a crowd run's cost; by default they are stepped with the physics.
-  double crowd_rate_hz{240.0};
+  /// people are most of a crowd run's cost: at 120 Hz (every other physics step) the
+  /// 100-resident bench runs ~15 % faster, and a dense group's flow through a door stays in
+  /// the hydraulic band (EvacueesTest); at 80 Hz it neared the band's floor and residents were
+  /// left behind in the two wards without the robot.
+  double crowd_rate_hz{120.0};
   double base_max_linear_acceleration{1.0};   ///< [m/s²]
   double base_max_angular_acceleration{2.0};  ///< [rad/s²]
   double base_max_linear_speed{0.8};          ///< [m/s] (HSR: ~3 km/h)
