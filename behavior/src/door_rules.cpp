@@ -67,6 +67,24 @@ bool IsInAnyDoorZone(const TaskServices& task, const Eigen::Vector2d& p_MB) {
   return false;
 }
 
+bool PassesThroughAnyDoorway(const TaskServices& task, const Eigen::Vector2d& p_MFrom,
+                             const Eigen::Vector2d& p_MTo) {
+  const auto cross = [](const Eigen::Vector2d& u, const Eigen::Vector2d& v) {
+    return u.x() * v.y() - u.y() * v.x();
+  };
+  const Eigen::Vector2d way = p_MTo - p_MFrom;
+  for (const auto& door : task.map->doors) {
+    const Eigen::Vector2d line = door.p_MLatch - door.p_MHinge;
+    const double from_side = cross(line, p_MFrom - door.p_MHinge);
+    const double to_side = cross(line, p_MTo - door.p_MHinge);
+    if (from_side * to_side > 0.0) continue;  // both on one side of the door line
+    // And the crossing between the jambs: the hinge and latch on either side of the way.
+    if (cross(way, door.p_MHinge - p_MFrom) * cross(way, door.p_MLatch - p_MFrom) <= 0.0)
+      return true;
+  }
+  return false;
+}
+
 bool IsDoorZoneOccupied(const TaskServices& task, const std::string& door) {
   const perception::DoorModel* model = task.map->FindDoor(door);
   ThrowUnless(model != nullptr, "unknown door '", door, "' (not in the building map)");

@@ -607,7 +607,13 @@ std::optional<Pose2> PeopleRoom::BestSpotAround(const std::vector<Pose2>& way, d
       const Eigen::Vector2d q = at_ + radius * Eigen::Vector2d(std::cos(a), std::sin(a));
       corners.back() = q;
       const double s = Score(corners);
-      if (s <= beat || IsInAnyDoorZone(task_, q) || !IsWayClear(corners)) continue;
+      // Nor through a doorway to a spot on its far side: the leaf may close meanwhile, and the
+      // way passes where people walk through (two wards seed 5, at 120 Hz crowd steps: backing
+      // out of door_d as it began to close, the robot turned back through it to a spot 1.6 m
+      // beyond and met the leaf).
+      if (s <= beat || IsInAnyDoorZone(task_, q) ||
+          PassesThroughAnyDoorway(task_, way.back().translation(), q) || !IsWayClear(corners))
+        continue;
       const Pose2 candidate{q.x(), q.y(), yaw};
       if (!task_.planner->IsPathValid({way.back(), candidate})) continue;
       best = candidate;

@@ -270,5 +270,20 @@ TEST_F(DoorZoneRulesTest, DoorZonesReachZoneDepthFromTheLineAndCoverTheLeafsSwee
   EXPECT_FALSE(IsInAnyDoorZone(services_, {2.0, 3.3}));
 }
 
+// A step aside never goes through a doorway (two wards seed 5: a retreat's spot 1.6 m beyond
+// door_d as its leaf closed). The door line runs y = 3 between its jambs at x = ±0.475.
+TEST_F(DoorZoneRulesTest, AWayThroughADoorwayCrossesTheDoorLineBetweenItsJambs) {
+  EXPECT_TRUE(PassesThroughAnyDoorway(services_, {0.0, 1.3}, {0.0, 4.5}));   // straight through
+  EXPECT_TRUE(PassesThroughAnyDoorway(services_, {0.0, 4.5}, {0.0, 1.3}));   // either way
+  EXPECT_TRUE(PassesThroughAnyDoorway(services_, {-1.0, 1.5}, {1.0, 4.5}));  // on a slant
+  EXPECT_TRUE(PassesThroughAnyDoorway(services_, {0.0, 2.0}, {0.0, 3.0}));   // to the line
+  EXPECT_FALSE(PassesThroughAnyDoorway(services_, {0.0, 1.3}, {1.5, 2.9}));  // this side only
+  EXPECT_FALSE(PassesThroughAnyDoorway(services_, {0.0, 3.2}, {1.5, 4.5}));  // the far side only
+  // Across the wall's line beside the opening (through the wall, which the planner rejects):
+  // not through the doorway.
+  EXPECT_FALSE(PassesThroughAnyDoorway(services_, {1.0, 2.0}, {1.0, 4.0}));
+  EXPECT_FALSE(PassesThroughAnyDoorway(services_, {-3.0, 2.0}, {-0.6, 4.0}));
+}
+
 }  // namespace
 }  // namespace egress::behavior

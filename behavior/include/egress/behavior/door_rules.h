@@ -37,6 +37,10 @@ bool IsHoldingDoorAside(const TaskServices& task, const perception::TrackedPerso
 /// door line (and half a metre beside its opening), or where a door's leaf sweeps (with the
 /// leaf clearance). A retreat ends outside them; the executive's last safe pose is outside.
 bool IsInAnyDoorZone(const TaskServices& task, const Eigen::Vector2d& p_MB);
+/// Whether the straight way from p_MFrom to p_MTo passes through a doorway: crosses a door's
+/// line between its jambs (an end on the line counts).
+bool PassesThroughAnyDoorway(const TaskServices& task, const Eigen::Vector2d& p_MFrom,
+                             const Eigen::Vector2d& p_MTo);
 /// True when a person (not one holding this door aside) is in, or forecast into, the zone of
 /// `door`; or crossing it (TaskConfig::yield_to_crossing); or, on its far side, waiting for it
 /// while its opening is young (TaskConfig::right_of_way_time).
