@@ -6,10 +6,10 @@
 #include <memory>
 
 #include <fmt/format.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "commands.h"
 #include "egress/perception/costmap.h"
+#include "egress/perception/image_io.h"
 #include "render.h"
 
 namespace egress::apps {
@@ -42,7 +42,7 @@ void Run(const CostmapOptions& options) {
                         {options.doorways[i + 2], options.doorways[i + 3]}});
   }
   const cv::Mat image = RenderCostmap(costmap);
-  if (!cv::imwrite(options.out, image))
+  if (!perception::WriteImageFile(options.out, image))
     throw CommandFailed(fmt::format("cannot write '{}'", options.out));
   std::size_t lethal = 0, free_cells = 0;
   for (const auto cost : costmap.costs()) {

@@ -26,7 +26,6 @@
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "brain_trial.h"
@@ -34,6 +33,7 @@
 #include "crowd_rate_options.h"
 #include "doorway_judge.h"
 #include "egress/hsr_interface/error.h"
+#include "egress/perception/image_io.h"
 #include "egress/twin/scenario.h"
 #include "egress/twin/sdf_world_loader.h"
 #include "egress/twin/twin_model.h"
@@ -317,7 +317,7 @@ void DrawEvacuated(const std::map<std::string, std::vector<nlohmann::json>>& by_
     cv::polylines(img, std::vector<std::vector<cv::Point>>{median}, false, col, 2);
     cv::putText(img, c, {W - 200, top + 20 + 20 * legend++}, cv::FONT_HERSHEY_SIMPLEX, 0.5, col, 2);
   }
-  if (!cv::imwrite(png.string(), img))
+  if (!perception::WriteImageFile(png, img))
     throw CommandFailed(fmt::format("cannot write '{}'", png.string()));
 }
 

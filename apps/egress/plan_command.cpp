@@ -11,11 +11,11 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include "commands.h"
 #include "egress/hsr_interface/error.h"
 #include "egress/nav/v1/navigation.grpc.pb.h"
+#include "egress/perception/image_io.h"
 #include "egress/planning/base_planner.h"
 #include "egress/twin/sdf_world_loader.h"
 #include "render.h"
@@ -74,7 +74,7 @@ v1::MapBytes ToMapBytes(const perception::OccupancyGrid& grid) {
     }
   }
   std::vector<std::uint8_t> png;
-  cv::imencode(".png", image, png);
+  perception::EncodeImage(".png", image, &png);
   v1::MapBytes bytes;
   bytes.set_image(std::string(png.begin(), png.end()));
   bytes.set_resolution(g.resolution);
@@ -209,7 +209,7 @@ void Run(const PlanOptions& options) {
   if (!options.png.empty()) {
     cv::Mat image = RenderCostmap(costmap);
     DrawPath(image, costmap.geometry(), result.path);
-    if (!cv::imwrite(options.png, image))
+    if (!perception::WriteImageFile(options.png, image))
       throw CommandFailed(fmt::format("cannot write '{}'", options.png));
   }
   if (options.json) {

@@ -4,11 +4,10 @@
 #include <fstream>
 
 #include <fmt/format.h>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 
 #include "commands.h"
+#include "egress/perception/image_io.h"
 
 namespace egress::apps {
 namespace {
@@ -211,7 +210,7 @@ cv::Mat RenderTraceFrame(const TraceFile& trace, std::size_t index, double pixel
 }
 
 void WriteTracePng(const TraceFile& trace, const std::filesystem::path& png) {
-  if (!cv::imwrite(png.string(), RenderTraceFrame(trace, trace.samples.size() - 1))) {
+  if (!perception::WriteImageFile(png, RenderTraceFrame(trace, trace.samples.size() - 1))) {
     throw CommandFailed(fmt::format("cannot write '{}'", png.string()));
   }
 }
@@ -219,14 +218,13 @@ void WriteTracePng(const TraceFile& trace, const std::filesystem::path& png) {
 void WriteTraceVideo(const TraceFile& trace, const std::filesystem::path& mp4, double speedup) {
   const double rate = trace.header.at("rate_hz").get<double>();
   const cv::Mat first = RenderTraceFrame(trace, 0);
-  cv::VideoWriter writer(mp4.string(), cv::VideoWriter::fourcc('m', 'p', '4', 'v'), rate * speedup,
-                         first.size());
-  if (!writer.isOpened()) {
+  perception::VideoFileWriter writer(mp4, "mp4v", rate * speedup, first.size());
+  if (!writer.opened()) {
     throw CommandFailed(fmt::format(
         "cannot open '{}' for MP4 video (OpenCV has no MP4 writer here)", mp4.string()));
   }
   for (std::size_t i = 0; i < trace.samples.size(); ++i)
-    writer.write(RenderTraceFrame(trace, i));
+    writer.Write(RenderTraceFrame(trace, i));
 }
 
 }  // namespace egress::apps

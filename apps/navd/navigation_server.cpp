@@ -11,7 +11,6 @@
 #include <stdexcept>
 
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include "connection_gate.h"
 #include "egress/hsr_interface/error.h"

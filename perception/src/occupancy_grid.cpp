@@ -6,10 +6,9 @@
 #include <map>
 #include <sstream>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "egress/hsr_interface/error.h"
 #include "egress/hsr_interface/text_file.h"
+#include "egress/perception/image_io.h"
 
 namespace egress::perception {
 
@@ -153,8 +152,8 @@ cv::Mat OccupancyGrid::DecodeMapImage(std::string_view bytes, std::int64_t max_c
         StrCat(what, ": ", width, " x ", height, " cells; the limit is ", max_cells, " cells"));
   }
   const cv::Mat encoded(1, int(bytes.size()), CV_8UC1,
-                        const_cast<char*>(bytes.data()));  // imdecode only reads it
-  cv::Mat image = cv::imdecode(encoded, cv::IMREAD_GRAYSCALE);
+                        const_cast<char*>(bytes.data()));  // decoding only reads it
+  cv::Mat image = DecodeGrayImage(encoded);
   if (image.empty()) throw LoadError(StrCat(what, ": the image cannot be decoded"));
   return image;
 }

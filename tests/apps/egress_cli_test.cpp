@@ -248,6 +248,25 @@ std::filesystem::path WriteRoomMap() {
   return dir;
 }
 
+// Images are written by a module opened on first use (perception/image_io.h): one that cannot be
+// loaded is an error naming where it was looked for, not a crash; nothing else needs it.
+TEST(EgressCliTest, AnImageModuleThatCannotBeLoadedIsAClearError) {
+  const auto dir = WriteRoomMap();
+  const std::string out = (dir / "costmap.png").string();
+  std::filesystem::remove(out);
+  ASSERT_EQ(setenv("EGRESS_IMAGE_IO_MODULE", "/nonexistent/libegress_image_io.so", 1), 0);
+  const Result result = RunEgress("costmap " + (dir / "map.yaml").string() + " --out " + out);
+  const Result version = RunEgress("--version");
+  unsetenv("EGRESS_IMAGE_IO_MODULE");
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_THAT(result.output, HasSubstr("cannot load egress's image module"));
+  EXPECT_THAT(result.output, HasSubstr("/nonexistent/libegress_image_io.so"));
+  EXPECT_THAT(result.output, HasSubstr("EGRESS_IMAGE_IO_MODULE"));
+  EXPECT_FALSE(std::filesystem::exists(out));
+  EXPECT_EQ(version.exit_code, 0) << version.output;
+  std::filesystem::remove_all(dir);
+}
+
 TEST(EgressCliTest, CostmapRendersAPng) {
   const auto dir = WriteRoomMap();
   const std::string out = (dir / "costmap.png").string();

@@ -14,12 +14,11 @@
 
 #include <unistd.h>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
 #include "egress/nav/v1/navigation.grpc.pb.h"
+#include "egress/perception/image_io.h"
 
 namespace egress::navd {
 namespace {
@@ -449,7 +448,7 @@ TEST_F(NavigationServerTest, AnImageIsMeasuredBeforeItIsDecoded) {
   Start(config);
   // 4000 x 4000 white: a few kB of PNG, 16 M cells decoded.
   std::vector<std::uint8_t> png;
-  cv::imencode(".png", cv::Mat(4000, 4000, CV_8UC1, cv::Scalar(255)), png);
+  ASSERT_TRUE(perception::EncodeImage(".png", cv::Mat(4000, 4000, CV_8UC1, cv::Scalar(255)), &png));
   ASSERT_LT(png.size(), 100'000u);
   v1::LoadWorldRequest request;
   request.mutable_map()->set_image(std::string(png.begin(), png.end()));

@@ -6,10 +6,10 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
-#include <opencv2/imgcodecs.hpp>
 #include "test_paths.h"
 
 #include "egress/hsr_interface/error.h"
+#include "egress/perception/image_io.h"
 
 namespace egress::perception {
 namespace {
@@ -26,7 +26,7 @@ class MapServerTest : public ::testing::Test {
     cv::Mat image(3, 4, CV_8UC1, cv::Scalar(254));
     image.at<std::uint8_t>(0, 0) = 0;
     image.at<std::uint8_t>(1, 1) = 205;
-    cv::imwrite((dir_ / "map.pgm").string(), image);
+    ASSERT_TRUE(WriteImageFile(dir_ / "map.pgm", image));
   }
   void TearDown() override { fs::remove_all(dir_); }
   fs::path WriteYaml(const std::string& text) {
