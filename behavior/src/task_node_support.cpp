@@ -607,10 +607,7 @@ std::optional<Pose2> PeopleRoom::BestSpotAround(const std::vector<Pose2>& way, d
       const Eigen::Vector2d q = at_ + radius * Eigen::Vector2d(std::cos(a), std::sin(a));
       corners.back() = q;
       const double s = Score(corners);
-      // Nor through a doorway to a spot on its far side: the leaf may close meanwhile, and the
-      // way passes where people walk through (two wards seed 5, at 120 Hz crowd steps: backing
-      // out of door_d as it began to close, the robot turned back through it to a spot 1.6 m
-      // beyond and met the leaf).
+      // Nor through a doorway: its leaf may close meanwhile (two wards seed 5 met door_d's).
       if (s <= beat || IsInAnyDoorZone(task_, q) ||
           PassesThroughAnyDoorway(task_, way.back().translation(), q) || !IsWayClear(corners))
         continue;
