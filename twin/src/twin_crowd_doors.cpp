@@ -40,6 +40,8 @@ constexpr double kGiveWaySec = 1.5;
 constexpr double kPressingGapM = 0.05;
 // How far a walker who gives way steps back [m]: room for a wide body beside it to pass.
 constexpr double kGiveWayStepM = 0.3;
+// Room left between the one who gives way and the body coming across in front of them [m].
+constexpr double kGiveWayMarginM = 0.05;
 // Kept from the actuator this long, a person gives up operating it (and for as long again) [s].
 constexpr double kOperateGiveUpSec = 12.0;
 // Held up (Person::slow_for) this long within this of the spot before a shut door, an evacuee
@@ -239,28 +241,67 @@ std::optional<Eigen::Vector2d> TwinWorld::Impl::OutOfRobotsWayTo(const Person& p
 }
 
 void TwinWorld::Impl::GiveWayIfJammed(Person& p) {
-  // The jam's front is whoever is nearest the bottleneck (the next doorway of the route, else the
-  // waypoint): they keep their drive, and everyone pressing on them from behind or beside steps
-  // back a moment. One bottleneck for all who share it, so two never give way to each other. In
-  // an arch of wide bodies before a doorway (a pushed wheelchair on the axis, two more pressed
-  // into the corners beside the jambs heading for the spot it stands on), each held the others
-  // still for good: 22 residents left at the clinic's open exit (two wards seed 48).
+  // The jam's front is whoever is nearest the bottleneck: the next doorway of the route (by
+  // distance from the door's line), else the waypoint. They keep their drive; whoever presses on
+  // them steps back a moment, and so does the column pressing on that one from behind. One
+  // bottleneck for all who share it, so two never give way to each other.
+  // Before a doorway, an arch of wide bodies (a pushed wheelchair on the axis, two more in the
+  // corners beside the jambs heading for the spot it stands on) held everyone still for good:
+  // two wards seed 48 (22 residents at the open exit). Ranked by distance from the doorway's
+  // centre, the one on the axis went first, but the corner ones stood nearer the door line and
+  // kept it there; they stepped away from the centre into the side walls, the five behind held
+  // the axis one in place, and the arch stood for 210 s (two wards seed 36, people at 120 Hz).
+  // Now a corner one goes first, and the axis one and its column step back square to the door's
+  // wall, far enough for a wide body to come across in front of them.
   if (p.state.phase != PersonPhase::kWalking || time < p.give_way_until) return;
   Eigen::Vector2d bottleneck = p.walker.target;
+  const DoorModel* door = nullptr;
   const auto doorway = p.doorway_waypoints.lower_bound(p.reached);
-  if (doorway != p.doorway_waypoints.end())
-    bottleneck = doors[std::size_t(doorway->second)].fixed->centre;
-  const Eigen::Vector2d back = p.walker.position - bottleneck;
-  const double mine = back.norm();
-  if (mine < 1e-6) return;
+  if (doorway != p.doorway_waypoints.end()) {
+    door = doors[std::size_t(doorway->second)].fixed;
+    bottleneck = door->centre;
+  }
+  const auto depth = [&](const Person& q) {
+    const Eigen::Vector2d r = q.walker.position - bottleneck;
+    return door != nullptr ? std::abs(r.dot(door->normal)) : r.norm();
+  };
+  const auto pressing = [](const Person& a, const Person& b) {
+    return (a.walker.position - b.walker.position).norm() - a.walker.radius - b.walker.radius <=
+           kPressingGapM;
+  };
+  const Eigen::Vector2d from_bottleneck = p.walker.position - bottleneck;
+  const double mine = depth(p);
+  if (from_bottleneck.norm() < 1e-6) return;
+  const Eigen::Vector2d back =
+      door != nullptr && mine > 1e-6
+          ? Eigen::Vector2d(door->normal * std::copysign(1.0, from_bottleneck.dot(door->normal)))
+          : Eigen::Vector2d(from_bottleneck.normalized());
   for (const Person& o : people) {
-    if (&o == &p || o.state.out || !o.state.started) continue;
-    const double gap =
-        (o.walker.position - p.walker.position).norm() - o.walker.radius - p.walker.radius;
-    if (gap > kPressingGapM || (o.walker.position - bottleneck).norm() >= mine) continue;
-    p.give_way_spot = p.walker.position + back / mine * kGiveWayStepM;
-    p.give_way_until = time + kGiveWaySec;
-    AddEvent("person_gives_way", p.state.name, o.state.name);
+    if (&o == &p || o.state.out || !o.state.started || !pressing(o, p) || depth(o) >= mine)
+      continue;
+    // Far enough for o to come across in front of them, at least a step.
+    const double step = std::max(
+        kGiveWayStepM, door != nullptr
+                           ? p.walker.radius + o.walker.radius - (mine - depth(o)) + kGiveWayMarginM
+                           : 0.0);
+    const auto give_way = [&](Person& q, const Person& to) {
+      q.give_way_spot = q.walker.position + back * step;
+      q.give_way_until = time + kGiveWaySec;
+      AddEvent("person_gives_way", q.state.name, to.state.name);
+    };
+    give_way(p, o);
+    std::vector<Person*> column = {&p};
+    while (!column.empty()) {
+      const Person& q = *column.back();
+      column.pop_back();
+      for (Person& r : people) {
+        if (&r == &q || r.state.out || !r.state.started || r.state.phase != PersonPhase::kWalking ||
+            time < r.give_way_until || !pressing(r, q) || depth(r) <= depth(q))
+          continue;
+        give_way(r, q);
+        column.push_back(&r);
+      }
+    }
     return;
   }
 }
