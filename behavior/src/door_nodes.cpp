@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "egress/perception/door_estimation.h"
+
 namespace egress::behavior::detail {
 namespace {
 
@@ -175,11 +177,12 @@ Pose2 WallAlignedPose(const TaskServices& task, const MapActuator& actuator,
   const Pose2 X_ML = task.belief->X_MB * task.belief->X_BL;
   std::vector<double> distances;
   const LaserScan& scan = *task.belief->scan;
+  const std::vector<Eigen::Vector2d>& u_L = perception::BeamDirections(scan);
+  const Eigen::Matrix2d R_ML = X_ML.rotation();
   for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
     const double r = scan.ranges[i];
     if (!std::isfinite(r) || r < scan.range_min || r > 2.0) continue;
-    const double a = scan.angle_min + double(i) * scan.angle_increment;
-    const Eigen::Vector2d p_M = X_ML * Eigen::Vector2d(r * std::cos(a), r * std::sin(a));
+    const Eigen::Vector2d p_M = R_ML * (r * u_L[i]) + X_ML.translation();
     // Near the wall plane, within 0.4 m of the actuator along the wall.
     if (std::abs((p_M - p_MWall).dot(n)) > 0.15 || std::abs((p_M - p_MWall).dot(t)) > 0.4) continue;
     distances.push_back((X_ML.translation() - p_M).dot(n));

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "egress/perception/door_estimation.h"
+
 namespace egress::behavior::detail {
 
 bool NearMappedWall(const perception::OccupancyGrid& grid, const Eigen::Vector2d& p_M) {
@@ -23,10 +25,12 @@ bool NearMappedWall(const perception::OccupancyGrid& grid, const Eigen::Vector2d
 
 LaserScan WithoutDoorLeaves(const LaserScan& scan, const MissionMap& map, const Pose2& X_ML) {
   LaserScan out = scan;
+  const std::vector<Eigen::Vector2d>& u_L = perception::BeamDirections(out);
+  const Eigen::Matrix2d R_ML = X_ML.rotation();
+  const Eigen::Vector2d p_ML = X_ML.translation();
   for (std::size_t i = 0; i < out.ranges.size(); ++i) {
     if (!out.IsValidReturn(i)) continue;
-    const double a = out.AngleAt(i), r = out.ranges[i];
-    const Eigen::Vector2d p_M = X_ML * Eigen::Vector2d(r * std::cos(a), r * std::sin(a));
+    const Eigen::Vector2d p_M = R_ML * (out.ranges[i] * u_L[i]) + p_ML;
     for (const auto& door : map.doors) {
       const Eigen::Vector2d offset = p_M - door.p_MHinge;
       const bool in_sweep =

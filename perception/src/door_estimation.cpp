@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <random>
 
@@ -125,14 +126,39 @@ std::vector<Eigen::Vector2d> ScanPointsInBearings(const LaserScan& scan, const P
                                                   double bearing_min, double bearing_max) {
   scan.Validate();
   ThrowUnless(X_ML.IsFinite(), "Invalid laser pose X_ML: must be finite.");
+  const std::vector<Eigen::Vector2d>& u_L = BeamDirections(scan);
+  const Eigen::Matrix2d R_ML = X_ML.rotation();
+  const Eigen::Vector2d p_ML = X_ML.translation();
   std::vector<Eigen::Vector2d> points;
+  points.reserve(scan.ranges.size());
   for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
     const double angle = scan.AngleAt(i);
     if (angle < bearing_min || angle > bearing_max || !scan.IsValidReturn(i)) continue;
-    points.push_back(
-        X_ML * Eigen::Vector2d(scan.ranges[i] * std::cos(angle), scan.ranges[i] * std::sin(angle)));
+    points.push_back(R_ML * (scan.ranges[i] * u_L[i]) + p_ML);
   }
   return points;
+}
+
+const std::vector<Eigen::Vector2d>& BeamDirections(const LaserScan& scan) {
+  struct Cache {
+    double angle_min{0.0}, angle_increment{0.0};
+    std::vector<Eigen::Vector2d> u_L;
+  };
+  thread_local Cache cache;
+  // Compared bit for bit: a scan of another shape (NaN angles included) is computed afresh.
+  if (cache.u_L.size() != scan.ranges.size() ||
+      std::memcmp(&cache.angle_min, &scan.angle_min, sizeof(double)) != 0 ||
+      std::memcmp(&cache.angle_increment, &scan.angle_increment, sizeof(double)) != 0) {
+    cache.angle_min = scan.angle_min;
+    cache.angle_increment = scan.angle_increment;
+    cache.u_L.clear();
+    cache.u_L.reserve(scan.ranges.size());
+    for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
+      const double angle = scan.AngleAt(i);
+      cache.u_L.emplace_back(std::cos(angle), std::sin(angle));
+    }
+  }
+  return cache.u_L;
 }
 
 std::vector<Eigen::Vector2d> ScanPoints(const LaserScan& scan, const Pose2& X_ML) {

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "egress/hsr_interface/error.h"
+#include "egress/perception/door_estimation.h"
 
 namespace egress::perception {
 
@@ -36,9 +37,7 @@ void FreeSpaceMotion::AddScan(const LaserScan& scan, const Pose2& X_ML) {
               "FreeSpaceMotion: a scan stamped before the last one");
   if (u_L_.size() != scan.ranges.size() || u_angle_min_ != scan.angle_min ||
       u_angle_increment_ != scan.angle_increment) {
-    u_L_.clear();
-    for (std::size_t i = 0; i < scan.ranges.size(); ++i)
-      u_L_.emplace_back(std::cos(scan.AngleAt(i)), std::sin(scan.AngleAt(i)));
+    u_L_ = BeamDirections(scan);  // a copy: held scans read them after other lasers' calls
     u_angle_min_ = scan.angle_min;
     u_angle_increment_ = scan.angle_increment;
     // Held scans of another geometry would read the new directions: start again.

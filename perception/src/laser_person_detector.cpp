@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 
 #include "egress/hsr_interface/error.h"
+#include "egress/perception/door_estimation.h"
 
 namespace egress::perception {
 namespace {
@@ -84,6 +85,8 @@ std::vector<LaserPersonDetection> LaserPersonDetector::Detect(
   scan.Validate();
   ThrowUnless(X_ML.IsFinite(), "LaserPersonDetector: the laser pose X_ML must be finite");
   const Eigen::Vector2d p_ML = X_ML.translation();
+  const Eigen::Matrix2d R_ML = X_ML.rotation();
+  const std::vector<Eigen::Vector2d>& u_L = BeamDirections(scan);
 
   // Clusters of returns off the map on neighbouring beams, closer than cluster_gap in turn. A
   // cluster on the scan's first or last beam may go on past the field of view's edge (unless the
@@ -106,9 +109,7 @@ std::vector<LaserPersonDetection> LaserPersonDetector::Detect(
   };
   for (std::size_t i = 0; i < n; ++i) {
     if (!scan.IsValidReturn(i) || scan.ranges[i] > config_.max_range) continue;
-    const double angle = scan.AngleAt(i);
-    const Eigen::Vector2d p_M =
-        X_ML * Eigen::Vector2d(scan.ranges[i] * std::cos(angle), scan.ranges[i] * std::sin(angle));
+    const Eigen::Vector2d p_M = R_ML * (scan.ranges[i] * u_L[i]) + p_ML;
     if (is_background && is_background(p_M)) continue;
     if (!current.points.empty() &&
         (i != last_beam + 1 || (p_M - current.points.back()).norm() > config_.cluster_gap)) {

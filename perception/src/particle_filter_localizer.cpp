@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "egress/hsr_interface/error.h"
+#include "egress/perception/door_estimation.h"
 
 namespace egress::perception {
 namespace {
@@ -235,13 +236,13 @@ bool ParticleFilterLocalizer::Correct(const LaserScan& scan) {
 std::vector<Eigen::Vector2d> ParticleFilterLocalizer::UsableBeams(const LaserScan& scan,
                                                                   std::size_t* considered) const {
   std::vector<Eigen::Vector2d> beams;  // end points in L
+  const std::vector<Eigen::Vector2d>& u_L = BeamDirections(scan);
   const std::size_t n = scan.ranges.size();
   const std::size_t step = std::max<std::size_t>(1, n / std::size_t(config_.max_beams));
   *considered = (n + step - 1) / step;
   for (std::size_t i = 0; i < n; i += step) {
     if (!scan.IsValidReturn(i) || scan.ranges[i] > config_.laser_max_range) continue;
-    const double angle = scan.AngleAt(i), range = scan.ranges[i];
-    beams.emplace_back(range * std::cos(angle), range * std::sin(angle));
+    beams.emplace_back(scan.ranges[i] * u_L[i]);
   }
   if (beams.size() < std::size_t(config_.min_beams)) beams.clear();
   return beams;

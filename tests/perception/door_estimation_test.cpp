@@ -1,6 +1,7 @@
 #include "egress/perception/door_estimation.h"
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <random>
 
@@ -234,6 +235,46 @@ TEST(DoorEstimationTest, GlassLeafAngleFromTheDetectorBoxEdges) {
   EXPECT_FALSE(DoorAngleFromBearings(door, X_MV, std::nullopt, std::nullopt).has_value());
   // A box nowhere near the door.
   EXPECT_FALSE(DoorAngleFromBearings(door, X_MV, -1.2, -1.0).has_value());
+}
+
+TEST(DoorEstimationTest, BeamDirectionsAreEachBeamsCosineAndSineForEveryScanShape) {
+  LaserScan a;
+  a.angle_min = -2.1;
+  a.angle_increment = 0.0175;
+  a.ranges.assign(241, 1.0);
+  LaserScan b = a;
+  b.angle_min = -1.0;
+  b.ranges.assign(7, 1.0);
+  for (int round = 0; round < 2; ++round) {  // shapes in turn: each recomputed, never mixed up
+    for (const LaserScan* scan : {&a, &b}) {
+      const std::vector<Eigen::Vector2d>& u_L = BeamDirections(*scan);
+      ASSERT_EQ(u_L.size(), scan->ranges.size());
+      for (std::size_t i = 0; i < u_L.size(); ++i) {
+        EXPECT_EQ(u_L[i].x(), std::cos(scan->AngleAt(i)));
+        EXPECT_EQ(u_L[i].y(), std::sin(scan->AngleAt(i)));
+      }
+    }
+  }
+}
+
+TEST(DoorEstimationTest, ScanPointsAreTheValidReturnsInTheMapFrame) {
+  LaserScan scan;
+  scan.angle_min = -std::numbers::pi / 2;
+  scan.angle_increment = std::numbers::pi / 2;
+  scan.range_min = 0.05;
+  scan.range_max = 10.0;
+  scan.ranges = {1.0, std::numeric_limits<float>::infinity(), 2.0};
+  const Pose2 X_ML{1.0, 2.0, std::numbers::pi / 2};
+  const std::vector<Eigen::Vector2d> p_M = ScanPoints(scan, X_ML);
+  ASSERT_EQ(p_M.size(), 2u);
+  // Beam 0 points along L's -y, which is M's +x; beam 2 along L's +y, M's -x.
+  EXPECT_NEAR(p_M[0].x(), 2.0, 1e-12);
+  EXPECT_NEAR(p_M[0].y(), 2.0, 1e-12);
+  EXPECT_NEAR(p_M[1].x(), -1.0, 1e-12);
+  EXPECT_NEAR(p_M[1].y(), 2.0, 1e-12);
+  const std::vector<Eigen::Vector2d> ahead = ScanPointsInBearings(scan, X_ML, 0.1, 2.0);
+  ASSERT_EQ(ahead.size(), 1u);
+  EXPECT_NEAR(ahead[0].x(), -1.0, 1e-12);
 }
 
 }  // namespace

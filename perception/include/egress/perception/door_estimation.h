@@ -78,6 +78,11 @@ std::vector<Eigen::Vector2d> ScanPointsInBearings(const LaserScan& scan, const P
                                                   double bearing_min, double bearing_max);
 /// Every valid return of the scan, in M.
 std::vector<Eigen::Vector2d> ScanPoints(const LaserScan& scan, const Pose2& X_ML);
+/// The unit direction in L of each beam of scans shaped as `scan` (cos and sin of AngleAt(i),
+/// exactly): every scan of one laser shares them, so they are computed once per thread and
+/// shape (angle_min, angle_increment, beam count) rather than twice per beam per scan. Valid
+/// until the next call on this thread with another shape.
+const std::vector<Eigen::Vector2d>& BeamDirections(const LaserScan& scan);
 
 struct DoorAngleMeasurement {
   double angle{0.0};       ///< From closed [rad], in [0, max_open_angle].
