@@ -116,6 +116,50 @@ TEST(TwinWorldRayTest, ADownwardRayMeetsAPersonBeforeTheFloorBehindThem) {
   EXPECT_NEAR(floor_hit.distance, (short_of - from).norm(), 1e-4);
 }
 
+TEST(TwinWorldRayTest, AFanCastsTheSameHitsAsOneRayAtATime) {
+  // CastRayFan bins the candidates by bearing once instead of walking the grid per ray: the hits
+  // must be CastRay's, bit for bit, among walking people, doors (door_b's glass leaf) and walls,
+  // for rays level, down to the floor, up, straight down, and short or long, in every glass mode.
+  const Scenario scenario = LoadScenario(WorldsDir() / "scenarios/evacuation/clinic_escort.yaml");
+  TwinWorld world(scenario, LoadSdfWorld(scenario.world_file), 3, Hsr());
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> x(0.5, 21.5), y(-2.0, 6.0), unit(-1.0, 1.0);
+  int hits = 0, people = 0, glass = 0, fans = 0;
+  for (const double t : {0.0, 70.0, 40.0}) {
+    world.StepFor(t);
+    for (int f = 0; f < 12; ++f, ++fans) {
+      const Eigen::Vector3d from(x(rng), y(rng), f % 3 == 0 ? 0.2 : 1.0);
+      std::vector<Eigen::Vector3d> tos;
+      for (int k = 0; k < 300; ++k) {
+        Eigen::Vector3d d(unit(rng), unit(rng), k % 2 == 0 ? 0.0 : 0.5 * unit(rng));
+        if (k % 60 == 1) d = Eigen::Vector3d(0.0, 0.0, -1.0);
+        tos.push_back(from + d.normalized() * (k % 3 == 0 ? 2.0 : 12.0));
+      }
+      const GlassMode mode = std::array{GlassMode::kOpaque, GlassMode::kLaser,
+                                        GlassMode::kTransparent}[std::size_t(f % 3)];
+      std::vector<RayHit> fan;
+      world.CastRayFan(from, tos, mode, &fan, 0.3);
+      ASSERT_EQ(fan.size(), tos.size());
+      for (std::size_t k = 0; k < tos.size(); ++k) {
+        const RayHit one = world.CastRay(from, tos[k], mode, 0.3);
+        ASSERT_EQ(fan[k].hit, one.hit) << "fan " << fans << " ray " << k;
+        EXPECT_EQ(fan[k].distance, one.distance) << "fan " << fans << " ray " << k;
+        EXPECT_EQ(fan[k].point, one.point) << "fan " << fans << " ray " << k;
+        EXPECT_EQ(fan[k].normal, one.normal) << "fan " << fans << " ray " << k;
+        EXPECT_EQ(fan[k].entity, one.entity) << "fan " << fans << " ray " << k;
+        EXPECT_EQ(fan[k].glass, one.glass) << "fan " << fans << " ray " << k;
+        hits += one.hit;
+        people += one.hit && world.entity_kind(one.entity) == EntityKind::kPerson;
+        glass += one.glass;
+      }
+    }
+  }
+  // The rays met what the comparison is about.
+  EXPECT_GT(hits, 5000);
+  EXPECT_GT(people, 20);
+  EXPECT_GT(glass, 0);
+}
+
 TEST(DepthCameraSimulatorTest, DepthEqualsTheAnalyticDistanceAndGlassIsInvalid) {
   auto loaded = LoadText(At("lab.sdf", -1.5, 0.0, 0.0), WorldsDir() / "lab");
   TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());

@@ -36,9 +36,15 @@ LaserScan LaserSimulator::Capture(const TwinWorld& world, std::mt19937_64& rng) 
   scan.ranges.resize(beams_);
   std::normal_distribution<double> noise(0.0, config_.laser_noise);
   const double glass_incidence = config_.laser_glass_max_incidence_deg * kDegToRad;
+  // The beams' ends, cast as one fan from the laser's origin (CastRayFan: CastRay's hits).
+  thread_local std::vector<Eigen::Vector3d> ends;
+  thread_local std::vector<RayHit> hits;
+  ends.resize(beams_);
+  for (std::size_t i = 0; i < beams_; ++i)
+    ends[i] = X_WL * (directions_L_[i] * config_.laser_range_max);
+  world.CastRayFan(X_WL.translation(), ends, GlassMode::kLaser, &hits, glass_incidence);
   for (std::size_t i = 0; i < beams_; ++i) {
-    const Eigen::Vector3d to = X_WL * (directions_L_[i] * config_.laser_range_max);
-    const RayHit hit = world.CastRay(X_WL.translation(), to, GlassMode::kLaser, glass_incidence);
+    const RayHit& hit = hits[i];
     const double n = config_.laser_noise > 0 ? noise(rng) : 0.0;
     if (!hit.hit) {
       scan.ranges[i] = std::numeric_limits<float>::infinity();
@@ -71,10 +77,18 @@ DepthImage DepthCameraSimulator::Capture(const TwinWorld& world, std::mt19937_64
   image.height = intrinsics_.height;
   image.depth.resize(directions_C_.size());
   std::normal_distribution<double> unit(0.0, 1.0);
+  // The pixels' rays, cast as one fan from the camera's origin (CastRayFan: CastRay's hits).
+  thread_local std::vector<Eigen::Vector3d> ends;
+  thread_local std::vector<RayHit> hits;
+  ends.resize(directions_C_.size());
   for (std::size_t k = 0; k < directions_C_.size(); ++k) {
     const Eigen::Vector3d& d_C = directions_C_[k];
-    const Eigen::Vector3d to = X_WC * (d_C * (config_.depth_range_max / d_C.z()));
-    const RayHit hit = world.CastRay(X_WC.translation(), to, GlassMode::kOpaque);
+    ends[k] = X_WC * (d_C * (config_.depth_range_max / d_C.z()));
+  }
+  world.CastRayFan(X_WC.translation(), ends, GlassMode::kOpaque, &hits);
+  for (std::size_t k = 0; k < directions_C_.size(); ++k) {
+    const Eigen::Vector3d& d_C = directions_C_[k];
+    const RayHit& hit = hits[k];
     if (!hit.hit || hit.glass) {
       image.depth[k] = std::numeric_limits<float>::quiet_NaN();
       continue;

@@ -90,12 +90,11 @@ void CompileStatics(const Scenario& scenario, const WorldDescription& world,
     add(ground);
   }
   c->wall_cells = WallCells(c->walls);
-  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> box_extents;
   for (const RayBox& box : c->ray_boxes) {
     const Eigen::Vector2d half_W = (box.R_SW.transpose().cwiseAbs() * box.half).head<2>();
-    box_extents.emplace_back(box.p_WS.head<2>() - half_W, box.p_WS.head<2>() + half_W);
+    c->ray_box_extents.emplace_back(box.p_WS.head<2>() - half_W, box.p_WS.head<2>() + half_W);
   }
-  c->ray_box_bins.Build(box_extents, kRayBinCellM);
+  c->ray_box_bins.Build(c->ray_box_extents, kRayBinCellM);
   if (merged->getNumTriangles() > 0) {
     c->static_mesh_shape = std::make_unique<btBvhTriangleMeshShape>(merged.get(), true);
     c->static_mesh = std::move(merged);

@@ -68,6 +68,8 @@ struct TwinModel::Compiled {
   // Rays test boxes and planes analytically (a slab test is far cheaper than a BVH walk over
   // their triangles) and only the meshes' triangles through their own BVH.
   std::vector<world_detail::RayBox> ray_boxes;
+  // Their XY extents in W (lower, upper corners), binned for a single ray and for a fan.
+  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> ray_box_extents;
   world_detail::RayBins ray_box_bins;   // which ray_boxes a ray may cross
   std::vector<std::size_t> ray_planes;  // the ray_boxes that are planes (floors), opaque
   std::unique_ptr<btTriangleMesh> ray_mesh;

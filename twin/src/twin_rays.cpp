@@ -109,7 +109,8 @@ double TwinWorld::Impl::PlaneClip(const Eigen::Vector3d& from, const Eigen::Vect
 }
 
 RayHit TwinWorld::Impl::CastSegment(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
-                                    GlassMode mode, double glass_max_incidence) const {
+                                    GlassMode mode, double glass_max_incidence,
+                                    const RayFanBins* fan, long fan_bin) const {
   const btVector3 a = ToBt(from), b = ToBt(to);
   TwinRayCallback cb(b - a, mode, glass_max_incidence, ray_is_glass, ray_entity_of);
   // Bullet's ray tests, object by object rather than through the broadphase: first the cheap
@@ -127,9 +128,26 @@ RayHit TwinWorld::Impl::CastSegment(const Eigen::Vector3d& from, const Eigen::Ve
   // Nothing past an opaque plane's crossing can be the closest hit: the ground track is walked
   // only that far (most of a downward camera's rays end on the floor a few metres out).
   const double plane_clip = PlaneClip(from, to);
+  // A fan's candidates come nearest first by ground distance from its origin: none beyond the
+  // ground distance of fraction t of this segment can be hit before t (the margin, for rounding,
+  // in metres: the walks' 1e-9 in t is less than that on a ray of up to 30 m).
+  const Eigen::Vector2d ground = (to - from).head<2>();
+  const double ground_from = fan ? (from.head<2>() - fan->targets.origin()).norm() : 0.0;
+  const double ground_length = fan ? ground.norm() : 0.0;
+  constexpr double kFanMarginM = 1e-6;
+  const auto beyond = [&](double near, double t) {
+    return near > ground_from + t * ground_length + kFanMarginM;
+  };
   // The targets a walk step yields, in its order: a hit closer than the closest so far is kept.
-  const auto test_targets = [&](const std::vector<int>& candidates) {
-    for (const int k : candidates) {
+  const auto test_targets = [&](const auto& candidates) {
+    for (const auto& candidate : candidates) {
+      int k = 0;
+      if constexpr (std::is_same_v<std::decay_t<decltype(candidate)>, int>) {
+        k = candidate;
+      } else {
+        if (beyond(candidate.near, std::min(double(cb.m_closestHitFraction), plane_clip))) break;
+        k = candidate.box;
+      }
       const std::size_t i = std::size_t(k);
       const btCollisionObject* target = ray_targets[i];
       btVector3 normal;
@@ -158,12 +176,16 @@ RayHit TwinWorld::Impl::CastSegment(const Eigen::Vector3d& from, const Eigen::Ve
                                       target->getCollisionShape(), target->getWorldTransform(), cb);
     }
   };
-  world_detail::RayBins::Walk targets(ray_target_bins, from.head<2>(),
-                                      from.head<2>() + (to - from).head<2>() * plane_clip);
   double t_beyond = 0.0;
-  while (targets.Next(&near, &t_beyond)) {
-    test_targets(near);
-    if (cb.m_closestHitFraction < t_beyond * plane_clip - kWalkMargin) break;
+  if (fan) {
+    test_targets(fan->targets.Along(fan_bin));
+  } else {
+    world_detail::RayBins::Walk targets(ray_target_bins, from.head<2>(),
+                                        from.head<2>() + ground * plane_clip);
+    while (targets.Next(&near, &t_beyond)) {
+      test_targets(near);
+      if (cb.m_closestHitFraction < t_beyond * plane_clip - kWalkMargin) break;
+    }
   }
   // Static boxes and planes: slab tests in each shape's frame, on the ray as a segment t in
   // [0, 1]. A ray starting inside a box hits its far side (as the triangles' did).
@@ -178,47 +200,56 @@ RayHit TwinWorld::Impl::CastSegment(const Eigen::Vector3d& from, const Eigen::Ve
     int k{-1};
     Eigen::Vector3d n_W{Eigen::Vector3d::Zero()};
   } closest_box;
-  world_detail::RayBins::Walk boxes(fixed.ray_box_bins, from.head<2>(),
-                                    from.head<2>() + d.head<2>() * box_reach);
-  while (boxes.Next(&near, &t_beyond)) {
-    for (const int k : near) {
-      const RayBox& box = fixed.ray_boxes[std::size_t(k)];
-      const Eigen::Vector3d o = box.R_SW * (from - box.p_WS);
-      const Eigen::Vector3d v = box.R_SW * d;
-      double t_in = -std::numeric_limits<double>::infinity();
-      double t_out = std::numeric_limits<double>::infinity();
-      int axis_in = -1, axis_out = -1;
-      bool miss = false;
-      for (int i = 0; i < 3 && !miss; ++i) {
-        if (std::abs(v[i]) < 1e-12) {
-          miss = std::abs(o[i]) > box.half[i] || box.half[i] == 0.0;
-          continue;
-        }
-        double ta = (-box.half[i] - o[i]) / v[i], tb = (box.half[i] - o[i]) / v[i];
-        if (ta > tb) std::swap(ta, tb);
-        if (ta > t_in) {
-          t_in = ta;
-          axis_in = i;
-        }
-        if (tb < t_out) {
-          t_out = tb;
-          axis_out = i;
-        }
-        miss = t_in > t_out;
+  const auto test_box = [&](int k) {
+    const RayBox& box = fixed.ray_boxes[std::size_t(k)];
+    const Eigen::Vector3d o = box.R_SW * (from - box.p_WS);
+    const Eigen::Vector3d v = box.R_SW * d;
+    double t_in = -std::numeric_limits<double>::infinity();
+    double t_out = std::numeric_limits<double>::infinity();
+    int axis_in = -1, axis_out = -1;
+    bool miss = false;
+    for (int i = 0; i < 3 && !miss; ++i) {
+      if (std::abs(v[i]) < 1e-12) {
+        miss = std::abs(o[i]) > box.half[i] || box.half[i] == 0.0;
+        continue;
       }
-      if (miss) continue;
-      const bool inside = t_in < 0.0;
-      const double t = inside ? t_out : t_in;
-      const int axis = inside ? axis_out : axis_in;
-      if (axis < 0 || t < 0.0 || t >= target_t) continue;
-      if (t > closest_box.t || (t == closest_box.t && k > closest_box.k)) continue;
-      // Outward normal of the face the ray meets.
-      const double sign = (v[axis] > 0.0) == inside ? 1.0 : -1.0;
-      closest_box.t = t;
-      closest_box.k = k;
-      closest_box.n_W = box.R_SW.row(axis).transpose() * sign;
+      double ta = (-box.half[i] - o[i]) / v[i], tb = (box.half[i] - o[i]) / v[i];
+      if (ta > tb) std::swap(ta, tb);
+      if (ta > t_in) {
+        t_in = ta;
+        axis_in = i;
+      }
+      if (tb < t_out) {
+        t_out = tb;
+        axis_out = i;
+      }
+      miss = t_in > t_out;
     }
-    if (std::min(target_t, closest_box.t) < t_beyond * box_reach - kWalkMargin) break;
+    if (miss) return;
+    const bool inside = t_in < 0.0;
+    const double t = inside ? t_out : t_in;
+    const int axis = inside ? axis_out : axis_in;
+    if (axis < 0 || t < 0.0 || t >= target_t) return;
+    if (t > closest_box.t || (t == closest_box.t && k > closest_box.k)) return;
+    // Outward normal of the face the ray meets.
+    const double sign = (v[axis] > 0.0) == inside ? 1.0 : -1.0;
+    closest_box.t = t;
+    closest_box.k = k;
+    closest_box.n_W = box.R_SW.row(axis).transpose() * sign;
+  };
+  if (fan) {
+    for (const auto& candidate : fan->boxes.Along(fan_bin)) {
+      if (beyond(candidate.near, std::min({box_reach, target_t, closest_box.t}))) break;
+      test_box(candidate.box);
+    }
+  } else {
+    world_detail::RayBins::Walk boxes(fixed.ray_box_bins, from.head<2>(),
+                                      from.head<2>() + ground * box_reach);
+    while (boxes.Next(&near, &t_beyond)) {
+      for (const int k : near)
+        test_box(k);
+      if (std::min(target_t, closest_box.t) < t_beyond * box_reach - kWalkMargin) break;
+    }
   }
   if (closest_box.k >= 0) {
     cb.m_closestHitFraction = btScalar(closest_box.t);
@@ -246,23 +277,50 @@ RayHit TwinWorld::Impl::CastSegment(const Eigen::Vector3d& from, const Eigen::Ve
   return hit;
 }
 
-RayHit TwinWorld::CastRay(const Eigen::Vector3d& from, const Eigen::Vector3d& to, GlassMode mode,
-                          double glass_max_incidence) const {
-  // The sensors see doors, people and payloads where they are now.
-  if (impl_->ray_proxies_stale) impl_->SyncRayProxies();
+RayHit TwinWorld::Impl::CastRayInPieces(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
+                                        GlassMode mode, double glass_max_incidence,
+                                        const RayFanBins* fan) const {
   // Cast near first, then the rest: most rays indoors hit within a few metres, and a hit in the
   // near piece skips the far piece's walk of the BVH.
   constexpr double kNearSegment = 3.0;  // [m]
   const double length = (to - from).norm();
+  // Both pieces in the ray's bin of the fan (the far piece's own direction may round into the
+  // next; either bin holds all it may cross).
+  const long bin = fan ? world_detail::RayFan::Bin((to - from).head<2>()) : 0;
   if (length > 1.5 * kNearSegment) {
     const Eigen::Vector3d mid = from + (to - from) * (kNearSegment / length);
-    RayHit near = impl_->CastSegment(from, mid, mode, glass_max_incidence);
+    RayHit near = CastSegment(from, mid, mode, glass_max_incidence, fan, bin);
     if (near.hit) return near;
-    RayHit far = impl_->CastSegment(mid, to, mode, glass_max_incidence);
+    RayHit far = CastSegment(mid, to, mode, glass_max_incidence, fan, bin);
     if (far.hit) far.distance += kNearSegment;
     return far;
   }
-  return impl_->CastSegment(from, to, mode, glass_max_incidence);
+  return CastSegment(from, to, mode, glass_max_incidence, fan, bin);
+}
+
+RayHit TwinWorld::CastRay(const Eigen::Vector3d& from, const Eigen::Vector3d& to, GlassMode mode,
+                          double glass_max_incidence) const {
+  // The sensors see doors, people and payloads where they are now.
+  if (impl_->ray_proxies_stale) impl_->SyncRayProxies();
+  return impl_->CastRayInPieces(from, to, mode, glass_max_incidence, nullptr);
+}
+
+void TwinWorld::CastRayFan(const Eigen::Vector3d& from, std::span<const Eigen::Vector3d> tos,
+                           GlassMode mode, std::vector<RayHit>* hits,
+                           double glass_max_incidence) const {
+  ThrowUnless(hits != nullptr, "CastRayFan: no output");
+  if (impl_->ray_proxies_stale) impl_->SyncRayProxies();
+  // The candidates by bearing from `from`, once for the fan, as far as its longest ray reaches
+  // on the ground.
+  double reach = 0.0;
+  for (const Eigen::Vector3d& to : tos)
+    reach = std::max(reach, (to - from).head<2>().norm());
+  thread_local Impl::RayFanBins fan;
+  fan.targets.Build(from.head<2>(), impl_->ray_target_extents, reach);
+  fan.boxes.Build(from.head<2>(), impl_->fixed.ray_box_extents, reach);
+  hits->resize(tos.size());
+  for (std::size_t k = 0; k < tos.size(); ++k)
+    (*hits)[k] = impl_->CastRayInPieces(from, tos[k], mode, glass_max_incidence, &fan);
 }
 
 EntityKind TwinWorld::entity_kind(int entity) const {

@@ -94,7 +94,8 @@ void TwinWorld::Impl::SyncRayProxies() const {
     ray_targets[i]->getCollisionShape()->getAabb(
         ray_targets[i]->getWorldTransform(), ray_target_aabbs[i].first, ray_target_aabbs[i].second);
   }
-  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> extents;
+  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>>& extents = ray_target_extents;
+  extents.clear();
   extents.reserve(ray_target_aabbs.size());
   for (std::size_t i = 0; i < ray_targets.size(); ++i) {
     const bool plane =

@@ -7,6 +7,7 @@
 // sensors).
 
 #include "ray_convex.h"
+#include "ray_fan.h"
 #include "twin_model_compiled.h"
 
 namespace egress::twin {
@@ -294,6 +295,8 @@ struct TwinWorld::Impl {
   // Per ray target: the proxy's polytope, cast analytically; null for Bullet shapes.
   std::vector<const world_detail::ConvexPolytope*> ray_target_polytopes;
   mutable std::vector<std::pair<btVector3, btVector3>> ray_target_aabbs;  // their world bounds
+  // Their XY extents (a plane's infinite), binned for a single ray and for a fan.
+  mutable std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> ray_target_extents;
   mutable world_detail::RayBins ray_target_bins;  // which ray_targets a ray may cross
   mutable bool ray_proxies_stale{true};           // bodies moved since the proxies were posed
 
@@ -301,8 +304,20 @@ struct TwinWorld::Impl {
   // everything, with a small margin; 1 when it crosses none.
   double PlaneClip(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const;
 
+  // The candidates of a fan of rays from one point (CastRayFan): the targets and the static
+  // boxes by bearing from it.
+  struct RayFanBins {
+    world_detail::RayFan targets, boxes;
+  };
+  // The closest hit on the segment from-to; the candidates from `fan`'s `fan_bin` (a ray of the
+  // fan from its origin, or the far piece of one) instead of the grid walks when given: the same
+  // hit.
   RayHit CastSegment(const Eigen::Vector3d& from, const Eigen::Vector3d& to, GlassMode mode,
-                     double glass_max_incidence) const;
+                     double glass_max_incidence, const RayFanBins* fan = nullptr,
+                     long fan_bin = 0) const;
+  // CastRay's near piece, then its far one.
+  RayHit CastRayInPieces(const Eigen::Vector3d& from, const Eigen::Vector3d& to, GlassMode mode,
+                         double glass_max_incidence, const RayFanBins* fan) const;
   // The ray callbacks' views of the entities, made once rather than per ray.
   const std::function<bool(int)> ray_is_glass = [this](int e) {
     return e >= 0 && entities[std::size_t(e)].glass;

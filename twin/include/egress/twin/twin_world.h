@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -180,6 +181,11 @@ class TwinWorld {
   /// Casts a ray from `from` to `to` in W, ignoring the robot's own body.
   RayHit CastRay(const Eigen::Vector3d& from, const Eigen::Vector3d& to, GlassMode mode,
                  double glass_max_incidence = 0.26) const;
+  /// CastRay from one point to each of `tos`, bit for bit: hits[k] is CastRay(from, tos[k], ...).
+  /// For a sensor's sweep (many rays from one point): the candidates are binned by bearing from
+  /// `from` once, instead of a grid walk per ray.
+  void CastRayFan(const Eigen::Vector3d& from, std::span<const Eigen::Vector3d> tos, GlassMode mode,
+                  std::vector<RayHit>* hits, double glass_max_incidence = 0.26) const;
   /// Kind and name of an entity from RayHit::entity.
   EntityKind entity_kind(int entity) const;
   const std::string& entity_name(int entity) const;
