@@ -184,17 +184,35 @@ Eigen::Vector2d SocialForceModel::CalcTermsAmong(std::size_t i, const std::vecto
   thread_local std::vector<Nearest> nearest;
   nearest.clear();
   const std::size_t candidates = near.walls ? near.walls->size() : walls.size();
+  // Beyond this no segment counts (the wall cutoff; contact alone: the body's radius). In a
+  // cell's list (by rank: an obstacle's fixed segments together, its rank whichever of them
+  // comes first) a segment whose bounding box lies farther is skipped unmeasured: its nearest
+  // point would be farther still, so it could neither be its obstacle's nearest that counts nor
+  // count itself (the margin keeps the box's rounding on the safe side).
+  constexpr double kSkipMarginM = 1e-9;
+  const double reach = (social_terms ? kWallCutoffM : w.radius) + kSkipMarginM;
+  const double reach_squared = reach * reach;
   for (std::size_t k = 0; k < candidates; ++k) {
     const std::size_t s = near.walls ? (*near.walls)[k] : k;
-    const WallSegment& wall = s < walls.size() ? walls[s] : (*near.moving)[s - walls.size()];
+    const bool fixed = s < walls.size();
+    const WallSegment& wall = fixed ? walls[s] : (*near.moving)[s - walls.size()];
+    const bool listed_by_rank = fixed && near.walls && near.wall_rank;
+    if (listed_by_rank && (wall.a.cwiseMin(wall.b) - w.position)
+                                  .cwiseMax(w.position - wall.a.cwiseMax(wall.b))
+                                  .cwiseMax(0.0)
+                                  .squaredNorm() > reach_squared)
+      continue;
     const Eigen::Vector2d q = ClosestPointOnSegment(w.position, wall);
     // Contact alone: only an obstacle the body overlaps pushes, from its nearest point, which
     // is then among the segments it overlaps.
     if (!social_terms && (w.position - q).squaredNorm() >= w.radius * w.radius) continue;
+    // In a cell's list, an obstacle's entry, if any, is the last one made.
     auto it = wall.obstacle < 0 ? nearest.end()
-                                : std::find_if(nearest.begin(), nearest.end(), [&](const auto& e) {
-                                    return e.id == wall.obstacle;
-                                  });
+              : listed_by_rank
+                  ? (!nearest.empty() && nearest.back().id == wall.obstacle ? nearest.end() - 1
+                                                                            : nearest.end())
+                  : std::find_if(nearest.begin(), nearest.end(),
+                                 [&](const auto& e) { return e.id == wall.obstacle; });
     if (it == nearest.end()) {
       const bool ranked = near.wall_rank && s < near.wall_rank->size();
       nearest.push_back({ranked ? (*near.wall_rank)[s] : s, wall.obstacle, q});

@@ -174,7 +174,7 @@ class SocialForceModel {
   // Who can reach walker i, from Step's cell lists (nullptr: everyone, everything).
   struct Neighbours {
     const std::vector<std::size_t>* walkers{nullptr};  // indices, ascending
-    const std::vector<std::size_t>* walls{nullptr};    // indices, ascending
+    const std::vector<std::size_t>* walls{nullptr};    // indices; a cell's by wall_rank
     // Per wall: the index of the first wall of its obstacle (the order obstacles are summed).
     const std::vector<std::size_t>* wall_rank{nullptr};
     const std::vector<Reach>* reach{nullptr};  // per walker: WalkerReach
