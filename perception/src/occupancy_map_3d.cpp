@@ -4,30 +4,14 @@
 #include <cmath>
 
 #include "egress/hsr_interface/error.h"
+#include "morton_code.h"
+#include "sorted_leaf_writer.h"
 
 namespace egress::perception {
 namespace {
-// A key's bits interleaved from the top (x lowest in each group of three): the order of a
-// depth-first walk of the tree visiting children 0..7, and each group of three a child index.
-constexpr int kKeyBits = 16;  // OctoMap's tree depth
-std::uint64_t MortonCode(const octomap::OcTreeKey& key) {
-  std::uint64_t code = 0;
-  for (int b = kKeyBits - 1; b >= 0; --b) {
-    code = (code << 3) | ((key[0] >> b) & 1u) | (((key[1] >> b) & 1u) << 1) |
-           (((key[2] >> b) & 1u) << 2);
-  }
-  return code;
-}
-octomap::OcTreeKey KeyOfMortonCode(std::uint64_t code) {
-  octomap::OcTreeKey key(0, 0, 0);
-  for (int b = 0; b < kKeyBits; ++b) {
-    const unsigned group = unsigned(code >> (3 * b)) & 7u;
-    key[0] = octomap::key_type(key[0] | ((group & 1u) << b));
-    key[1] = octomap::key_type(key[1] | (((group >> 1) & 1u) << b));
-    key[2] = octomap::key_type(key[2] | (((group >> 2) & 1u) << b));
-  }
-  return key;
-}
+
+using detail::KeyOfMortonCode;
+using detail::MortonCode;
 
 // Adds each Morton code to `out` once, in the order first offered: an open-addressing table of
 // code + 1 (0 marks an empty slot) in `slots`, kept from image to image for its memory. A depth
@@ -166,20 +150,22 @@ std::size_t OccupancyMap3D::InsertDepthImage(const DepthImage& depth,
       occupied_in_band_.erase(code);
     }
   };
-  // A voxel both marked and carved is marked.
+  // A voxel both marked and carved is marked. Both written in order, each from where the last
+  // one's path parts (octomap's updateNode, in one descent).
+  detail::SortedLeafWriter writer(tree_.get());
   auto marked = occupied.begin();
   for (const std::uint64_t code : free) {
     while (marked != occupied.end() && *marked < code)
       ++marked;
     if (marked != occupied.end() && *marked == code) continue;
     const octomap::OcTreeKey key = KeyOfMortonCode(code);
-    note(code, key, tree_->updateNode(key, false, /*lazy_eval=*/true));
+    note(code, key, writer.Update(code, key, /*occupied=*/false));
   }
   const auto carved_end = long(touched.size());
   const double now = ToSeconds(depth.stamp);
   for (const std::uint64_t code : occupied) {
     const octomap::OcTreeKey key = KeyOfMortonCode(code);
-    note(code, key, tree_->updateNode(key, true, /*lazy_eval=*/true));
+    note(code, key, writer.Update(code, key, /*occupied=*/true));
     marked_at_[key] = now;
   }
   const auto marked_end = long(touched.size());
