@@ -180,18 +180,40 @@ struct RobotModel::Impl {
   Pose3 LinkPoseInBase(std::string_view link,
                        const std::map<std::string, double, std::less<>>& q) const {
     Pose3 X_BLink;
-    for (const JointInfo* joint : PathFromRoot(link)) {
-      double value = 0.0;
-      if (joint->mimic_leader) {
-        auto it = q.find(*joint->mimic_leader);
-        const double leader = it == q.end() ? 0.0 : it->second;
-        value = joint->mimic_multiplier * leader + joint->mimic_offset;
-      } else if (auto it = q.find(joint->name); it != q.end()) {
-        value = it->second;
-      }
-      X_BLink = X_BLink * joint->X_PJ * joint->Motion(value);
-    }
+    for (const JointInfo* joint : PathFromRoot(link))
+      X_BLink = X_BLink * joint->X_PJ * joint->Motion(JointValue(*joint, q));
     return X_BLink;
+  }
+
+  // A joint's position in q: a mimic joint's from its leader's, a joint not in q at 0.
+  static double JointValue(const JointInfo& joint,
+                           const std::map<std::string, double, std::less<>>& q) {
+    if (joint.mimic_leader) {
+      auto it = q.find(*joint.mimic_leader);
+      const double leader = it == q.end() ? 0.0 : it->second;
+      return joint.mimic_multiplier * leader + joint.mimic_offset;
+    }
+    auto it = q.find(joint.name);
+    return it != q.end() ? it->second : 0.0;
+  }
+
+  // LinkPoseInBase through `cache` (link -> pose in B): a link's pose is its parent's times its
+  // joint's, the very product LinkPoseInBase forms on its way down (from the identity at the
+  // root), so each link on the way is computed once for all the links below it.
+  const Pose3& CachedLinkPoseInBase(std::string_view link,
+                                    const std::map<std::string, double, std::less<>>& q,
+                                    std::map<std::string, Pose3, std::less<>>* cache) const {
+    if (auto it = cache->find(link); it != cache->end()) return it->second;
+    if (link == kRootLink) return cache->emplace(std::string(link), Pose3()).first->second;
+    auto parent_joint = parent_joint_of_link.find(link);
+    if (parent_joint == parent_joint_of_link.end()) {
+      throw InvalidArgument(StrCat("Unknown link '", link, "' in robot model '", name, "'."));
+    }
+    const JointInfo& joint = joints.at(parent_joint->second);
+    const Pose3 X_BParent = CachedLinkPoseInBase(joint.parent_link, q, cache);
+    return cache
+        ->emplace(std::string(link), X_BParent * joint.X_PJ * joint.Motion(JointValue(joint, q)))
+        .first->second;
   }
 
   void ReadJoints(const urdf::ModelInterface& model) {
@@ -669,10 +691,7 @@ std::vector<PlacedShape> RobotModel::CalcCollisionShapesInBase(
          shape.link.find("distal") != std::string::npos)) {
       continue;
     }
-    auto it = link_poses.find(shape.link);
-    if (it == link_poses.end())
-      it = link_poses.emplace(shape.link, impl_->LinkPoseInBase(shape.link, q)).first;
-    out.push_back({shape, it->second * shape.X_LS});
+    out.push_back({shape, impl_->CachedLinkPoseInBase(shape.link, q, &link_poses) * shape.X_LS});
   }
   return out;
 }

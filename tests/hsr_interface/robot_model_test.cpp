@@ -211,6 +211,30 @@ TEST_F(RobotModelTest, CollisionShapesComeFromTheUrdfAndFollowTheJoints) {
                InvalidArgument);
 }
 
+TEST_F(RobotModelTest, EveryShapeIsPlacedOnItsLinksPoseExactly) {
+  // The shapes' link poses are computed once per link on the way down (a link's from its
+  // parent's): the same products as CalcLinkPoseInBase's from the root, bit for bit, whatever
+  // the joints (head, arm, lift and its mimic torso).
+  std::mt19937_64 rng(4);
+  std::uniform_real_distribution<double> angle(-1.5, 1.5), lift(0.0, 0.6);
+  for (int k = 0; k < 50; ++k) {
+    std::vector<std::pair<std::string, double>> q;
+    for (const char* joint :
+         {"head_pan_joint", "head_tilt_joint", "arm_flex_joint", "arm_roll_joint",
+          "wrist_flex_joint", "wrist_roll_joint", "hand_motor_joint", "arm_lift_joint"}) {
+      q.emplace_back(joint, std::string_view(joint) == "arm_lift_joint" ? lift(rng) : angle(rng));
+    }
+    if (k % 2 == 0) q.pop_back();  // a joint left out stands at 0
+    for (const bool skip_fingers : {true, false}) {
+      for (const PlacedShape& placed : model().CalcCollisionShapesInBase(q, skip_fingers)) {
+        const Pose3 X_BS = model().CalcLinkPoseInBase(placed.shape.link, q) * placed.shape.X_LS;
+        ASSERT_EQ(placed.X_BS.translation(), X_BS.translation()) << placed.shape.name;
+        ASSERT_EQ(placed.X_BS.rotation(), X_BS.rotation()) << placed.shape.name;
+      }
+    }
+  }
+}
+
 TEST_F(RobotModelTest, RejectsNonFiniteConfigurations) {
   WholeBodyVector q = WholeBodyVector::Zero();
   q[kArmFlex] = std::nan("");
