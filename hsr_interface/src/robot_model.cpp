@@ -179,10 +179,8 @@ struct RobotModel::Impl {
 
   Pose3 LinkPoseInBase(std::string_view link,
                        const std::map<std::string, double, std::less<>>& q) const {
-    Pose3 X_BLink;
-    for (const JointInfo* joint : PathFromRoot(link))
-      X_BLink = X_BLink * joint->X_PJ * joint->Motion(JointValue(*joint, q));
-    return X_BLink;
+    std::map<std::string, Pose3, std::less<>> cache;
+    return CachedLinkPoseInBase(link, q, &cache);
   }
 
   // A joint's position in q: a mimic joint's from its leader's, a joint not in q at 0.
@@ -197,9 +195,9 @@ struct RobotModel::Impl {
     return it != q.end() ? it->second : 0.0;
   }
 
-  // LinkPoseInBase through `cache` (link -> pose in B): a link's pose is its parent's times its
-  // joint's, the very product LinkPoseInBase forms on its way down (from the identity at the
-  // root), so each link on the way is computed once for all the links below it.
+  // A link's pose in B through `cache` (link -> pose in B): its parent's times its joint's, from
+  // the identity at the root, so each link on the way is computed once for all the links below
+  // it (CalcCollisionShapesInBase shares one cache among all its shapes' links).
   const Pose3& CachedLinkPoseInBase(std::string_view link,
                                     const std::map<std::string, double, std::less<>>& q,
                                     std::map<std::string, Pose3, std::less<>>* cache) const {

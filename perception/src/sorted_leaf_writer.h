@@ -7,6 +7,7 @@
 /// path parts from this one's rather than from the root: an image's voxels, written in Morton
 /// order, share all but the last levels of their paths.
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cstdint>

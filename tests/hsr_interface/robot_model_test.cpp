@@ -212,9 +212,9 @@ TEST_F(RobotModelTest, CollisionShapesComeFromTheUrdfAndFollowTheJoints) {
 }
 
 TEST_F(RobotModelTest, EveryShapeIsPlacedOnItsLinksPoseExactly) {
-  // The shapes' link poses are computed once per link on the way down (a link's from its
-  // parent's): the same products as CalcLinkPoseInBase's from the root, bit for bit, whatever
-  // the joints (head, arm, lift and its mimic torso).
+  // The shapes' link poses are computed once per link on the way down, shared among the
+  // shapes: the same as each link's own CalcLinkPoseInBase, bit for bit, whatever the joints
+  // (head, arm, lift and its mimic torso).
   std::mt19937_64 rng(4);
   std::uniform_real_distribution<double> angle(-1.5, 1.5), lift(0.0, 0.6);
   for (int k = 0; k < 50; ++k) {
