@@ -1,5 +1,9 @@
 #include "egress/planning/route_planner.h"
 
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
 #include <gtest/gtest.h>
 
 #include "egress/hsr_interface/error.h"
@@ -97,6 +101,39 @@ TEST(RoutePlannerTest, ADoorAtACorridorCornerIsApproachedAlongTheRoute) {
   EXPECT_GT((leg.X_MB_approach.translation() - door.p_MHinge).norm(), 1.1);
   const Eigen::Vector2d to_door = Eigen::Vector2d(4.6, 1.6) - leg.X_MB_approach.translation();
   EXPECT_NEAR(leg.X_MB_approach.yaw, std::atan2(to_door.y(), to_door.x()), 1e-9);
+}
+
+TEST(RoutePlannerTest, ClearanceIsTheDistanceToTheNearestOccupiedCellWithinAFractionOfACell) {
+  // The lab with a pillar and a slanted wall: every free cell's clearance against a brute-force
+  // search over all occupied cells. The propagation's distance is always to some occupied
+  // cell (never below the true one) and never more than a fifth of a cell above it.
+  Lab lab;
+  lab.grid.AddBox({{1.2, 5.1, 0.0}, {0.3, 0.3}});
+  lab.grid.AddBox({{-1.5, 1.0, 0.6}, {1.5, 0.1}});
+  const RoutePlanner planner(lab.grid, {lab.door});
+  const perception::GridGeometry& g = lab.grid.geometry();
+  std::vector<Eigen::Vector2i> occupied;
+  for (int iy = 0; iy < g.height; ++iy) {
+    for (int ix = 0; ix < g.width; ++ix) {
+      if (lab.grid.at(ix, iy) != perception::kFreeCost) occupied.emplace_back(ix, iy);
+    }
+  }
+  ASSERT_GT(occupied.size(), 100u);
+  double worst_over = 0.0;
+  for (int iy = 0; iy < g.height; iy += 3) {
+    for (int ix = 0; ix < g.width; ix += 3) {
+      double nearest = 1e9;
+      for (const Eigen::Vector2i& o : occupied) {
+        nearest = std::min(
+            nearest, std::sqrt(double((o.x() - ix) * (o.x() - ix) + (o.y() - iy) * (o.y() - iy))) *
+                         g.resolution);
+      }
+      const double clearance = planner.ClearanceAt(g.CellCenter(ix, iy));
+      ASSERT_GE(clearance, nearest - 1e-6) << ix << ", " << iy;
+      worst_over = std::max(worst_over, clearance - nearest);
+    }
+  }
+  EXPECT_LE(worst_over, 0.2 * g.resolution);
 }
 
 TEST(RoutePlannerTest, BadConfigAndDoorsAreRefused) {
