@@ -109,7 +109,10 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
             InputPort<double>("wait_for", 20.0,
                               "the hold is over when nobody at all has been near for this long "
                               "(they went ahead, or are elsewhere) [s]"),
-            InputPort<double>("max_hold", 600.0, "the longest the robot holds one door [s]")};
+            InputPort<double>("max_hold", 600.0, "the longest the robot holds one door [s]"),
+            InputPort<bool>("under_way", false,
+                            "the evacuation is known to be under way (the robot let residents "
+                            "out of a room): whoever stands at the door waits for it")};
   }
 
   NodeStatus OnStart() override {
@@ -144,6 +147,11 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   }
 
   NodeStatus OnRunning() override {
+    // Residents the sweep let out come to the route's doors after the robot: one waiting at a
+    // door that stood open before them is waiting for it, not a group yet to set off (the
+    // clinic, one wheelchair user in room A, seed 6: let out by the sweep, they waited at door_e
+    // and the robot stood short of it until max_hold).
+    if (Input<bool>("under_way")) under_way_ = true;
     const DoorPass pass = CalcDoorPass(*task_.map, door_, standoff_);
     const double held = ToSeconds(belief_.now - *started_);
     const Surroundings around =

@@ -463,6 +463,8 @@ void RegisterGraspNodes(bt::BehaviorTreeFactory& factory, const TaskServices* se
 void RegisterReleaseNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 void RegisterRouteNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 void RegisterEscortNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
+/// PlanSweep, FeederApproachPose, WatchDoorway (sweep_nodes.cpp): the escort's sweep.
+void RegisterSweepNodes(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 /// IsNobodyComing (escort_guard.cpp), registered by RegisterEscortNodes.
 void RegisterEscortGuard(bt::BehaviorTreeFactory& factory, const TaskServices* services);
 

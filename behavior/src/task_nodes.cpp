@@ -86,6 +86,7 @@ std::string TaskNodesModelXml() {
   detail::RegisterReleaseNodes(factory, nullptr);
   detail::RegisterRouteNodes(factory, nullptr);
   detail::RegisterEscortNodes(factory, nullptr);
+  detail::RegisterSweepNodes(factory, nullptr);
   return factory.WriteTreeNodesModelXml(false);
 }
 
@@ -103,6 +104,7 @@ void RegisterTaskNodes(bt::BehaviorTreeFactory& factory, const TaskServices* ser
   detail::RegisterGraspNodes(factory, services);
   detail::RegisterReleaseNodes(factory, services);
   detail::RegisterEscortNodes(factory, services);
+  detail::RegisterSweepNodes(factory, services);
 }
 
 }  // namespace egress::behavior

@@ -637,6 +637,55 @@ TEST(EgressCliTest, EvacStudyNamesWhoIsLeftBehindAndTheDoorTheyWaitAt) {
   std::filesystem::remove_all(dir);
 }
 
+// The escort's sweep (evacuation_escort.xml): the robot starts in the clinic's corridor, its route
+// out through door_e and the exit door only; a wheelchair user in room A sets off at 1 s for
+// door_a. Seed 6 draws one who cannot operate it (the no-robot condition leaves them behind it).
+// Before leaving by the exit door the robot sweeps the rooms whose way out leaves by it, room A
+// first (the farthest), opens door_a, and holds door_e and the exit door for them.
+TEST(EgressCliTest, TheEscortSweepsTheRoomsOffItsRouteAndLetsOutWhoeverWaitsBehindADoor) {
+  const auto dir = egress::testing::TestTempPath("study_sweep");
+  const std::string scenario = WriteTemp("room_a_wheelchair.yaml", R"(name: clinic, room A
+world: )" + kWorldsDir + R"(/clinic/clinic.sdf
+seed: 1
+time_limit: 600
+robot:
+  start: {x: 18.0, y: 1.0, yaw_deg: 0}
+  goal: {place: exit_outside}
+people:
+  - name: resident
+    behavior: evacuate
+    route: [door_a, door_e, exit_door]
+    start: {x: 4.0, y: 4.5}
+    goal: {x: 21.0, y: 11.5}
+    mobility: {wheelchair: 1}
+    trigger: {at: 1.0}
+mission:
+  tree: )" + kWorldsDir + R"(/../behavior/trees/evacuation_escort.xml
+  blackboard: {max_yields: "30", clear_for: "3", wait_for: "5", keep_clear: "3.5"}
+)");
+  Result run = RunEgress("evac study " + scenario +
+                         " --trials 1 --seed-base 6 -q --conditions robot no_robot --out " +
+                         (dir / "out").string());
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const auto study = nlohmann::json::parse(std::ifstream(dir / "out" / "study.json"));
+  const auto condition = [&](const std::string& name) {
+    for (const auto& c : study.at("conditions"))
+      if (c.at("condition") == name) return c;
+    ADD_FAILURE() << "no condition " << name << " in study.json";
+    return nlohmann::json::object();
+  };
+  const nlohmann::json robot = condition("robot"), alone = condition("no_robot");
+  ASSERT_EQ(alone.value("left_behind", -1), 1) << "seed 6 no longer draws someone who "
+                                                  "cannot operate door_a";
+  EXPECT_EQ(alone.at("left_behind_people").at(0).at("waiting_for"), "door_a");
+  EXPECT_EQ(robot.value("left_behind", -1), 0) << run.output;
+  EXPECT_EQ(robot.at("contacts").get<int>(), 0);
+  const auto& door_a = robot.at("doors").at("door_a");
+  EXPECT_GE(door_a.at("operated_by_robot_median").get<double>(), 1.0) << door_a.dump();
+  EXPECT_EQ(door_a.at("operated_by_residents_median").get<double>(), 0.0);
+  std::filesystem::remove_all(dir);
+}
+
 // A door's flow is a rate: two residents through at least. One resident alone gives none (null,
 // "n/a"), not a flow of 0 persons/s; their queue time and who opened the door are still given.
 TEST(EgressCliTest, EvacStudyGivesNoFlowThroughADoorOnlyOneResidentPassed) {
