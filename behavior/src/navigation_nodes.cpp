@@ -1,4 +1,6 @@
 #include "egress/behavior/proxemics.h"
+#include "escort_room.h"
+#include "escort_watch.h"
 #include "task_node_support.h"
 
 #include <algorithm>
@@ -282,6 +284,34 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
       }
     }
     if (!chosen) {
+      // Nowhere to go, at the visited door's actuator beside the lane before its doorway: a step
+      // sideways along the door line, away from the opening, up to the wall, leaves whoever waits
+      // before the door the way through (the clinic, one wheelchair user coming to door_e after
+      // the robot's hold had ended: the robot stood at the standoff beside the lane, the leaf
+      // opening towards them, and for 550 s they could not get between its edge and the robot).
+      if (visit && task_.map->FindDoor(visit->door) != nullptr) {
+        const DoorPass pass = CalcKnownPass(task_, visit->door, &*visit);
+        const std::optional<Pose2> aside = InTheLane(pass, belief_.X_MB.translation(), task_.config)
+                                               ? SqueezeAsidePose(task_, pass, visit->door)
+                                               : std::nullopt;
+        // Not nearer anyone: the step keeps the footprint + 0.1 m from them, as the retreat does.
+        const auto roomy = [&](const Eigen::Vector2d& q) {
+          const double body = task_.config.footprint_radius + 0.1;
+          for (const auto& entry : belief_.world.people)
+            if ((entry.person.p_MP - q).norm() < body + task_.config.person_radius) return false;
+          for (const Eigen::Vector2d& p : belief_.off_map_returns)
+            if ((p - q).norm() < body) return false;
+          return true;
+        };
+        if (aside && roomy(aside->translation())) {
+          task_.motion->FollowPath({belief_.X_MB, *aside}, {false}, TuckedArm(*task_.model),
+                                   belief_.now, task_.config.retreat_speed);
+          this->SetOutput("retreating", true);
+          Note(StrCat("nowhere to back off to without passing someone: squeezing aside to ",
+                      PoseText(*aside), ", out of the way through ", visit->door));
+          return;
+        }
+      }
       Note("nowhere to back off to without passing someone: standing still");
       return;
     }
