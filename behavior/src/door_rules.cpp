@@ -178,17 +178,26 @@ double ExitDistance(const TaskServices& task, const std::string& door) {
                   w + task.config.footprint_radius + kLeafClearance);
 }
 
+// Half a leaf's thickness, with a margin: how far an open leaf stands into its doorway [m].
+constexpr double kLeafHalfThickness = 0.03;
+
 Eigen::Vector2d ClearOpeningCentre(const TaskServices& task, const std::string& door_id) {
   const perception::DoorModel& door = *task.map->FindDoor(door_id);
   double angle = M_PI / 2;
   for (const auto& d : task.belief->world.doors) {
     if (d.model.id == door_id && d.state.observed) angle = std::min(d.state.angle, M_PI / 2);
   }
-  constexpr double kLeafHalfThickness = 0.03;  // [m] with a margin
   const double w = door.width();
   const double clear_from = std::min(w, w * std::cos(angle) + kLeafHalfThickness);
   const Eigen::Vector2d along = (door.p_MLatch - door.p_MHinge) / w;
   return door.p_MHinge + along * (clear_from + w) / 2;
+}
+
+double DoorPassPoseSigma(const TaskServices& task, const std::string& door) {
+  constexpr double kSigmas = 3.0;
+  const double clear = task.map->FindDoor(door)->width() - kLeafHalfThickness;
+  const double margin = (clear - 2.0 * task.config.footprint_radius) / 2.0;
+  return std::max(task.config.precise_pose_sigma, margin / kSigmas);
 }
 
 // How far before the door line the robot lines up and waits: on the side the leaf opens into,

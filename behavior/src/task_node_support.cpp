@@ -666,13 +666,13 @@ double PositionSigma(const TaskServices& task) {
 }
 
 NodeStatus RelocalizeGate::Check(const TaskServices& task, const std::string& act,
-                                 const EventNoteFn& note) {
+                                 const EventNoteFn& note, std::optional<double> act_limit) {
   // Checked every tick of an act: after a wait that timed out, a new one each tick the act was
   // still not under way took 3 s at a time until the door's window had gone (random building
   // seed 12: three waits, "the door did not open in time", and again each press to 400 s).
   if (gave_up_) return NodeStatus::kSuccess;
   const double sigma = PositionSigma(task);
-  const double limit = task.config.precise_pose_sigma;
+  const double limit = act_limit.value_or(task.config.precise_pose_sigma);
   if (!waiting_since_) {
     if (sigma <= limit) return NodeStatus::kSuccess;
     waiting_since_ = task.belief->now;

@@ -207,6 +207,13 @@ double ExitDistance(const TaskServices& task, const std::string& door);
 /// The middle of `door`'s clear opening [M], between its latch jamb and its leaf at the angle
 /// last estimated (a leaf never seen: square to the door line): the way through an open door.
 Eigen::Vector2d ClearOpeningCentre(const TaskServices& task, const std::string& door);
+/// How far the localizer may be unsure of the robot's position [m, one standard deviation] for a
+/// drive through `door`: a 3σ error across its clear opening (the leaf fully open) still leaves
+/// the footprint inside it; never tighter than config.precise_pose_sigma. A 0.9 m door and the
+/// HSR's 0.215 m footprint radius give about 7 cm. (Held to the press's 2 cm, the pass waited
+/// 3 s after the press, standing, for a pose that stood at 20-23 mm north of the clinic's
+/// door_e, and then found the door's window too short: two wards seed 10 failed it 8 times.)
+double DoorPassPoseSigma(const TaskServices& task, const std::string& door);
 /// How far before the door line the robot lines up and waits [m].
 double EntryDistance(const TaskServices& task, const std::string& door, const DoorPass& pass);
 /// The robot's way from X_MB_from onto `door`'s axis, at EntryDistance, facing through it:
@@ -413,9 +420,10 @@ std::vector<std::pair<const perception::TrackedPerson*, double>> PeopleComing(
 /// the xy block of the belief's covariance [m].
 double PositionSigma(const TaskServices& task);
 
-/// Holds a precise act until the pose is certain enough: when PositionSigma exceeds
-/// config.precise_pose_sigma, the base stands still while the localizer corrects on scans of
-/// the walls and door around it, until it is below again or config.relocalize_timeout passed.
+/// Holds a precise act until the pose is certain enough: when PositionSigma exceeds the act's
+/// limit (config.precise_pose_sigma unless the act names its own), the base stands still while the
+/// localizer corrects on scans of the walls and door around it, until it is below again or
+/// config.relocalize_timeout passed.
 class RelocalizeGate {
  public:
   /// A new act: forget any earlier wait.
@@ -426,7 +434,8 @@ class RelocalizeGate {
   /// RUNNING while re-localizing; SUCCESS when the pose is good enough (or the wait timed out,
   /// noted: then SUCCESS until the next Reset, as another wait would end the same way). Each wait
   /// is noted as a DecisionEvent::kRelocalizing (the executive counts them).
-  NodeStatus Check(const TaskServices& task, const std::string& act, const EventNoteFn& note);
+  NodeStatus Check(const TaskServices& task, const std::string& act, const EventNoteFn& note,
+                   std::optional<double> limit = std::nullopt);
 
  private:
   std::optional<Time> waiting_since_;

@@ -95,7 +95,8 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
         [[fallthrough]];
       }
       case Phase::kWaiting: {
-        if (gate_.Check(task_, "driving through the door", EventNoter()) == NodeStatus::kRunning)
+        if (gate_.Check(task_, "driving through the door", EventNoter(),
+                        DoorPassPoseSigma(task_, door_)) == NodeStatus::kRunning)
           return NodeStatus::kRunning;
         if (const NodeStatus arm =
                 ArmMotionStatus(task_, [this](const std::string& t) { Note(t); });

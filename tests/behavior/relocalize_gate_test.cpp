@@ -1,6 +1,7 @@
 // RelocalizeGate (behavior/src/task_node_support.h): precise acts wait, standing, for an
 // uncertain pose to settle, and go on anyway after the timeout.
 
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -72,6 +73,49 @@ TEST(RelocalizeGateTest, AnUncertainPoseIsSettledBeforeTheAct) {
   belief.now = At(14.0);
   EXPECT_EQ(gate.Check(ctx, "grasping", note), bt::NodeStatus::kRunning);
   EXPECT_EQ(relocalizations, 3);
+}
+
+TEST(RelocalizeGateTest, AnActWithItsOwnLimitWaitsOnlyAboveIt) {
+  const RobotModel model = RobotModel::LoadDefault();
+  MotionExecutor motion(model);
+  Belief belief;
+  TaskServices ctx;
+  ctx.motion = &motion;
+  ctx.belief = &belief;
+  int relocalizations = 0;
+  const EventNoteFn note = [&](const std::string&, DecisionEvent e) {
+    if (e == DecisionEvent::kRelocalizing) ++relocalizations;
+  };
+  RelocalizeGate gate;
+  // 5 cm: within a 7 cm limit the act goes on; under the 2 cm default it waits.
+  belief.world.X_MB_covariance = Eigen::Vector3d(0.05 * 0.05, 1e-4, 1e-4).asDiagonal();
+  EXPECT_EQ(gate.Check(ctx, "driving through the door", note, 0.07), bt::NodeStatus::kSuccess);
+  EXPECT_EQ(relocalizations, 0);
+  EXPECT_EQ(gate.Check(ctx, "driving through the door", note, 0.04), bt::NodeStatus::kRunning);
+  EXPECT_EQ(relocalizations, 1);
+  gate.Reset();
+  EXPECT_EQ(gate.Check(ctx, "pressing", note), bt::NodeStatus::kRunning);
+  EXPECT_EQ(relocalizations, 2);
+}
+
+TEST(RelocalizeGateTest, ADoorPassToleratesWhatItsClearOpeningLeavesTheFootprint) {
+  MissionMap map;
+  map.doors.push_back({"wide", {0.0, 0.0}, {0.9, 0.0}, 1.0, std::numbers::pi / 2});
+  map.doors.push_back({"narrow", {0.0, 2.0}, {0.5, 2.0}, 1.0, std::numbers::pi / 2});
+  Belief belief;
+  TaskServices ctx;
+  ctx.belief = &belief;
+  ctx.map = &map;
+  // 0.9 m: 0.87 m clear past the open leaf, 0.44 m left beside the 0.43 m footprint, 0.22 m a
+  // side: 3 sigma of it.
+  const double wide = (0.87 - 2 * ctx.config.footprint_radius) / 2 / 3;
+  EXPECT_NEAR(DoorPassPoseSigma(ctx, "wide"), wide, 1e-12);
+  EXPECT_GT(DoorPassPoseSigma(ctx, "wide"), 0.07);
+  // A door barely wider than the robot (2 cm a side): never looser than the precise acts' limit.
+  EXPECT_DOUBLE_EQ(DoorPassPoseSigma(ctx, "narrow"), ctx.config.precise_pose_sigma);
+  // The limit follows the footprint.
+  ctx.config.footprint_radius = 0.3;
+  EXPECT_NEAR(DoorPassPoseSigma(ctx, "wide"), (0.87 - 0.6) / 2 / 3, 1e-12);
 }
 
 }  // namespace
