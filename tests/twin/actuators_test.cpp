@@ -63,6 +63,26 @@ TEST(PushButtonTest, AJabPastTheBottomIsRefusedAsOverForce) {
   EXPECT_GT(b.force(), 22.0);
 }
 
+// The finger was behind the button's plane, away from it (the robot in a room behind that
+// wall), and comes round to press it from the front: a press, counted from the front face.
+TEST(PushButtonTest, AFingerFromBehindThePlaneElsewherePressesFromTheFront) {
+  PushButton b(WallButton(), 0.004, 5.0, 22.0);
+  EXPECT_EQ(b.Update({4.0, 3.5, 1.0}), PushButton::Result::kNone);  // behind, 3 m along
+  EXPECT_EQ(b.Update({1.0, 3.5, 0.4}), PushButton::Result::kNone);  // behind, below it
+  EXPECT_EQ(b.Update({1.5, 2.5, 1.0}), PushButton::Result::kNone);  // in front, beside it
+  // In from beside the cap, 5 cm out from the face, then the stroke.
+  for (int i = 0; i <= 20; ++i)
+    EXPECT_EQ(b.Update({1.5 - 0.5 * i / 20, 2.88, 1.0}), PushButton::Result::kNone);
+  EXPECT_EQ(Poke(&b, 1.0, 1.0, 0.005, 200), PushButton::Result::kPressed);
+  EXPECT_LT(b.force(), 22.0);
+  // A finger still behind the wall that comes over the cap's back is on the back: no press from
+  // the front face's count.
+  PushButton back(WallButton(), 0.004, 5.0, 22.0);
+  EXPECT_EQ(back.Update({1.5, 3.5, 1.0}), PushButton::Result::kNone);
+  EXPECT_EQ(back.Update({1.0, 3.5, 1.0}), PushButton::Result::kNone);
+  EXPECT_EQ(back.travel(), 0.0);
+}
+
 TEST(ProximityPlateTest, TriggersWithinRangeOnceUntilTheHandLeaves) {
   ProximityPlate plate(WallButton(), 0.3);
   EXPECT_FALSE(plate.Update({{1.0, 2.93 - 0.35, 1.0}}));
