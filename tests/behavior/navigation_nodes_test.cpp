@@ -494,6 +494,40 @@ TEST_F(NavigationNodesTest, RetractToSafeBacksOutOfTheDoorwayWhenTheWayOnIsUnsee
   EXPECT_FALSE(Noted(DecisionEvent::kRetreating));
 }
 
+// Issue 17: with nowhere to back off, standing at the visited door's button beside the lane
+// before its doorway (the robot blocks the way between the open leaf's edge and itself), it
+// squeezes aside along the door line, away from the opening; with someone standing there it
+// stays where it is.
+TEST_F(NavigationNodesTest, RetractToSafeWithNowhereToBackOffSqueezesAsideOutOfTheLane) {
+  const auto retreat_with = [&](std::vector<perception::TrackedPersonWithIntent> people) {
+    log_.Take();
+    motion_.StopBase();
+    bt::Tree tree = Tree(R"(<RetractToSafe/>)", VisitFromTheSouth());
+    belief_.X_MB = {0.75, 2.45, M_PI / 2};  // at the button, beside the lane, facing the wall
+    belief_.last_safe = Pose2{0.75, 1.2, M_PI / 2};
+    belief_.world.people = std::move(people);
+    belief_.now = At(1.0);
+    tree.TickOnce();
+    return tree;  // kept: a tree destroyed halts its nodes, and the retreat stops the base
+  };
+  // Someone on the way back and someone waiting in the lane for the door.
+  const auto behind = Person({0.75, 1.75}, perception::PersonIntent::kStationary);
+  const auto waiting = Person({-0.1, 2.0}, perception::PersonIntent::kStationary);
+  bt::Tree squeezing = retreat_with({behind, waiting});
+  ASSERT_TRUE(NotedText("squeezing aside")) << log_.pending().back().text;
+  ASSERT_TRUE(motion_.base_moving());
+  const Pose2 aside = motion_.path().back();
+  EXPECT_NEAR(aside.y, 2.45, 0.05) << "along the door line";
+  EXPECT_GT(aside.x, 0.75 + 0.1) << "away from the opening";
+  EXPECT_LE(aside.x, 0.75 + 0.4 + 1e-9) << "a step, not a walk";
+  // Someone standing where the step would go: it does not step at them.
+  squeezing.HaltTree();
+  bt::Tree staying =
+      retreat_with({behind, waiting, Person({1.15, 2.4}, perception::PersonIntent::kStationary)});
+  EXPECT_TRUE(NotedText("standing still"));
+  EXPECT_FALSE(motion_.base_moving());
+}
+
 // Halted just past the door line, having left the door's zone on the far side before (its last
 // safe pose is there): it goes on to that pose, never back through the doorway (clinic family
 // seed 2007: it backed through door_b as the leaf closed on it).
