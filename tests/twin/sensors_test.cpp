@@ -116,6 +116,35 @@ TEST(TwinWorldRayTest, ADownwardRayMeetsAPersonBeforeTheFloorBehindThem) {
   EXPECT_NEAR(floor_hit.distance, (short_of - from).norm(), 1e-4);
 }
 
+TEST(TwinWorldRayTest, AWalkingPersonsBodyIsWhereTheirStateSaysAfterEveryStep) {
+  // A person's body is posed on the body itself (no motion state) and people() is copied when
+  // asked for: after each step both must agree, or the sensors see someone the judge does not.
+  auto loaded = LoadText(At("lab.sdf", -1.5, 0.0, 0.0,
+                            "people:\n  - {name: p, behavior: walk_past, start: [2.5, -1.0], "
+                            "goal: [2.5, 1.5]}\n"),
+                         WorldsDir() / "lab");
+  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+  const double start_y = world.people().front().position.y();
+  int steps_checked = 0;
+  while (world.time() < 3.0) {
+    world.Step();
+    const PersonState& p = world.people().front();
+    if (world.step_count() % 24 != 0) continue;
+    // A level ray along x through the person's centre meets their front surface.
+    const Eigen::Vector3d from(0.0, p.position.y(), 1.0);
+    const RayHit hit = world.CastRay(from, {5.0, p.position.y(), 1.0}, GlassMode::kOpaque);
+    ASSERT_TRUE(hit.hit) << "t " << world.time();
+    EXPECT_NEAR(hit.point.x(), p.position.x() - p.radius, 0.02) << "t " << world.time();
+    ++steps_checked;
+  }
+  EXPECT_GT(steps_checked, 20);
+  const PersonState& p = world.people().front();
+  EXPECT_GT(p.position.y() - start_y, 1.0) << "they walked";
+  // Where they started, nobody is left.
+  const RayHit at_start =
+      world.CastRay({0.0, start_y, 1.0}, {5.0, start_y, 1.0}, GlassMode::kOpaque);
+  EXPECT_TRUE(!at_start.hit || at_start.point.x() > 2.5 + p.radius) << at_start.point.x();
+}
 TEST(TwinWorldRayTest, AFanCastsTheSameHitsAsOneRayAtATime) {
   // CastRayFan bins the candidates by bearing once instead of walking the grid per ray: the hits
   // must be CastRay's, bit for bit, among walking people, doors (door_b's glass leaf) and walls,

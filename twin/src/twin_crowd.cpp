@@ -173,6 +173,10 @@ void TwinWorld::Impl::BuildPeople() {
           AddBody(std::make_unique<btCapsuleShapeZ>(body_radius, kPersonHeight - 2 * body_radius),
                   X_W, 0.0, kGPerson, kMaskPerson, e);
       MakeKinematic(p.body);
+      // Posed by PlacePersonBody alone: without a motion state Bullet reads the transform set
+      // on the body, the same one, instead of a copy through a virtual call per person and
+      // physics step (~1 % of a 100-resident run).
+      p.body->setMotionState(nullptr);
       people.push_back(std::move(p));
       states_cache.push_back(people.back().state);
     }
@@ -231,7 +235,6 @@ void TwinWorld::Impl::UpdatePeople() {
           p.state.phase = PersonPhase::kDone;
           p.state.waiting_for.clear();
           const btTransform T(btQuaternion::getIdentity(), btVector3(0, 0, kOutOfSceneZ));
-          p.body->getMotionState()->setWorldTransform(T);
           p.body->setWorldTransform(T);
         }
       }

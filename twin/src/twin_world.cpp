@@ -199,8 +199,7 @@ void TwinWorld::Impl::StepOnce() {
   UpdateArmBodies();
   FollowHeldPayload();
   RecordContacts();
-  for (std::size_t i = 0; i < people.size(); ++i)
-    states_cache[i] = people[i].state;
+  states_stale = true;       // TwinWorld::people() copies them when asked
   ray_proxies_stale = true;  // re-posed before the next ray cast (sensors run at 5-40 Hz)
 }
 
@@ -216,8 +215,7 @@ void TwinWorld::Impl::CarryPeople() {
 void TwinWorld::Impl::PlacePersonBody(Person& p) {
   const btTransform T(btQuaternion::getIdentity(),
                       btVector3(p.walker.position.x(), p.walker.position.y(), kPersonHeight / 2));
-  p.body->getMotionState()->setWorldTransform(T);
-  p.body->setWorldTransform(T);
+  p.body->setWorldTransform(T);  // no motion state (MakePersonBody)
 }
 
 TwinWorld::TwinWorld(std::shared_ptr<const TwinModel> model, std::uint64_t seed) {
@@ -374,6 +372,11 @@ int TwinWorld::button_presses(std::size_t i) const {
 }
 
 const std::vector<PersonState>& TwinWorld::people() const {
+  if (impl_->states_stale) {
+    for (std::size_t i = 0; i < impl_->people.size(); ++i)
+      impl_->states_cache[i] = impl_->people[i].state;
+    impl_->states_stale = false;
+  }
   return impl_->states_cache;
 }
 

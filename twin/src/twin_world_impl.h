@@ -333,7 +333,11 @@ struct TwinWorld::Impl {
   // The free edge of `d` (an element of `doors`: its index keys the cache) at its angle now.
   Eigen::Vector2d FreeEdge(const Door& d) const;
   std::vector<Person> people;
-  std::vector<PersonState> states_cache;
+  // What TwinWorld::people() returns: the people's states, copied from `people` when asked for
+  // after a step (states_stale), not every physics step (their names are strings: ~1 % of a
+  // 100-resident run). Steps are the only writers of the states, so it is the same copy.
+  mutable std::vector<PersonState> states_cache;
+  mutable bool states_stale{false};
   std::vector<Payload> payloads;
   SocialForceModel sfm;
 

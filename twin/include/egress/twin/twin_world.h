@@ -172,6 +172,8 @@ class TwinWorld {
   int FindDoorIndex(const std::string& name) const;  ///< −1 if unknown
   int button_presses(std::size_t door_index) const;
 
+  /// The people's states after the last step. The vector is refreshed when this is called
+  /// (not by every step): call it again after stepping rather than keep the reference.
   const std::vector<PersonState>& people() const;
   Pose3 payload_pose(const std::string& name) const;
   std::vector<std::string> payload_names() const;
