@@ -49,7 +49,10 @@ class ApproachButton final : public TaskNode<bt::StatefulActionNode> {
   using TaskNode::TaskNode;
   static PortsList ProvidedPorts() {
     return {InputPort<std::string>("door", "door whose actuator to stand off (base facing it)"),
-            VisitPort(bt::PortDirection::kInOut)};
+            VisitPort(bt::PortDirection::kInOut),
+            InputPort<bool>("door_speed", false,
+                            "drive to the standoff at the door speed (TrajectoryConfig::"
+                            "door_speed): a resident already waits at the door")};
   }
   NodeStatus OnStart() override {
     DoorVisit visit = Visit();
@@ -111,8 +114,9 @@ class ApproachButton final : public TaskNode<bt::StatefulActionNode> {
     if (!solution.converged) Note("whole-body IK did not converge; using the nominal standoff");
     visit.button_plan = plan;
     Remember(visit);
-    return StartPath(task_, plan.X_MB_standoff, StrCat("the ", actuator->id, " standoff"),
-                     [this](const std::string& s) { Note(s); });
+    return StartPath(
+        task_, plan.X_MB_standoff, StrCat("the ", actuator->id, " standoff"),
+        [this](const std::string& s) { Note(s); }, Input<bool>("door_speed"));
   }
   NodeStatus OnRunning() override {
     const auto note = [this](const std::string& s) { Note(s); };

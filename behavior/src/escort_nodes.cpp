@@ -81,6 +81,10 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   static PortsList ProvidedPorts() {
     return {InputPort<std::string>("door", "door held open for the residents"),
             VisitPort(bt::PortDirection::kInput),
+            InputPort<bool>("door_speed", false,
+                            "drive to the spot beside the door (or the actuator) at the door "
+                            "speed (TrajectoryConfig::door_speed): residents the robot let out "
+                            "are ahead of it"),
             OutputPort<std::string>("spot", "where the robot waits beside the door (x;y;yaw)",
                                     "{hold_spot}"),
             InputPort<double>("aside", 1.5,
@@ -409,7 +413,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
       const bool set_off =
           StartPath(
               task_, goal, &wait_at == &spot_ ? "the spot beside the door" : "the actuator",
-              [&notes](const std::string& t) { notes.push_back(t); }, false,
+              [&notes](const std::string& t) { notes.push_back(t); }, Input<bool>("door_speed"),
               PathHeading::kAcrossTravel) == NodeStatus::kRunning;
       // Why it cannot go, noted once while that lasts (every tick filled the log: seed 8).
       if (set_off || !drive_failing_)

@@ -23,7 +23,10 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
     return {InputPort<std::string>("goal", "goal: a place of the building, or a pose x;y;yaw"),
             InputPort<double>("detour_speed", 0.2,
                               "speed of the Bug2 detour when the costmap has no path [m/s]"),
-            InputPort<double>("patience", 15.0, "how long to keep re-planning a blocked goal [s]")};
+            InputPort<double>("patience", 15.0, "how long to keep re-planning a blocked goal [s]"),
+            InputPort<bool>("door_speed", false,
+                            "drive every segment at the door speed (TrajectoryConfig::door_speed): "
+                            "a trip that cannot wait")};
   }
   NodeStatus OnStart() override {
     blocked_since_.reset();
@@ -111,9 +114,12 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
     }
     const Pose2 goal = *goal_;
     // Quiet while re-planning: the first failure is noted, not every retry.
-    const NodeStatus s = StartPath(task_, goal, "goal", [this](const std::string& t) {
-      if (!blocked_since_) Note(t);
-    });
+    const NodeStatus s = StartPath(
+        task_, goal, "goal",
+        [this](const std::string& t) {
+          if (!blocked_since_) Note(t);
+        },
+        Input<bool>("door_speed"));
     if (s != NodeStatus::kFailure) {
       if (blocked_since_) Note("the way is free again");
       blocked_since_.reset();

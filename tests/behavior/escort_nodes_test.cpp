@@ -1015,6 +1015,37 @@ TEST_F(HoldForResidentsTest, LetsSomeoneWalkingUpBehindItPassBeforeDrivingOn) {
 // Its spot taken while it drives there: it stops short (the drive's slowing near people spares
 // whoever stands at its goal: two wards seed 10, a resident came to wait for door_e beside the
 // spot and the robot crept on into them); someone near the way but not the spot does not stop it.
+// door_speed (a round behind residents the robot let out on a sweep): to the same spot, every
+// segment at the door speed.
+class HoldForResidentsAtTheDoorSpeedTest : public HoldForResidentsTest {
+ protected:
+  HoldForResidentsAtTheDoorSpeedTest() {
+    tree_ = Tree(R"(<HoldForResidents door="lab_door" clear_for="3.0" wait_for="10.0"
+                                      door_speed="true"/>)",
+                 blackboard_);
+  }
+};
+
+TEST_F(HoldForResidentsAtTheDoorSpeedTest, ItDrivesToTheSpotAtTheDoorSpeed) {
+  const Pose2 spot = DriveToTheSpotFrom([](const Pose2& spot) {
+    return Pose2{spot.x, spot.y - 2.5, M_PI / 2};
+  });
+  const std::vector<Pose2> path = motion_.path();
+  ASSERT_GE(path.size(), 2u);
+  EXPECT_LT((path.back().translation() - spot.translation()).norm(), 1e-6);
+  const planning::TrajectoryConfig& trajectory = motion_.trajectory_config();
+  ASSERT_LT(trajectory.nominal_speed, trajectory.door_speed);
+  double at_door_speed = 0.0, at_nominal_speed = 0.0;
+  for (std::size_t k = 1; k < path.size(); ++k) {
+    const double length = (path[k].translation() - path[k - 1].translation()).norm();
+    const double turn = std::abs(std::remainder(path[k].yaw - path[k - 1].yaw, 2 * M_PI));
+    at_door_speed += planning::SegmentDuration(length, turn, true, trajectory);
+    at_nominal_speed += planning::SegmentDuration(length, turn, false, trajectory);
+  }
+  EXPECT_LT(at_door_speed, at_nominal_speed - 1.0);
+  EXPECT_NEAR(motion_.base_duration(), at_door_speed, 1e-6);
+}
+
 TEST_F(HoldForResidentsTest, StopsShortWhenItsSpotIsTakenOnTheWay) {
   const Pose2 spot = DriveToTheSpotFrom([](const Pose2& spot) {
     return Pose2{spot.x, spot.y - 2.5, M_PI / 2};

@@ -25,6 +25,37 @@ TEST_F(NavigationNodesTest, NavigateToPlansAndFollowsAPathToTheGoal) {
   EXPECT_FALSE(motion_.base_moving());
 }
 
+// door_speed: the same path, every segment at the door speed (a sweep to let residents out).
+TEST_F(NavigationNodesTest, NavigateToAtTheDoorSpeedFollowsTheSamePathFaster) {
+  const auto planned = [&](const std::string& xml) {
+    motion_.StopBase();
+    bt::Tree tree = Tree(xml);
+    belief_.now = At(1.0);
+    EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning) << xml;
+    return std::pair(motion_.path(), motion_.base_duration());
+  };
+  const auto [path, nominal] = planned(R"(<NavigateTo goal="1.5;1.0;0.0"/>)");
+  const auto [same_path, default_too] =
+      planned(R"(<NavigateTo goal="1.5;1.0;0.0" door_speed="false"/>)");
+  const auto [fast_path, fast] = planned(R"(<NavigateTo goal="1.5;1.0;0.0" door_speed="true"/>)");
+  ASSERT_EQ(fast_path.size(), path.size());
+  for (std::size_t k = 0; k < path.size(); ++k)
+    EXPECT_LT((fast_path[k].translation() - path[k].translation()).norm(), 1e-9) << k;
+  EXPECT_DOUBLE_EQ(default_too, nominal);
+  const planning::TrajectoryConfig& trajectory = motion_.trajectory_config();
+  ASSERT_LT(trajectory.nominal_speed, trajectory.door_speed);
+  // Each segment takes max(L / v, its floor): at twice the speed, at most what it took before
+  // and less on the long ones.
+  EXPECT_LT(fast, nominal - 1.0);
+  double expected = 0.0;
+  for (std::size_t k = 1; k < path.size(); ++k)
+    expected += planning::SegmentDuration(
+        (fast_path[k].translation() - fast_path[k - 1].translation()).norm(),
+        std::abs(std::remainder(fast_path[k].yaw - fast_path[k - 1].yaw, 2 * M_PI)), true,
+        trajectory);
+  EXPECT_NEAR(fast, expected, 1e-6);
+}
+
 // A goal behind the robot, keeping its heading: the even turn would back the whole way into the
 // base laser's blind sector, where someone standing behind it is never seen. It turns to face
 // the way first, drives facing it and turns back to the goal's heading there.
