@@ -215,7 +215,7 @@ void TwinWorld::Impl::CarryPeople() {
 void TwinWorld::Impl::PlacePersonBody(Person& p) {
   const btTransform T(btQuaternion::getIdentity(),
                       btVector3(p.walker.position.x(), p.walker.position.y(), kPersonHeight / 2));
-  p.body->setWorldTransform(T);  // no motion state (MakePersonBody)
+  p.body->setWorldTransform(T);  // no motion state (BuildPeople)
 }
 
 TwinWorld::TwinWorld(std::shared_ptr<const TwinModel> model, std::uint64_t seed) {
