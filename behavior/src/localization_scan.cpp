@@ -28,11 +28,22 @@ LaserScan WithoutDoorLeaves(const LaserScan& scan, const MissionMap& map, const 
   const std::vector<Eigen::Vector2d>& u_L = perception::BeamDirections(out);
   const Eigen::Matrix2d R_ML = X_ML.rotation();
   const Eigen::Vector2d p_ML = X_ML.translation();
+  // Every test below holds only within the leaf's width and a margin of the hinge (the door
+  // line's band reaches sqrt(width² + band²) from it): the rest of the scan skips the door
+  // (with a hair more, so rounding never skips a point a test would drop).
+  std::vector<double> reach_squared;
+  reach_squared.reserve(map.doors.size());
+  for (const auto& door : map.doors) {
+    const double reach = door.width() + std::max(kSweepMarginM, kClosedLeafBandM) + 1e-6;
+    reach_squared.push_back(reach * reach);
+  }
   for (std::size_t i = 0; i < out.ranges.size(); ++i) {
     if (!out.IsValidReturn(i)) continue;
     const Eigen::Vector2d p_M = R_ML * (out.ranges[i] * u_L[i]) + p_ML;
-    for (const auto& door : map.doors) {
+    for (std::size_t k = 0; k < map.doors.size(); ++k) {
+      const auto& door = map.doors[k];
       const Eigen::Vector2d offset = p_M - door.p_MHinge;
+      if (offset.squaredNorm() > reach_squared[k]) continue;  // none of the tests below holds
       const bool in_sweep =
           offset.norm() <= door.width() + kSweepMarginM && offset.dot(door.SwingSide()) > 0.0;
       // The leaf itself, at whatever angle, is dropped near a wall too: by the hinge its returns

@@ -1,7 +1,10 @@
 #include "egress/perception/costmap.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 
 #include <opencv2/imgproc.hpp>
 
@@ -26,6 +29,79 @@ void CostmapConfig::Validate() const {
 
 namespace {
 constexpr int kLookupSubdivisions = 8;
+
+// Squared Euclidean distance [cells²] from each cell to the nearest cell where `is_site` holds,
+// exactly (Felzenszwalb and Huttenlocher's lower envelope of parabolas, by columns then rows,
+// in integers); kNoSite where there is none.
+constexpr std::uint32_t kNoSite = std::numeric_limits<std::uint32_t>::max();
+template <typename IsSite>
+std::vector<std::uint32_t> SquaredDistanceToSites(int width, int height, IsSite&& is_site) {
+  constexpr std::int64_t kFar = std::int64_t(1) << 40;
+  const std::size_t w = std::size_t(width), h = std::size_t(height);
+  std::vector<std::int64_t> column(w * h);
+  // 1D transform of f over n samples into d (v: parabola apexes, z: boundaries, as ratios).
+  std::vector<std::int64_t> f(std::max(w, h)), d(std::max(w, h));
+  std::vector<std::size_t> v(std::max(w, h));
+  std::vector<double> z(std::max(w, h) + 1);
+  const auto transform = [&](std::size_t n) {
+    // Where the parabolas of q and p (q > p) cross: exact enough, their numerator and
+    // denominator being integers far below 2^53.
+    const auto meet = [&](std::size_t q, std::size_t p) {
+      return double((f[q] + std::int64_t(q * q)) - (f[p] + std::int64_t(p * p))) /
+             double(2 * (std::int64_t(q) - std::int64_t(p)));
+    };
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    std::ptrdiff_t k = -1;  // the envelope's last parabola (none yet)
+    for (std::size_t q = 0; q < n; ++q) {
+      if (f[q] >= kFar) continue;  // not a site
+      if (k < 0) {
+        k = 0;
+        v[0] = q;
+        z[0] = -kInf;
+        z[1] = kInf;
+        continue;
+      }
+      double s = meet(q, v[std::size_t(k)]);
+      while (s <= z[std::size_t(k)]) {  // z[0] = -inf ends it
+        --k;
+        s = meet(q, v[std::size_t(k)]);
+      }
+      ++k;
+      v[std::size_t(k)] = q;
+      z[std::size_t(k)] = s;
+      z[std::size_t(k) + 1] = kInf;
+    }
+    if (k < 0) {
+      std::fill(d.begin(), d.begin() + std::ptrdiff_t(n), kFar);
+      return;
+    }
+    std::size_t e = 0;
+    for (std::size_t q = 0; q < n; ++q) {
+      while (z[e + 1] < double(q))
+        ++e;
+      const std::int64_t dq = std::int64_t(q) - std::int64_t(v[e]);
+      d[q] = dq * dq + f[v[e]];
+    }
+  };
+  for (std::size_t x = 0; x < w; ++x) {
+    for (std::size_t y = 0; y < h; ++y)
+      f[y] = is_site(x + y * w) ? 0 : kFar;
+    transform(h);
+    for (std::size_t y = 0; y < h; ++y)
+      column[x + y * w] = d[y];
+  }
+  std::vector<std::uint32_t> out(w * h);
+  for (std::size_t y = 0; y < h; ++y) {
+    for (std::size_t x = 0; x < w; ++x)
+      f[x] = column[x + y * w];
+    transform(w);
+    for (std::size_t x = 0; x < w; ++x)
+      out[x + y * w] =
+          d[x] >= kFar || d[x] >= std::int64_t(kNoSite) ? kNoSite : std::uint32_t(d[x]);
+  }
+  return out;
+}
+
 constexpr double kMaxInflationCells = 1000.0;
 constexpr double kMaxDoorwayWidthM = 10.0;
 }  // namespace
@@ -39,6 +115,8 @@ Costmap2D::Costmap2D(const OccupancyGrid& static_map, CostmapConfig config)
   ThrowUnless(config_.inflation_radius / geometry_.resolution <= kMaxInflationCells,
               "Costmap: the inflation radius (", config_.inflation_radius, " m) spans more than ",
               kMaxInflationCells, " cells of ", geometry_.resolution, " m");
+  static_lethal_d2_ = SquaredDistanceToSites(
+      geometry_.width, geometry_.height, [&](std::size_t i) { return static_[i] == kLethalCost; });
   obstacle_.assign(geometry_.size(), kFreeCost);
   marked_at_.assign(geometry_.size(), 0.0);
   in_marked_.assign(geometry_.size(), 0);
@@ -291,16 +369,38 @@ bool Costmap2D::IsNearLethal(const Eigen::Vector2d& p_MQ, double radius,
   if (!c) return false;
   const int n = int(std::ceil(radius / geometry_.resolution));
   if (n < 0) return false;
+  const double r2 = std::pow(radius / geometry_.resolution, 2);
+  // The map's lethal cells by their distance transform; the other layers (which change with
+  // every scan) by a search.
+  std::array<const std::vector<std::uint8_t>*, 4> searched{};
+  std::size_t count = 0;
+  const auto near_a_leaf = [&] {
+    return std::any_of(leaf_cell_boxes_.begin(), leaf_cell_boxes_.end(), [&](const auto& box) {
+      return c->x() + n >= box[0] && c->y() + n >= box[1] && c->x() - n <= box[2] &&
+             c->y() - n <= box[3];
+    });
+  };
+  for (const auto* layer : layers) {
+    if (layer == &static_) {
+      if (double(static_lethal_d2_[geometry_.Index(c->x(), c->y())]) <= r2) return true;
+    } else if (layer == &leaves_ && !near_a_leaf()) {
+      continue;  // no leaf within reach
+    } else {
+      ThrowUnless(count < searched.size(), "Costmap: IsNearLethal takes at most ", searched.size(),
+                  " layers besides the map's");
+      searched[count++] = layer;
+    }
+  }
+  if (count == 0) return false;
   // Nearest first, ring by ring out from its own cell: most points asked about are a wall's
   // laser returns, in or beside a lethal cell.
-  const double r2 = std::pow(radius / geometry_.resolution, 2);
   const auto lethal = [&](int dx, int dy) {
     const int x = c->x() + dx, y = c->y() + dy;
     if (dx * dx + dy * dy > r2 || x < 0 || y < 0 || x >= geometry_.width || y >= geometry_.height)
       return false;
     const std::size_t i = geometry_.Index(x, y);
-    for (const auto* layer : layers)
-      if ((*layer)[i] == kLethalCost) return true;
+    for (std::size_t k = 0; k < count; ++k)
+      if ((*searched[k])[i] == kLethalCost) return true;
     return false;
   };
   if (lethal(0, 0)) return true;
@@ -383,8 +483,18 @@ void Costmap2D::SetDoorLeafAngle(const std::string& id, std::optional<double> an
     leaf_angles_[id] = *angle;
   }
   // Other leaves may share cells with the one removed: mark them again.
-  for (const auto& [other, other_angle] : leaf_angles_)
-    MarkLeaf(doorways_.at(other), other_angle, kLethalCost);
+  leaf_cell_boxes_.clear();
+  for (const auto& [other, other_angle] : leaf_angles_) {
+    const Doorway& marked = doorways_.at(other);
+    MarkLeaf(marked, other_angle, kLethalCost);
+    const Eigen::Vector2d r = Eigen::Vector2d::Constant(marked.width());
+    const Eigen::Vector2d lo = (marked.p_MHinge - r - geometry_.origin) / geometry_.resolution;
+    const Eigen::Vector2d hi = (marked.p_MHinge + r - geometry_.origin) / geometry_.resolution;
+    // A cell more each way, for the rounding of MarkLeaf's steps along the leaf.
+    const auto cell = [](double x) { return int(std::clamp(std::floor(x), -1e9, 1e9)); };
+    leaf_cell_boxes_.push_back(
+        {cell(lo.x()) - 1, cell(lo.y()) - 1, cell(hi.x()) + 1, cell(hi.y()) + 1});
+  }
   const double reach = doorway.width();
   const auto lo = geometry_.CellOf(doorway.p_MHinge - Eigen::Vector2d(reach, reach));
   const auto hi = geometry_.CellOf(doorway.p_MHinge + Eigen::Vector2d(reach, reach));

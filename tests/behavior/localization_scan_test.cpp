@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <random>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -94,6 +95,40 @@ TEST(LocalizationScanTest, AClosedLeafSeenFromTheSideItDoesNotOpenToIsLeftOut) {
   }
   EXPECT_GT(leaf, 50);
   EXPECT_GT(wall, 50);
+}
+
+// Returns all round a door, out to past its reach (and the door line's band beyond the
+// latch): each is dropped exactly when one of the documented tests holds (in the leaf's reach;
+// in its sweep away from the mapped walls; on the door's line between the jambs).
+TEST(LocalizationScanTest, EachReturnIsDroppedExactlyWhenALeafTestHolds) {
+  const MissionMap map = WallWithDoor();
+  const auto& door = map.doors.front();
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> range(0.05, 1.6);
+  for (const Pose2& X_ML : {Pose2{0.45, 0.6, 0.3}, Pose2{1.2, -0.4, 2.0}, Pose2{-0.2, 0.3, 1.0}}) {
+    const std::size_t beams = 2000;
+    std::vector<Eigen::Vector2d> points;
+    for (std::size_t i = 0; i < beams; ++i) {
+      const double a = X_ML.yaw - std::numbers::pi + 2 * std::numbers::pi * double(i) / beams;
+      points.push_back(X_ML.translation() + range(rng) * Eigen::Vector2d(std::cos(a), std::sin(a)));
+    }
+    const LaserScan scan = ScanOf(X_ML, points);
+    const LaserScan kept = WithoutDoorLeaves(scan, map, X_ML);
+    int dropped = 0;
+    for (std::size_t i = 0; i < beams; ++i) {
+      const Eigen::Vector2d& p = points[i];
+      const Eigen::Vector2d offset = p - door.p_MHinge;
+      const bool in_sweep =
+          offset.norm() <= door.width() + kSweepMarginM && offset.dot(door.SwingSide()) > 0.0;
+      const bool leaf = door.InLeafReach(p, kSweepMarginM) ||
+                        (in_sweep && !NearMappedWall(map.grid, p)) ||
+                        door.OnDoorLine(p, kClosedLeafBandM);
+      ASSERT_EQ(std::isinf(kept.ranges[i]), leaf) << "return at " << p.transpose();
+      dropped += leaf;
+    }
+    EXPECT_GT(dropped, 100);
+    EXPECT_LT(dropped, int(beams) - 100);
+  }
 }
 
 TEST(LocalizationScanTest, InTheSweepOnlyTheMappedWallsAreKept) {

@@ -156,6 +156,47 @@ TEST(CostmapTest, IsNearMappedObstacleFindsALethalCellAnywhereWithinTheRadius) {
   EXPECT_FALSE(costmap.IsNearMappedObstacle({5.0, 5.0}, -0.2)) << "no radius";
 }
 
+// The map's lethal cells are found through their distance transform (no search): on maps of
+// scattered obstacles, at the edges too, and on a map with none, it answers as a scan of the
+// whole disc of cells does.
+TEST(CostmapTest, IsNearMappedObstacleMatchesADiscScanOnScatteredMaps) {
+  const double res = 0.05;
+  std::mt19937 rng(11);
+  for (int map = 0; map < 4; ++map) {
+    std::uniform_real_distribution<double> x(0.0, 4.0), y(0.0, 3.0), half(0.01, 0.2);
+    std::vector<Box2> boxes;
+    const int count = map == 0 ? 0 : 5 * map;
+    for (int k = 0; k < count; ++k)
+      boxes.push_back({{x(rng), y(rng), x(rng)}, {half(rng), half(rng)}});
+    const OccupancyGrid grid = OccupancyGrid::FromBoxes(boxes, {0, 0}, {4, 3}, res);
+    const Costmap2D costmap(grid);
+    const auto brute_force = [&](const Eigen::Vector2d& p, double radius) {
+      const int cx = int(std::floor(p.x() / res)), cy = int(std::floor(p.y() / res));
+      for (int yy = 0; yy < grid.geometry().height; ++yy)
+        for (int xx = 0; xx < grid.geometry().width; ++xx)
+          if ((xx - cx) * (xx - cx) + (yy - cy) * (yy - cy) <= std::pow(radius / res, 2) &&
+              grid.cells()[grid.geometry().Index(xx, yy)] == kLethalCost)
+            return true;
+      return false;
+    };
+    std::uniform_real_distribution<double> px(0.0, 3.999), py(0.0, 2.999), radius(0.0, 0.6);
+    int near = 0;
+    for (int k = 0; k < 400; ++k) {
+      const Eigen::Vector2d p(px(rng), py(rng));
+      const double r = radius(rng);
+      const bool expected = brute_force(p, r);
+      ASSERT_EQ(costmap.IsNearMappedObstacle(p, r), expected)
+          << "map " << map << " at " << p.transpose() << " r " << r;
+      near += expected;
+    }
+    if (map == 0) {
+      EXPECT_EQ(near, 0);
+    } else if (map == 3) {
+      EXPECT_GT(near, 40);
+    }
+  }
+}
+
 TEST(CostmapTest, SensedObstaclesAreTheMapTheLaserAndLeavesNotTheProjection) {
   const OccupancyGrid walls =
       OccupancyGrid::FromBoxes({{{5.0, 2.25, 0.0}, {0.1, 4.5}}}, {0, 0}, {10, 10}, 0.05);
@@ -171,6 +212,44 @@ TEST(CostmapTest, SensedObstaclesAreTheMapTheLaserAndLeavesNotTheProjection) {
   costmap.SetDoorLeafAngle("office", 0.0);
   EXPECT_TRUE(costmap.IsNearSensedObstacle({5.05, 5.0}, 0.1));
   EXPECT_FALSE(costmap.IsNearSensedObstacle({-1.0, -1.0}, 0.1));  // outside the map
+}
+
+// Door leaves are searched only near a doorway with a leaf marked: on a map without walls, with
+// leaves at random angles (some removed again), a point is near a leaf exactly when a lethal
+// cell of the costmap (here only leaves) lies within the radius.
+TEST(CostmapTest, IsNearMappedObstacleFindsEveryLeafWithinTheRadius) {
+  const double res = 0.05;
+  const OccupancyGrid floor({res, {0.0, 0.0}, 120, 120}, kFreeCost);
+  Costmap2D costmap(floor);
+  costmap.AddDoorway({"a", {1.0, 1.0}, {1.0, 2.0}, 1.0, 0.3});
+  costmap.AddDoorway({"b", {4.0, 4.0}, {4.9, 4.3}, -1.0, 0.3});
+  costmap.AddDoorway({"c", {5.2, 1.0}, {4.4, 1.2}, 1.0, 0.3});
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> angle(0.0, 1.6), px(0.0, 5.999), radius(0.0, 0.5);
+  for (int round = 0; round < 6; ++round) {
+    costmap.SetDoorLeafAngle("a", angle(rng));
+    costmap.SetDoorLeafAngle("b", round % 2 == 0 ? std::optional(angle(rng)) : std::nullopt);
+    costmap.SetDoorLeafAngle("c", round % 3 == 0 ? std::optional(angle(rng)) : std::nullopt);
+    std::vector<Eigen::Vector2i> lethal;
+    for (int y = 0; y < 120; ++y)
+      for (int x = 0; x < 120; ++x)
+        if (costmap.CostAt({(x + 0.5) * res, (y + 0.5) * res}) == kLethalCost)
+          lethal.emplace_back(x, y);
+    ASSERT_GT(lethal.size(), 10u);
+    int near = 0;
+    for (int k = 0; k < 300; ++k) {
+      const Eigen::Vector2d p(px(rng), px(rng));
+      const double r = radius(rng);
+      const Eigen::Vector2i c(int(std::floor(p.x() / res)), int(std::floor(p.y() / res)));
+      const bool expected = std::any_of(lethal.begin(), lethal.end(), [&](const auto& q) {
+        return double((q - c).squaredNorm()) <= std::pow(r / res, 2);
+      });
+      ASSERT_EQ(costmap.IsNearMappedObstacle(p, r), expected)
+          << "round " << round << " at " << p.transpose() << " r " << r;
+      near += expected;
+    }
+    EXPECT_GT(near, 0);
+  }
 }
 
 // What the laser marked off the map is remembered where no ray clears it: the making-room

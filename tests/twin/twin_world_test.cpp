@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <fstream>
+#include <functional>
+#include <limits>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
@@ -470,6 +472,79 @@ TEST(TwinWorldTest, BaseFollowsVelocityWithAccelerationLimitAndStopsAfterTimeout
   bad.joint_names = {"base_x"};
   bad.points.push_back({{1.0}, {}, {}, SecondsToDuration(1.0)});
   EXPECT_THROW(world.SetArmTrajectory(bad), InvalidArgument);
+}
+
+// Drives the robot (from 4 s on, at 0.3 m/s straight ahead) in two worlds of `scenario`, one
+// with people's bodies asleep far from the robot (the default), one with them always awake:
+// the runs must be the same step for step. Returns the worlds' robot-person contact events.
+int SameRunAsleepAndAwake(const testing::Loaded& loaded, double seconds, double* closest,
+                          double speed = 0.3,
+                          const std::function<void(const TwinWorld&)>& at_end = {}) {
+  TwinConfig awake;
+  awake.person_body_awake_reach = std::numeric_limits<double>::infinity();
+  TwinWorld sleeping_world(loaded.scenario, loaded.world, 1, Hsr());
+  TwinWorld awake_world(loaded.scenario, loaded.world, 1, Hsr(), awake);
+  *closest = std::numeric_limits<double>::infinity();
+  while (sleeping_world.time() < seconds) {
+    for (TwinWorld* w : {&sleeping_world, &awake_world}) {
+      if (w->time() > 4.0) w->SetBaseVelocity({speed, 0.0, 0.0});
+      w->Step();
+    }
+    const Pose2 a = sleeping_world.robot_pose(), b = awake_world.robot_pose();
+    EXPECT_TRUE(a.x == b.x && a.y == b.y && a.yaw == b.yaw) << "t " << sleeping_world.time();
+    EXPECT_EQ(sleeping_world.people().front().position, awake_world.people().front().position);
+    if (::testing::Test::HasFailure()) return -1;
+    *closest =
+        std::min(*closest, (sleeping_world.people().front().position - a.translation()).norm());
+  }
+  EXPECT_EQ(CountEvents(sleeping_world, "contact"), CountEvents(awake_world, "contact"));
+  for (const auto& payload : loaded.scenario.payloads) {
+    EXPECT_EQ(sleeping_world.payload_pose(payload.name).translation(),
+              awake_world.payload_pose(payload.name).translation());
+  }
+  if (at_end) at_end(sleeping_world);
+  return CountEvents(sleeping_world, "contact");
+}
+
+TEST(TwinWorldTest, PeoplesBodiesAsleepFarFromTheRobotGiveTheSameRunAsAwake) {
+  // Someone walks from 5 m away towards the robot, which drives at them (they step aside): their
+  // Bullet body sleeps until within person_body_awake_reach, then wakes moving, with the bounds
+  // and velocity it would have had awake.
+  double closest = 0.0;
+  const auto walker = LoadText(
+      "world: lab.sdf\nrobot: {start: {x: -2.4, y: 0.8, yaw: 0.0}}\npeople:\n"
+      "  - {name: p, behavior: approach_and_wait, start: [2.6, 1.0], goal: [0.0, 0.8], "
+      "wait_s: 60}\n",
+      WorldsDir() / "lab");
+  SameRunAsleepAndAwake(walker, 20.0, &closest);
+  EXPECT_LT(closest, 1.0) << "they never came near: their body never woke";
+  // Someone standing 4 m ahead (yet to set off), whom the robot drives into: the contact is the
+  // same as with their body awake all along, and it stops the robot.
+  const auto stander = LoadText(
+      "world: lab.sdf\nrobot: {start: {x: -2.4, y: 0.8, yaw: 0.0}}\npeople:\n"
+      "  - {name: p, behavior: approach_and_wait, start: [1.6, 0.8], goal: [1.6, 2.0], "
+      "trigger: {at: 100}}\n",
+      WorldsDir() / "lab");
+  EXPECT_GE(SameRunAsleepAndAwake(stander, 20.0, &closest), 1);
+  // Someone walks from 5 m away into a bottle on the floor (people do not avoid payloads) and
+  // kicks it: their body wakes 3 m before it, and what Bullet makes of the kick is the same.
+  const auto kicker = LoadText(
+      "world: lab.sdf\nrobot: {start: {x: -2.5, y: -0.5, yaw: 0.0}}\npeople:\n"
+      "  - {name: p, behavior: walk_past, start: [2.6, 1.5], goal: [-1.5, 1.5]}\n"
+      "payloads:\n  - {name: bottle, kind: water_bottle, x: -0.6, y: 1.5, z: 0.11}\n",
+      WorldsDir() / "lab");
+  const Eigen::Vector3d p_WBottle = [&] {
+    TwinWorld w(kicker.scenario, kicker.world, 1, Hsr());
+    return w.payload_pose("bottle").translation();
+  }();
+  double moved = 0.0;
+  SameRunAsleepAndAwake(kicker, 8.0, &closest, 0.0, [&](const TwinWorld& w) {
+    moved = (w.payload_pose("bottle").translation() - p_WBottle).norm();
+  });
+  EXPECT_GT(moved, 0.05) << "the bottle was not kicked";
+  TwinConfig too_near;
+  too_near.person_body_awake_reach = 1.0;
+  EXPECT_THROW(too_near.Validate(), InvalidArgument);
 }
 
 TEST(TwinWorldTest, SameSeedSameTraceOtherSeedOtherTrace) {

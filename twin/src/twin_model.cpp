@@ -23,6 +23,10 @@ void TwinConfig::Validate() const {
                   crowd_social_rate_hz <= crowd_rate_hz,
               "TwinConfig: crowd_social_rate_hz must be positive and at most crowd_rate_hz (got ",
               crowd_social_rate_hz, ", crowd_rate_hz ", crowd_rate_hz, ")");
+  ThrowUnless(person_body_awake_reach >= 2.0,
+              "TwinConfig: person_body_awake_reach must be at least 2 m (the arm's reach and a "
+              "body's size; infinity: always awake) (got ",
+              person_body_awake_reach, ")");
   const std::pair<const char*, double> positive[] = {
       {"base_max_linear_acceleration", base_max_linear_acceleration},
       {"base_max_angular_acceleration", base_max_angular_acceleration},

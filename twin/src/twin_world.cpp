@@ -193,6 +193,7 @@ void TwinWorld::Impl::StepOnce() {
   FollowHeldPayload();
   UpdateActuators();
   UpdateDoors();
+  WakeNearPeople();
   dynamics->stepSimulation(dt, 1, dt);
   ++step;
   time = double(step) * dt;
@@ -215,7 +216,38 @@ void TwinWorld::Impl::CarryPeople() {
 void TwinWorld::Impl::PlacePersonBody(Person& p) {
   const btTransform T(btQuaternion::getIdentity(),
                       btVector3(p.walker.position.x(), p.walker.position.y(), kPersonHeight / 2));
+  p.body_before = p.body->getWorldTransform();
+  p.body_placed_step = step;
   p.body->setWorldTransform(T);  // no motion state (BuildPeople)
+}
+
+void TwinWorld::Impl::WakeNearPeople() {
+  // TwinConfig::person_body_awake_reach: nobody closes its margin over the arm's reach and a
+  // body's size in one step.
+  const double reach = config.person_body_awake_reach;
+  const btVector3& p_WB = base->getWorldTransform().getOrigin();
+  for (Person& p : people) {
+    const btVector3& p_WP = p.body->getWorldTransform().getOrigin();
+    const auto near = [&](const btVector3& q) {
+      return (q - p_WP).x() * (q - p_WP).x() + (q - p_WP).y() * (q - p_WP).y() < reach * reach;
+    };
+    bool awake = near(p_WB);
+    for (const Payload& payload : payloads)
+      awake = awake || near(payload.body->getWorldTransform().getOrigin());
+    if (awake == !p.body_asleep) continue;
+    if (awake) {
+      // As if it had been awake: Bullet derives its velocity over this step from where it was
+      // before this step's placing (or where it stands, if not placed this step). Its bounds are
+      // kept up to date asleep too (Bullet updates every body's by default), so that Bullet's
+      // broadphase, and the order it finds contacts in, is the same as with it awake.
+      p.body->setInterpolationWorldTransform(
+          p.body_placed_step == step ? p.body_before : p.body->getWorldTransform());
+      p.body->forceActivationState(DISABLE_DEACTIVATION);
+    } else {
+      p.body->forceActivationState(ISLAND_SLEEPING);
+    }
+    p.body_asleep = !awake;
+  }
 }
 
 TwinWorld::TwinWorld(std::shared_ptr<const TwinModel> model, std::uint64_t seed) {

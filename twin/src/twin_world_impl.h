@@ -75,6 +75,11 @@ struct Person {
   double operate_retry_at{0.0};     // [s] not before this (after giving up)
   const people::PersonBehaviorModel* behavior{nullptr};  // the model's behaviour
   btRigidBody* body{nullptr};
+  // Bullet's body sleeps while far from everything it can touch (Impl::WakeNearPeople); placing
+  // it then keeps the transform it had before, from which Bullet takes its velocity on waking.
+  bool body_asleep{false};
+  btTransform body_before{btTransform::getIdentity()};  // the body's pose before the last placing
+  std::uint64_t body_placed_step{0};                    // the physics step it was placed in
 };
 
 }  // namespace world_detail
@@ -156,6 +161,10 @@ struct TwinWorld::Impl {
   void CarryPeople();
   // The person's Bullet body to where its walker stands.
   void PlacePersonBody(Person& p);
+  // Wakes the bodies of people within reach of the robot or a payload (the bodies people can
+  // touch in Bullet) and puts the others to sleep: Bullet neither derives a sleeping kinematic
+  // body's velocity nor updates its bounds, most of what 100 people cost it.
+  void WakeNearPeople();
 
   // Someone else is in the doorway: wait for them to come through (one at a time).
   bool DoorwayTaken(const Person& me, int door) const;

@@ -16,6 +16,7 @@
 ///    pass someone standing in a doorway, only not by choice.
 /// Updates are local: a scan recomputes only the window it touched plus the inflation margin.
 
+#include <array>
 #include <cstdint>
 #include <initializer_list>
 #include <map>
@@ -149,12 +150,18 @@ class Costmap2D {
   CostmapConfig config_;
   GridGeometry geometry_;
   std::vector<std::uint8_t> static_;
+  /// Per cell: the squared distance [cells²] to the nearest lethal cell of static_ (exact; a
+  /// large value where there is none), so IsNearLethal answers for the map without a search.
+  std::vector<std::uint32_t> static_lethal_d2_;
   std::vector<std::uint8_t> obstacle_;
   std::vector<double> marked_at_;    ///< When a scan last marked each obstacle cell [s].
   std::vector<std::size_t> marked_;  ///< The cells a scan marked, each once (some since cleared).
   std::vector<std::uint8_t> in_marked_;  ///< 1 for a cell in marked_.
   std::vector<std::uint8_t> projection_;
   std::vector<std::uint8_t> leaves_;
+  /// The cells [x0, y0, x1, y1] each marked leaf may cover at any angle (its hinge +- its width):
+  /// leaves_ has no lethal cell outside them.
+  std::vector<std::array<int, 4>> leaf_cell_boxes_;
   std::vector<std::uint8_t> doorway_zone_;  ///< 1 inside a doorway threshold.
   std::vector<std::uint8_t> master_;
   std::vector<Eigen::Vector2i> projected_cells_;

@@ -52,9 +52,15 @@ struct TwinConfig {
   double grasp_tolerance{0.02};               ///< Lateral centring error a grasp accepts [m]
   double person_hold_force{100.0};            ///< Force a person holds a door with [N]
   double door_crossed_open_angle_deg{60.0};   ///< "Open when crossed" threshold [deg]
+  /// A person's Bullet body is awake only within this of the robot's base or a payload [m] (the
+  /// bodies people can touch there); asleep, Bullet neither derives its velocity nor updates its
+  /// bounds, most of what a crowd costs it, and waking it gives it the velocity and bounds it
+  /// would have had awake, so runs are the same (infinity: always awake). The arm reaches ~1 m
+  /// from the base and a body is at most ~0.7 m across: at least 2 m.
+  double person_body_awake_reach{3.0};
   /// @throws InvalidArgument naming the field for a physics rate below 60 Hz, a crowd rate that
-  /// does not divide it or a crowd social rate above the crowd rate, or a non-positive or
-  /// non-finite limit.
+  /// does not divide it or a crowd social rate above the crowd rate, a non-positive or
+  /// non-finite limit, or a person body awake reach under 2 m.
   void Validate() const;
 };
 
