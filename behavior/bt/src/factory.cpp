@@ -153,6 +153,17 @@ Tree BehaviorTreeFactory::CreateTree(std::string_view tree_id, Blackboard::Ptr b
   blackboard->SetTypeRegistry(impl_->types.get());
   tree.blackboards_.push_back(blackboard);
 
+  // A departure from BT.CPP, which applies a SubTree model's defaults only where a SubTree node
+  // calls it: run as the main tree, a tree's modelled input ports with a literal default get it
+  // where its blackboard has no entry, so a tree with an optional port runs the same on its own
+  // as when called without that port. (A default naming an entry, {key}, has no parent to read.)
+  if (auto model = impl_->subtree_models.find(main); model != impl_->subtree_models.end()) {
+    for (const auto& [port, info] : model->second) {
+      if (info.default_value && !BlackboardKeyOf(*info.default_value, port) &&
+          !blackboard->Has(port))
+        Impl::ApplySubTreePort(blackboard, port, *info.default_value);
+    }
+  }
   Impl::BuildState state{&tree, &options, {main}, {}, {}, {}};
   const auto& definition = impl_->trees.at(main);
   impl_->Build(definition.element->FirstChildElement(), blackboard, "", definition, state);

@@ -235,6 +235,37 @@ TEST_F(FactoryTest, SubTreeModelsGiveDefaultsAndRequirePorts) {
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);  // expected=1 (default), value -> {vector}=1
 }
 
+TEST_F(FactoryTest, AMainTreeGetsItsModelsLiteralDefaultsWhereItsBlackboardHasNoEntry) {
+  // The same tree run on its own: its optional ports take the model's defaults (as a SubTree
+  // call's do: numbers parsed, the rest text that typed ports convert), an entry the caller set
+  // wins, and a default naming an entry ({key}) is left alone (no parent to read it from).
+  const std::string xml =
+      "<root BTCPP_format='4'><BehaviorTree ID='Check'><ScriptCondition code='speed == "
+      "expected'/></BehaviorTree><TreeNodesModel><SubTree ID='Check'><input_port "
+      "name='fast' default='false'/><input_port name='speed' default='2'/><input_port "
+      "name='expected'/><input_port name='other' default='{elsewhere}'/></SubTree>"
+      "</TreeNodesModel></root>";
+  auto board = Blackboard::Create();
+  board->Set("expected", 2);
+  Tree tree = factory.CreateTreeFromText(xml, "Check", board);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kSuccess);
+  EXPECT_EQ(board->Get<std::string>("fast"), "false");
+  EXPECT_FALSE(board->Has("other"));
+  factory.ClearRegisteredTrees();
+  auto given = Blackboard::Create();
+  given->Set("expected", 3);
+  given->Set("speed", 3);
+  given->Set("fast", true);
+  Tree fast = factory.CreateTreeFromText(xml, "Check", given);
+  EXPECT_EQ(fast.TickOnce(), NodeStatus::kSuccess);
+  EXPECT_TRUE(given->Get<bool>("fast"));
+  factory.ClearRegisteredTrees();
+  auto other = Blackboard::Create();
+  other->Set("expected", 3);  // speed defaults to 2: the condition fails
+  Tree slow = factory.CreateTreeFromText(xml, "Check", other);
+  EXPECT_EQ(slow.TickOnce(), NodeStatus::kFailure);
+}
+
 TEST_F(FactoryTest, RecursionDuplicatesAndMissingSubTrees) {
   EXPECT_THAT(
       LoadError("<root BTCPP_format='4'><BehaviorTree ID='A'><SubTree ID='B'/></BehaviorTree>"
