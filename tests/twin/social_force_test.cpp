@@ -25,6 +25,34 @@ std::vector<WallSegment> Corridor() {
   return {{{-10, -1.2}, {10, -1.2}}, {{-10, 1.2}, {10, 1.2}}};
 }
 
+// A wall acts out to where its term falls to a thousandth of its value at contact (a gap of
+// wall_range ln 1000), as the social terms do; the binned walls give the same sums as all walls,
+// and walls binned for less than the model's reach are an error, not a silently dropped wall.
+TEST(SocialForceModelTest, AWallActsOutToWhereItsTermIsAThousandthOfItsContactValue) {
+  SocialForceModel sfm;
+  const double cutoff = sfm.params().wall_range * std::log(1000.0);
+  const std::vector<WallSegment> wall = {{{-10, 0}, {10, 0}}};
+  const auto wall_push = [&](double gap) {
+    Walker w;
+    w.position = {0.0, w.radius + gap};
+    w.target = w.position;  // no drive
+    const Eigen::Vector2d a = sfm.CalcAcceleration(0, {w}, {}, wall);
+    const Eigen::Vector2d binned =
+        sfm.CalcAccelerations({w}, {}, WallCells(wall, sfm.WallReach()), {}).front();
+    EXPECT_EQ(a, binned) << "gap " << gap;
+    return a.y();
+  };
+  const double at_contact = wall_push(1e-6);
+  EXPECT_GT(at_contact, 0.0);
+  EXPECT_GT(wall_push(cutoff - 0.01), 0.0);
+  EXPECT_LT(wall_push(cutoff - 0.01), 1.1e-3 * at_contact);
+  EXPECT_EQ(wall_push(cutoff + 0.01), 0.0);
+  EXPECT_GE(sfm.WallReach(), 1.0 + cutoff);
+  Walker w;
+  EXPECT_THROW(sfm.CalcAccelerations({w}, {}, WallCells(wall, 1.0), {}), InvalidArgument);
+  EXPECT_THROW(WallCells(wall, 0.0), InvalidArgument);
+}
+
 TEST(SocialForceModelTest, TwoPeoplePassHeadOnWithoutOverlap) {
   SocialForceModel sfm;
   std::vector<Walker> w(2);

@@ -25,9 +25,6 @@ double NegligibleBeyond(double range) {
   return range * std::log(1.0 / kSocialNegligibleFraction);
 }
 
-// Beyond this distance from its nearest point an obstacle exerts no force [m].
-constexpr double kWallCutoffM = 3.0;
-
 }  // namespace
 
 Eigen::Vector2d ClosestPointOnSegment(const Eigen::Vector2d& p, const WallSegment& s) {
@@ -190,7 +187,9 @@ Eigen::Vector2d SocialForceModel::CalcTermsAmong(std::size_t i, const std::vecto
   // point would be farther still, so it could neither be its obstacle's nearest that counts nor
   // count itself (the margin keeps the box's rounding on the safe side).
   constexpr double kSkipMarginM = 1e-9;
-  const double reach = (social_terms ? kWallCutoffM : w.radius) + kSkipMarginM;
+  // Beyond this from its nearest point an obstacle exerts no force (its term is negligible).
+  const double wall_cutoff = w.radius + NegligibleBeyond(P.wall_range);
+  const double reach = (social_terms ? wall_cutoff : w.radius) + kSkipMarginM;
   const double reach_squared = reach * reach;
   for (std::size_t k = 0; k < candidates; ++k) {
     const std::size_t s = near.walls ? (*near.walls)[k] : k;
@@ -227,7 +226,7 @@ Eigen::Vector2d SocialForceModel::CalcTermsAmong(std::size_t i, const std::vecto
   for (const Nearest& e : nearest) {
     const Eigen::Vector2d r = w.position - e.q;
     const double dist = r.norm();
-    if (dist < 1e-9 || dist > kWallCutoffM) continue;
+    if (dist < 1e-9 || dist > wall_cutoff) continue;
     const Eigen::Vector2d n = r / dist;
     const double gap = dist - w.radius;
     Eigen::Vector2d f = Eigen::Vector2d::Zero();
@@ -252,7 +251,14 @@ std::pair<long, long> WallCellOf(double x, double y) {
 }
 }  // namespace
 
-WallCells::WallCells(std::vector<WallSegment> walls) : walls_(std::move(walls)) {
+double SocialForceModel::WallReach() const {
+  return kMaxBodyReachM + NegligibleBeyond(params_.wall_range);
+}
+
+WallCells::WallCells(std::vector<WallSegment> walls, double reach)
+    : walls_(std::move(walls)), reach_(reach) {
+  ThrowUnless(std::isfinite(reach) && reach > 0.0, "WallCells: the reach must be positive (got ",
+              reach, " m)");
   // Each segment is listed in every cell its bounding box, grown by the reach, overlaps, so a
   // walker's own cell lists every segment within reach.
   rank_.resize(walls_.size());
@@ -260,8 +266,8 @@ WallCells::WallCells(std::vector<WallSegment> walls) : walls_(std::move(walls)) 
   for (std::size_t s = 0; s < walls_.size(); ++s) {
     const WallSegment& wall = walls_[s];
     rank_[s] = wall.obstacle < 0 ? s : first_of_obstacle.emplace(wall.obstacle, s).first->second;
-    const Eigen::Vector2d lo = wall.a.cwiseMin(wall.b).array() - kWallCutoffM;
-    const Eigen::Vector2d hi = wall.a.cwiseMax(wall.b).array() + kWallCutoffM;
+    const Eigen::Vector2d lo = wall.a.cwiseMin(wall.b).array() - reach_;
+    const Eigen::Vector2d hi = wall.a.cwiseMax(wall.b).array() + reach_;
     if (!lo.allFinite() || !hi.allFinite()) continue;
     const auto [x0, y0] = WallCellOf(lo.x(), lo.y());
     const auto [x1, y1] = WallCellOf(hi.x(), hi.y());
@@ -299,7 +305,7 @@ const std::vector<std::size_t>& WallCells::Near(const Eigen::Vector2d& p) const 
 
 void SocialForceModel::Step(std::vector<Walker>* walkers, const std::vector<DiscObstacle>& discs,
                             const std::vector<WallSegment>& walls, double dt) const {
-  Step(walkers, discs, WallCells(walls), {}, dt);
+  Step(walkers, discs, WallCells(walls, WallReach()), {}, dt);
 }
 
 void SocialForceModel::Step(std::vector<Walker>* walkers, const std::vector<DiscObstacle>& discs,
@@ -337,6 +343,9 @@ std::vector<Eigen::Vector2d> SocialForceModel::SumTerms(
   // reach (the box round its social circle and touching distance) overlaps the cell, so a walker
   // meets only those that may reach it, in the order of the whole crowd: the sums (and the run) are
   // the same as without the grid, in O(n) instead of O(n^2).
+  ThrowUnless(fixed.reach() >= WallReach() - 1e-9, "SocialForceModel: the walls are binned for ",
+              fixed.reach(), " m, but reach ", WallReach(), " m with wall_range ",
+              params_.wall_range, " m (build WallCells with WallReach())");
   std::vector<Eigen::Vector2d> accelerations(all.size(), Eigen::Vector2d::Zero());
   const bool contact_only = terms == Terms::kContact;
   std::vector<Reach> reach(all.size());

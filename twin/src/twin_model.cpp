@@ -93,7 +93,7 @@ void CompileStatics(const Scenario& scenario, const WorldDescription& world,
     ground.kind = ShapeKind::kPlane;
     add(ground);
   }
-  c->wall_cells = WallCells(c->walls);
+  c->wall_cells = WallCells(c->walls, SocialForceModel().WallReach());
   for (const RayBox& box : c->ray_boxes) {
     const Eigen::Vector2d half_W = (box.R_SW.transpose().cwiseAbs() * box.half).head<2>();
     c->ray_box_extents.emplace_back(box.p_WS.head<2>() - half_W, box.p_WS.head<2>() + half_W);

@@ -97,7 +97,13 @@ bool SegmentsCross(const Eigen::Vector2d& a, const Eigen::Vector2d& b, const Eig
 class WallCells {
  public:
   WallCells() = default;
-  explicit WallCells(std::vector<WallSegment> walls);
+  /// Lists, for each cell, every segment within `reach` [m] of it: at least the model's
+  /// SocialForceModel::WallReach() (the default is for the default parameters).
+  explicit WallCells(std::vector<WallSegment> walls, double reach = kDefaultReachM);
+  /// The reach of SocialForceModel's default parameters [m].
+  static constexpr double kDefaultReachM = 2.4;
+
+  double reach() const { return reach_; }
 
   const std::vector<WallSegment>& walls() const { return walls_; }
   /// Indices into walls() of every segment within the wall reach of p (and maybe a few more),
@@ -110,6 +116,7 @@ class WallCells {
 
  private:
   std::vector<WallSegment> walls_;
+  double reach_{kDefaultReachM};
   std::vector<std::size_t> rank_;
   std::map<std::pair<long, long>, std::vector<std::size_t>> cells_;
   std::map<std::pair<long, long>, std::vector<std::size_t>> touching_cells_;
@@ -162,6 +169,11 @@ class SocialForceModel {
                  double dt, const std::vector<DiscObstacle>& discs = {}) const;
 
   const SocialForceParams& params() const { return params_; }
+  /// How far from a walker's centre a wall still acts on it, for the largest body [m]: the wall
+  /// term is dropped where it is below a thousandth of its value at contact (a gap of
+  /// wall_range ln 1000, 1.38 m for HM95's 0.2 m), as the social terms are. WallCells must
+  /// list the walls this far from each cell.
+  double WallReach() const;
 
  private:
   // Where walker o's terms can be non-zero: its social term within `social_radius` of
