@@ -536,10 +536,13 @@ bool Executive::Step(RobotPort& port) {
       return std::any_of(belief_.world.doors.begin(), belief_.world.doors.end(),
                          [&](const auto& d) { return detail::NearEstimatedLeaf(d, p, kOffMapM); });
     };
-    for (const Eigen::Vector2d& p : perception::ScanPoints(*snapshot.scan, X_ML))
-      if ((p - X_ML.translation()).norm() <= belief_.people_range &&
-          !costmap_->IsNearMappedObstacle(p, kOffMapM) && !on_last_seen_leaf(p))
+    for (const Eigen::Vector2d& p : perception::ScanPoints(*snapshot.scan, X_ML)) {
+      const double range = (p - X_ML.translation()).norm();
+      if (range <= belief_.people_range &&
+          !costmap_->IsNearMappedObstacle(p, kOffMapM + kOffMapPerRangeM * range) &&
+          !on_last_seen_leaf(p))
         belief_.off_map_returns.push_back(p);
+    }
     belief_.moving_returns = scan_motion_.Update(now, X_ML, belief_.off_map_returns);
   }
   bool newly_occupied = false;

@@ -386,6 +386,44 @@ TEST(ExecutiveTest, OffMapReturnsCountOnlyAsFarAsTheLaserDetectsPeople) {
   EXPECT_EQ(off_map(15.0).size(), 2u);
 }
 
+// A standing robot whose laser sees one return straight ahead at `range`.
+class OneReturnRobot final : public ScriptedRobot {
+ public:
+  explicit OneReturnRobot(float range) : range_(range) {}
+
+ private:
+  SensorSnapshot DoSense() override {
+    SensorSnapshot s = Stamped();
+    LaserScan scan = EmptyScan(s.stamp);
+    scan.ranges[50] = range_;  // straight ahead
+    s.scan = scan;
+    return s;
+  }
+  float range_;
+};
+
+// The farther a return, the farther from the map it must be to be off it (the heading error
+// moves it sideways): a return ~0.17 m from a wall's face is off the map 2 m away, and the wall
+// itself 8 m away (room A seed 11: such returns held the robot's spot beside door_e taken).
+TEST(ExecutiveTest, AFarReturnMustBeFartherFromTheMapToBeOffIt) {
+  const auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
+  MissionMap hall;
+  // A wall whose face is y = 0.1, along the hall.
+  hall.grid = perception::OccupancyGrid::FromBoxes(
+      {{{15.0, 0.05, 0.0}, {30.0, 0.1}}, {{15.0, 5.95, 0.0}, {30.0, 0.1}}}, {0, 0}, {30, 6}, 0.05);
+  const auto off_map = [&](float range) {
+    ExecutiveConfig config;
+    config.perception.laser_detector.max_range = 15.0;
+    OneReturnRobot robot(range);
+    Executive brain(model, hall, GoTo(), {2.0, 0.26, 0.0}, config);
+    brain.Step(robot);
+    return brain.belief().off_map_returns.size();
+  };
+  EXPECT_EQ(off_map(2.0f), 1u);
+  EXPECT_EQ(off_map(8.0f), 0u);
+  EXPECT_GT(kOffMapPerRangeM, 0.0);
+}
+
 TEST(ExecutiveTest, BadConfigurationsAreRefusedNamingTheField) {
   ExecutiveConfig config;
   config.octomap_person_radius = -1.0;

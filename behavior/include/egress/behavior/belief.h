@@ -25,6 +25,11 @@ namespace egress::behavior {
 /// [m] A laser return this far from every wall and door leaf of the costmap is off the map: three
 /// cells, more than the localizer's error at a wall.
 inline constexpr double kOffMapM = 0.15;
+/// [m per m of range] How much farther from the map a return must lie, per metre of its range,
+/// to be off it: the estimate's heading error (~0.5 degrees) moves a far return sideways (room A
+/// seed 11: returns off the corridor's wall 10 m away, 0.1 m off it, read as someone on the
+/// robot's spot beside door_e, which it then waited to be free of until the time limit).
+inline constexpr double kOffMapPerRangeM = 0.01;
 /// [s] How long Belief::swept_p_MB remembers where the base drove.
 inline constexpr double kSweptMemorySec = 5.0;
 /// [m] Belief::swept_p_MB's spacing.
@@ -39,8 +44,9 @@ struct Belief {
   /// The fingers moved after the last gripper command and have come to rest (GraspMonitor).
   bool gripper_at_rest{false};
   std::optional<LaserScan> scan;  ///< The latest laser scan.
-  /// The latest scan's returns off the map (farther than kOffMapM from every wall and door leaf
-  /// of the costmap) within the laser people detector's max_range of the laser: people, and
+  /// The latest scan's returns off the map (farther than kOffMapM, plus kOffMapPerRangeM per
+  /// metre of range, from every wall and door leaf of the costmap) within the laser people
+  /// detector's max_range of the laser: people, and
   /// whatever else is not on the map. In M.
   std::vector<Eigen::Vector2d> off_map_returns;
   /// How far from the laser people are known: its off-map returns and people detections reach
