@@ -7,6 +7,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <map>
 #include <optional>
 #include <sstream>
 
@@ -350,17 +351,22 @@ TEST(ExecutiveTest, WhereTheBaseDroveFacingTheWayIsRememberedForAWhile) {
   EXPECT_TRUE(swept.empty());
 }
 
-// A standing robot whose laser sees two returns in open floor straight ahead, at 4 m and 12 m.
-class TwoReturnsRobot final : public ScriptedRobot {
+// A standing robot whose laser sees the given returns (beam index -> range); beam 50 points
+// straight ahead, beam 51 2.7 deg to its left.
+class ReturnsRobot final : public ScriptedRobot {
+ public:
+  explicit ReturnsRobot(std::map<std::size_t, float> returns) : returns_(std::move(returns)) {}
+
  private:
   SensorSnapshot DoSense() override {
     SensorSnapshot s = Stamped();
     LaserScan scan = EmptyScan(s.stamp);
-    scan.ranges[50] = 4.0f;   // straight ahead
-    scan.ranges[51] = 12.0f;  // 2.7 deg to the left
+    for (const auto& [beam, range] : returns_)
+      scan.ranges[beam] = range;
     s.scan = scan;
     return s;
   }
+  std::map<std::size_t, float> returns_;
 };
 
 // Off-map returns are read as bodies only as far as the laser's people are detected: farther
@@ -374,7 +380,7 @@ TEST(ExecutiveTest, OffMapReturnsCountOnlyAsFarAsTheLaserDetectsPeople) {
   const auto off_map = [&](double max_range) {
     ExecutiveConfig config;
     config.perception.laser_detector.max_range = max_range;
-    TwoReturnsRobot robot;
+    ReturnsRobot robot({{50, 4.0f}, {51, 12.0f}});  // in open floor, ahead
     Executive brain(model, hall, GoTo(), {2.0, 3.0, 0.0}, config);
     brain.Step(robot);
     return brain.belief().off_map_returns;
@@ -385,22 +391,6 @@ TEST(ExecutiveTest, OffMapReturnsCountOnlyAsFarAsTheLaserDetectsPeople) {
   EXPECT_GT(near_only.front().x(), 5.5);
   EXPECT_EQ(off_map(15.0).size(), 2u);
 }
-
-// A standing robot whose laser sees one return straight ahead at `range`.
-class OneReturnRobot final : public ScriptedRobot {
- public:
-  explicit OneReturnRobot(float range) : range_(range) {}
-
- private:
-  SensorSnapshot DoSense() override {
-    SensorSnapshot s = Stamped();
-    LaserScan scan = EmptyScan(s.stamp);
-    scan.ranges[50] = range_;  // straight ahead
-    s.scan = scan;
-    return s;
-  }
-  float range_;
-};
 
 // The farther a return, the farther from the map it must be to be off it (the heading error
 // moves it sideways): a return ~0.17 m from a wall's face is off the map 2 m away, and the wall
@@ -414,7 +404,7 @@ TEST(ExecutiveTest, AFarReturnMustBeFartherFromTheMapToBeOffIt) {
   const auto off_map = [&](float range) {
     ExecutiveConfig config;
     config.perception.laser_detector.max_range = 15.0;
-    OneReturnRobot robot(range);
+    ReturnsRobot robot({{50, range}});  // straight ahead
     Executive brain(model, hall, GoTo(), {2.0, 0.26, 0.0}, config);
     brain.Step(robot);
     return brain.belief().off_map_returns.size();

@@ -229,7 +229,8 @@ void TwinWorld::Impl::WakeNearPeople() {
   for (Person& p : people) {
     const btVector3& p_WP = p.body->getWorldTransform().getOrigin();
     const auto near = [&](const btVector3& q) {
-      return (q - p_WP).x() * (q - p_WP).x() + (q - p_WP).y() * (q - p_WP).y() < reach * reach;
+      const btVector3 d = q - p_WP;
+      return d.x() * d.x() + d.y() * d.y() < reach * reach;
     };
     bool awake = near(p_WB);
     for (const Payload& payload : payloads)
