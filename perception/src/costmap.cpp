@@ -96,8 +96,7 @@ std::vector<std::uint32_t> SquaredDistanceToSites(int width, int height, IsSite&
       f[x] = column[x + y * w];
     transform(w);
     for (std::size_t x = 0; x < w; ++x)
-      out[x + y * w] =
-          d[x] >= kFar || d[x] >= std::int64_t(kNoSite) ? kNoSite : std::uint32_t(d[x]);
+      out[x + y * w] = d[x] >= std::int64_t(kNoSite) ? kNoSite : std::uint32_t(d[x]);  // kFar too
   }
   return out;
 }

@@ -369,21 +369,31 @@ class ReturnsRobot final : public ScriptedRobot {
   std::map<std::size_t, float> returns_;
 };
 
+// The off-map returns after one step of a robot standing at X_MB in a 30 m x 6 m hall (walls
+// along y = 0 and y = 6, their faces at y = 0.1 and 5.9) whose laser sees `returns` (beam ->
+// range), people detected out to `max_range`.
+std::vector<Eigen::Vector2d> OffMapReturnsInAHall(const Pose2& X_MB,
+                                                  std::map<std::size_t, float> returns,
+                                                  double max_range) {
+  MissionMap hall;
+  hall.grid = perception::OccupancyGrid::FromBoxes(
+      {{{15.0, 0.05, 0.0}, {30.0, 0.1}}, {{15.0, 5.95, 0.0}, {30.0, 0.1}}}, {0, 0}, {30, 6}, 0.05);
+  ExecutiveConfig config;
+  config.perception.laser_detector.max_range = max_range;
+  ReturnsRobot robot(std::move(returns));
+  Executive brain(std::make_shared<const RobotModel>(RobotModel::LoadDefault()), hall, GoTo(), X_MB,
+                  config);
+  brain.Step(robot);
+  return brain.belief().off_map_returns;
+}
+
 // Off-map returns are read as bodies only as far as the laser's people are detected: farther
 // out one is as likely a wall seen a little off (range noise, the pose's yaw error times the
 // range; clinic room A seed 22: one by a wall 17 m away took the robot's spot beside a door).
 TEST(ExecutiveTest, OffMapReturnsCountOnlyAsFarAsTheLaserDetectsPeople) {
-  const auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
-  MissionMap hall;
-  hall.grid = perception::OccupancyGrid::FromBoxes(
-      {{{15.0, 0.05, 0.0}, {30.0, 0.1}}, {{15.0, 5.95, 0.0}, {30.0, 0.1}}}, {0, 0}, {30, 6}, 0.05);
   const auto off_map = [&](double max_range) {
-    ExecutiveConfig config;
-    config.perception.laser_detector.max_range = max_range;
-    ReturnsRobot robot({{50, 4.0f}, {51, 12.0f}});  // in open floor, ahead
-    Executive brain(model, hall, GoTo(), {2.0, 3.0, 0.0}, config);
-    brain.Step(robot);
-    return brain.belief().off_map_returns;
+    // In open floor, ahead.
+    return OffMapReturnsInAHall({2.0, 3.0, 0.0}, {{50, 4.0f}, {51, 12.0f}}, max_range);
   };
   const auto near_only = off_map(Defaults().perception.laser_detector.max_range);
   ASSERT_EQ(near_only.size(), 1u);
@@ -396,18 +406,9 @@ TEST(ExecutiveTest, OffMapReturnsCountOnlyAsFarAsTheLaserDetectsPeople) {
 // moves it sideways): a return ~0.17 m from a wall's face is off the map 2 m away, and the wall
 // itself 8 m away (room A seed 11: such returns held the robot's spot beside door_e taken).
 TEST(ExecutiveTest, AFarReturnMustBeFartherFromTheMapToBeOffIt) {
-  const auto model = std::make_shared<const RobotModel>(RobotModel::LoadDefault());
-  MissionMap hall;
-  // A wall whose face is y = 0.1, along the hall.
-  hall.grid = perception::OccupancyGrid::FromBoxes(
-      {{{15.0, 0.05, 0.0}, {30.0, 0.1}}, {{15.0, 5.95, 0.0}, {30.0, 0.1}}}, {0, 0}, {30, 6}, 0.05);
   const auto off_map = [&](float range) {
-    ExecutiveConfig config;
-    config.perception.laser_detector.max_range = 15.0;
-    ReturnsRobot robot({{50, range}});  // straight ahead
-    Executive brain(model, hall, GoTo(), {2.0, 0.26, 0.0}, config);
-    brain.Step(robot);
-    return brain.belief().off_map_returns.size();
+    // Straight ahead, along the wall whose face is y = 0.1.
+    return OffMapReturnsInAHall({2.0, 0.26, 0.0}, {{50, range}}, 15.0).size();
   };
   EXPECT_EQ(off_map(2.0f), 1u);
   EXPECT_EQ(off_map(8.0f), 0u);
