@@ -244,7 +244,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
                      : std::nullopt) {
       // At the door speed (the quickest the trajectories go): a resident walks at 1 m/s.
       task_.motion->FollowPath({belief_.X_MB, *room}, {true}, task_.motion->arm_target(),
-                               belief_.now);
+                               belief_.now, std::nullopt, /*brisk=*/true);
       making_room_ = true;
       room_to_ = room->translation();
       room_since_ = belief_.now;

@@ -55,11 +55,12 @@ bool MotionExecutor::arm_moving(Time now) const {
 
 void MotionExecutor::FollowPath(const std::vector<Pose2>& path,
                                 const std::vector<bool>& through_door, const ArmPose& arm, Time now,
-                                std::optional<double> speed) {
+                                std::optional<double> speed, bool brisk) {
   ThrowUnless(path.size() >= 2, "FollowPath: a path needs at least 2 waypoints");
   ThrowUnless(!speed || (std::isfinite(*speed) && *speed > 0), "FollowPath: speed must be > 0");
   planning::TrajectoryConfig config = trajectory_config_;
   if (speed) config.nominal_speed = *speed;
+  config.brisk = config.brisk || brisk;
   std::vector<WholeBodyVector> waypoints;
   double previous_yaw = path.front().yaw;
   for (const Pose2& X_MB : path) {

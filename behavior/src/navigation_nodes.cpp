@@ -311,7 +311,7 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
         };
         if (aside && roomy(aside->translation())) {
           task_.motion->FollowPath({belief_.X_MB, *aside}, {false}, TuckedArm(*task_.model),
-                                   belief_.now, task_.config.retreat_speed);
+                                   belief_.now, task_.config.retreat_speed, /*brisk=*/true);
           this->SetOutput("retreating", true);
           Note(StrCat("nowhere to back off to without passing someone: squeezing aside to ",
                       PoseText(*aside), ", out of the way through ", visit->door));
@@ -325,7 +325,8 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
     if ((path.back().translation() - spot.translation()).norm() > 0.05) path.push_back(spot);
     if (path.size() < 2) return;
     task_.motion->FollowPath(path, std::vector<bool>(path.size() - 1, false),
-                             TuckedArm(*task_.model), belief_.now, task_.config.retreat_speed);
+                             TuckedArm(*task_.model), belief_.now, task_.config.retreat_speed,
+                             /*brisk=*/true);
     this->SetOutput("retreating", true);
     const bool out_of_doorway_only =
         !aside && (spot.translation() - belief_.last_safe->translation()).norm() > 0.05;

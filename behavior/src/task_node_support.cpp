@@ -656,7 +656,7 @@ std::vector<std::pair<const perception::TrackedPerson*, double>> PeopleComing(
 
 void StepAsideTo(const TaskServices& task, const Pose2& spot) {
   task.motion->FollowPath({task.belief->X_MB, spot}, {false}, task.motion->arm_target(),
-                          task.belief->now, task.config.retreat_speed);
+                          task.belief->now, task.config.retreat_speed, /*brisk=*/true);
 }
 
 double PositionSigma(const TaskServices& task) {

@@ -376,10 +376,13 @@ class PeopleRoom {
   std::vector<Occupant> now_;
 };
 
-/// [m/s] The base slower than this has stopped; [s] it is given this long to stop before a step
-/// aside or a retreat starts anyway (a path begun at speed the other way leaves the reference
-/// behind and trips the watchdog).
-inline constexpr double kStoppedMps = 0.05;
+/// [m/s] The base slower than this has stopped, as far as turning back goes: a step aside or a
+/// retreat may start (from rest, where the base is), since the base stops from it within
+/// ~0.1 s and 1 cm at its 1 m/s². Waiting for a standstill cost the reversal ~0.2 s more (a
+/// stop, a BT tick, a new path's slow start), standing in a doorway beside a resident; [s] it is
+/// given this long to stop before a step aside or a retreat starts anyway (a path begun at speed
+/// the other way leaves the reference behind and trips the watchdog).
+inline constexpr double kStoppedMps = 0.15;
 inline constexpr double kStopWithinSec = 1.5;
 /// [m/s] People slower than this are standing, not walking (a laser-tracked person standing
 /// still reads 0.3-0.4 m/s now and then: the legs' midpoint jitters; the slowest walkers with a

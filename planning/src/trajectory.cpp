@@ -78,7 +78,8 @@ SegmentTimeScaling::SegmentTimeScaling(double base_distance, double duration,
               ") must be finite and > 0.");
   const double a = config.max_base_acceleration, L = base_distance, T = duration;
   // A hair of tolerance: the quintic exactly at the limit stays the quintic.
-  if (kQuinticPeakAccelFactor * L / (T * T) <= a * (1.0 + 1e-9)) return;
+  if (L <= 0.0 || (!config.brisk && kQuinticPeakAccelFactor * L / (T * T) <= a * (1.0 + 1e-9)))
+    return;
   // t_a (T - t_a) = L / a: the smaller root (the larger would brake before it coasts).
   const double discriminant = std::max(0.0, T * T - 4.0 * L / a);
   accel_time_ = 0.5 * (T - std::sqrt(discriminant));

@@ -70,6 +70,25 @@ TEST(MotionExecutorTest, StoppingOrAPathEndsTheDetour) {
   EXPECT_TRUE(motion.base_moving());
 }
 
+// A brisk path (a step out of someone's way) asks the base for speed from the start: 0.1 s
+// into a 1 m retreat at 0.4 m/s it is planned at the limit's 0.1 m/s, where the quintic plans
+// 0.02 m/s; both take the same time.
+TEST(MotionExecutorTest, ABriskPathSetsOffAtTheBasesLimit) {
+  const RobotModel model = RobotModel::LoadDefault();
+  const Pose2 start{0.0, 0.0, 0.0}, goal{1.0, 0.0, 0.0};
+  const auto speed_at = [&](bool brisk, double t) {
+    MotionExecutor motion(model);
+    motion.FollowPath({start, goal}, {false}, TuckedArm(model), Time{}, 0.4, brisk);
+    motion.Update(Time{} + SecondsToDuration(t), start, {});
+    return std::pair{motion.planned_velocity().norm(), motion.base_duration()};
+  };
+  const auto [brisk_speed, brisk_duration] = speed_at(true, 0.1);
+  const auto [gentle_speed, gentle_duration] = speed_at(false, 0.1);
+  EXPECT_NEAR(brisk_speed, 0.1, 0.01);
+  EXPECT_LT(gentle_speed, 0.03);
+  EXPECT_DOUBLE_EQ(brisk_duration, gentle_duration);
+}
+
 }  // namespace
 }  // namespace egress::behavior
 

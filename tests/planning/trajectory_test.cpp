@@ -108,6 +108,31 @@ TEST(TrajectoryTest, TheCoastingProfileIsConsistent) {
   EXPECT_NEAR(0.9 * s.Acceleration(s.duration() - 0.01), -config.max_base_acceleration, 1e-12);
 }
 
+// A brisk segment (a step out of someone's way) accelerates at the base's limit from the
+// start where the quintic, which would keep within it, starts at zero acceleration; in the
+// same time, it ends at rest where the quintic does, and peaks no faster.
+TEST(TrajectoryTest, BriskSegmentsAccelerateAtTheLimitFromTheStart) {
+  TrajectoryConfig config;
+  config.nominal_speed = 0.4;
+  const double L = 1.0, T = SegmentDuration(L, false, config);
+  const SegmentTimeScaling gentle(L, T, config);
+  config.brisk = true;
+  const SegmentTimeScaling brisk(L, T, config);
+  ASSERT_TRUE(gentle.quintic());
+  ASSERT_FALSE(brisk.quintic());
+  EXPECT_DOUBLE_EQ(brisk.duration(), gentle.duration());
+  EXPECT_NEAR(L * brisk.Acceleration(0.01), config.max_base_acceleration, 1e-12);
+  EXPECT_LT(L * gentle.Acceleration(0.01), 0.05);
+  // 5 cm/s within 0.06 s: the quintic takes 0.16 s.
+  EXPECT_GT(L * brisk.Rate(0.06), 0.05);
+  EXPECT_LT(L * gentle.Rate(0.1), 0.05);
+  EXPECT_DOUBLE_EQ(brisk.Progress(T), 1.0);
+  EXPECT_NEAR(brisk.Rate(T), 0.0, 1e-12);
+  EXPECT_LE(brisk.peak_rate(), gentle.peak_rate());
+  // A turn on the spot has no base distance to accelerate over: the quintic.
+  EXPECT_TRUE(SegmentTimeScaling(0.0, 1.5, config).quintic());
+}
+
 // A short step with a turn: the coasting profile's peak rate (up to 2/T) still keeps the yaw
 // under max_yaw_rate.
 TEST(TrajectoryTest, ACoastingSegmentKeepsTheYawRate) {

@@ -54,10 +54,13 @@ class MotionExecutor {
 
   /// Follows `path` (X_MB waypoints, the first one the current pose); `through_door[i]` marks
   /// segment i as a door crossing (0.4 m/s). The arm holds `arm`. `speed` [m/s], if given,
-  /// replaces the nominal speed of the other segments (a retreat from someone).
+  /// replaces the nominal speed of the other segments (a retreat from someone). `brisk`: the
+  /// segments accelerate at the base's limit from the start (TrajectoryConfig::brisk), for a
+  /// step out of someone's way.
   /// @throws InvalidArgument for fewer than 2 waypoints, non-finite poses or a speed <= 0.
   void FollowPath(const std::vector<Pose2>& path, const std::vector<bool>& through_door,
-                  const ArmPose& arm, Time now, std::optional<double> speed = std::nullopt);
+                  const ArmPose& arm, Time now, std::optional<double> speed = std::nullopt,
+                  bool brisk = false);
   /// Drives the base to `p_MGoal` with the Bug2 local planner instead (head for the goal,
   /// follow an obstacle's boundary round it, stop for people ahead) — the detour when the
   /// costmap has no path. It sees what SetSurroundings last gave it.
