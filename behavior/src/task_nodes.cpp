@@ -15,6 +15,9 @@ void TaskConfig::Validate() const {
               "TaskConfig: motion times must be positive");
   ThrowUnless(std::isfinite(door_peek_time) && door_peek_time >= 0,
               "TaskConfig: door_peek_time must be >= 0 (s)");
+  ThrowUnless(
+      std::isfinite(door_peek_turn_deg) && door_peek_turn_deg >= 0 && door_peek_turn_deg <= 90,
+      "TaskConfig: door_peek_turn_deg must be in [0, 90] (deg)");
   ThrowUnless(std::isfinite(passage_clearance) && passage_clearance >= 0 &&
                   std::isfinite(passage_quiet_time) && passage_quiet_time >= 0 &&
                   std::isfinite(passage_max_wait) && passage_max_wait >= 0,

@@ -63,10 +63,12 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
           return arm;
         const Eigen::Vector2d entry = EntryPoint();
         const double slide = (entry - belief_.X_MB.translation()).norm();
+        // The slide turns the base back square to the door (TaskConfig::door_peek_turn_deg).
+        const double turn = std::remainder(yaw_ - belief_.X_MB.yaw, 2 * M_PI);
         const double slide_time =
-            planning::SegmentDuration(slide, true, task_.motion->trajectory_config());
+            planning::SegmentDuration(slide, turn, true, task_.motion->trajectory_config());
         const double slow_slide_time =
-            planning::SegmentDuration(slide, false, task_.motion->trajectory_config());
+            planning::SegmentDuration(slide, turn, false, task_.motion->trajectory_config());
         const double looked = ToSeconds(belief_.now - waiting_since_);
         // From beside the lane the leaf is often behind the jamb: its clearance is checked
         // again on the axis, where it is in view.
@@ -183,11 +185,14 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
       // window of an open door leaves 10 s, about what the direct line-up and the pass take).
       const auto& trajectory = task_.motion->trajectory_config();
       const Eigen::Vector2d entry = EntryPoint();
+      const double turn = std::remainder(peek->yaw - belief_.X_MB.yaw, 2 * M_PI);
+      const double turn_back = std::remainder(yaw_ - peek->yaw, 2 * M_PI);
       const double lead =
-          planning::SegmentDuration((peek->translation() - belief_.X_MB.translation()).norm(), true,
-                                    trajectory) +
+          planning::SegmentDuration((peek->translation() - belief_.X_MB.translation()).norm(), turn,
+                                    true, trajectory) +
           task_.config.door_peek_time +
-          planning::SegmentDuration((entry - peek->translation()).norm(), true, trajectory);
+          planning::SegmentDuration((entry - peek->translation()).norm(), turn_back, true,
+                                    trajectory);
       const std::vector<Pose2> path{belief_.X_MB, *peek};
       if (const DoorVisit visit = Visit();
           DoorWindowLeavesTime(task_, door_, &visit, lead) && task_.planner->IsPathValid(path)) {
@@ -217,7 +222,9 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
   }
 
   // Where the robot stops to look through the door before lining up: on the entry line, just
-  // clear of the lane through the opening on the robot's side. Only for a door that opens away
+  // clear of the lane through the opening on the robot's side, turned door_peek_turn_deg from
+  // facing through the door towards the lane (TaskConfig::door_peek_turn_deg). Only for a door
+  // that opens away
   // (one that opens towards the robot stands its leaf between the lane's edge and the far
   // side) and a robot beside the lane, farther out than that.
   std::optional<Pose2> PeekPose() const {
@@ -231,7 +238,10 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     const double edge = door.width() / 2 + task_.config.footprint_radius + kEdgeClearance;
     if (std::abs(lateral) < edge + kMinSlide) return std::nullopt;
     const Eigen::Vector2d p = EntryPoint() + along * std::copysign(edge, lateral);
-    return Pose2{p.x(), p.y(), yaw_};
+    const double turn = task_.config.door_peek_turn_deg * M_PI / 180.0;
+    const Eigen::Vector2d facing =
+        -pass_.n_M * std::cos(turn) - along * std::copysign(std::sin(turn), lateral);
+    return Pose2{p.x(), p.y(), std::atan2(facing.y(), facing.x())};
   }
 
   // Whether the robot waits at the entry for people to pass the doorway (IsPassageClear over the

@@ -362,7 +362,8 @@ double DoorNodesTest::SlideOntoTheAxisAfterLookingThrough(std::optional<bt::Tree
   const Pose2 edge = motion_.path().back();
   EXPECT_NEAR(edge.x, 0.475 + services_.config.footprint_radius + 0.05, 1e-6);
   EXPECT_NEAR(edge.y, 3.0 - services_.config.door_entry_distance, 1e-6);
-  EXPECT_NEAR(edge.yaw, M_PI / 2, 1e-6);
+  // Turned door_peek_turn_deg from square to the door (+y), towards the lane (-x): left.
+  EXPECT_NEAR(edge.yaw, M_PI / 2 + services_.config.door_peek_turn_deg * M_PI / 180.0, 1e-6);
   EXPECT_TRUE(NotedText("look through the door"));
   // There, it waits while the leaf still opens (seen now).
   motion_.StopBase();
@@ -394,6 +395,31 @@ TEST_F(DoorNodesTest, TraverseDoorFromBesideTheLaneLooksThroughTheOpeningFromIts
   const double slide = 0.475 + services_.config.footprint_radius + 0.05;
   EXPECT_NEAR(SlideOntoTheAxisAfterLookingThrough(),
               planning::SegmentDuration(slide, true, trajectory), 1e-6);
+}
+
+// From the other side of the lane the peek turns the other way, towards the lane (+x): right;
+// with door_peek_turn_deg 0 it faces square through the door.
+TEST_F(DoorNodesTest, TheLookThroughTurnsTowardsTheLaneFromEitherSide) {
+  const auto peek_yaw = [&](double turn_deg) {
+    services_.config.door_peek_turn_deg = turn_deg;
+    auto blackboard = bt::Blackboard::Create();
+    DoorVisit visit;
+    visit.door = "lab_door";
+    visit.operated_at = At(0.0);
+    blackboard->Set("door_visit", bt::Any(visit));
+    bt::Tree tree = Tree(R"(<TraverseDoor door="lab_door"/>)", blackboard);
+    belief_.X_MB = {-1.15, 2.43, M_PI / 2};  // beside the lane, on the latch side
+    DoorSeenOpen(40.0, 0.0);
+    belief_.world.doors[0].state.motion = perception::DoorMotion::kOpening;
+    belief_.door_open_since.clear();
+    belief_.now = At(1.0);
+    EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+    EXPECT_TRUE(NotedText("look through the door"));
+    EXPECT_LT(motion_.path().back().x, -0.475) << "at the lane's edge on this side";
+    return motion_.path().back().yaw;
+  };
+  EXPECT_NEAR(peek_yaw(20.0), M_PI / 2 - 20.0 * M_PI / 180.0, 1e-6);
+  EXPECT_NEAR(peek_yaw(0.0), M_PI / 2, 1e-6);
 }
 
 TEST_F(DoorNodesTest, TraverseDoorSlidesOntoTheAxisAtTheNominalSpeedWhenTheWindowLeavesTime) {

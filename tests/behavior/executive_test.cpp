@@ -425,6 +425,15 @@ TEST(ExecutiveTest, BadConfigurationsAreRefusedNamingTheField) {
   } catch (const InvalidArgument& e) {
     EXPECT_NE(std::string(e.what()).find("octomap_person_radius"), std::string::npos) << e.what();
   }
+  ExecutiveConfig peek;
+  peek.tasks.door_peek_turn_deg = 120.0;  // it would turn its back on the door
+  try {
+    Executive e(std::make_shared<const RobotModel>(RobotModel::LoadDefault()), EmptyRoom(), GoTo(),
+                {2.0, 3.0, 0.0}, peek);
+    FAIL() << "accepted a peek turned away from the door";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("door_peek_turn_deg"), std::string::npos) << e.what();
+  }
   ExecutiveConfig grasp;
   grasp.grasp.min_opening = 0.0;
   EXPECT_THROW(Executive(std::make_shared<const RobotModel>(RobotModel::LoadDefault()), EmptyRoom(),
