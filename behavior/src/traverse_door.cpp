@@ -224,9 +224,8 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
   // Where the robot stops to look through the door before lining up: on the entry line, just
   // clear of the lane through the opening on the robot's side, turned door_peek_turn_deg from
   // facing through the door towards the lane (TaskConfig::door_peek_turn_deg). Only for a door
-  // that opens away
-  // (one that opens towards the robot stands its leaf between the lane's edge and the far
-  // side) and a robot beside the lane, farther out than that.
+  // that opens away (one that opens towards the robot stands its leaf between the lane's edge
+  // and the far side) and a robot beside the lane, farther out than that.
   std::optional<Pose2> PeekPose() const {
     if (task_.config.door_peek_time <= 0.0) return std::nullopt;
     const perception::DoorModel& door = *task_.map->FindDoor(door_);

@@ -82,7 +82,9 @@ SegmentTimeScaling::SegmentTimeScaling(double base_distance, double duration,
     return;
   // t_a (T - t_a) = L / a: the smaller root (the larger would brake before it coasts).
   const double discriminant = std::max(0.0, T * T - 4.0 * L / a);
-  accel_time_ = 0.5 * (T - std::sqrt(discriminant));
+  const double accel_time = 0.5 * (T - std::sqrt(discriminant));
+  if (accel_time <= 0.0) return;  // brisk, over a distance too small to tell from none
+  accel_time_ = accel_time;
   accel_ = 1.0 / (accel_time_ * (T - accel_time_));
 }
 

@@ -129,8 +129,12 @@ TEST(TrajectoryTest, BriskSegmentsAccelerateAtTheLimitFromTheStart) {
   EXPECT_DOUBLE_EQ(brisk.Progress(T), 1.0);
   EXPECT_NEAR(brisk.Rate(T), 0.0, 1e-12);
   EXPECT_LE(brisk.peak_rate(), gentle.peak_rate());
-  // A turn on the spot has no base distance to accelerate over: the quintic.
+  // A turn on the spot has no base distance to accelerate over: the quintic; nor has a step
+  // too small to tell from none (its acceleration time would round to 0).
   EXPECT_TRUE(SegmentTimeScaling(0.0, 1.5, config).quintic());
+  const SegmentTimeScaling tiny(1e-300, 1.5, config);
+  EXPECT_TRUE(std::isfinite(tiny.Progress(0.7)) && std::isfinite(tiny.Acceleration(0.7)));
+  EXPECT_TRUE(std::isfinite(tiny.peak_rate()));
 }
 
 // A short step with a turn: the coasting profile's peak rate (up to 2/T) still keeps the yaw
