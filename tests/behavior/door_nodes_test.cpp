@@ -14,6 +14,20 @@ class DoorNodesTest : public node_testing::TaskNodeFixture {
  protected:
   // `tree` keeps the TraverseDoor node for ticks after the slide has started.
   double SlideOntoTheAxisAfterLookingThrough(std::optional<bt::Tree>* tree_out = nullptr);
+  // A TraverseDoor of the lab door after the robot's own press at 0 s (the window leaves time
+  // for the stop at the lane's edge), the robot at X_MB, the leaf last seen opening at 40 deg.
+  bt::Tree TraverseAfterOwnPress(const Pose2& X_MB) {
+    auto blackboard = bt::Blackboard::Create();
+    DoorVisit visit;
+    visit.door = "lab_door";
+    visit.operated_at = At(0.0);
+    blackboard->Set("door_visit", bt::Any(visit));
+    bt::Tree tree = Tree(R"(<TraverseDoor door="lab_door"/>)", blackboard);
+    belief_.X_MB = X_MB;
+    DoorSeenOpen(40.0, 0.0);
+    belief_.world.doors[0].state.motion = perception::DoorMotion::kOpening;
+    return tree;
+  }
   // ApproachButton from (0, 1) puts its plan in the visit on `blackboard` (with `operated_at`, an
   // earlier press, if given); the leaf is last seen at `seen_at` [s], at `angle_deg` and
   // `motion`, and not since (from beside the actuator it is behind the jamb); then the robot
@@ -342,15 +356,8 @@ TEST_F(DoorNodesTest, APressRightAfterTheRobotsOwnOpeningPassesInThatOpeningsWin
 // From the button's standoff beside the lane of the lab door (which opens away): to the lane's
 // edge, look through the opening, then slide onto the axis. Returns the slide's planned duration.
 double DoorNodesTest::SlideOntoTheAxisAfterLookingThrough(std::optional<bt::Tree>* tree_out) {
-  auto blackboard = bt::Blackboard::Create();
-  DoorVisit visit;
-  visit.door = "lab_door";
-  visit.operated_at = At(0.0);  // the robot's own press: the window leaves time for the stop
-  blackboard->Set("door_visit", bt::Any(visit));
-  bt::Tree tree = Tree(R"(<TraverseDoor door="lab_door"/>)", blackboard);
-  belief_.X_MB = {1.15, 2.43, M_PI / 2};  // the button's standoff, beside the lane
-  DoorSeenOpen(40.0, 0.0);
-  belief_.world.doors[0].state.motion = perception::DoorMotion::kOpening;
+  // From the button's standoff, beside the lane.
+  bt::Tree tree = TraverseAfterOwnPress({1.15, 2.43, M_PI / 2});
   belief_.door_open_since.clear();
   belief_.now = At(1.0);
   EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
@@ -402,15 +409,8 @@ TEST_F(DoorNodesTest, TraverseDoorFromBesideTheLaneLooksThroughTheOpeningFromIts
 TEST_F(DoorNodesTest, TheLookThroughTurnsTowardsTheLaneFromEitherSide) {
   const auto peek_yaw = [&](double turn_deg) {
     services_.config.door_peek_turn_deg = turn_deg;
-    auto blackboard = bt::Blackboard::Create();
-    DoorVisit visit;
-    visit.door = "lab_door";
-    visit.operated_at = At(0.0);
-    blackboard->Set("door_visit", bt::Any(visit));
-    bt::Tree tree = Tree(R"(<TraverseDoor door="lab_door"/>)", blackboard);
-    belief_.X_MB = {-1.15, 2.43, M_PI / 2};  // beside the lane, on the latch side
-    DoorSeenOpen(40.0, 0.0);
-    belief_.world.doors[0].state.motion = perception::DoorMotion::kOpening;
+    // Beside the lane, on the latch side.
+    bt::Tree tree = TraverseAfterOwnPress({-1.15, 2.43, M_PI / 2});
     belief_.door_open_since.clear();
     belief_.now = At(1.0);
     EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
@@ -479,15 +479,8 @@ TEST_F(DoorNodesTest, TraverseDoorSlidesAsSlowlyAsTheWindowLeavesTimeForWithTime
 }
 
 TEST_F(DoorNodesTest, TraverseDoorOutOfViewOfTheLeafGivesItTheOperatorsOpeningTime) {
-  auto blackboard = bt::Blackboard::Create();
-  DoorVisit visit;
-  visit.door = "lab_door";
-  visit.operated_at = At(0.0);
-  blackboard->Set("door_visit", bt::Any(visit));
-  bt::Tree tree = Tree(R"(<TraverseDoor door="lab_door"/>)", blackboard);
-  belief_.X_MB = {1.15, 2.43, M_PI / 2};
-  DoorSeenOpen(40.0, 0.0);  // last seen opening at 1 s, then behind the jamb
-  belief_.world.doors[0].state.motion = perception::DoorMotion::kOpening;
+  // Last seen opening at 1 s, then behind the jamb.
+  bt::Tree tree = TraverseAfterOwnPress({1.15, 2.43, M_PI / 2});
   belief_.world.doors[0].state.clearance_width = 0.3;  // too narrow when last seen
   belief_.door_open_since.clear();
   belief_.now = At(1.0);
