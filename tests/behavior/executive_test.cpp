@@ -416,24 +416,22 @@ TEST(ExecutiveTest, AFarReturnMustBeFartherFromTheMapToBeOffIt) {
 }
 
 TEST(ExecutiveTest, BadConfigurationsAreRefusedNamingTheField) {
+  // The executive refuses `config`, naming `field`.
+  const auto refused_naming = [](const ExecutiveConfig& config, const std::string& field) {
+    try {
+      Executive e(std::make_shared<const RobotModel>(RobotModel::LoadDefault()), EmptyRoom(),
+                  GoTo(), {2.0, 3.0, 0.0}, config);
+      ADD_FAILURE() << "accepted a bad " << field;
+    } catch (const InvalidArgument& e) {
+      EXPECT_NE(std::string(e.what()).find(field), std::string::npos) << e.what();
+    }
+  };
   ExecutiveConfig config;
   config.octomap_person_radius = -1.0;
-  try {
-    Executive e(std::make_shared<const RobotModel>(RobotModel::LoadDefault()), EmptyRoom(), GoTo(),
-                {2.0, 3.0, 0.0}, config);
-    FAIL() << "accepted a negative radius";
-  } catch (const InvalidArgument& e) {
-    EXPECT_NE(std::string(e.what()).find("octomap_person_radius"), std::string::npos) << e.what();
-  }
+  refused_naming(config, "octomap_person_radius");
   ExecutiveConfig peek;
   peek.tasks.door_peek_turn_deg = 120.0;  // it would turn its back on the door
-  try {
-    Executive e(std::make_shared<const RobotModel>(RobotModel::LoadDefault()), EmptyRoom(), GoTo(),
-                {2.0, 3.0, 0.0}, peek);
-    FAIL() << "accepted a peek turned away from the door";
-  } catch (const InvalidArgument& e) {
-    EXPECT_NE(std::string(e.what()).find("door_peek_turn_deg"), std::string::npos) << e.what();
-  }
+  refused_naming(peek, "door_peek_turn_deg");
   ExecutiveConfig grasp;
   grasp.grasp.min_opening = 0.0;
   EXPECT_THROW(Executive(std::make_shared<const RobotModel>(RobotModel::LoadDefault()), EmptyRoom(),
