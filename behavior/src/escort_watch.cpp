@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 #include "task_node_support.h"
@@ -144,19 +146,42 @@ AtTheDoorway ByTheDoorway(const Belief& belief, const DoorPass& pass, const Eige
     }
   }
   someone = someone || !frontier.empty();
+  // Someone tracked stands about already: which returns are whose no longer matters (the flood
+  // below is quadratic in the returns, and a crowd at the door gives hundreds).
+  if (!alone) return {someone, false, false};
   for (std::size_t i = 0; i < near.size(); ++i) {
     if (!linked[i] && on_someone_by(near[i])) {
       linked[i] = true;
       frontier.push_back(i);
     }
   }
+  // Returns binned in kSameBodyM cells: a return's body neighbours lie in the 3 x 3 cells round it.
+  const auto cell_of = [](const Eigen::Vector2d& p) {
+    return Eigen::Vector2i(static_cast<int>(std::floor(p.x() / kSameBodyM)),
+                           static_cast<int>(std::floor(p.y() / kSameBodyM)));
+  };
+  const auto key_of = [](int cx, int cy) {
+    return (static_cast<std::int64_t>(cx) << 32) ^ static_cast<std::uint32_t>(cy);
+  };
+  std::unordered_map<std::int64_t, std::vector<std::size_t>> cells;
+  for (std::size_t i = 0; i < near.size(); ++i) {
+    const Eigen::Vector2i c = cell_of(near[i]);
+    cells[key_of(c.x(), c.y())].push_back(i);
+  }
   while (!frontier.empty()) {
     const std::size_t i = frontier.back();
     frontier.pop_back();
-    for (std::size_t j = 0; j < near.size(); ++j) {
-      if (linked[j] || (near[j] - near[i]).norm() >= kSameBodyM) continue;
-      linked[j] = true;
-      frontier.push_back(j);
+    const Eigen::Vector2i c = cell_of(near[i]);
+    for (int dx = -1; dx <= 1; ++dx) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        const auto it = cells.find(key_of(c.x() + dx, c.y() + dy));
+        if (it == cells.end()) continue;
+        for (const std::size_t j : it->second) {
+          if (linked[j] || (near[j] - near[i]).norm() >= kSameBodyM) continue;
+          linked[j] = true;
+          frontier.push_back(j);
+        }
+      }
     }
   }
   alone = alone && std::all_of(linked.begin(), linked.end(), [](bool b) { return b; });
