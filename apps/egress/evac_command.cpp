@@ -227,6 +227,7 @@ nlohmann::json RunStudyTrial(const twin::Scenario& scenario, const twin::WorldDe
           {"arrivals", arrivals},
           {"doors", doors},
           {"contacts", m.contacts.count("person") ? m.contacts.at("person") : 0},
+          {"obstacle_contacts", m.ObstacleContacts()},
           {"closest", std::isfinite(m.min_person_distance) ? nlohmann::json(m.min_person_distance)
                                                            : nlohmann::json(nullptr)},
           {"doorway_block_s", doorway_judge.in_doorway_s()},
@@ -395,9 +396,10 @@ void RunStudy(const StudyOptions& o) {
   for (const std::string& c : conditions) {
     const auto& trials = by_condition[c];
     std::vector<double> times;
-    int left = 0, contacts = 0;
-    // The seeds to look at: where someone was left behind, where the robot touched someone.
-    std::map<std::uint64_t, int> left_by_seed, contacts_by_seed;
+    int left = 0, contacts = 0, obstacle_contacts = 0;
+    // The seeds to look at: where someone was left behind, where the robot touched someone, or a
+    // wall or a door's leaf.
+    std::map<std::uint64_t, int> left_by_seed, contacts_by_seed, obstacle_contacts_by_seed;
     nlohmann::json left_people = nlohmann::json::array();  // each with its seed
     double closest = std::numeric_limits<double>::infinity(), blocking = 0.0, standing = 0.0;
     std::map<std::string, std::vector<double>> flow, queue, by_residents, by_robot;
@@ -411,6 +413,9 @@ void RunStudy(const StudyOptions& o) {
         left_people.push_back(std::move(p));
       }
       if (const int k = t.at("contacts").get<int>(); k > 0) contacts_by_seed[seed] = k;
+      if (const int k = t.at("obstacle_contacts").get<int>(); k > 0)
+        obstacle_contacts_by_seed[seed] = k;
+      obstacle_contacts += t.at("obstacle_contacts").get<int>();
       left += t.at("left_behind").get<int>();
       contacts += t.at("contacts").get<int>();
       if (!t.at("closest").is_null()) closest = std::min(closest, t.at("closest").get<double>());
@@ -446,6 +451,9 @@ void RunStudy(const StudyOptions& o) {
     PrintLeftBehind(left_people);
     if (!contacts_by_seed.empty())
       fmt::print("    contacts in seeds {}\n", seeds_text(contacts_by_seed));
+    if (!obstacle_contacts_by_seed.empty())
+      fmt::print("    the robot touched a wall or a door's leaf in seeds {}\n",
+                 seeds_text(obstacle_contacts_by_seed));
     nlohmann::json doors = nlohmann::json::object();
     for (const auto& [door, q] : queue) {
       // Null (and "n/a") where no trial saw two residents through: no rate to give.
@@ -490,6 +498,8 @@ void RunStudy(const StudyOptions& o) {
          {"left_behind_people", left_people},
          {"contacts", contacts},
          {"contacts_by_seed", seeds_json(contacts_by_seed)},
+         {"obstacle_contacts", obstacle_contacts},
+         {"obstacle_contacts_by_seed", seeds_json(obstacle_contacts_by_seed)},
          {"closest_m", std::isfinite(closest) ? nlohmann::json(closest) : nlohmann::json(nullptr)},
          {"doorway_block_s", blocking},
          {"doorway_stand_s", standing},
@@ -499,7 +509,7 @@ void RunStudy(const StudyOptions& o) {
   std::ofstream(dir / "study.json") << study.dump(2) << "\n";
   std::ofstream csv(dir / "trials.csv");
   csv << "condition,seed,residents,out,left_behind,t_evac,contacts,closest,doorway_block_s,"
-         "doorway_stand_s,resident_operations,robot_operations\n";
+         "doorway_stand_s,resident_operations,robot_operations,obstacle_contacts\n";
   for (const auto& r : results) {
     csv << r.at("condition").get<std::string>() << "," << r.at("seed").get<std::uint64_t>() << ","
         << r.at("residents").get<int>() << "," << r.at("out").get<int>() << ","
@@ -510,7 +520,7 @@ void RunStudy(const StudyOptions& o) {
         << "," << fmt::format("{:.1f}", r.at("doorway_block_s").get<double>()) << ","
         << fmt::format("{:.1f}", r.at("doorway_stand_s").get<double>()) << ","
         << r.at("resident_operations").get<int>() << "," << r.at("robot_operations").get<int>()
-        << "\n";
+        << "," << r.at("obstacle_contacts").get<int>() << "\n";
   }
   DrawEvacuated(by_condition, base.time_limit, residents, dir / "evacuated.png");
   fmt::print("wrote {}, {} and {}\n", (dir / "study.json").string(), (dir / "trials.csv").string(),

@@ -684,6 +684,8 @@ mission:
   EXPECT_EQ(alone.at("left_behind_people").at(0).at("waiting_for"), "door_a");
   EXPECT_EQ(robot.value("left_behind", -1), 0) << run.output;
   EXPECT_EQ(robot.at("contacts").get<int>(), 0);
+  EXPECT_EQ(robot.at("obstacle_contacts").get<int>(), 0);  // no wall or leaf touched either
+  EXPECT_TRUE(robot.at("obstacle_contacts_by_seed").empty());
   const auto& door_a = robot.at("doors").at("door_a");
   // Per trial: seed 6's door_a opened by the robot alone, seed 5's by the resident.
   EXPECT_EQ(door_a.at("operated_by_robot_median").get<double>(), 0.5) << door_a.dump();

@@ -79,6 +79,7 @@ TEST(ScenarioJudgeTest, ContactWithANamedObstacleFailsItsPredicate) {
   EXPECT_EQ(v.predicates[1].name, "no_contact_with:leg");
   EXPECT_TRUE(v.predicates[1].passed);
   EXPECT_GE(v.metrics.contacts_with.at("top"), 1);
+  EXPECT_EQ(v.metrics.ObstacleContacts(), v.metrics.contacts.at("static"));
 
   auto unknown = LoadText(
       "world: lab.sdf\nrobot:\n  start: {x: 0.0, y: -0.5}\nsuccess: [{no_contact_with: shelf}]\n",
@@ -98,6 +99,7 @@ TEST(ScenarioJudgeTest, AgainstAClosedDoorTheRobotIsStoppedAndFails) {
   EXPECT_FALSE(v.success);
   EXPECT_TRUE(v.metrics.crossings.empty());
   EXPECT_GE(v.metrics.contacts.at("door"), 1);
+  EXPECT_GE(v.metrics.ObstacleContacts(), v.metrics.contacts.at("door"));
   EXPECT_FALSE(v.metrics.time_to_goal.has_value());
   const std::string table = FormatVerdict(v);
   EXPECT_THAT(table, HasSubstr("FAIL  reach_goal"));
@@ -120,6 +122,7 @@ TEST(ScenarioJudgeTest, PersonalSpaceAndPersonContactsAreMeasured) {
   EXPECT_THAT(FormatVerdict(v), HasSubstr("robot at"));
   EXPECT_THAT(VerdictToJson(v), HasSubstr("\"closest_robot_speed\":"));
   EXPECT_GE(v.metrics.contacts.count("person") ? v.metrics.contacts.at("person") : 0, 1);
+  EXPECT_EQ(v.metrics.ObstacleContacts(), 0);  // a person is not an obstacle of the building
   EXPECT_FALSE(v.success);
 }
 

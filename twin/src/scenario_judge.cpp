@@ -85,6 +85,13 @@ void ScenarioJudge::Observe(const TwinWorld& world) {
   last_time_ = t;
 }
 
+int RunMetrics::ObstacleContacts() const {
+  int n = 0;
+  for (const char* kind : {"static", "door"})
+    if (const auto it = contacts.find(kind); it != contacts.end()) n += it->second;
+  return n;
+}
+
 Verdict ScenarioJudge::Finish(const TwinWorld& world) const {
   Verdict v;
   v.metrics = metrics_;

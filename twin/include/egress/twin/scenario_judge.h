@@ -54,6 +54,10 @@ struct RunMetrics {
   std::vector<DoorCrossing> crossings;
   /// Button presses per crossing, over all doors (presses when nothing was crossed).
   double presses_per_traversal{0.0};
+
+  /// The robot's bumps into the building: walls and furniture ("static") and doors' leaves. Not
+  /// people, a payload it handles, or one it carries set down on furniture ("carried").
+  int ObstacleContacts() const;
 };
 
 struct PredicateResult {
