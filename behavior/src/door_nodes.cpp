@@ -52,7 +52,8 @@ class ApproachButton final : public TaskNode<bt::StatefulActionNode> {
             VisitPort(bt::PortDirection::kInOut),
             InputPort<bool>("door_speed", false,
                             "drive to the standoff at the door speed (TrajectoryConfig::"
-                            "door_speed): a resident already waits at the door")};
+                            "door_speed): a resident already waits at the door, or the escort, "
+                            "behind the group, goes to open a door nobody is near")};
   }
   NodeStatus OnStart() override {
     DoorVisit visit = Visit();
