@@ -611,6 +611,10 @@ std::optional<Pose2> PeopleRoom::BestSpotAround(const std::vector<Pose2>& way, d
       if (s <= beat || IsInAnyDoorZone(task_, q) ||
           PassesThroughAnyDoorway(task_, way.back().translation(), q) || !IsWayClear(corners))
         continue;
+      const perception::Costmap2D* costmap = task_.belief->world.costmap;
+      if (costmap != nullptr &&
+          costmap->IsNearMappedObstacle(q, task_.config.footprint_radius + kSpotWallClearanceM))
+        continue;
       const Pose2 candidate{q.x(), q.y(), yaw};
       if (!task_.planner->IsPathValid({way.back(), candidate})) continue;
       best = candidate;

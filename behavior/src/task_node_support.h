@@ -339,8 +339,9 @@ class PeopleRoom {
   /// is behind it. nullopt without a scan.
   std::optional<double> YawSeeing(const std::vector<Eigen::Vector2d>& corners) const;
   /// Of the spots round the robot (kSpotRadiiM x kSpotHeadings, at its heading) outside every
-  /// door's zone, reachable from `way` (the robot's pose first) by a clear straight line the
-  /// planner finds valid: the best-scoring one, if it scores above `beat`.
+  /// door's zone, at least kSpotWallClearanceM beyond the footprint from every mapped wall,
+  /// reachable from `way` (the robot's pose first) by a clear straight line the planner finds
+  /// valid: the best-scoring one, if it scores above `beat`.
   std::optional<Pose2> BestSpotAround(const std::vector<Pose2>& way, double beat) const;
 
   static constexpr double kSpotRadiiM[] = {0.6, 1.0, 1.5};
@@ -350,7 +351,11 @@ class PeopleRoom {
   static constexpr double kWayCostPerM = 0.2;        ///< a nearer spot wins a tie [m of room per m]
   static constexpr double kSpotRoomTieBreak = 0.05;  ///< see Score
   static constexpr double kPassMarginM = 0.1;        ///< beyond the footprint [m]
-  static constexpr double kPathSampleM = 0.05;       ///< ways checked this often [m]
+  /// A spot's gap to the walls [m]: the planner's pose check passes a footprint 3 mm off a wall
+  /// (its inscribed cost, in 5 cm cells), and the base, turning there to watch, drifts that much
+  /// (room A seed 29: stepped aside to 0.218 m from a wall, it touched it turning on the spot).
+  static constexpr double kSpotWallClearanceM = 0.05;
+  static constexpr double kPathSampleM = 0.05;  ///< ways checked this often [m]
   static constexpr double kSweepMarginRad = 10.0 * M_PI / 180.0;
   static constexpr double kLookTurnStepRad = 5.0 * M_PI / 180.0;  ///< see YawSeeing
   static constexpr double kSidestepSampleM = 0.05;  ///< sidesteps checked against walls this often

@@ -3,6 +3,7 @@
 // past may step round the robot as far as the walls let them.
 
 #include <algorithm>
+#include <cmath>
 #include <optional>
 #include <vector>
 
@@ -119,6 +120,12 @@ TEST_F(PeopleRoomTest, TwoAbreastAreLeftTheCorridorBySteppingToAWall) {
   const double wall_gap = std::min(spot->y, 2.0 - spot->y);
   EXPECT_LT(wall_gap, task_.config.footprint_radius + 0.25) << "at a wall: y = " << spot->y;
   EXPECT_TRUE(planner.IsValid(*spot));
+  // But not against it: the base turns there, and the planner's pose check passes a footprint
+  // millimetres off a wall. The gap is measured to the wall's cells' centres, half a cell in.
+  const double half_cell = costmap_.geometry().resolution / 2;
+  EXPECT_GT(wall_gap + half_cell,
+            task_.config.footprint_radius + PeopleRoom::kSpotWallClearanceM - 1e-9)
+      << "y = " << spot->y;
 
   // MakeWaySpot (NavigateTo's give-way, HoldForResidents letting people pass) is this spot, the
   // ways predicted twice the give-way horizon; asking for more room than any spot gains, none.
@@ -131,6 +138,36 @@ TEST_F(PeopleRoomTest, TwoAbreastAreLeftTheCorridorBySteppingToAWall) {
   // StepAsideTo starts the step there at retreat speed.
   StepAsideTo(task_, *made_way);
   EXPECT_TRUE(motion.base_moving());
+}
+
+// A spot the robot steps to keeps kSpotWallClearanceM off the walls: the base turns there to
+// watch, and one 3 mm off a wall touched it (room A seed 29). Two walk abreast down the
+// corridor's other side, and the robot stands anywhere from 0.45 to 0.95 m off the wall: the
+// spots that leave them the most room are at the wall, some within what the planner passes.
+TEST_F(PeopleRoomTest, ASpotToStepToKeepsClearOfTheWalls) {
+  const RobotModel model = RobotModel::LoadDefault();
+  MotionExecutor motion(model);
+  const planning::BasePlanner planner(costmap_, nullptr);
+  MissionMap map;  // no doors
+  task_.motion = &motion;
+  task_.planner = &planner;
+  task_.map = &map;
+  const double footprint = task_.config.footprint_radius;
+  ASSERT_TRUE(planner.IsValid({3.0, footprint + 0.01, 0.0})) << "the planner's limit";
+  belief_.world.people = {Walker({8.0, 1.2}, {-1.1, 0.0}), Walker({8.0, 1.7}, {-1.1, 0.0})};
+  int spots = 0;
+  for (double y = 0.45; y <= 0.95; y += 0.01) {
+    belief_.X_MB = {3.0, y, 0.0};
+    const PeopleRoom room(task_, 8.0, {.sidestep = true});
+    const std::optional<Pose2> spot =
+        room.BestSpotAround({belief_.X_MB}, room.Score({belief_.X_MB.translation()}));
+    if (!spot) continue;
+    ++spots;
+    EXPECT_FALSE(costmap_.IsNearMappedObstacle(spot->translation(),
+                                               footprint + PeopleRoom::kSpotWallClearanceM))
+        << "from y = " << y << " to " << spot->x << ", " << spot->y;
+  }
+  EXPECT_GT(spots, 40);
 }
 
 // Someone near, coming nearer while veering (their tracked velocity points at the wall, as when
