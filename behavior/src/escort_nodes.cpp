@@ -242,9 +242,11 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     if (const std::optional<Pose2> room =
             may_step ? FindRoom(task_, pass, making_room_ ? std::optional(room_to_) : std::nullopt)
                      : std::nullopt) {
-      // At the door speed (the quickest the trajectories go): a resident walks at 1 m/s.
-      task_.motion->FollowPath({belief_.X_MB, *room}, {true}, task_.motion->arm_target(),
-                               belief_.now, std::nullopt, /*brisk=*/true);
+      // At the door speed (the quickest the trajectories go): a resident walks at 1 m/s. The arm
+      // tucks on the way: an operation broken off leaves it out at the actuator, and stepping
+      // with it out dragged the hand along the wall (atrium west seeds 5 and 36).
+      task_.motion->FollowPath({belief_.X_MB, *room}, {true}, TuckedArm(*task_.model), belief_.now,
+                               std::nullopt, /*brisk=*/true);
       making_room_ = true;
       room_to_ = room->translation();
       room_since_ = belief_.now;

@@ -89,8 +89,11 @@ std::optional<Pose2> FindRoom(const TaskServices& task, const DoorPass& pass,
       const double room = worth(q);
       if (room <= best_room || !IsBlindWayClear(task, belief.X_MB, at, q, kBlindClearM)) continue;
       const Pose2 candidate{q.x(), q.y(), belief.X_MB.yaw};
-      // The straight step, not only where it ends: a free pose may lie beyond a wall.
-      if (!task.planner->IsPathValid({belief.X_MB, candidate})) continue;
+      // The straight step, not only where it ends: a free pose may lie beyond a wall; nor the
+      // hand, out ahead of the footprint, into the wall the robot faces.
+      if (!HandClearOfWalls(task, belief.X_MB, q) ||
+          !task.planner->IsPathValid({belief.X_MB, candidate}))
+        continue;
       best = candidate;
       best_room = room;
     }

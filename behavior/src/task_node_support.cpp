@@ -616,6 +616,7 @@ std::optional<Pose2> PeopleRoom::BestSpotAround(const std::vector<Pose2>& way, d
           costmap->IsNearMappedObstacle(q, task_.config.footprint_radius + kSpotWallClearanceM))
         continue;
       const Pose2 candidate{q.x(), q.y(), yaw};
+      if (!HandClearOfWalls(task_, way.back(), q)) continue;
       if (!task_.planner->IsPathValid({way.back(), candidate})) continue;
       best = candidate;
       beat = s;
@@ -661,6 +662,32 @@ std::vector<std::pair<const perception::TrackedPerson*, double>> PeopleComing(
 void StepAsideTo(const TaskServices& task, const Pose2& spot) {
   task.motion->FollowPath({task.belief->X_MB, spot}, {false}, task.motion->arm_target(),
                           task.belief->now, task.config.retreat_speed, /*brisk=*/true);
+}
+
+bool HandClearOfWalls(const TaskServices& task, const Pose2& from, const Eigen::Vector2d& to) {
+  const perception::Costmap2D* costmap = task.belief->world.costmap;
+  if (costmap == nullptr || task.model == nullptr || task.motion == nullptr) return true;
+  // The hand's offset from the base in M, with the arm where it is going now and tucked: a step
+  // tucks it on the way (an operation broken off leaves it out at the actuator), and the base,
+  // setting off briskly, may be all the way there before the arm is in.
+  const auto hand_offset = [&](const ArmPose& arm) -> Eigen::Vector2d {
+    WholeBodyVector q = WithArm(WholeBodyVector::Zero(), arm);
+    q[kBaseYaw] = from.yaw;
+    return task.model->CalcPalmPose(q).translation().head<2>();
+  };
+  const Eigen::Vector2d out = hand_offset(task.motion->arm_target());
+  const Eigen::Vector2d tucked = hand_offset(TuckedArm(*task.model));
+  if (costmap->IsNearMappedObstacle(from.translation() + out, kHandWallClearanceM)) return true;
+  constexpr double kSampleM = 0.05;
+  const Eigen::Vector2d way = to - from.translation();
+  const int steps = std::max(1, int(std::ceil(way.norm() / kSampleM)));
+  for (int k = 1; k <= steps; ++k) {
+    const Eigen::Vector2d p_MB = from.translation() + way * (double(k) / steps);
+    if (costmap->IsNearMappedObstacle(p_MB + out, kHandWallClearanceM) ||
+        costmap->IsNearMappedObstacle(p_MB + tucked, kHandWallClearanceM))
+      return false;
+  }
+  return true;
 }
 
 double PositionSigma(const TaskServices& task) {

@@ -409,6 +409,18 @@ std::optional<Pose2> MakeWaySpot(const TaskServices& task, double min_gain,
                                  const std::optional<Eigen::Vector2d>& stepping_to = std::nullopt);
 /// Starts the step to `spot` at retreat_speed, the arm held where it is going.
 void StepAsideTo(const TaskServices& task, const Pose2& spot);
+/// [m] The hand keeps this far off mapped walls on a step: its palm block's half-size and a
+/// margin. Out at an actuator it reaches past the round footprint every step is checked with
+/// (atrium west seeds 5 and 36: an operation broken off, a step towards the wall the robot
+/// faced brushed it with the hand as the arm tucked).
+inline constexpr double kHandWallClearanceM = 0.08;
+/// Whether the hand (the palm) stays kHandWallClearanceM off every mapped wall (and leaf) along
+/// the straight step of the base from `from` to `to` (its yaw kept), the arm where it is going
+/// now (MotionExecutor::arm_target) or tucked anywhere on the way (a step tucks it, and the base
+/// may be there before the arm): checked every 5 cm past the start. True without a costmap, a robot
+/// model or a motion executor, and when the hand is that near a wall already at the start (a step
+/// cannot be judged by it then).
+bool HandClearOfWalls(const TaskServices& task, const Pose2& from, const Eigen::Vector2d& to);
 /// [m] A spot aside must give this much more room than standing where the robot is.
 inline constexpr double kMakeWayMinGainM = 0.1;
 /// [s] A step aside under way is re-aimed (someone now comes at where it ends) only this long

@@ -170,6 +170,37 @@ TEST_F(PeopleRoomTest, ASpotToStepToKeepsClearOfTheWalls) {
   EXPECT_GT(spots, 40);
 }
 
+// A step with the arm out (an operation broken off) must not put the hand into the wall the
+// robot faces: the footprint's checks pass it, the hand reaches past them (atrium west seeds 5
+// and 36). The robot faces the corridor's south wall (its face at y = 0), the arm held straight
+// out ahead, the hand 0.2 m off the wall.
+TEST_F(PeopleRoomTest, AStepKeepsTheHandOffTheWallTheRobotFaces) {
+  const RobotModel model = RobotModel::LoadDefault();
+  MotionExecutor motion(model);
+  task_.model = &model;
+  task_.motion = &motion;
+  const ArmPose out = {0.3, -M_PI / 2, 0.0, 0.0, 0.0};  // arm forward, level
+  motion.MoveArm({{1.0, out}}, belief_.now);
+  ASSERT_EQ(motion.arm_target(), out);
+  WholeBodyVector q = WithArm(WholeBodyVector::Zero(), out);
+  q[kBaseYaw] = -M_PI / 2;
+  const Eigen::Vector2d p_BH_M = model.CalcPalmPose(q).translation().head<2>();
+  ASSERT_LT(p_BH_M.y(), -(task_.config.footprint_radius + 0.1)) << "the hand out ahead";
+  const Pose2 from{5.0, 0.2 - p_BH_M.y(), -M_PI / 2};
+  // Along the wall, and back from it: clear.
+  EXPECT_TRUE(HandClearOfWalls(task_, from, from.translation() + Eigen::Vector2d(0.6, 0.0)));
+  EXPECT_TRUE(HandClearOfWalls(task_, from, from.translation() + Eigen::Vector2d(0.0, 0.6)));
+  // 0.1 m nearer: the hand 0.1 m off, clear; 0.17 m nearer, 3 cm off: not.
+  EXPECT_TRUE(HandClearOfWalls(task_, from, from.translation() + Eigen::Vector2d(0.3, -0.1)));
+  EXPECT_FALSE(HandClearOfWalls(task_, from, from.translation() + Eigen::Vector2d(0.3, -0.17)));
+  // The base's own footprint is nowhere near the wall on that step.
+  EXPECT_FALSE(costmap_.IsNearMappedObstacle(from.translation() + Eigen::Vector2d(0.3, -0.17),
+                                             task_.config.footprint_radius + 0.3));
+  // Tucked, the hand stays over the base: the same step is clear.
+  motion.MoveArm({{1.0, TuckedArm(model)}}, belief_.now);
+  EXPECT_TRUE(HandClearOfWalls(task_, from, from.translation() + Eigen::Vector2d(0.3, -0.17)));
+}
+
 // Someone near, coming nearer while veering (their tracked velocity points at the wall, as when
 // skirting the robot): with head_on they may also walk on straight through the robot's place,
 // so a spot beyond the robot on that line is in their way; the velocity alone takes them to the
