@@ -38,6 +38,21 @@ class PeopleRoomTest : public ::testing::Test {
     belief_.world.costmap = &costmap_;
     task_.belief = &belief_;
   }
+  // What choosing and starting a step needs beyond the belief: the robot, its motion executor,
+  // a planner on the corridor and a map with no doors, wired into task_.
+  struct Stepping {
+    explicit Stepping(PeopleRoomTest& test)
+        : model(RobotModel::LoadDefault()), motion(model), planner(test.costmap_, nullptr) {
+      test.task_.model = &model;
+      test.task_.motion = &motion;
+      test.task_.planner = &planner;
+      test.task_.map = &map;
+    }
+    const RobotModel model;
+    MotionExecutor motion;
+    const planning::BasePlanner planner;
+    MissionMap map;
+  };
   perception::Costmap2D costmap_;
   Belief belief_;
   TaskServices task_;
@@ -101,13 +116,8 @@ TEST_F(PeopleRoomTest, PeopleWalkingPastStepRoundTheRobotAsFarAsTheWallsLet) {
 // at a wall, leaving them the rest of the corridor. On straight lines every spot aside is in one
 // of their lanes, and the robot stood where they squeezed past it on both sides.
 TEST_F(PeopleRoomTest, TwoAbreastAreLeftTheCorridorBySteppingToAWall) {
-  const RobotModel model = RobotModel::LoadDefault();
-  MotionExecutor motion(model);
-  const planning::BasePlanner planner(costmap_, nullptr);
-  MissionMap map;  // no doors
-  task_.motion = &motion;
-  task_.planner = &planner;
-  task_.map = &map;
+  Stepping stepping(*this);
+  const planning::BasePlanner& planner = stepping.planner;
   belief_.X_MB = {3.0, 0.95, 0.0};
   belief_.world.people = {Walker({8.0, 0.6}, {-1.1, 0.0}), Walker({8.0, 1.35}, {-1.1, 0.0})};
   const auto spot_for = [&](bool sidestep) {
@@ -137,7 +147,7 @@ TEST_F(PeopleRoomTest, TwoAbreastAreLeftTheCorridorBySteppingToAWall) {
   EXPECT_FALSE(MakeWaySpot(task_, 100.0).has_value());
   // StepAsideTo starts the step there at retreat speed.
   StepAsideTo(task_, *made_way);
-  EXPECT_TRUE(motion.base_moving());
+  EXPECT_TRUE(stepping.motion.base_moving());
 }
 
 // A spot the robot steps to keeps kSpotWallClearanceM off the walls: the base turns there to
@@ -145,13 +155,8 @@ TEST_F(PeopleRoomTest, TwoAbreastAreLeftTheCorridorBySteppingToAWall) {
 // corridor's other side, and the robot stands anywhere from 0.45 to 0.95 m off the wall: the
 // spots that leave them the most room are at the wall, some within what the planner passes.
 TEST_F(PeopleRoomTest, ASpotToStepToKeepsClearOfTheWalls) {
-  const RobotModel model = RobotModel::LoadDefault();
-  MotionExecutor motion(model);
-  const planning::BasePlanner planner(costmap_, nullptr);
-  MissionMap map;  // no doors
-  task_.motion = &motion;
-  task_.planner = &planner;
-  task_.map = &map;
+  Stepping stepping(*this);
+  const planning::BasePlanner& planner = stepping.planner;
   const double footprint = task_.config.footprint_radius;
   ASSERT_TRUE(planner.IsValid({3.0, footprint + 0.01, 0.0})) << "the planner's limit";
   belief_.world.people = {Walker({8.0, 1.2}, {-1.1, 0.0}), Walker({8.0, 1.7}, {-1.1, 0.0})};
@@ -175,10 +180,9 @@ TEST_F(PeopleRoomTest, ASpotToStepToKeepsClearOfTheWalls) {
 // and 36). The robot faces the corridor's south wall (its face at y = 0), the arm held straight
 // out ahead, the hand 0.2 m off the wall.
 TEST_F(PeopleRoomTest, AStepKeepsTheHandOffTheWallTheRobotFaces) {
-  const RobotModel model = RobotModel::LoadDefault();
-  MotionExecutor motion(model);
-  task_.model = &model;
-  task_.motion = &motion;
+  Stepping stepping(*this);
+  const RobotModel& model = stepping.model;
+  MotionExecutor& motion = stepping.motion;
   const ArmPose out = {0.3, -M_PI / 2, 0.0, 0.0, 0.0};  // arm forward, level
   motion.MoveArm({{1.0, out}}, belief_.now);
   ASSERT_EQ(motion.arm_target(), out);

@@ -1,0 +1,403 @@
+// People round the robot (task_node_support.h): their predicted ways (PeopleAround,
+// ThroughDoorWays), the room they leave the robot at a spot and on its way there (PeopleRoom),
+// what the base laser sees of them (IsInLaserSweep, IsInLaserSight, IsBlindWayClear), and the
+// steps the robot takes out of their way (MakeWaySpot, StepAsideTo, HandClearOfWalls).
+
+#include "task_node_support.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "egress/behavior/proxemics.h"
+#include "egress/planning/trajectory.h"
+
+namespace egress::behavior::detail {
+
+namespace {
+// A predicted way meeting a wall turns along it in steps of kWallTurnRad, up to kMaxWallTurns.
+constexpr double kWallTurnRad = 15.0 * M_PI / 180.0;
+constexpr int kMaxWallTurns = 6;
+}  // namespace
+
+void AppendPredictedWay(const TaskServices& task, const Eigen::Vector2d& at, double look,
+                        double horizon, double step, int first_step, Eigen::Vector2d p_MP,
+                        Eigen::Vector2d v_MP, std::vector<Occupant>& near) {
+  const perception::Costmap2D* costmap = task.belief->world.costmap;
+  const double wall_gap = 0.5 * task.config.person_radius;
+  const auto walkable = [&](const Eigen::Vector2d& p) {
+    return !costmap || !costmap->IsNearMappedObstacle(p, wall_gap);
+  };
+  const Eigen::Vector2d v_MStart = v_MP;
+  for (int k = 0; step > 0 ? k * step <= horizon + 1e-9 : k == 0; ++k) {
+    if (k > 0) {
+      // Nobody walks through a wall: a way predicted into one (a velocity a few degrees askew
+      // along a corridor, over seconds) turns along it, by the least turn that is free. Never
+      // back the way they came (more than kMaxWallTurns from where they walk now): at a dead
+      // end, or a wall straight ahead, they stop there (P2's group, walking to the corridor's
+      // end, was predicted back along the wall onto the robot's spot aside).
+      bool free = walkable(p_MP + v_MP * step);
+      for (int turn = 1; !free && turn <= kMaxWallTurns; ++turn) {
+        for (const double sign : {1.0, -1.0}) {
+          const Eigen::Vector2d v = Eigen::Rotation2Dd(sign * turn * kWallTurnRad) * v_MP;
+          if (v.dot(v_MStart) >= -1e-9 && walkable(p_MP + v * step)) {
+            v_MP = v;
+            free = true;
+            break;
+          }
+        }
+      }
+      if (!free) v_MP.setZero();
+      p_MP += v_MP * step;
+    }
+    if (k >= first_step && (p_MP - at).norm() < look)
+      near.push_back({p_MP, task.config.person_radius, k * step, v_MP});
+    if (step <= 0) break;
+  }
+}
+
+std::vector<Occupant> PeopleAround(const TaskServices& task, const Eigen::Vector2d& at, double look,
+                                   double horizon, double step) {
+  std::vector<Occupant> near;
+  for (const Eigen::Vector2d& p : task.belief->off_map_returns)
+    if ((p - at).norm() < look) near.push_back({p, 0.0});
+  for (const auto& entry : task.belief->world.people)
+    AppendPredictedWay(task, at, look, horizon, step, 0, entry.person.p_MP, entry.person.v_MP,
+                       near);
+  return near;
+}
+
+std::vector<Occupant> ThroughDoorWays(const TaskServices& task, const std::string& door,
+                                      double horizon) {
+  const perception::DoorModel* model = task.map->FindDoor(door);
+  ThrowUnless(model != nullptr, "unknown door '", door, "' (not in the building map)");
+  const perception::DoorZone zone{*model, task.config.zone_depth, task.config.person_radius};
+  const DoorPass pass = CalcDoorPass(*task.map, door, task.belief->X_MB);
+  const Eigen::Vector2d at = task.belief->X_MB.translation();
+  const double step = PeopleRoom::kPeopleStepSec;
+  std::vector<Occupant> ways;
+  for (const auto& entry : task.belief->world.people) {
+    const perception::TrackedPerson& person = entry.person;
+    const Eigen::Vector2d to_centre = pass.centre - person.p_MP;
+    const double distance = to_centre.norm();
+    const bool far_side = -to_centre.dot(pass.n_M) < 0.0;
+    if (distance > kThroughDoorRadiusM || !(far_side || zone.Contains(person.p_MP)) ||
+        IsHoldingDoorAside(task, entry, door) ||
+        (distance > 1e-6 && person.v_MP.dot(to_centre / distance) < -PeopleRoom::kSidestepMinMps))
+      continue;
+    const double speed = std::max(person.v_MP.norm(), kWalkingMps);
+    // To the middle of the opening, then on along the normal (walls turning the way).
+    const double t_centre = distance / speed;
+    int k = 1;
+    for (; k * step < t_centre && k * step <= horizon + 1e-9; ++k) {
+      const Eigen::Vector2d p = person.p_MP + to_centre * (k * step / t_centre);
+      if ((p - at).norm() < PeopleRoom::kPeopleLookM)
+        ways.push_back({p, task.config.person_radius, k * step, to_centre / distance * speed});
+    }
+    if (k * step > horizon + 1e-9) continue;
+    const std::size_t first = ways.size();
+    AppendPredictedWay(task, at, PeopleRoom::kPeopleLookM, horizon - t_centre, step, 0, pass.centre,
+                       pass.n_M * speed, ways);
+    for (std::size_t i = first; i < ways.size(); ++i)
+      ways[i].t += t_centre;
+  }
+  return ways;
+}
+
+double RoomAt(const std::vector<Occupant>& near, const Eigen::Vector2d& q) {
+  double room = std::numeric_limits<double>::infinity();
+  for (const Occupant& o : near)
+    room = std::min(room, (o.p_M - q).norm() - o.radius);
+  return room;
+}
+
+PeopleRoom::PeopleRoom(const TaskServices& task, double horizon, PeopleHypotheses hypotheses)
+    : task_(task),
+      at_(task.belief->X_MB.translation()),
+      predicted_(PeopleAround(task, at_, kPeopleLookM, horizon, kPeopleStepSec)),
+      now_(PeopleAround(task, at_, kPeopleLookM, 0.0, 0.0)) {
+  const bool sidestep = hypotheses.sidestep;
+  if (!hypotheses.through_door.empty()) {
+    const std::vector<Occupant> through = ThroughDoorWays(task, hypotheses.through_door, horizon);
+    predicted_.insert(predicted_.end(), through.begin(), through.end());
+  }
+  if (hypotheses.head_on) {
+    for (const auto& entry : task.belief->world.people) {
+      const Eigen::Vector2d to_robot = at_ - entry.person.p_MP;
+      const double speed = entry.person.v_MP.norm(), distance = to_robot.norm();
+      if (distance >= kHeadOnRadiusM || distance < 1e-6 || speed < kSidestepMinMps ||
+          entry.person.v_MP.dot(to_robot) <= 0.0)
+        continue;
+      // Their place now is already predicted: the way from the first step on.
+      AppendPredictedWay(task, at_, kPeopleLookM, horizon, kPeopleStepSec, 1, entry.person.p_MP,
+                         to_robot * (speed / distance), predicted_);
+    }
+  }
+  const perception::Costmap2D* costmap = task.belief->world.costmap;
+  const double body = task.config.person_radius;
+  for (const Occupant& o : predicted_) {
+    std::pair<Eigen::Vector2d, Eigen::Vector2d> ends{o.p_M, o.p_M};
+    const double speed = o.v_M.norm();
+    const double reach =
+        std::min(task.config.person_sidestep, task.config.person_sidestep_speed * o.t);
+    if (sidestep && o.radius > 0.0 && speed >= kSidestepMinMps && reach > 0.0) {
+      const Eigen::Vector2d across = Eigen::Vector2d(-o.v_M.y(), o.v_M.x()) / speed;
+      // As far to each side as the walls leave the body room.
+      const auto side = [&](double sign) {
+        Eigen::Vector2d end = o.p_M;
+        for (double s = kSidestepSampleM; s <= reach + 1e-9; s += kSidestepSampleM) {
+          const Eigen::Vector2d p = o.p_M + sign * s * across;
+          if (costmap && costmap->IsNearMappedObstacle(p, body)) break;
+          end = p;
+        }
+        return end;
+      };
+      ends = {side(1.0), side(-1.0)};
+    }
+    sidesteps_.push_back(ends);
+  }
+}
+
+double PeopleRoom::RoomFrom(std::size_t i, const Eigen::Vector2d& p_MB) const {
+  // The farthest point of the sidestep segment from the base is one of its ends.
+  const auto& [a, b] = sidesteps_[i];
+  return std::max((a - p_MB).norm(), (b - p_MB).norm()) - predicted_[i].radius;
+}
+
+double PeopleRoom::Predicted(const Eigen::Vector2d& q) const {
+  double room = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < predicted_.size(); ++i)
+    room = std::min(room, RoomFrom(i, q));
+  return room;
+}
+
+double PeopleRoom::RoomOnTheWay(const std::vector<Eigen::Vector2d>& corners) const {
+  planning::TrajectoryConfig timing = task_.motion->trajectory_config();
+  timing.nominal_speed = task_.config.retreat_speed;
+  // Each leg's start time and its progress 0 -> 1, as the trajectory will time it.
+  std::vector<double> starts{0.0};
+  std::vector<planning::SegmentTimeScaling> legs;
+  for (std::size_t i = 0; i + 1 < corners.size(); ++i) {
+    const double length = (corners[i + 1] - corners[i]).norm();
+    legs.emplace_back(length, planning::SegmentDuration(length, false, timing), timing);
+    starts.push_back(starts.back() + legs.back().duration());
+  }
+  const auto base_at = [&](double t) -> Eigen::Vector2d {
+    for (std::size_t i = 0; i < legs.size(); ++i)
+      if (t < starts[i + 1])
+        return corners[i] + (corners[i + 1] - corners[i]) * legs[i].Progress(t - starts[i]);
+    return corners.back();
+  };
+  double room = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < predicted_.size(); ++i) {
+    const Occupant& o = predicted_[i];
+    // A scan return off the map stands where it is: compared with the spot.
+    const Eigen::Vector2d p_MB = o.radius > 0.0 ? base_at(o.t) : corners.back();
+    room = std::min(room, RoomFrom(i, p_MB));
+  }
+  return room;
+}
+
+double PeopleRoom::Score(const std::vector<Eigen::Vector2d>& corners) const {
+  const double comfortable = task_.config.footprint_radius + task_.config.comfort_distance;
+  const Eigen::Vector2d& q = corners.back();
+  const double at_spot = std::min(Predicted(q), comfortable);
+  return std::min(at_spot, RoomOnTheWay(corners)) + kSpotRoomTieBreak * at_spot -
+         kWayCostPerM * (q - at_).norm();
+}
+
+bool IsInLaserSweep(const TaskServices& task, const Pose2& X_MB, const Eigen::Vector2d& p_M) {
+  const Belief& belief = *task.belief;
+  if (!belief.scan || (p_M - X_MB.translation()).norm() <= task.config.footprint_radius)
+    return true;
+  const Eigen::Vector2d p_L = (X_MB * belief.X_BL).Inverse() * p_M;
+  const double bearing = std::atan2(p_L.y(), p_L.x());
+  return bearing >= belief.scan->angle_min + PeopleRoom::kSweepMarginRad &&
+         bearing <= belief.scan->angle_max() - PeopleRoom::kSweepMarginRad;
+}
+
+bool IsInLaserSight(const TaskServices& task, const Pose2& X_MB, const Eigen::Vector2d& p_M) {
+  if (!IsInLaserSweep(task, X_MB, p_M)) return false;
+  const perception::Costmap2D* costmap = task.belief->world.costmap;
+  if (costmap == nullptr) return true;
+  // Sampled finer than a wall is thick; a cell's half-diagonal catches the corners between.
+  constexpr double kSightSampleM = 0.05;
+  const Eigen::Vector2d p_ML = (X_MB * task.belief->X_BL).translation();
+  const double length = (p_M - p_ML).norm() - kSightShortM;
+  if (length <= 0.0) return true;
+  const Eigen::Vector2d u = (p_M - p_ML).normalized();
+  const double half_cell = 0.5 * std::sqrt(2.0) * costmap->geometry().resolution;
+  for (double s = 0.0; s <= length; s += kSightSampleM)
+    if (costmap->IsNearMappedObstacle(p_ML + s * u, half_cell)) return false;
+  return true;
+}
+
+std::optional<Eigen::Vector2d> NearestOnGrid(
+    const Eigen::Vector2d& p_MFrom, const Eigen::Vector2d& along, double max_along,
+    const Eigen::Vector2d& out, double max_out, double step, double min_distance,
+    const std::function<bool(const Eigen::Vector2d&)>& ok) {
+  std::vector<Eigen::Vector2d> offsets;
+  for (int i = 0; i * step <= max_along + 1e-9; ++i)
+    for (int j = 0; j * step <= max_out + 1e-9; ++j)
+      offsets.push_back(along * i * step + out * j * step);
+  std::stable_sort(offsets.begin(), offsets.end(),
+                   [](const auto& l, const auto& r) { return l.norm() < r.norm(); });
+  for (const auto& offset : offsets) {
+    if (offset.norm() < min_distance - 1e-9) continue;
+    if (ok(p_MFrom + offset)) return p_MFrom + offset;
+  }
+  return std::nullopt;
+}
+
+bool IsBlindWayClear(const TaskServices& task, const Pose2& X_MB, const Eigen::Vector2d& p_MFrom,
+                     const Eigen::Vector2d& p_MTo, double clearance) {
+  const perception::Costmap2D* costmap = task.belief->world.costmap;
+  if (costmap == nullptr) return true;
+  constexpr double kSampleM = 0.15;  // the way is checked this often
+  const int steps = std::max(1, int(std::ceil((p_MTo - p_MFrom).norm() / kSampleM)));
+  for (int k = 1; k <= steps; ++k) {
+    const Eigen::Vector2d p = p_MFrom + (p_MTo - p_MFrom) * (double(k) / steps);
+    if (!IsInLaserSweep(task, X_MB, p) &&
+        costmap->IsNearUnmappedMark(p, task.config.footprint_radius + clearance, kOffMapM))
+      return false;
+  }
+  return true;
+}
+
+bool PeopleRoom::IsSeenFrom(const Pose2& X_MB, const Eigen::Vector2d& p) const {
+  // Where the base just drove, facing that way: nobody stood there as it passed.
+  for (const auto& [t, p_MB] : task_.belief->swept_p_MB)
+    if ((p - p_MB).norm() <= task_.config.footprint_radius) return true;
+  return IsInLaserSweep(task_, X_MB, p);
+}
+
+bool PeopleRoom::AllAlong(const std::vector<Eigen::Vector2d>& corners,
+                          const std::function<bool(const Eigen::Vector2d&)>& f) const {
+  for (std::size_t i = 0; i + 1 < corners.size(); ++i) {
+    const double length = (corners[i + 1] - corners[i]).norm();
+    const int steps = std::max(1, int(std::ceil(length / kPathSampleM)));
+    for (int k = 1; k <= steps; ++k)
+      if (!f(corners[i] + (corners[i + 1] - corners[i]) * (double(k) / steps))) return false;
+  }
+  return true;
+}
+
+bool PeopleRoom::IsWayClear(const std::vector<Eigen::Vector2d>& corners) const {
+  const double passable = task_.config.footprint_radius + kPassMarginM;
+  const Pose2& X_MB = task_.belief->X_MB;
+  return AllAlong(corners, [&](const Eigen::Vector2d& p) {
+    return RoomAt(now_, p) >= passable && IsSeenFrom(X_MB, p);
+  });
+}
+
+std::optional<double> PeopleRoom::YawSeeing(const std::vector<Eigen::Vector2d>& corners) const {
+  if (!task_.belief->scan) return std::nullopt;
+  Pose2 X_MB = task_.belief->X_MB;
+  const double yaw = X_MB.yaw;
+  for (double turn = 0.0; turn <= M_PI + 1e-9; turn += kLookTurnStepRad) {
+    for (const double sign : {1.0, -1.0}) {
+      X_MB.yaw = yaw + sign * turn;
+      if (AllAlong(corners, [&](const Eigen::Vector2d& p) { return IsSeenFrom(X_MB, p); }))
+        return X_MB.yaw;
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<Pose2> PeopleRoom::BestSpotAround(const std::vector<Pose2>& way, double beat) const {
+  std::vector<Eigen::Vector2d> corners;
+  for (const Pose2& p : way)
+    corners.push_back(p.translation());
+  corners.push_back(Eigen::Vector2d::Zero());
+  const double yaw = task_.belief->X_MB.yaw;
+  std::optional<Pose2> best;
+  for (const double radius : kSpotRadiiM) {
+    for (int k = 0; k < kSpotHeadings; ++k) {
+      const double a = 2 * M_PI * k / kSpotHeadings;
+      const Eigen::Vector2d q = at_ + radius * Eigen::Vector2d(std::cos(a), std::sin(a));
+      corners.back() = q;
+      const double s = Score(corners);
+      // Nor through a doorway: its leaf may close meanwhile (two wards seed 5 met door_d's).
+      if (s <= beat || IsInAnyDoorZone(task_, q) ||
+          PassesThroughAnyDoorway(task_, way.back().translation(), q) || !IsWayClear(corners))
+        continue;
+      const perception::Costmap2D* costmap = task_.belief->world.costmap;
+      if (costmap != nullptr &&
+          costmap->IsNearMappedObstacle(q, task_.config.footprint_radius + kSpotWallClearanceM))
+        continue;
+      const Pose2 candidate{q.x(), q.y(), yaw};
+      if (!HandClearOfWalls(task_, way.back(), q)) continue;
+      if (!task_.planner->IsPathValid({way.back(), candidate})) continue;
+      best = candidate;
+      beat = s;
+    }
+  }
+  return best;
+}
+
+bool StoppedOrStopTimedOut(const TaskServices& task, Time since) {
+  const Belief& belief = *task.belief;
+  return std::hypot(belief.V_B.vx, belief.V_B.vy) <= kStoppedMps ||
+         ToSeconds(belief.now - since) >= kStopWithinSec;
+}
+
+std::optional<Pose2> MakeWaySpot(const TaskServices& task, double min_gain,
+                                 PeopleHypotheses hypotheses,
+                                 const std::optional<Eigen::Vector2d>& stepping_to) {
+  hypotheses.sidestep = true;
+  const PeopleRoom room(task, 2.0 * task.config.give_way_horizon, std::move(hypotheses));
+  const Pose2& X_MB = task.belief->X_MB;
+  std::vector<Eigen::Vector2d> staying{X_MB.translation()};
+  if (stepping_to) staying.push_back(*stepping_to);
+  return room.BestSpotAround({X_MB}, room.Score(staying) + min_gain);
+}
+
+std::vector<std::pair<const perception::TrackedPerson*, double>> PeopleComing(
+    const TaskServices& task, const std::optional<Pose2>& goal) {
+  const Belief& belief = *task.belief;
+  const Eigen::Vector2d at = belief.X_MB.translation();
+  std::vector<std::pair<const perception::TrackedPerson*, double>> coming;
+  for (const auto& entry : belief.world.people) {
+    if (goal &&
+        IsWhomTheRobotGoesTo(entry.person.p_MP, at, goal->translation(), kGoalPersonRadiusM))
+      continue;
+    if (const auto t_pass = OncomingPassTime(
+            entry.person, at, task.config.footprint_radius, task.config.person_radius,
+            task.config.comfort_distance, task.config.give_way_horizon, kWalkingMps))
+      coming.emplace_back(&entry.person, *t_pass);
+  }
+  return coming;
+}
+
+void StepAsideTo(const TaskServices& task, const Pose2& spot) {
+  task.motion->FollowPath({task.belief->X_MB, spot}, {false}, task.motion->arm_target(),
+                          task.belief->now, task.config.retreat_speed, /*brisk=*/true);
+}
+
+bool HandClearOfWalls(const TaskServices& task, const Pose2& from, const Eigen::Vector2d& to) {
+  const perception::Costmap2D* costmap = task.belief->world.costmap;
+  if (costmap == nullptr || task.model == nullptr || task.motion == nullptr) return true;
+  // The hand's offset from the base in M, with the arm where it is going now and tucked: a step
+  // tucks it on the way (an operation broken off leaves it out at the actuator), and the base,
+  // setting off briskly, may be all the way there before the arm is in.
+  const auto hand_offset = [&](const ArmPose& arm) -> Eigen::Vector2d {
+    WholeBodyVector q = WithArm(WholeBodyVector::Zero(), arm);
+    q[kBaseYaw] = from.yaw;
+    return task.model->CalcPalmPose(q).translation().head<2>();
+  };
+  const Eigen::Vector2d out = hand_offset(task.motion->arm_target());
+  const Eigen::Vector2d tucked = hand_offset(TuckedArm(*task.model));
+  if (costmap->IsNearMappedObstacle(from.translation() + out, kHandWallClearanceM)) return true;
+  constexpr double kSampleM = 0.05;
+  const Eigen::Vector2d way = to - from.translation();
+  const int steps = std::max(1, int(std::ceil(way.norm() / kSampleM)));
+  for (int k = 1; k <= steps; ++k) {
+    const Eigen::Vector2d p_MB = from.translation() + way * (double(k) / steps);
+    if (costmap->IsNearMappedObstacle(p_MB + out, kHandWallClearanceM) ||
+        costmap->IsNearMappedObstacle(p_MB + tucked, kHandWallClearanceM))
+      return false;
+  }
+  return true;
+}
+
+}  // namespace egress::behavior::detail
