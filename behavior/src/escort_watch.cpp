@@ -160,10 +160,10 @@ AtTheDoorway ByTheDoorway(const Belief& belief, const DoorPass& pass, const Eige
     return Eigen::Vector2i(static_cast<int>(std::floor(p.x() / kSameBodyM)),
                            static_cast<int>(std::floor(p.y() / kSameBodyM)));
   };
-  const auto key_of = [](int cx, int cy) {
-    return (static_cast<std::int64_t>(cx) << 32) ^ static_cast<std::uint32_t>(cy);
+  const auto key_of = [](int cx, int cy) {  // unsigned: no shift of a negative number
+    return (std::uint64_t{static_cast<std::uint32_t>(cx)} << 32) | static_cast<std::uint32_t>(cy);
   };
-  std::unordered_map<std::int64_t, std::vector<std::size_t>> cells;
+  std::unordered_map<std::uint64_t, std::vector<std::size_t>> cells;
   for (std::size_t i = 0; i < near.size(); ++i) {
     const Eigen::Vector2i c = cell_of(near[i]);
     cells[key_of(c.x(), c.y())].push_back(i);
