@@ -401,7 +401,9 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // the lane it stops short as ever if the spot is taken.
     const double set_off_clear =
         InTheLane(pass, belief_.X_MB.translation(), task_.config) ? kStandoffFreeM : spot_clear;
-    if ((wait_at.translation() - belief_.X_MB.translation()).norm() > kAtSpotM &&
+    const bool may_plan =
+        !drive_failing_ || ToSeconds(belief_.now - drive_failed_at_) >= kReplanNoPathSec;
+    if ((wait_at.translation() - belief_.X_MB.translation()).norm() > kAtSpotM && may_plan &&
         WayClear(belief_, wait_at, set_off_clear, kSpotClearM, /*ahead_only=*/true)) {
       // Square to the way it drives, turning to watch at the spot (below): the laser sees both
       // ahead and back along the way. From the last door the way there runs away from where the
@@ -422,6 +424,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
         for (const std::string& t : notes)
           Note(t);
       drive_failing_ = !set_off;
+      if (!set_off) drive_failed_at_ = belief_.now;
       if (set_off) {
         driving_to_ = goal.translation();
         drive_clear_ = spot_clear;
@@ -643,6 +646,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
   double drive_clear_{0.0};  // [m] the room round its end that drive set off with (WayClear)
   std::optional<Time> stuck_since_;         // since when it is not on its way to where it waits
   bool drive_failing_{false};               // its last try to drive there found no path
+  Time drive_failed_at_{};                  // when (planned again kReplanNoPathSec after)
   std::optional<Time> letting_pass_since_;  // stopped for someone walking up behind
   Time follower_seen_{};                    // when someone last walked up behind
   bool aside_chosen_{false};                // the spot aside, while letting them pass

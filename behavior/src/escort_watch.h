@@ -43,6 +43,10 @@ inline constexpr double kComingForSec = 2.5;
 inline constexpr double kStirGapSec = 0.35;
 /// [s] Still this long after people came, those left near the door are waiting for it.
 inline constexpr double kStillForSec = 4.0;
+/// [s] HoldForResidents' drive to where the robot waits that found no path is planned again only
+/// this long after: a search that finds none covers the whole map, and tried every tick it was a
+/// fifth of the 100-resident crowd bench's instructions (627 failed plans in 420 s).
+inline constexpr double kReplanNoPathSec = 0.5;
 
 /// [m] A tracked person on the move came to the door only once they are this much nearer its
 /// doorway than they were (at the farthest) since their walk began: a standing person's track
