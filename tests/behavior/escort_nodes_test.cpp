@@ -51,6 +51,21 @@ class HoldForResidentsTest : public EscortNodesTest {
     visit.operated_at = belief_.now - SecondsToDuration(ago);
     blackboard_->Set("door_visit", bt::Any(visit));
   }
+  // The hold's first tick operates (the spot is planned, the laser sweeping); then its spot is
+  // blocked (something marked there in the costmap): the planner finds no path to it. Returns it.
+  Pose2 OperateThenBlockTheSpot() {
+    belief_.scan = node_testing::SweepScan();
+    EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);
+    const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
+    OperatedAgo(0.0);
+    blocked_costmap_.emplace(perception::OccupancyGrid::FromBoxes(
+        {{{spot.x, spot.y, 0.0}, {0.3, 0.3}}}, {-3.0, -1.0}, {3.0, 7.0}, 0.05));
+    blocked_planner_.emplace(*blocked_costmap_, nullptr);
+    services_.planner = &*blocked_planner_;
+    return spot;
+  }
+  std::optional<perception::Costmap2D> blocked_costmap_;
+  std::optional<planning::BasePlanner> blocked_planner_;
   // The hold begins with the robot at the far end of the room (6, 0.5) and the door shut (the
   // robot's last operation long past).
   void BeginFarFromAShutDoor() {
@@ -314,14 +329,7 @@ TEST_F(HoldForResidentsTest, BoxedInAtTheActuatorItOperatesForThoseWhoCameAndWai
 // sight: what blocks it may be marks of someone long gone, behind it, that only a ray clears
 // (seed 8: the spot stayed "in collision" for 340 s, in the laser's blind sector).
 TEST_F(HoldForResidentsTest, WithNoPathToItsSpotItTurnsToSeeIt) {
-  belief_.scan = node_testing::SweepScan();
-  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // operate; the spot is planned
-  const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
-  OperatedAgo(0.0);
-  const perception::Costmap2D blocked(perception::OccupancyGrid::FromBoxes(
-      {{{spot.x, spot.y, 0.0}, {0.3, 0.3}}}, {-3.0, -1.0}, {3.0, 7.0}, 0.05));
-  planning::BasePlanner planner(blocked, nullptr);
-  services_.planner = &planner;
+  const Pose2 spot = OperateThenBlockTheSpot();
   // Its back to the spot (the way in 55 degrees off ahead: no turn to watch it), someone waiting.
   const Eigen::Vector2d to_spot = spot.translation() - Standoff().translation();
   belief_.X_MB = Standoff();
@@ -344,15 +352,8 @@ TEST_F(HoldForResidentsTest, WithNoPathToItsSpotItTurnsToSeeIt) {
 // search that finds none covers the whole map, and tried every tick it was a fifth of the crowd
 // bench's instructions. Once the way is free it sets off at the next try.
 TEST_F(HoldForResidentsTest, ADriveThatFoundNoPathIsPlannedAgainOnlyAfterAPause) {
-  belief_.scan = node_testing::SweepScan();
-  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kSuccess);  // operate; the spot is planned
-  const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
-  OperatedAgo(0.0);
-  const perception::Costmap2D blocked(perception::OccupancyGrid::FromBoxes(
-      {{{spot.x, spot.y, 0.0}, {0.3, 0.3}}}, {-3.0, -1.0}, {3.0, 7.0}, 0.05));
-  planning::BasePlanner blocked_planner(blocked, nullptr);
   const planning::BasePlanner* free_planner = services_.planner;
-  services_.planner = &blocked_planner;
+  OperateThenBlockTheSpot();
   belief_.X_MB = Standoff();
   belief_.off_map_returns = {{-0.6, 1.4}};  // someone waiting: it waits at its spot
   log_.Take();
