@@ -167,6 +167,24 @@ TEST(SdfWorldLoaderTest, MalformedSdfNamesFileAndLine) {
   }
 }
 
+// Fuzzer finding: libsdformat reads a document that is not SDF again as URDF, through
+// urdfdom, which leaks on a robot whose joints form a cycle (and recursed past the stack on a
+// self-joint). The loader refuses the URDF first, naming the line of its <robot>.
+TEST(SdfWorldLoaderTest, AUrdfIsRefusedBeforeLibsdformatConvertsIt) {
+  const std::string urdf =
+      "<?xml version=\"1.0\"?>\n\n<robot name=\"r\">\n"
+      "  <link name=\"a\"/><link name=\"b\"/>\n"
+      "  <joint name=\"ab\" type=\"fixed\"><parent link=\"a\"/><child link=\"b\"/></joint>\n"
+      "  <joint name=\"ba\" type=\"fixed\"><parent link=\"b\"/><child link=\"a\"/></joint>\n"
+      "</robot>\n";
+  try {
+    LoadSdfWorldFromString(urdf, "cycle.urdf");
+    FAIL() << "a URDF was read as a world";
+  } catch (const LoadError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("cycle.urdf:3: a <robot> element (URDF)"));
+  }
+}
+
 // Found by probing (issue 19): degenerate or absurd shapes were accepted and failed later
 // without a file or field (a zero plane normal, a negative radius, a box 1e300 m long, door
 // limits of 1e300 rad). Each is refused by model and collision.

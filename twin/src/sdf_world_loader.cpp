@@ -3,6 +3,7 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <algorithm>
 #include <assimp/Importer.hpp>
 #include <cmath>
 #include <cstdlib>
@@ -380,6 +381,15 @@ WorldDescription LoadSdfWorldFromString(const std::string& sdf_xml, std::string_
     throw PathOutsideRoot(StrCat(source_name,
                                  ": <include> is not read here (files are confined to the data "
                                  "root); inline the included model"));
+  }
+  // libsdformat reads a document that is not valid SDF again as URDF, through urdfdom, whose
+  // model of a malformed robot (a kinematic cycle, a self-joint) leaks or recurses without end
+  // (fuzzer: sdf_world, kept in fuzz/regressions/sdf_world/urdf_*). A world is SDF: a <robot>
+  // element, the one urdfdom looks for, is refused before libsdformat sees the text.
+  if (const std::size_t at = sdf_xml.find("<robot"); at != std::string::npos) {
+    const auto line = 1 + std::count(sdf_xml.begin(), sdf_xml.begin() + std::ptrdiff_t(at), '\n');
+    throw LoadError(StrCat(source_name, ":", line,
+                           ": a <robot> element (URDF); a world file must be SDF (<sdf><world>)"));
   }
   sdf::Root root;
   const sdf::Errors errors = root.LoadSdfString(sdf_xml);
