@@ -30,23 +30,16 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
   }
   NodeStatus OnStart() override {
     blocked_since_.reset();
-    give_way_.reset();
+    give_way_.Reset();
     detour_tried_ = false;
     goal_.reset();  // a place without a heading is resolved once, from where the robot starts
     return Start();
   }
   NodeStatus OnRunning() override {
-    if (give_way_) return GiveWay();
-    if (task_.config.give_way && !task_.motion->bug_active()) {
-      if (const auto coming = PeopleComing(task_, goal_); !coming.empty()) {
-        const perception::TrackedPerson& p = *coming.front().first;
-        task_.motion->StopBase();
-        give_way_ = GiveWayState{belief_.now, belief_.now, false};
-        Note(StrCat("making way: person ", p.id, " at (", PoseText({p.p_MP.x(), p.p_MP.y(), 0.0}),
-                    "), ", std::round(p.v_MP.norm() * 10) / 10, " m/s is coming"));
-        return GiveWay();
-      }
-    }
+    if (give_way_.active()) return GiveWay();
+    if (task_.config.give_way && !task_.motion->bug_active() &&
+        give_way_.Begin(task_, goal_, [this](const std::string& t) { Note(t); }))
+      return GiveWay();
     if (blocked_since_) {
       if (ToSeconds(belief_.now - last_try_) < kReplanPeriod) return NodeStatus::kRunning;
       return Start();
@@ -61,45 +54,17 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
   }
   void OnHalted() override {
     task_.motion->StopBase();
-    give_way_.reset();
+    give_way_.Reset();
   }
 
  private:
   static constexpr double kReplanPeriod = 0.5;  // [s]
-  // [s] A slow walker far off is not waited for longer than this.
-  static constexpr double kMaxPassSec = 15.0;
 
-  struct GiveWayState {
-    Time since{};
-    Time until{};        // when the last person seen coming will have passed
-    bool chosen{false};  // the spot is chosen (once the base has stopped)
-  };
-
-  // Making way: once stopped, to the spot round the robot where the people coming will leave it
-  // the most room (or stand still if none is better); on give_way_clear_for after the last one
-  // seen coming has passed, or after `patience`.
+  // Making way (WayGiver), then on to the goal.
   NodeStatus GiveWay() {
-    GiveWayState& g = *give_way_;
-    if (!g.chosen && StoppedOrStopTimedOut(task_, g.since)) {
-      g.chosen = true;
-      if (const auto spot = MakeWaySpot(task_, kMakeWayMinGainM)) {
-        StepAsideTo(task_, *spot);
-        Note(StrCat("stepping aside to (", PoseText(*spot), ")"));
-      } else {
-        Note("standing still: no spot aside leaves more room");
-      }
-    }
-    if (task_.motion->base_failed()) task_.motion->StopBase();  // blocked: stay where it is
-    // Until everyone seen coming has passed (by their last prediction: a person the camera
-    // loses behind another is still coming) and give_way_clear_for after.
-    for (const auto& [person, t_pass] : PeopleComing(task_, goal_))
-      g.until = std::max(g.until, belief_.now + SecondsToDuration(std::min(t_pass, kMaxPassSec)));
-    const bool clear = ToSeconds(belief_.now - g.until) >= task_.config.give_way_clear_for;
-    const bool waited = ToSeconds(belief_.now - g.since) > Input<double>("patience");
-    if (!clear && !waited) return NodeStatus::kRunning;
-    give_way_.reset();
-    Note(clear ? "nobody is coming any more: going on" : "made way long enough: going on");
-    return Start();
+    const NodeStatus s = give_way_.Update(task_, goal_, Input<double>("patience"),
+                                          [this](const std::string& t) { Note(t); });
+    return s == NodeStatus::kRunning ? s : Start();
   }
 
   NodeStatus Start() {
@@ -150,7 +115,7 @@ class NavigateTo final : public TaskNode<bt::StatefulActionNode> {
     return NodeStatus::kRunning;
   }
   std::optional<Time> blocked_since_;
-  std::optional<GiveWayState> give_way_;
+  WayGiver give_way_;
   std::optional<Pose2> goal_;
   Time last_try_{};
   bool detour_tried_{false};

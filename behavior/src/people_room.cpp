@@ -374,6 +374,43 @@ void StepAsideTo(const TaskServices& task, const Pose2& spot) {
                           task.belief->now, task.config.retreat_speed, /*brisk=*/true);
 }
 
+bool WayGiver::Begin(const TaskServices& task, const std::optional<Pose2>& goal,
+                     const NoteFn& note) {
+  const auto coming = PeopleComing(task, goal);
+  if (coming.empty()) return false;
+  const perception::TrackedPerson& p = *coming.front().first;
+  task.motion->StopBase();
+  since_ = task.belief->now;
+  until_ = task.belief->now;
+  chosen_ = false;
+  note(StrCat("making way: person ", p.id, " at (", PoseText({p.p_MP.x(), p.p_MP.y(), 0.0}), "), ",
+              std::round(p.v_MP.norm() * 10) / 10, " m/s is coming"));
+  return true;
+}
+
+NodeStatus WayGiver::Update(const TaskServices& task, const std::optional<Pose2>& goal,
+                            double patience, const NoteFn& note) {
+  const Time now = task.belief->now;
+  if (!chosen_ && StoppedOrStopTimedOut(task, *since_)) {
+    chosen_ = true;
+    if (const auto spot = MakeWaySpot(task, kMakeWayMinGainM)) {
+      StepAsideTo(task, *spot);
+      note(StrCat("stepping aside to (", PoseText(*spot), ")"));
+    } else {
+      note("standing still: no spot aside leaves more room");
+    }
+  }
+  if (task.motion->base_failed()) task.motion->StopBase();  // blocked: stay where it is
+  for (const auto& [person, t_pass] : PeopleComing(task, goal))
+    until_ = std::max(until_, now + SecondsToDuration(std::min(t_pass, kMaxPassSec)));
+  const bool clear = ToSeconds(now - until_) >= task.config.give_way_clear_for;
+  const bool waited = ToSeconds(now - *since_) > patience;
+  if (!clear && !waited) return NodeStatus::kRunning;
+  since_.reset();
+  note(clear ? "nobody is coming any more: going on" : "made way long enough: going on");
+  return NodeStatus::kSuccess;
+}
+
 bool HandClearOfWalls(const TaskServices& task, const Pose2& from, const Eigen::Vector2d& to) {
   const perception::Costmap2D* costmap = task.belief->world.costmap;
   if (costmap == nullptr || task.model == nullptr || task.motion == nullptr) return true;

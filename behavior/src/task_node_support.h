@@ -409,6 +409,30 @@ std::optional<Pose2> MakeWaySpot(const TaskServices& task, double min_gain,
                                  const std::optional<Eigen::Vector2d>& stepping_to = std::nullopt);
 /// Starts the step to `spot` at retreat_speed, the arm held where it is going.
 void StepAsideTo(const TaskServices& task, const Pose2& spot);
+
+/// Making way for people walking at the robot (TaskConfig::give_way), for a node that drives:
+/// Begin when someone is coming (PeopleComing) stops the base; once it has stopped, Update steps
+/// to MakeWaySpot (or stands still if no spot leaves more room), and reports SUCCESS
+/// give_way_clear_for after the last person seen coming has passed (by their last prediction,
+/// at most kMaxPassSec ahead: a person the camera loses behind another is still coming), or
+/// after `patience` [s]; RUNNING until then.
+class WayGiver {
+ public:
+  /// [s] A slow walker far off is not waited for longer than this.
+  static constexpr double kMaxPassSec = 15.0;
+  /// True (and the base stopped, the person noted) if someone is coming; false otherwise.
+  /// `goal`: whom the robot goes to, there, is not made way for (PeopleComing).
+  bool Begin(const TaskServices& task, const std::optional<Pose2>& goal, const NoteFn& note);
+  NodeStatus Update(const TaskServices& task, const std::optional<Pose2>& goal, double patience,
+                    const NoteFn& note);
+  bool active() const { return since_.has_value(); }
+  void Reset() { since_.reset(); }
+
+ private:
+  std::optional<Time> since_;
+  Time until_{};        ///< when the last person seen coming will have passed
+  bool chosen_{false};  ///< the spot is chosen (once the base has stopped)
+};
 /// [m] The hand keeps this far off mapped walls on a step: its palm block's half-size and a
 /// margin. Out at an actuator it reaches past the round footprint every step is checked with
 /// (atrium west seeds 5 and 36: an operation broken off, a step towards the wall the robot
