@@ -261,6 +261,9 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
       if (task_.motion->base_moving()) return NodeStatus::kRunning;
       return AlignOrOperate();
     }
+    // The arm is on its way to open the door: the head turns to look through it.
+    if (task_.gaze != nullptr)
+      task_.gaze->ExpectOpening(Door(), belief_.now + SecondsToDuration(kLookRequestSec));
     // Seen shut after the arm set off (a closing leaf that closed during the stroke): this press
     // opens the door afresh, it restarts no window (H1 seed 2006: timed as a restart, the window
     // ended 0.8 s before the real one, and the robot waited at the open door until it shut).

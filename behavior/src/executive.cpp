@@ -644,7 +644,7 @@ bool Executive::Step(RobotPort& port) {
     port.SendHeadCommand(*head);
     if (m.gaze.reason() != gaze_before) {
       static constexpr const char* kWhy[] = {"ahead", "through the door", "at a person coming",
-                                             "at what the task needs"};
+                                             "at what the task needs", "behind (a wall ahead)"};
       decisions_.push_back({ToSeconds(now), StrCat("head: looking ", kWhy[int(m.gaze.reason())]),
                             DecisionEvent::kNote});
     }

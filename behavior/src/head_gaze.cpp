@@ -11,18 +11,27 @@ namespace {
 constexpr double kDegToRad = M_PI / 180.0;
 // [rad] A door whose centre is within this of the robot's heading is ahead of it.
 constexpr double kDoorAheadRad = M_PI / 2;
+// [s] A glance kept on someone in the laser's blind sector is renewed by this much at a time.
+constexpr double kGlanceRenewSec = 0.2;
 }  // namespace
 
 void HeadGazeConfig::Validate() const {
   ThrowUnless(camera_hfov_deg > 0 && camera_hfov_deg < 180,
               "HeadGazeConfig: camera_hfov_deg must be in (0, 180)");
   ThrowUnless(glance_range >= 0 && approach_speed >= 0 && glance_time >= 0 &&
-                  glance_cooldown >= 0 && door_look_range >= 0 && door_look_beyond >= 0,
+                  glance_cooldown >= 0 && max_blind_glance >= 0 && door_look_range >= 0 &&
+                  door_look_beyond >= 0,
               "HeadGazeConfig: ranges, speeds and times must be >= 0");
   ThrowUnless(door_open_fraction >= 0 && door_open_fraction <= 1,
               "HeadGazeConfig: door_open_fraction must be in [0, 1]");
-  ThrowUnless(max_pan_deg >= 0 && max_pan_deg <= 180 && min_change_deg >= 0,
-              "HeadGazeConfig: max_pan_deg must be in [0, 180], min_change_deg >= 0");
+  ThrowUnless(min_pan_deg <= 0 && min_pan_deg >= -360 && max_pan_deg >= 0 && max_pan_deg <= 360 &&
+                  min_change_deg >= 0,
+              "HeadGazeConfig: min_pan_deg must be in [-360, 0], max_pan_deg in [0, 360], "
+              "min_change_deg >= 0");
+  ThrowUnless(wall_ahead_range >= 0 && blind_look_pan_deg >= min_pan_deg &&
+                  blind_look_pan_deg <= max_pan_deg,
+              "HeadGazeConfig: wall_ahead_range must be >= 0, blind_look_pan_deg within "
+              "[min_pan_deg, max_pan_deg]");
   ThrowUnless(max_tilt_down_deg >= 0 && max_tilt_down_deg <= 90 && max_tilt_up_deg >= 0 &&
                   max_tilt_up_deg <= 90,
               "HeadGazeConfig: max_tilt_down_deg and max_tilt_up_deg must be in [0, 90]");
@@ -32,11 +41,22 @@ HeadGaze::HeadGaze(HeadGazeConfig config) : config_(config) {
   config_.Validate();
 }
 
-double HeadGaze::PanTowards(const Pose2& X_MB, const Eigen::Vector2d& p_M) const {
+double HeadGaze::PanTowards(const Pose2& X_MB, const Eigen::Vector2d& p_M, double looking) const {
   const Eigen::Vector2d d = p_M - X_MB.translation();
   const double bearing = std::remainder(std::atan2(d.y(), d.x()) - X_MB.yaw, 2 * M_PI);
-  const double limit = config_.max_pan_deg * kDegToRad;
-  return std::clamp(bearing, -limit, limit);
+  const double lo = config_.min_pan_deg * kDegToRad;
+  const double hi = config_.max_pan_deg * kDegToRad;
+  std::optional<double> best;
+  for (const double pan : {bearing - 2 * M_PI, bearing, bearing + 2 * M_PI}) {
+    if (pan < lo || pan > hi) continue;
+    if (!best || std::abs(pan - looking) < std::abs(*best - looking)) best = pan;
+  }
+  if (best) return *best;
+  // Out of reach: the limit nearer the bearing, round the circle.
+  return std::abs(std::remainder(bearing - lo, 2 * M_PI)) <
+                 std::abs(std::remainder(bearing - hi, 2 * M_PI))
+             ? lo
+             : hi;
 }
 
 double HeadGaze::TiltTowards(const Pose3& X_MC, const Eigen::Vector3d& p_M) const {
@@ -44,6 +64,35 @@ double HeadGaze::TiltTowards(const Pose3& X_MC, const Eigen::Vector3d& p_M) cons
   const double tilt = std::atan2(d.z(), std::max(d.head<2>().norm(), 1e-3));
   return std::clamp(tilt, -config_.max_tilt_down_deg * kDegToRad,
                     config_.max_tilt_up_deg * kDegToRad);
+}
+
+bool HeadGaze::WallAhead(const Belief& belief) const {
+  if (!belief.scan || config_.wall_ahead_range <= 0) return false;
+  const LaserScan& scan = *belief.scan;
+  const double half_fov = config_.camera_hfov_deg * kDegToRad / 2;
+  int returns = 0;
+  for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
+    const double bearing = std::remainder(scan.AngleAt(i) + belief.X_BL.yaw, 2 * M_PI);
+    if (std::abs(bearing) > half_fov) continue;
+    const double range = scan.ranges[i];
+    if (std::isnan(range)) continue;  // an invalid beam says nothing
+    // No return (open space) or a far one: there is something to see ahead.
+    if (!(range < config_.wall_ahead_range && range <= scan.range_max)) return false;
+    ++returns;
+  }
+  return returns > 0;
+}
+
+bool HeadGaze::InLaserBlindSector(const Belief& belief, const Eigen::Vector2d& p_M) const {
+  if (!belief.scan || belief.scan->ranges.empty()) return false;
+  const Eigen::Vector2d d = p_M - belief.X_MB.translation();
+  const double bearing_L =
+      std::remainder(std::atan2(d.y(), d.x()) - belief.X_MB.yaw - belief.X_BL.yaw, 2 * M_PI);
+  return bearing_L < belief.scan->angle_min || bearing_L > belief.scan->angle_max();
+}
+
+void HeadGaze::ExpectOpening(const std::string& door, Time until) {
+  expected_opening_[door] = until;
 }
 
 void HeadGaze::RequestLook(const Eigen::Vector3d& p_M, Time until) {
@@ -65,9 +114,18 @@ std::optional<HeadCommand> HeadGaze::Update(const Belief& belief, std::optional<
   // 1. A glance under way goes on while its person is still tracked.
   if (glance_id_ >= 0 && belief.now < glance_until_) {
     for (const auto& entry : belief.world.people) {
-      if (entry.person.id == glance_id_) {
-        pan = PanTowards(X_MB, entry.person.p_MP);
-        reason = GazeReason::kPerson;
+      if (entry.person.id != glance_id_) continue;
+      pan = PanTowards(X_MB, entry.person.p_MP, looking);
+      reason = GazeReason::kPerson;
+      // Someone still coming in the laser's blind sector has only the camera: the glance goes
+      // on, up to max_blind_glance, so their track keeps being measured (a track coasting on a
+      // glance's first, still-converging velocity read a walker at 1.3 m/s as 0.5).
+      const Eigen::Vector2d d = entry.person.p_MP - at;
+      if (d.norm() > 1e-6 && -entry.person.v_MP.dot(d.normalized()) >= config_.approach_speed &&
+          InLaserBlindSector(belief, entry.person.p_MP) &&
+          ToSeconds(belief.now - glance_began_) < config_.max_blind_glance) {
+        glance_until_ = std::max(glance_until_, belief.now + SecondsToDuration(kGlanceRenewSec));
+        glance_ended_[glance_id_] = glance_until_;
       }
     }
   }
@@ -82,11 +140,14 @@ std::optional<HeadCommand> HeadGaze::Update(const Belief& belief, std::optional<
       if (distance >= nearest || distance < 1e-6) continue;
       const double closing = -person.v_MP.dot(d / distance);
       if (closing < config_.approach_speed) continue;
-      const double bearing = PanTowards(X_MB, person.p_MP);
-      if (std::abs(std::remainder(bearing - looking, 2 * M_PI)) < half_fov) continue;
-      if (const auto it = glanced_at_.find(person.id);
-          it != glanced_at_.end() &&
-          ToSeconds(belief.now - it->second) < config_.glance_time + config_.glance_cooldown)
+      const double bearing = PanTowards(X_MB, person.p_MP, looking);
+      // One in view needs no glance, but for one in the laser's blind sector: the camera
+      // alone measures them, and a door opening ahead would take the head off them.
+      if (std::abs(std::remainder(bearing - looking, 2 * M_PI)) < half_fov &&
+          !InLaserBlindSector(belief, person.p_MP))
+        continue;
+      if (const auto it = glance_ended_.find(person.id);
+          it != glance_ended_.end() && ToSeconds(belief.now - it->second) < config_.glance_cooldown)
         continue;
       nearest = distance;
       glance_id_ = person.id;
@@ -94,21 +155,34 @@ std::optional<HeadCommand> HeadGaze::Update(const Belief& belief, std::optional<
       reason = GazeReason::kPerson;
     }
     if (glance_id_ >= 0) {
-      glanced_at_[glance_id_] = belief.now;
+      glance_began_ = belief.now;
       glance_until_ = belief.now + SecondsToDuration(config_.glance_time);
+      glance_ended_[glance_id_] = glance_until_;
     }
   }
   // 2. What the task asked for.
   if (!pan && requested_ && belief.now < requested_until_) {
-    pan = PanTowards(X_MB, requested_->head<2>());
+    pan = PanTowards(X_MB, requested_->head<2>(), looking);
     tilt = TiltTowards(belief.X_MC, *requested_);
     reason = GazeReason::kTask;
   }
   // 3. Through the nearest door that is open or opening.
   if (!pan) {
+    // Someone tracked in the laser's blind sector keeps the head behind until the door really
+    // opens (P1: people waiting there set off as the robot presses).
+    bool someone_behind = false;
+    for (const auto& entry : belief.world.people) {
+      someone_behind |= (entry.person.p_MP - at).norm() < config_.glance_range &&
+                        InLaserBlindSector(belief, entry.person.p_MP);
+    }
     double nearest = config_.door_look_range;
     for (const auto& door : belief.world.doors) {
-      if (!door.state.observed || door.state.open_fraction < config_.door_open_fraction) continue;
+      const auto expected = expected_opening_.find(door.model.id);
+      const bool operated =
+          expected != expected_opening_.end() && belief.now < expected->second && !someone_behind;
+      if (!operated &&
+          (!door.state.observed || door.state.open_fraction < config_.door_open_fraction))
+        continue;
       const Eigen::Vector2d centre = (door.model.p_MHinge + door.model.p_MLatch) / 2;
       const double distance = (centre - at).norm();
       if (distance >= nearest) continue;
@@ -121,16 +195,20 @@ std::optional<HeadCommand> HeadGaze::Update(const Belief& belief, std::optional<
       Eigen::Vector2d n(-along.y(), along.x());
       if (n.dot(at - centre) < 0) n = -n;  // towards the robot's side
       nearest = distance;
-      pan = PanTowards(X_MB, centre - n * config_.door_look_beyond);
+      pan = PanTowards(X_MB, centre - n * config_.door_look_beyond, looking);
       reason = GazeReason::kDoor;
     }
   }
+  // 4. Behind, with only a wall to see ahead.
+  if (!pan && WallAhead(belief)) {
+    pan = config_.blind_look_pan_deg * kDegToRad;
+    reason = GazeReason::kBehind;
+  }
   if (!pan) pan = 0.0;
   reason_ = reason;
-  for (auto it = glanced_at_.begin(); it != glanced_at_.end();) {
-    const bool stale =
-        ToSeconds(belief.now - it->second) > config_.glance_time + config_.glance_cooldown;
-    it = stale ? glanced_at_.erase(it) : std::next(it);
+  for (auto it = glance_ended_.begin(); it != glance_ended_.end();) {
+    const bool stale = ToSeconds(belief.now - it->second) > config_.glance_cooldown;
+    it = stale ? glance_ended_.erase(it) : std::next(it);
   }
   const double min_change = config_.min_change_deg * kDegToRad;
   if (sent_ && std::abs(*pan - commanded_pan_) < min_change &&

@@ -43,7 +43,15 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     phase_ = Phase::kWaiting;
     waiting_since_ = belief_.now;
     passage_wait_over_ = false;
+    give_way_.Reset();
     if (lateral > 0.05 || offset.dot(pass_.n_M) > entry_distance_ + 0.05) {
+      // Out of the way of anyone walking up to the door first: the line-up crosses the
+      // approach to the doorway (P1: someone walking up behind the robot at the button to go
+      // through met it driving to the lane's edge, 0.38 m off).
+      if (task_.config.give_way && give_way_.Begin(task_, std::nullopt, WayNoter())) {
+        phase_ = Phase::kGivingWay;
+        return NodeStatus::kRunning;
+      }
       if (const NodeStatus s = StartLineUp(); s != NodeStatus::kRunning) return s;
     }
     return OnRunning();
@@ -51,7 +59,18 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
   NodeStatus OnRunning() override {
     const auto note = [this](const std::string& t) { Note(t); };
     switch (phase_) {
+      case Phase::kGivingWay: {
+        if (give_way_.Update(task_, std::nullopt, Input<double>("wait_timeout"), note) ==
+            NodeStatus::kRunning)
+          return NodeStatus::kRunning;
+        if (const NodeStatus s = StartLineUp(); s != NodeStatus::kRunning) return s;
+        return NodeStatus::kRunning;
+      }
       case Phase::kToPeek: {
+        if (task_.config.give_way && give_way_.Begin(task_, std::nullopt, note)) {
+          phase_ = Phase::kGivingWay;
+          return NodeStatus::kRunning;
+        }
         const NodeStatus s = DriveStatus(task_, note, true);
         if (s != NodeStatus::kSuccess) return s;
         phase_ = Phase::kPeeking;
@@ -59,6 +78,10 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
         [[fallthrough]];
       }
       case Phase::kPeeking: {
+        if (task_.config.give_way && give_way_.Begin(task_, std::nullopt, note)) {
+          phase_ = Phase::kGivingWay;
+          return NodeStatus::kRunning;
+        }
         if (const NodeStatus arm = ArmMotionStatus(task_, note); arm != NodeStatus::kSuccess)
           return arm;
         const Eigen::Vector2d entry = EntryPoint();
@@ -172,7 +195,10 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     }
     return NodeStatus::kFailure;
   }
-  void OnHalted() override { task_.motion->StopBase(); }
+  void OnHalted() override {
+    task_.motion->StopBase();
+    give_way_.Reset();
+  }
 
  private:
   RelocalizeGate gate_;
@@ -333,7 +359,13 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
            ToSeconds(belief_.now - d->state.stamp) < kOperatorOpeningTime;
   }
 
-  enum class Phase { kToPeek, kPeeking, kToEntry, kWaiting, kThrough };
+  NoteFn WayNoter() {
+    return [this](const std::string& t) { Note(t); };
+  }
+
+  // kGivingWay: making way for people walking up before the line-up (WayGiver).
+  enum class Phase { kGivingWay, kToPeek, kPeeking, kToEntry, kWaiting, kThrough };
+  WayGiver give_way_;
   std::string door_;
   DoorPass pass_;
   double entry_distance_{0.0};

@@ -1,6 +1,7 @@
 #include "egress/behavior/head_gaze.h"
 
 #include <cmath>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -162,12 +163,125 @@ TEST_F(HeadGazeTest, SomeoneComingOutranksTheTasksTarget) {
 
 TEST_F(HeadGazeTest, PanStaysWithinItsLimit) {
   HeadGazeConfig config;
+  config.min_pan_deg = -90.0;
   config.max_pan_deg = 90.0;
+  config.blind_look_pan_deg = -90.0;  // within the range, or refused
   HeadGaze gaze(config);
   belief_.world.people = {Walker(4, {1.15, 0.9}, {0.0, 1.0})};  // straight behind
   const auto look = gaze.Update(belief_, 0.0);
   ASSERT_TRUE(look.has_value());
   EXPECT_NEAR(std::abs(look->pan), M_PI / 2, 1e-9);
+}
+
+// The HSR's head turns right round past straight behind (-220 deg) but only 100 deg to the
+// left: someone behind and to the left is looked at the long way, to the right.
+TEST_F(HeadGazeTest, PanGoesTheWayRoundTheJointAllows) {
+  // Behind-left of the robot (facing +y): bearing +150 deg, coming at it.
+  const double bearing = 150.0 * M_PI / 180.0;
+  const Eigen::Vector2d p(1.15 + 2.0 * std::cos(M_PI / 2 + bearing),
+                          2.4 + 2.0 * std::sin(M_PI / 2 + bearing));
+  belief_.world.people = {Walker(5, p, (belief_.X_MB.translation() - p).normalized())};
+  const auto look = Update(0.0);
+  ASSERT_TRUE(look.has_value());
+  EXPECT_EQ(gaze_.reason(), GazeReason::kPerson);
+  EXPECT_NEAR(look->pan, bearing - 2 * M_PI, 1e-9);  // -210 deg
+}
+
+// A laser scan of 270 deg (the HSR's), every beam returning at `range`, but those within
+// `ahead_deg` of straight ahead, which return at `ahead_range`.
+LaserScan Scan(double range, double ahead_range, double ahead_deg) {
+  LaserScan scan;
+  scan.angle_min = -135.0 * M_PI / 180.0;
+  scan.angle_increment = M_PI / 720.0;
+  scan.range_min = 0.05;
+  scan.range_max = 20.0;
+  for (int i = 0; i <= 1080; ++i) {
+    const double a = scan.AngleAt(std::size_t(i));
+    scan.ranges.push_back(float(std::abs(a) <= ahead_deg * M_PI / 180.0 ? ahead_range : range));
+  }
+  return scan;
+}
+
+TEST_F(HeadGazeTest, LooksBehindWithOnlyAWallToSeeAhead) {
+  belief_.scan = Scan(4.0, 0.4, 40.0);  // facing the wall at the button, 0.4 m off
+  const auto behind = Update(0.0);
+  ASSERT_TRUE(behind.has_value());
+  EXPECT_EQ(gaze_.reason(), GazeReason::kBehind);
+  EXPECT_NEAR(behind->pan, -M_PI, 1e-9);
+  // Part of the camera's view open (a return beyond wall_ahead_range): ahead again.
+  belief_.scan = Scan(4.0, 0.4, 20.0);
+  const auto ahead = Update(behind->pan);
+  ASSERT_TRUE(ahead.has_value());
+  EXPECT_EQ(gaze_.reason(), GazeReason::kAhead);
+  // Nothing returned ahead (open space) is no wall either.
+  belief_.scan = Scan(4.0, std::numeric_limits<float>::infinity(), 40.0);
+  Update(0.0);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kAhead);
+  // A door opening beside the robot outranks the look behind.
+  belief_.scan = Scan(4.0, 0.4, 40.0);
+  belief_.world.doors = {LabDoor(0.3)};
+  Update(0.0);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kDoor);
+}
+
+TEST_F(HeadGazeTest, KeepsLookingAtSomeoneComingInTheLasersBlindSector) {
+  belief_.scan = Scan(4.0, 4.0, 0.0);
+  belief_.world.doors = {LabDoor(0.5)};
+  // Straight behind the robot, 3 m off, coming at 0.4 m/s: outside the laser's 270 deg.
+  const auto walker_at = [](double t) {
+    return Walker(9, {1.15, -0.6 + 0.4 * (t - 1.0)}, {0.0, 0.4});
+  };
+  belief_.world.people = {walker_at(1.0)};
+  Update(0.0);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kPerson);
+  // Past glance_time (1 s) the glance goes on while they are there and coming, though the
+  // camera has them in view (it alone measures them there), up to max_blind_glance (4 s) ...
+  for (double t = 1.1; t < 4.95; t += 0.1) {
+    belief_.now = At(t);
+    belief_.world.people = {walker_at(t)};
+    Update(-M_PI);
+    ASSERT_EQ(gaze_.reason(), GazeReason::kPerson) << "at " << t << " s";
+  }
+  // ... then through the door, and not back at them for glance_cooldown.
+  for (double t = 5.2; t < 7.9; t += 0.1) {
+    belief_.now = At(t);
+    belief_.world.people = {walker_at(t)};
+    Update(0.0);
+    ASSERT_EQ(gaze_.reason(), GazeReason::kDoor) << "at " << t << " s";
+  }
+  // Someone in the laser's view is glanced at for glance_time only.
+  HeadGaze gaze;
+  belief_.now = At(10.0);
+  belief_.world.people = {Walker(3, {-0.8, 2.2}, {1.0, 0.0})};  // to the left, coming
+  gaze.Update(belief_, 0.0);
+  EXPECT_EQ(gaze.reason(), GazeReason::kPerson);
+  belief_.now = At(10.5);
+  gaze.Update(belief_, 0.0);
+  EXPECT_EQ(gaze.reason(), GazeReason::kPerson);
+  belief_.now = At(11.1);
+  gaze.Update(belief_, 0.0);
+  EXPECT_EQ(gaze.reason(), GazeReason::kDoor);
+}
+
+TEST_F(HeadGazeTest, ADoorBeingOperatedIsLookedThroughUnlessSomeoneIsBehind) {
+  belief_.scan = Scan(4.0, 0.4, 40.0);
+  belief_.world.doors = {LabDoor(0.0)};  // shut
+  Update(0.0);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kBehind);
+  gaze_.ExpectOpening("lab_door", At(1.5));
+  Update(-M_PI);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kDoor);
+  // Someone standing in the laser's blind sector: the head stays behind until the door opens.
+  belief_.world.people = {Walker(2, {1.6, 0.6}, {0.0, 0.0})};
+  Update(-M_PI);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kBehind);
+  belief_.world.people.clear();
+  Update(-M_PI);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kDoor);
+  // The expectation lapses.
+  belief_.now = At(1.6);
+  Update(0.0);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kBehind);
 }
 
 TEST_F(HeadGazeTest, DisabledSendsNothingAndBadConfigsAreRefused) {
@@ -182,6 +296,15 @@ TEST_F(HeadGazeTest, DisabledSendsNothingAndBadConfigsAreRefused) {
     c.*bad = -1.0;
     EXPECT_THROW(HeadGaze{c}, InvalidArgument);
   }
+  HeadGazeConfig c;
+  c.min_pan_deg = 10.0;  // the range must hold straight ahead
+  EXPECT_THROW(HeadGaze{c}, InvalidArgument);
+  c = {};
+  c.blind_look_pan_deg = -230.0;  // past the joint's range
+  EXPECT_THROW(HeadGaze{c}, InvalidArgument);
+  c = {};
+  c.wall_ahead_range = -1.0;
+  EXPECT_THROW(HeadGaze{c}, InvalidArgument);
 }
 
 }  // namespace
