@@ -121,6 +121,7 @@ class ApproachButton final : public TaskNode<bt::StatefulActionNode> {
   }
   NodeStatus OnRunning() override {
     const auto note = [this](const std::string& s) { Note(s); };
+    WatchBehind();
     if (looking_until_) {
       if (const NodeStatus s = BaseMotionStatus(task_, note); s != NodeStatus::kSuccess) return s;
       if (belief_.now < *looking_until_) return NodeStatus::kRunning;
@@ -246,6 +247,7 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
       return NodeStatus::kFailure;
     }
     plan_ = *visit.button_plan;
+    WatchBehind();
     alignments_ = 0;
     arm_started_ = false;
     waiting_out_ = false;
@@ -253,6 +255,7 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
     return AlignOrOperate();
   }
   NodeStatus OnRunning() override {
+    WatchBehind();
     if (!arm_started_) {
       if (task_.motion->base_failed()) {
         Note("could not square up to the actuator: " + task_.motion->base_failure());

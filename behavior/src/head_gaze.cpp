@@ -199,8 +199,8 @@ std::optional<HeadCommand> HeadGaze::Update(const Belief& belief, std::optional<
       reason = GazeReason::kDoor;
     }
   }
-  // 4. Behind, with only a wall to see ahead.
-  if (!pan && WallAhead(belief)) {
+  // 4. Behind, at an actuator with only a wall to see ahead.
+  if (!pan && belief.now < watch_behind_until_ && WallAhead(belief)) {
     pan = config_.blind_look_pan_deg * kDegToRad;
     reason = GazeReason::kBehind;
   }

@@ -83,6 +83,13 @@ class TaskNode : public Base {
     if (task_.gaze != nullptr)
       task_.gaze->RequestLook(p_M, belief_.now + SecondsToDuration(kLookRequestSec));
   }
+  /// At a door's actuator (driving to it, squaring up, operating it): facing the wall there, the
+  /// laser's blind sector is the room people come from, and the head may watch it for the next
+  /// kLookRequestSec (HeadGaze::WatchBehind, rule 4).
+  void WatchBehind() const {
+    if (task_.gaze != nullptr)
+      task_.gaze->WatchBehind(belief_.now + SecondsToDuration(kLookRequestSec));
+  }
   /// The visit to this node's door on the `visit` port; a new one if there is none yet or the
   /// port holds a visit to another door.
   DoorVisit Visit() const {

@@ -216,10 +216,11 @@ TEST_F(DoorNodesTest, AWaveWithTheHandLeftAtThePlateTakesItAwayFirst) {
   EXPECT_NEAR(hand_at_plate_after(60.0), c.arm_tuck_time + c.press_reach_time, 1e-9);
 }
 
-// While the arm is on its way to the button the head turns to look through the door it opens
-// (from a look behind, the head takes 4 s to come round; the leaf opens in ~3): HeadGaze takes the
-// shut door as opening while the press lasts.
-TEST_F(DoorNodesTest, WhileTheArmPressesTheHeadLooksThroughTheDoorItOpens) {
+// At the actuator, facing its wall, the head watches the laser's blind sector (HeadGaze rule 4);
+// while the arm is on its way to the button it turns to look through the door it opens (from a
+// look behind, the head takes 4 s to come round; the leaf opens in ~3): HeadGaze takes the shut
+// door as opening while the press lasts.
+TEST_F(DoorNodesTest, AtTheButtonTheHeadWatchesBehindThenLooksThroughTheDoorThePressOpens) {
   HeadGaze gaze;
   services_.gaze = &gaze;
   auto blackboard = bt::Blackboard::Create();
@@ -227,6 +228,21 @@ TEST_F(DoorNodesTest, WhileTheArmPressesTheHeadLooksThroughTheDoorItOpens) {
   belief_.now = At(20.0);
   gaze.Update(belief_, 0.0);
   EXPECT_EQ(gaze.reason(), GazeReason::kAhead) << "a shut door: nothing to see through";
+  // The laser sees the wall 0.4 m ahead across the camera's view.
+  LaserScan wall;
+  wall.angle_min = -M_PI / 4;
+  wall.angle_increment = M_PI / 180.0;
+  wall.range_max = 20.0;
+  wall.ranges.assign(91, 0.4f);
+  belief_.scan = wall;
+  {
+    bt::Tree squaring_up = Tree(R"(<PressButton door="lab_door"/>)", blackboard);
+    ASSERT_EQ(squaring_up.TickOnce(), NodeStatus::kRunning);
+    gaze.Update(belief_, 0.0);
+    EXPECT_EQ(gaze.reason(), GazeReason::kBehind) << "at the actuator, facing its wall";
+  }
+  belief_.scan.reset();  // (the base squared up: no more laser correction)
+  motion_.StopBase();
   bt::Tree press = Tree(R"(<PressButton door="lab_door"/>)", blackboard);
   ASSERT_EQ(press.TickOnce(), NodeStatus::kRunning);
   ASSERT_TRUE(motion_.arm_moving(belief_.now));
@@ -239,7 +255,7 @@ TEST_F(DoorNodesTest, WhileTheArmPressesTheHeadLooksThroughTheDoorItOpens) {
   ASSERT_EQ(press.TickOnce(), NodeStatus::kSuccess);
   belief_.now = At(40.0 + detail::kLookRequestSec + 0.1);
   gaze.Update(belief_, 0.0);
-  EXPECT_EQ(gaze.reason(), GazeReason::kAhead);
+  EXPECT_EQ(gaze.reason(), GazeReason::kAhead) << "away from the actuator's task: no look behind";
   services_.gaze = nullptr;
 }
 

@@ -202,8 +202,12 @@ LaserScan Scan(double range, double ahead_range, double ahead_deg) {
   return scan;
 }
 
-TEST_F(HeadGazeTest, LooksBehindWithOnlyAWallToSeeAhead) {
+TEST_F(HeadGazeTest, LooksBehindAtAnActuatorWithOnlyAWallToSeeAhead) {
   belief_.scan = Scan(4.0, 0.4, 40.0);  // facing the wall at the button, 0.4 m off
+  // Not on its own (at a table the look ahead finds the payload): a task at an actuator asks.
+  Update(0.0);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kAhead);
+  gaze_.WatchBehind(At(10.0));
   const auto behind = Update(0.0);
   ASSERT_TRUE(behind.has_value());
   EXPECT_EQ(gaze_.reason(), GazeReason::kBehind);
@@ -222,6 +226,11 @@ TEST_F(HeadGazeTest, LooksBehindWithOnlyAWallToSeeAhead) {
   belief_.world.doors = {LabDoor(0.3)};
   Update(0.0);
   EXPECT_EQ(gaze_.reason(), GazeReason::kDoor);
+  // The task's word lapses: ahead.
+  belief_.world.doors.clear();
+  belief_.now = At(10.1);
+  Update(0.0);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kAhead);
 }
 
 TEST_F(HeadGazeTest, KeepsLookingAtSomeoneComingInTheLasersBlindSector) {
@@ -266,6 +275,7 @@ TEST_F(HeadGazeTest, KeepsLookingAtSomeoneComingInTheLasersBlindSector) {
 TEST_F(HeadGazeTest, ADoorBeingOperatedIsLookedThroughUnlessSomeoneIsBehind) {
   belief_.scan = Scan(4.0, 0.4, 40.0);
   belief_.world.doors = {LabDoor(0.0)};  // shut
+  gaze_.WatchBehind(At(10.0));
   Update(0.0);
   EXPECT_EQ(gaze_.reason(), GazeReason::kBehind);
   gaze_.ExpectOpening("lab_door", At(1.5));

@@ -14,10 +14,12 @@
 ///      operates its actuator (ExpectOpening; unless someone tracked is in the laser's blind
 ///      sector: they are watched until the leaf really moves): at the point `door_look_beyond`
 ///      past the doorway's centre, on its far side, where people wait for it and come through;
-///   4. with a wall close ahead (every laser return in the camera's view straight ahead nearer
-///      than `wall_ahead_range`: at a button, a plate, a wall it waits by), over the laser's
-///      blind sector behind the base (`blind_look_pan_deg`): ahead the camera would see only
-///      the wall, and people walking up behind the robot are in neither sensor's view;
+///   4. while a task asks (WatchBehind: at a door's actuator) and a wall is close ahead (every
+///      laser return in the camera's view straight ahead nearer than `wall_ahead_range`), over
+///      the laser's blind sector behind the base (`blind_look_pan_deg`): ahead the camera would
+///      see only the wall, and people walking up behind the robot to the door are in neither
+///      sensor's view (only on a task's word: at a table, the default look ahead finds the
+///      payload);
 ///   5. straight ahead (pan 0, tilt 0), the paper's fixed gaze.
 /// The tilt moves only for a task's request (a payload on a table below the camera, near the
 /// robot, is below a level camera's view); people and doors are looked at level. Pan angles are
@@ -80,6 +82,8 @@ class HeadGaze {
   /// (the robot clock), so the head is turned through it by the time the leaf swings (from a
   /// look behind, the head takes 4 s to come round). Renewed each tick by the operating node.
   void ExpectOpening(const std::string& door, Time until);
+  /// A task at a door's actuator: rule 4 may look behind until `until`. Renewed each tick.
+  void WatchBehind(Time until) { watch_behind_until_ = until; }
   GazeReason reason() const { return reason_; }
   /// The pan last commanded [rad] (0 before any).
   double commanded_pan() const { return commanded_pan_; }
@@ -110,6 +114,7 @@ class HeadGaze {
   Time glance_until_{};
   Time glance_began_{};
   std::map<int, Time> glance_ended_;  ///< Track id -> when its last glance ended (or ends).
+  Time watch_behind_until_{};
   std::map<std::string, Time> expected_opening_;  ///< ExpectOpening: door -> until.
 };
 
