@@ -34,13 +34,7 @@ class TraverseDoorTest : public node_testing::TaskNodeFixture {
 // opened. The line-up to the lane's edge crosses their way to the doorway; the robot makes
 // way first and lines up once they have passed.
 TEST_F(TraverseDoorTest, MakesWayForSomeoneWalkingUpToTheDoorBeforeLiningUp) {
-  auto blackboard = bt::Blackboard::Create();
-  DoorVisit visit;
-  visit.door = "lab_door";
-  visit.operated_at = At(0.0);
-  blackboard->Set("door_visit", bt::Any(visit));
-  bt::Tree tree = Tree(R"(<TraverseDoor door="lab_door"/>)", blackboard);
-  belief_.X_MB = {1.15, 2.43, M_PI / 2};  // at the button's standoff, beside the lane
+  bt::Tree tree = TraverseAfterOwnPress({1.15, 2.43, M_PI / 2});  // at the button, by the lane
   // From behind and to the right, heading for the doorway's centre (0, 3) at 1.2 m/s.
   auto walker = node_testing::Person({1.9, 0.4}, perception::PersonIntent::kApproaching);
   const Eigen::Vector2d heading = (Eigen::Vector2d(0.0, 3.0) - walker.person.p_MP).normalized();
@@ -73,13 +67,7 @@ TEST_F(TraverseDoorTest, MakesWayForSomeoneWalkingUpToTheDoorBeforeLiningUp) {
 // Without give_way the robot lines up at once (the way it did before).
 TEST_F(TraverseDoorTest, WithoutGiveWayItLinesUpAtOnce) {
   services_.config.give_way = false;
-  auto blackboard = bt::Blackboard::Create();
-  DoorVisit visit;
-  visit.door = "lab_door";
-  visit.operated_at = At(0.0);
-  blackboard->Set("door_visit", bt::Any(visit));
-  bt::Tree tree = Tree(R"(<TraverseDoor door="lab_door"/>)", blackboard);
-  belief_.X_MB = {1.15, 2.43, M_PI / 2};
+  bt::Tree tree = TraverseAfterOwnPress({1.15, 2.43, M_PI / 2});
   auto walker = node_testing::Person({1.9, 0.4}, perception::PersonIntent::kApproaching);
   walker.person.v_MP = 1.2 * (Eigen::Vector2d(0.0, 3.0) - walker.person.p_MP).normalized();
   belief_.now = At(1.0);
