@@ -44,12 +44,14 @@ class ButtonType final : public TaskNode<bt::SyncActionNode> {
   }
 };
 
+std::pair<std::string, bt::PortInfo> HeadGazePort();
+
 class ApproachButton final : public TaskNode<bt::StatefulActionNode> {
  public:
   using TaskNode::TaskNode;
   static PortsList ProvidedPorts() {
     return {InputPort<std::string>("door", "door whose actuator to stand off (base facing it)"),
-            VisitPort(bt::PortDirection::kInOut),
+            VisitPort(bt::PortDirection::kInOut), HeadGazePort(),
             InputPort<bool>("door_speed", false,
                             "drive to the standoff at the door speed (TrajectoryConfig::"
                             "door_speed): a resident already waits at the door, or the escort, "
@@ -121,7 +123,7 @@ class ApproachButton final : public TaskNode<bt::StatefulActionNode> {
   }
   NodeStatus OnRunning() override {
     const auto note = [this](const std::string& s) { Note(s); };
-    WatchBehind();
+    if (Input<bool>("head_gaze")) WatchBehind();
     if (looking_until_) {
       if (const NodeStatus s = BaseMotionStatus(task_, note); s != NodeStatus::kSuccess) return s;
       if (belief_.now < *looking_until_) return NodeStatus::kRunning;
@@ -226,6 +228,15 @@ Pose2 WallAlignedPose(const TaskServices& task, const MapActuator& actuator,
   return corrected;
 }
 
+// The actuator nodes' `head_gaze` port: whether they turn the head (HeadGaze::WatchBehind while
+// at the actuator, HeadGaze::ExpectOpening while operating it).
+std::pair<std::string, bt::PortInfo> HeadGazePort() {
+  return InputPort<bool>("head_gaze", true,
+                         "at the actuator the head watches the laser's blind sector behind the "
+                         "robot, and looks through the door while the arm opens it; false: the "
+                         "tree looks by itself (EvacuationEscort's hold)");
+}
+
 // The actuator nodes' `to_pass` port (ActuatorAction::PressWaitsUntil).
 std::pair<std::string, bt::PortInfo> ToPassPort() {
   return InputPort<bool>("to_pass", true,
@@ -247,7 +258,8 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
       return NodeStatus::kFailure;
     }
     plan_ = *visit.button_plan;
-    WatchBehind();
+    head_gaze_ = Input<bool>("head_gaze");
+    if (head_gaze_) WatchBehind();
     alignments_ = 0;
     arm_started_ = false;
     waiting_out_ = false;
@@ -255,7 +267,7 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
     return AlignOrOperate();
   }
   NodeStatus OnRunning() override {
-    WatchBehind();
+    if (head_gaze_) WatchBehind();
     if (!arm_started_) {
       if (task_.motion->base_failed()) {
         Note("could not square up to the actuator: " + task_.motion->base_failure());
@@ -265,7 +277,7 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
       return AlignOrOperate();
     }
     // The arm is on its way to open the door: the head turns to look through it.
-    if (task_.gaze != nullptr)
+    if (task_.gaze != nullptr && head_gaze_)
       task_.gaze->ExpectOpening(Door(), belief_.now + SecondsToDuration(kLookRequestSec));
     // Seen shut after the arm set off (a closing leaf that closed during the stroke): this press
     // opens the door afresh, it restarts no window (H1 seed 2006: timed as a restart, the window
@@ -298,6 +310,7 @@ class ActuatorAction : public TaskNode<bt::StatefulActionNode> {
 
  private:
   RelocalizeGate gate_;
+  bool head_gaze_{true};                           // the `head_gaze` port, read at the start
   static constexpr double kAlignTolerance = 0.01;  // [m] base off its standoff
   static constexpr int kMaxAlignments = 2;
 
@@ -471,7 +484,7 @@ class PressButton final : public ActuatorAction {
   static PortsList ProvidedPorts() {
     return {InputPort<std::string>(
                 "door", "door whose push button to press (fingertip past the face by the stroke)"),
-            ToPassPort(), VisitPort(bt::PortDirection::kInOut)};
+            ToPassPort(), HeadGazePort(), VisitPort(bt::PortDirection::kInOut)};
   }
 };
 
@@ -483,7 +496,7 @@ class WaveAtPlate final : public ActuatorAction {
     return {
         InputPort<std::string>(
             "door", "door whose proximity plate to wave at (palm within its range, no contact)"),
-        ToPassPort(), VisitPort(bt::PortDirection::kInOut)};
+        ToPassPort(), HeadGazePort(), VisitPort(bt::PortDirection::kInOut)};
   }
 };
 

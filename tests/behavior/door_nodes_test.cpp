@@ -259,6 +259,23 @@ TEST_F(DoorNodesTest, AtTheButtonTheHeadWatchesBehindThenLooksThroughTheDoorTheP
   services_.gaze = nullptr;
 }
 
+// With head_gaze="false" (the escort's hold looks by itself) the press leaves the head alone.
+TEST_F(DoorNodesTest, APressWithoutHeadGazeLeavesTheHeadToTheTree) {
+  HeadGaze gaze;
+  services_.gaze = &gaze;
+  auto blackboard = bt::Blackboard::Create();
+  StandAtTheStandoff(blackboard, std::nullopt, 1.0, 0.0, perception::DoorMotion::kClosed);
+  belief_.now = At(20.0);
+  bt::Tree press = Tree(R"(<PressButton door="lab_door" head_gaze="false"/>)", blackboard);
+  ASSERT_EQ(press.TickOnce(), NodeStatus::kRunning);
+  ASSERT_TRUE(motion_.arm_moving(belief_.now));
+  belief_.now = At(20.1);
+  ASSERT_EQ(press.TickOnce(), NodeStatus::kRunning);
+  gaze.Update(belief_, 0.0);
+  EXPECT_EQ(gaze.reason(), GazeReason::kAhead);
+  services_.gaze = nullptr;
+}
+
 TEST_F(DoorNodesTest, APressOnADoorNotSeenClosedRestartsItsWindowFromTheHandsArrival) {
   for (const bool closed : {true, false}) {
     auto blackboard = bt::Blackboard::Create();
