@@ -48,10 +48,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
       // Out of the way of anyone walking up to the door first: the line-up crosses the
       // approach to the doorway (P1: someone walking up behind the robot at the button to go
       // through met it driving to the lane's edge, 0.38 m off).
-      if (task_.config.give_way && give_way_.Begin(task_, std::nullopt, WayNoter())) {
-        phase_ = Phase::kGivingWay;
-        return NodeStatus::kRunning;
-      }
+      if (GiveWayIfComing()) return NodeStatus::kRunning;
       if (const NodeStatus s = StartLineUp(); s != NodeStatus::kRunning) return s;
     }
     return OnRunning();
@@ -63,14 +60,10 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
         if (give_way_.Update(task_, std::nullopt, Input<double>("wait_timeout"), note) ==
             NodeStatus::kRunning)
           return NodeStatus::kRunning;
-        if (const NodeStatus s = StartLineUp(); s != NodeStatus::kRunning) return s;
-        return NodeStatus::kRunning;
+        return StartLineUp();
       }
       case Phase::kToPeek: {
-        if (task_.config.give_way && give_way_.Begin(task_, std::nullopt, note)) {
-          phase_ = Phase::kGivingWay;
-          return NodeStatus::kRunning;
-        }
+        if (GiveWayIfComing()) return NodeStatus::kRunning;
         const NodeStatus s = DriveStatus(task_, note, true);
         if (s != NodeStatus::kSuccess) return s;
         phase_ = Phase::kPeeking;
@@ -78,10 +71,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
         [[fallthrough]];
       }
       case Phase::kPeeking: {
-        if (task_.config.give_way && give_way_.Begin(task_, std::nullopt, note)) {
-          phase_ = Phase::kGivingWay;
-          return NodeStatus::kRunning;
-        }
+        if (GiveWayIfComing()) return NodeStatus::kRunning;
         if (const NodeStatus arm = ArmMotionStatus(task_, note); arm != NodeStatus::kSuccess)
           return arm;
         const Eigen::Vector2d entry = EntryPoint();
@@ -359,8 +349,13 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
            ToSeconds(belief_.now - d->state.stamp) < kOperatorOpeningTime;
   }
 
-  NoteFn WayNoter() {
-    return [this](const std::string& t) { Note(t); };
+  // Starts making way (phase kGivingWay) if someone is coming (TaskConfig::give_way).
+  bool GiveWayIfComing() {
+    if (!task_.config.give_way ||
+        !give_way_.Begin(task_, std::nullopt, [this](const std::string& t) { Note(t); }))
+      return false;
+    phase_ = Phase::kGivingWay;
+    return true;
   }
 
   // kGivingWay: making way for people walking up before the line-up (WayGiver).

@@ -13,6 +13,15 @@ using node_testing::At;
 
 class DoorNodesTest : public node_testing::TaskNodeFixture {
  protected:
+  // The head (gaze_) in the services; the robot at the standoff of the shut lab door at 20 s
+  // (StandAtTheStandoff). Returns the blackboard with the visit.
+  bt::Blackboard::Ptr AtTheShutDoorsStandoffWithAHead() {
+    services_.gaze = &gaze_;
+    auto blackboard = bt::Blackboard::Create();
+    StandAtTheStandoff(blackboard, std::nullopt, 1.0, 0.0, perception::DoorMotion::kClosed);
+    belief_.now = At(20.0);
+    return blackboard;
+  }
   // ApproachButton from (0, 1) puts its plan in the visit on `blackboard` (with `operated_at`, an
   // earlier press, if given); the leaf is last seen at `seen_at` [s], at `angle_deg` and
   // `motion`, and not since (from beside the actuator it is behind the jamb); then the robot
@@ -36,6 +45,7 @@ class DoorNodesTest : public node_testing::TaskNodeFixture {
     motion_.StopBase();
     return visit;
   }
+  HeadGaze gaze_;
 };
 
 TEST_F(DoorNodesTest, ButtonTypeWritesTheActuatorKindOfThisSide) {
@@ -221,13 +231,9 @@ TEST_F(DoorNodesTest, AWaveWithTheHandLeftAtThePlateTakesItAwayFirst) {
 // look behind, the head takes 4 s to come round; the leaf opens in ~3): HeadGaze takes the shut
 // door as opening while the press lasts.
 TEST_F(DoorNodesTest, AtTheButtonTheHeadWatchesBehindThenLooksThroughTheDoorThePressOpens) {
-  HeadGaze gaze;
-  services_.gaze = &gaze;
-  auto blackboard = bt::Blackboard::Create();
-  StandAtTheStandoff(blackboard, std::nullopt, 1.0, 0.0, perception::DoorMotion::kClosed);
-  belief_.now = At(20.0);
-  gaze.Update(belief_, 0.0);
-  EXPECT_EQ(gaze.reason(), GazeReason::kAhead) << "a shut door: nothing to see through";
+  const auto blackboard = AtTheShutDoorsStandoffWithAHead();
+  gaze_.Update(belief_, 0.0);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kAhead) << "a shut door: nothing to see through";
   // The laser sees the wall 0.4 m ahead across the camera's view.
   LaserScan wall;
   wall.angle_min = -M_PI / 4;
@@ -238,8 +244,8 @@ TEST_F(DoorNodesTest, AtTheButtonTheHeadWatchesBehindThenLooksThroughTheDoorTheP
   {
     bt::Tree squaring_up = Tree(R"(<PressButton door="lab_door"/>)", blackboard);
     ASSERT_EQ(squaring_up.TickOnce(), NodeStatus::kRunning);
-    gaze.Update(belief_, 0.0);
-    EXPECT_EQ(gaze.reason(), GazeReason::kBehind) << "at the actuator, facing its wall";
+    gaze_.Update(belief_, 0.0);
+    EXPECT_EQ(gaze_.reason(), GazeReason::kBehind) << "at the actuator, facing its wall";
   }
   belief_.scan.reset();  // (the base squared up: no more laser correction)
   motion_.StopBase();
@@ -248,32 +254,26 @@ TEST_F(DoorNodesTest, AtTheButtonTheHeadWatchesBehindThenLooksThroughTheDoorTheP
   ASSERT_TRUE(motion_.arm_moving(belief_.now));
   belief_.now = At(20.1);
   ASSERT_EQ(press.TickOnce(), NodeStatus::kRunning);
-  gaze.Update(belief_, 0.0);
-  EXPECT_EQ(gaze.reason(), GazeReason::kDoor);
+  gaze_.Update(belief_, 0.0);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kDoor);
   // The press over, the door still read shut: the expectation lapses.
   belief_.now = At(40.0);
   ASSERT_EQ(press.TickOnce(), NodeStatus::kSuccess);
   belief_.now = At(40.0 + detail::kLookRequestSec + 0.1);
-  gaze.Update(belief_, 0.0);
-  EXPECT_EQ(gaze.reason(), GazeReason::kAhead) << "away from the actuator's task: no look behind";
-  services_.gaze = nullptr;
+  gaze_.Update(belief_, 0.0);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kAhead) << "away from the actuator's task: no look behind";
 }
 
 // With head_gaze="false" (the escort's hold looks by itself) the press leaves the head alone.
 TEST_F(DoorNodesTest, APressWithoutHeadGazeLeavesTheHeadToTheTree) {
-  HeadGaze gaze;
-  services_.gaze = &gaze;
-  auto blackboard = bt::Blackboard::Create();
-  StandAtTheStandoff(blackboard, std::nullopt, 1.0, 0.0, perception::DoorMotion::kClosed);
-  belief_.now = At(20.0);
+  const auto blackboard = AtTheShutDoorsStandoffWithAHead();
   bt::Tree press = Tree(R"(<PressButton door="lab_door" head_gaze="false"/>)", blackboard);
   ASSERT_EQ(press.TickOnce(), NodeStatus::kRunning);
   ASSERT_TRUE(motion_.arm_moving(belief_.now));
   belief_.now = At(20.1);
   ASSERT_EQ(press.TickOnce(), NodeStatus::kRunning);
-  gaze.Update(belief_, 0.0);
-  EXPECT_EQ(gaze.reason(), GazeReason::kAhead);
-  services_.gaze = nullptr;
+  gaze_.Update(belief_, 0.0);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kAhead);
 }
 
 TEST_F(DoorNodesTest, APressOnADoorNotSeenClosedRestartsItsWindowFromTheHandsArrival) {
