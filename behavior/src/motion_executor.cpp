@@ -78,6 +78,7 @@ void MotionExecutor::FollowPath(const std::vector<Pose2>& path,
                     now);
   base_active_ = true;
   path_ = path;
+  brisk_step_ = brisk;
   base_failed_ = false;
   base_failure_.clear();
   bug_.reset();
@@ -90,6 +91,7 @@ void MotionExecutor::FollowBug(const Pose2& X_MB, const Eigen::Vector2d& p_MGoal
   bug_last_step_ = now;
   base_active_ = true;
   path_ = {X_MB, {p_MGoal.x(), p_MGoal.y(), X_MB.yaw}};
+  brisk_step_ = false;
   base_failed_ = false;
   base_failure_.clear();
 }
@@ -105,6 +107,7 @@ void MotionExecutor::StopBase() {
   bug_.reset();
   base_active_ = false;
   path_.clear();
+  brisk_step_ = false;
 }
 
 void MotionExecutor::MoveArm(const std::vector<std::pair<double, ArmPose>>& knots, Time now) {

@@ -136,21 +136,29 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
             VisitPort(bt::PortDirection::kInput), RetreatingPort(bt::PortDirection::kOutput)};
   }
   NodeStatus OnStart() override {
-    task_.motion->StopBase();
     failure_noted_ = false;
     looked_back_ = false;
     looking_back_until_.reset();
     started_ = belief_.now;
+    pending_ = Input<bool>("back_off") && belief_.last_safe &&
+               (belief_.last_safe->translation() - belief_.X_MB.translation()).norm() > 0.05;
+    // With nothing to back off to, a step out of someone's way under way (TraverseDoor's, halted
+    // as they entered the door zone) is let end: it is the standby's own making way.
+    const bool stepping = !pending_ && task_.motion->stepping_out_of_way();
+    make_way_pending_ = !pending_ && !stepping && task_.config.give_way;
+    if (!stepping) task_.motion->StopBase();
     if (!ArmAt(task_.motion->arm_target(), TuckedArm(*task_.model)) ||
         task_.motion->arm_moving(belief_.now)) {
       task_.motion->MoveArm({{task_.config.arm_tuck_time, TuckedArm(*task_.model)}}, belief_.now);
       Note("tucking the arm");
     }
-    pending_ = Input<bool>("back_off") && belief_.last_safe &&
-               (belief_.last_safe->translation() - belief_.X_MB.translation()).norm() > 0.05;
     if (pending_) {
       this->SetOutput("retreating", true);
       StartRetreatOnceStopped();
+    }
+    if (stepping) {
+      this->SetOutput("retreating", true);
+      Note("going on with the step out of people's way");
     }
     return NodeStatus::kRunning;
   }
@@ -158,6 +166,11 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
     if (pending_) {
       StartRetreatOnceStopped();
       return NodeStatus::kRunning;
+    }
+    if (make_way_pending_) {
+      if (!StoppedOrStopTimedOut(task_, started_)) return NodeStatus::kRunning;
+      make_way_pending_ = false;
+      MakeWayInPlace();
     }
     if (task_.motion->base_failed() && !failure_noted_) {
       // Blocked: stay, arm tucked.
@@ -172,12 +185,38 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
   void OnHalted() override {
     task_.motion->StopBase();
     pending_ = false;
+    make_way_pending_ = false;
     this->SetOutput("retreating", false);
   }
 
  private:
   // How far ahead people's paths are predicted [s].
   static constexpr double kPeopleHorizonSec = 3.0;
+
+  // Nothing to back off to (the robot stands where it was last safe: at an actuator beside the
+  // lane, say): while the arm tucks it makes way for anyone walking at it, or through the visited
+  // door, as WaitForClear would after it — but the tuck takes 1.5 s, and a walker has passed by
+  // then (P1: someone walking up behind the robot at the button to the door it opened; a step
+  // aside under way as the door zone filled was stopped by this standby).
+  void MakeWayInPlace() {
+    const std::optional<DoorVisit> visit = Shared<DoorVisit>("visit");
+    PeopleHypotheses hypotheses;
+    if (visit && task_.map->FindDoor(visit->door) != nullptr) hypotheses.through_door = visit->door;
+    const double horizon = 2.0 * task_.config.give_way_horizon;  // as MakeWaySpot's
+    const bool coming = !PeopleComing(task_, std::nullopt).empty();
+    const bool through = !hypotheses.through_door.empty() &&
+                         RoomAt(ThroughDoorWays(task_, hypotheses.through_door, horizon),
+                                belief_.X_MB.translation()) <
+                             task_.config.footprint_radius + task_.config.comfort_distance;
+    if (!coming && !through) return;
+    const auto spot = MakeWaySpot(task_, kMakeWayMinGainM, hypotheses);
+    if (!spot) return;
+    StepAsideTo(task_, *spot);
+    this->SetOutput("retreating", true);
+    Note(StrCat("making way for ", coming ? "someone coming" : "whoever comes through the doorway",
+                ": stepping aside to (", PoseText(*spot), ")"),
+         DecisionEvent::kRetreating);
+  }
 
   void StartRetreatOnceStopped() {
     if (!StoppedOrStopTimedOut(task_, started_)) return;
@@ -343,6 +382,7 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
   static constexpr double kLookBackDwellSec = 0.5;
 
   bool pending_{false};
+  bool make_way_pending_{false};  ///< MakeWayInPlace once the base has stopped
   bool failure_noted_{false};
   bool looked_back_{false};
   std::optional<Time> looking_back_until_;  ///< turning to see the way back until then, at least

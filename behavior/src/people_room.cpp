@@ -80,11 +80,18 @@ std::vector<Occupant> ThroughDoorWays(const TaskServices& task, const std::strin
     const perception::TrackedPerson& person = entry.person;
     const Eigen::Vector2d to_centre = pass.centre - person.p_MP;
     const double distance = to_centre.norm();
+    if (distance < 1e-6 || IsHoldingDoorAside(task, entry, door)) continue;
+    const double towards = person.v_MP.dot(to_centre / distance);
     const bool far_side = -to_centre.dot(pass.n_M) < 0.0;
-    if (distance > kThroughDoorRadiusM || !(far_side || zone.Contains(person.p_MP)) ||
-        IsHoldingDoorAside(task, entry, door) ||
-        (distance > 1e-6 && person.v_MP.dot(to_centre / distance) < -PeopleRoom::kSidestepMinMps))
+    // Out of the zone on the robot's side, only someone walking at the opening goes through it
+    // (P1: walking up behind the robot at the button to the door it opened, tracked straight on,
+    // they turned into the doorway and passed 0.65 m off the robot that had found no better
+    // spot): to the far side.
+    const bool inward = !far_side && !zone.Contains(person.p_MP);
+    if (inward ? distance > kIntoDoorRadiusM || towards < PeopleRoom::kSidestepMinMps
+               : distance > kThroughDoorRadiusM || towards < -PeopleRoom::kSidestepMinMps)
       continue;
+    const Eigen::Vector2d n_MOn = inward ? Eigen::Vector2d(-pass.n_M) : pass.n_M;
     const double speed = std::max(person.v_MP.norm(), kWalkingMps);
     // To the middle of the opening, then on along the normal (walls turning the way).
     const double t_centre = distance / speed;
@@ -97,7 +104,7 @@ std::vector<Occupant> ThroughDoorWays(const TaskServices& task, const std::strin
     if (k * step > horizon + 1e-9) continue;
     const std::size_t first = ways.size();
     AppendPredictedWay(task, at, PeopleRoom::kPeopleLookM, horizon - t_centre, step, 0, pass.centre,
-                       pass.n_M * speed, ways);
+                       n_MOn * speed, ways);
     for (std::size_t i = first; i < ways.size(); ++i)
       ways[i].t += t_centre;
   }
@@ -117,10 +124,13 @@ PeopleRoom::PeopleRoom(const TaskServices& task, double horizon, PeopleHypothese
       predicted_(PeopleAround(task, at_, kPeopleLookM, horizon, kPeopleStepSec)),
       now_(PeopleAround(task, at_, kPeopleLookM, 0.0, 0.0)) {
   const bool sidestep = hypotheses.sidestep;
+  // A way through a doorway's middle is where they must go: no room for stepping off it.
+  const std::size_t through_first = predicted_.size();
   if (!hypotheses.through_door.empty()) {
     const std::vector<Occupant> through = ThroughDoorWays(task, hypotheses.through_door, horizon);
     predicted_.insert(predicted_.end(), through.begin(), through.end());
   }
+  const std::size_t through_end = predicted_.size();
   if (hypotheses.head_on) {
     for (const auto& entry : task.belief->world.people) {
       const Eigen::Vector2d to_robot = at_ - entry.person.p_MP;
@@ -135,12 +145,14 @@ PeopleRoom::PeopleRoom(const TaskServices& task, double horizon, PeopleHypothese
   }
   const perception::Costmap2D* costmap = task.belief->world.costmap;
   const double body = task.config.person_radius;
-  for (const Occupant& o : predicted_) {
+  for (std::size_t i = 0; i < predicted_.size(); ++i) {
+    const Occupant& o = predicted_[i];
+    const bool through = i >= through_first && i < through_end;
     std::pair<Eigen::Vector2d, Eigen::Vector2d> ends{o.p_M, o.p_M};
     const double speed = o.v_M.norm();
     const double reach =
         std::min(task.config.person_sidestep, task.config.person_sidestep_speed * o.t);
-    if (sidestep && o.radius > 0.0 && speed >= kSidestepMinMps && reach > 0.0) {
+    if (sidestep && !through && o.radius > 0.0 && speed >= kSidestepMinMps && reach > 0.0) {
       const Eigen::Vector2d across = Eigen::Vector2d(-o.v_M.y(), o.v_M.x()) / speed;
       // As far to each side as the walls leave the body room.
       const auto side = [&](double sign) {
@@ -389,11 +401,12 @@ bool WayGiver::Begin(const TaskServices& task, const std::optional<Pose2>& goal,
 }
 
 NodeStatus WayGiver::Update(const TaskServices& task, const std::optional<Pose2>& goal,
-                            double patience, const NoteFn& note) {
+                            double patience, const NoteFn& note,
+                            const PeopleHypotheses& hypotheses) {
   const Time now = task.belief->now;
   if (!chosen_ && StoppedOrStopTimedOut(task, *since_)) {
     chosen_ = true;
-    if (const auto spot = MakeWaySpot(task, kMakeWayMinGainM)) {
+    if (const auto spot = MakeWaySpot(task, kMakeWayMinGainM, hypotheses)) {
       StepAsideTo(task, *spot);
       note(StrCat("stepping aside to (", PoseText(*spot), ")"));
     } else {

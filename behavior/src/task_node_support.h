@@ -245,15 +245,23 @@ struct Occupant {
 /// there), and the latest scan's returns off the map.
 std::vector<Occupant> PeopleAround(const TaskServices& task, const Eigen::Vector2d& at, double look,
                                    double horizon, double step);
-/// [m] People this near a door's opening, on its far side, may come through it (ThroughDoorWays).
+/// [m] People this near a door's opening may go through it (ThroughDoorWays).
 inline constexpr double kThroughDoorRadiusM = 3.0;
-/// The ways of the people within kThroughDoorRadiusM of `door`'s opening on its far side from
-/// the robot, or in its zone (not holding it aside, not walking away from the opening faster
-/// than PeopleRoom::kSidestepMinMps), if they walk through the middle of the opening and on
-/// straight along the door's normal to the robot's side, at their speed or kWalkingMps if
-/// faster: every PeopleRoom::kPeopleStepSec up to `horizon` [s], from the first step on (where
-/// they are now is their tracked way's). People walk through a doorway's middle, not along the
-/// line they happen to walk on (S2: a crosser tracked 0.27 m off the axis passed 0.12 m off it).
+/// [m] People on the robot's side walking at a door's opening this near it may go through it
+/// (ThroughDoorWays): as far as people round the robot count (PeopleRoom::kPeopleLookM; P1's
+/// walker, coming up behind the robot at the button, was 3.0 m from the opening when the robot
+/// chose where to make way).
+inline constexpr double kIntoDoorRadiusM = 5.0;
+/// The ways of the people near `door`'s opening (not holding it aside) who may go through it:
+/// within kThroughDoorRadiusM on its far side from the robot, or in its zone, unless walking away
+/// from the opening faster than PeopleRoom::kSidestepMinMps, to the robot's side; within
+/// kIntoDoorRadiusM on the robot's side out of the zone, walking at the opening at least that
+/// fast, to the far side. Each walks
+/// through the middle of the opening and on straight along the door's normal, at their speed or
+/// kWalkingMps if faster: every PeopleRoom::kPeopleStepSec up to `horizon` [s], from the first
+/// step on (where they are now is their tracked way's). People walk through a doorway's middle,
+/// not along the line they happen to walk on (S2: a crosser tracked 0.27 m off the axis passed
+/// 0.12 m off it).
 /// @throws InvalidArgument for an unknown door.
 std::vector<Occupant> ThroughDoorWays(const TaskServices& task, const std::string& door,
                                       double horizon);
@@ -299,7 +307,9 @@ std::optional<Eigen::Vector2d> NearestOnGrid(const Eigen::Vector2d& p_MFrom,
 struct PeopleHypotheses {
   /// People walking past step round the robot (TaskConfig::person_sidestep): each predicted
   /// position is a short segment across the walk, and the room a spot leaves a person is from
-  /// its far end.
+  /// its far end. Not on a way through a doorway's middle (through_door): that is where they
+  /// must go (P1: judged to step round the robot beside the opening, a walker passed it
+  /// 0.64 m off).
   bool sidestep{false};
   /// Anyone walking within PeopleRoom::kHeadOnRadiusM and coming nearer may also walk on straight
   /// through the robot's place, at their speed: a velocity tracked while they veer round the robot
@@ -307,8 +317,8 @@ struct PeopleHypotheses {
   /// they skirted the halted robot, went on west; the retreat chose a spot 1 m west, across
   /// their way, and the robot drove into them).
   bool head_on{false};
-  /// A door's id (empty: none): anyone near it on its far side, or in its zone, may also walk
-  /// through it to the robot's side (ThroughDoorWays): someone dawdling in a doorway as the leaf
+  /// A door's id (empty: none): anyone near it who may go through it may also walk through its
+  /// middle (ThroughDoorWays), either way: someone dawdling in a doorway as the leaf
   /// opens reads as standing until they stride out (S2: the crosser read 0.2-0.3 m/s in the
   /// doorway for 1.5 s, then passed the waiting robot 0.69 m off).
   std::string through_door{};
@@ -422,7 +432,8 @@ void StepAsideTo(const TaskServices& task, const Pose2& spot);
 /// to MakeWaySpot (or stands still if no spot leaves more room), and reports SUCCESS
 /// give_way_clear_for after the last person seen coming has passed (by their last prediction,
 /// at most kMaxPassSec ahead: a person the camera loses behind another is still coming), or
-/// after `patience` [s]; RUNNING until then.
+/// after `patience` [s]; RUNNING until then. `hypotheses`: what people may do beyond walking on
+/// (MakeWaySpot's).
 class WayGiver {
  public:
   /// [s] A slow walker far off is not waited for longer than this.
@@ -431,7 +442,7 @@ class WayGiver {
   /// `goal`: whom the robot goes to, there, is not made way for (PeopleComing).
   bool Begin(const TaskServices& task, const std::optional<Pose2>& goal, const NoteFn& note);
   NodeStatus Update(const TaskServices& task, const std::optional<Pose2>& goal, double patience,
-                    const NoteFn& note);
+                    const NoteFn& note, const PeopleHypotheses& hypotheses = {});
   bool active() const { return since_.has_value(); }
   void Reset() { since_.reset(); }
 

@@ -89,6 +89,25 @@ TEST(MotionExecutorTest, ABriskPathSetsOffAtTheBasesLimit) {
   EXPECT_DOUBLE_EQ(brisk_duration, gentle_duration);
 }
 
+// A brisk path is a step out of someone's way until it is stopped or another path replaces it.
+TEST(MotionExecutorTest, ABriskPathIsAStepOutOfTheWayUntilStoppedOrReplaced) {
+  const RobotModel model = RobotModel::LoadDefault();
+  MotionExecutor motion(model);
+  const std::vector<Pose2> path{{0.0, 0.0, 0.0}, {1.0, 0.0, 0.0}};
+  EXPECT_FALSE(motion.stepping_out_of_way());
+  motion.FollowPath(path, {false}, TuckedArm(model), Time{}, 0.4, /*brisk=*/true);
+  EXPECT_TRUE(motion.stepping_out_of_way());
+  motion.StopBase();
+  EXPECT_FALSE(motion.stepping_out_of_way());
+  motion.FollowPath(path, {false}, TuckedArm(model), Time{}, 0.4, /*brisk=*/true);
+  motion.FollowPath(path, {false}, TuckedArm(model), Time{}, 0.4, /*brisk=*/false);
+  EXPECT_FALSE(motion.stepping_out_of_way());
+  EXPECT_TRUE(motion.base_moving());
+  motion.FollowPath(path, {false}, TuckedArm(model), Time{}, 0.4, /*brisk=*/true);
+  motion.FollowBug({0.0, 0.0, 0.0}, {4.0, 0.0}, planning::BugConfig{}, Time{});
+  EXPECT_FALSE(motion.stepping_out_of_way());
+}
+
 }  // namespace
 }  // namespace egress::behavior
 

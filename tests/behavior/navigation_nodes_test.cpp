@@ -390,6 +390,12 @@ TEST_F(NavigationNodesTest, RetractToSafeStepsWhereItGetsBeforeAFastWalkerDoes) 
   EXPECT_GT(std::abs(spot.x()), 0.4) << "aside, out of the walker's way";
   EXPECT_LT((spot - belief_.X_MB.translation()).norm(), 1.2)
       << "a near spot it reaches in time, not one of the 1.5 m ring";
+  // The retreat under way is not restarted as a make-way in place (that is for a standby with
+  // nothing to back off to): the path stays.
+  belief_.now = At(1.1);
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_FALSE(NotedText("making way for"));
+  EXPECT_LT((motion_.path().back().translation() - spot).norm(), 1e-9);
   // The same walker at a stroll, 1.6 m nearer in 3 s: they pass nowhere near the last safe pose,
   // which the robot backs off to.
   motion_.StopBase();
@@ -563,6 +569,59 @@ TEST_F(NavigationNodesTest, RetractToSafeWithNowhereToBackOffSqueezesAsideOutOfT
       retreat_with({behind, waiting, Person({1.15, 2.4}, perception::PersonIntent::kStationary)});
   EXPECT_TRUE(NotedText("standing still"));
   EXPECT_FALSE(motion_.base_moving());
+}
+
+// Nothing to back off to (the robot stands where it was last safe, at the button beside the
+// lane): once stopped it steps out of the way of someone walking at it or through the visited
+// door, as WaitForClear would after the 1.5 s tuck, by when they have passed (P1). A step out of
+// someone's way already under way (TraverseDoor's, halted as they entered the door zone) it lets
+// end; any other drive it stops. Nobody coming: it stands.
+TEST_F(NavigationNodesTest, RetractToSafeInPlaceMakesWayAndLetsAStepOutOfTheWayEnd) {
+  const Pose2 at_button{1.15, 2.43, M_PI / 2};
+  const auto standby_with = [&](std::vector<perception::TrackedPersonWithIntent> people) {
+    log_.Take();
+    motion_.StopBase();
+    bt::Tree tree = Tree(R"(<RetractToSafe/>)", VisitFromTheSouth());
+    belief_.X_MB = at_button;
+    belief_.last_safe = at_button;
+    belief_.world.people = std::move(people);
+    belief_.now = At(1.0);
+    EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+    belief_.now = At(1.1);
+    tree.TickOnce();  // stopped: makes way, or (arm tucked, base idle) is done
+    return tree;      // kept: a tree destroyed halts its nodes, and the standby stops the base
+  };
+  // From behind and to the right, heading for the doorway's middle (0, 3) at 1.2 m/s.
+  auto walker = Person({1.9, 0.4}, perception::PersonIntent::kApproaching);
+  walker.person.v_MP = 1.2 * (Eigen::Vector2d(0.0, 3.0) - walker.person.p_MP).normalized();
+  bt::Tree making_way = standby_with({walker});
+  EXPECT_TRUE(NotedText("making way for"));
+  EXPECT_TRUE(Noted(DecisionEvent::kRetreating));
+  ASSERT_TRUE(motion_.stepping_out_of_way());
+  EXPECT_GT(motion_.path().back().x, at_button.x + 0.3) << "away from the lane";
+  making_way.HaltTree();
+
+  bt::Tree standing = standby_with({});
+  EXPECT_FALSE(NotedText("making way for"));
+  EXPECT_FALSE(motion_.base_moving());
+  standing.HaltTree();
+
+  // A step aside under way goes on; a drive that is not one is stopped.
+  for (const bool brisk : {true, false}) {
+    log_.Take();
+    const Pose2 aside{1.9, 2.43, M_PI / 2};
+    motion_.FollowPath({at_button, aside}, {false}, motion_.arm_target(), At(2.0),
+                       services_.config.retreat_speed, brisk);
+    bt::Tree tree = Tree(R"(<RetractToSafe/>)", VisitFromTheSouth());
+    belief_.now = At(2.1);
+    EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+    EXPECT_EQ(motion_.base_moving(), brisk);
+    EXPECT_EQ(NotedText("going on with the step"), brisk);
+    if (brisk) {
+      EXPECT_LT((motion_.path().back().translation() - aside.translation()).norm(), 1e-9);
+    }
+    tree.HaltTree();
+  }
 }
 
 // Halted just past the door line, having left the door's zone on the far side before (its last

@@ -239,8 +239,7 @@ TEST_F(PeopleRoomTest, SomeoneNearComingNearerMayWalkStraightThroughTheRobotsPla
 // People near a door's far side (or in its zone) may walk through the middle of its opening and
 // on to the robot's side: the way goes through the opening's middle whatever line they walk on
 // now, then along the normal, at their speed (or a walker's, if they dawdle). Nobody walking
-// away from the opening, on the robot's side outside the zone, or farther than
-// kThroughDoorRadiusM has such a way.
+// away from the opening, or farther than kThroughDoorRadiusM, has such a way.
 TEST(ThroughDoorWaysTest, PeopleNearADoorsFarSideWalkThroughTheMiddleOfItsOpening) {
   const MissionMap map = node_testing::LabDoor();  // door line y = 3, the middle at (0, 3)
   Belief belief;
@@ -280,9 +279,47 @@ TEST(ThroughDoorWaysTest, PeopleNearADoorsFarSideWalkThroughTheMiddleOfItsOpenin
   EXPECT_NEAR(dawdling.back().p_M.y(), 3.2 - kWalkingMps * dawdling.back().t, 1e-9);
 
   EXPECT_TRUE(ways_of({-0.3, 4.5}, {0.0, 0.8}).empty()) << "walking away from the opening";
-  EXPECT_TRUE(ways_of({1.5, 1.0}, {0.0, 0.8}).empty()) << "on the robot's side, off the zone";
   EXPECT_TRUE(ways_of({0.0, 3.0 + kThroughDoorRadiusM + 0.2}, {0.0, -1.0}).empty()) << "far";
+
+  // On the robot's side, off the zone: only someone walking at the opening goes through it, and
+  // on to the far side (P1: walking up behind the robot at the button, into the doorway).
+  const std::vector<Occupant> inward = ways_of({1.5, 1.0}, {0.0, 0.8});
+  ASSERT_FALSE(inward.empty());
+  const double to_opening = std::hypot(1.5, 2.0);
+  for (const Occupant& o : inward)
+    if (o.t > to_opening / 0.8 + 1e-9) {
+      EXPECT_NEAR(o.p_M.x(), 0.0, 1e-9) << "along the normal after the middle";
+      EXPECT_NEAR(o.p_M.y(), 3.0 + 0.8 * (o.t - to_opening / 0.8), 1e-9) << "to the far side";
+    }
+  EXPECT_GT(inward.back().p_M.y(), 3.0 + 0.5);
+  EXPECT_TRUE(ways_of({1.5, 1.0}, {0.8, 0.0}).empty()) << "walking along, not at the opening";
+  EXPECT_TRUE(ways_of({1.5, 1.0}, {0.0, 0.2}).empty()) << "slower than kSidestepMinMps";
+  EXPECT_TRUE(ways_of({0.0, 3.0 - kIntoDoorRadiusM - 0.2}, {0.0, 1.0}).empty()) << "far";
+  EXPECT_FALSE(ways_of({0.0, 3.0 - kIntoDoorRadiusM + 0.2}, {0.0, 1.0}).empty());
   EXPECT_THROW(ThroughDoorWays(task, "no_such_door", 4.0), InvalidArgument);
+}
+
+// A way through a doorway's middle is where they must go: PeopleRoom grants it no sidestep (P1:
+// the robot beside the opening judged a walker coming up behind it would step round it, stood,
+// and was passed 0.64 m off). Their tracked way keeps its sidestep.
+TEST_F(PeopleRoomTest, AWayThroughADoorwaysMiddleHasNoRoomToStepOff) {
+  Stepping stepping(*this);
+  stepping.map = node_testing::LabDoor();  // door line y = 3, the middle at (0, 3)
+  belief_.world.costmap = nullptr;         // the lab door's open floor, not the corridor
+  belief_.X_MB = {1.0, 2.4, M_PI / 2};
+  // Dawdling in the doorway: through the middle and down x = 0 at a walker's pace.
+  belief_.world.people = {Walker({0.0, 3.2}, {0.0, -0.1})};
+  const Eigen::Vector2d on_the_way(0.0, 2.0);
+  const PeopleRoom through(task_, 4.0, {.sidestep = true, .through_door = "lab_door"});
+  const PeopleRoom tracked(task_, 4.0, {.sidestep = true});
+  EXPECT_LT(through.Predicted(on_the_way), 0.0) << "no step off the way through the middle";
+  EXPECT_GT(tracked.Predicted(on_the_way), 0.3) << "the tracked way stops short of it";
+  // Walking down x = 0 at 1 m/s, tracked: they may step round a spot on their way.
+  belief_.world.people = {Walker({0.0, 4.5}, {0.0, -1.0})};
+  const PeopleRoom walking(task_, 4.0, {.sidestep = true, .through_door = "lab_door"});
+  const PeopleRoom straight(task_, 4.0, {.through_door = "lab_door"});
+  EXPECT_LT(walking.Predicted(on_the_way), 0.0) << "the way through the middle is on it";
+  EXPECT_NEAR(walking.Predicted(on_the_way), straight.Predicted(on_the_way), 1e-9);
 }
 
 // The base has stopped below kStoppedMps, or is given kStopWithinSec to.

@@ -64,6 +64,43 @@ TEST_F(TraverseDoorTest, MakesWayForSomeoneWalkingUpToTheDoorBeforeLiningUp) {
   EXPECT_TRUE(NotedText("lane's edge") || NotedText("lining up"));
 }
 
+// The same walker: they may be going through the door, so the robot, standing by the lane,
+// steps away from it rather than stand where they would pass it within comfort_distance (P1:
+// judged to step round the robot, they passed it 0.64 m off). Halted as they enter the door
+// zone, the node lets the step end (the executive stops the base when it halts the whole tree);
+// any other drive it stops.
+TEST_F(TraverseDoorTest, StepsAwayFromTheLaneForSomeoneWalkingUpAndLetsTheStepEndWhenHalted) {
+  const Pose2 at_button{1.15, 2.43, M_PI / 2};
+  bt::Tree tree = TraverseAfterOwnPress(at_button);
+  auto walker = node_testing::Person({1.9, 0.4}, perception::PersonIntent::kApproaching);
+  const Eigen::Vector2d heading = (Eigen::Vector2d(0.0, 3.0) - walker.person.p_MP).normalized();
+  walker.person.v_MP = 1.2 * heading;
+  for (double t = 1.0; t < 2.0 && !motion_.stepping_out_of_way(); t += 0.1) {
+    belief_.now = At(t);
+    DoorSeenOpen(80.0, 0.0);
+    See({walker});
+    EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  }
+  ASSERT_TRUE(motion_.stepping_out_of_way());
+  EXPECT_TRUE(NotedText("stepping aside"));
+  EXPECT_GT(motion_.path().back().x, at_button.x + 0.3) << "away from the lane";
+  tree.HaltTree();
+  EXPECT_TRUE(motion_.stepping_out_of_way()) << "the step goes on";
+
+  // Lining up (nobody coming): halted, it stops.
+  motion_.StopBase();
+  log_.Take();
+  bt::Tree lining_up = TraverseAfterOwnPress(at_button);
+  belief_.now = At(3.0);
+  DoorSeenOpen(80.0, 0.0);
+  See({});
+  EXPECT_EQ(lining_up.TickOnce(), NodeStatus::kRunning);
+  ASSERT_TRUE(motion_.base_moving());
+  ASSERT_FALSE(motion_.stepping_out_of_way());
+  lining_up.HaltTree();
+  EXPECT_FALSE(motion_.base_moving());
+}
+
 // Without give_way the robot lines up at once (the way it did before).
 TEST_F(TraverseDoorTest, WithoutGiveWayItLinesUpAtOnce) {
   services_.config.give_way = false;

@@ -92,6 +92,8 @@ class MotionExecutor {
 
   const planning::TrajectoryConfig& trajectory_config() const { return trajectory_config_; }
   bool base_moving() const { return base_active_; }
+  /// The base is on a path given with `brisk` (a step out of someone's way, a retreat).
+  bool stepping_out_of_way() const { return base_active_ && brisk_step_; }
   /// The path being followed (empty when the base is idle).
   const std::vector<Pose2>& path() const { return path_; }
   /// The last base motion ended by the watchdog (tracking error beyond its limits).
@@ -128,6 +130,7 @@ class MotionExecutor {
   planning::TrackingController controller_;
   bool base_active_{false};
   std::vector<Pose2> path_;
+  bool brisk_step_{false};  ///< path_ was given with `brisk`
   bool base_failed_{false};
   std::string base_failure_;
   std::optional<planning::Bug2Navigator> bug_;
