@@ -67,47 +67,65 @@ std::vector<Occupant> PeopleAround(const TaskServices& task, const Eigen::Vector
   return near;
 }
 
-std::vector<Occupant> ThroughDoorWays(const TaskServices& task, const std::string& door,
-                                      double horizon) {
-  const perception::DoorModel* model = task.map->FindDoor(door);
-  ThrowUnless(model != nullptr, "unknown door '", door, "' (not in the building map)");
-  const perception::DoorZone zone{*model, task.config.zone_depth, task.config.person_radius};
-  const DoorPass pass = CalcDoorPass(*task.map, door, task.belief->X_MB);
+namespace {
+
+// The way `entry` may walk through the middle of a door's opening (ThroughDoorWays' rule; `zone`
+// and `pass` are the door's), appended to `ways`.
+void AppendThroughDoorWay(const TaskServices& task, const std::string& door,
+                          const perception::DoorZone& zone, const DoorPass& pass,
+                          const perception::TrackedPersonWithIntent& entry, double horizon,
+                          std::vector<Occupant>& ways) {
+  const perception::TrackedPerson& person = entry.person;
+  const Eigen::Vector2d to_centre = pass.centre - person.p_MP;
+  const double distance = to_centre.norm();
+  if (distance < 1e-6 || IsHoldingDoorAside(task, entry, door)) return;
+  const double towards = person.v_MP.dot(to_centre / distance);
+  const bool far_side = -to_centre.dot(pass.n_M) < 0.0;
+  // Out of the zone on the robot's side, only someone walking at the opening goes through it
+  // (P1: walking up behind the robot at the button to the door it opened, tracked straight on,
+  // they turned into the doorway and passed 0.65 m off the robot that had found no better
+  // spot): to the far side.
+  const bool inward = !far_side && !zone.Contains(person.p_MP);
+  if (inward ? distance > kIntoDoorRadiusM || towards < PeopleRoom::kSidestepMinMps
+             : distance > kThroughDoorRadiusM || towards < -PeopleRoom::kSidestepMinMps)
+    return;
+  const Eigen::Vector2d n_MOn = inward ? Eigen::Vector2d(-pass.n_M) : pass.n_M;
   const Eigen::Vector2d at = task.belief->X_MB.translation();
   const double step = PeopleRoom::kPeopleStepSec;
-  std::vector<Occupant> ways;
-  for (const auto& entry : task.belief->world.people) {
-    const perception::TrackedPerson& person = entry.person;
-    const Eigen::Vector2d to_centre = pass.centre - person.p_MP;
-    const double distance = to_centre.norm();
-    if (distance < 1e-6 || IsHoldingDoorAside(task, entry, door)) continue;
-    const double towards = person.v_MP.dot(to_centre / distance);
-    const bool far_side = -to_centre.dot(pass.n_M) < 0.0;
-    // Out of the zone on the robot's side, only someone walking at the opening goes through it
-    // (P1: walking up behind the robot at the button to the door it opened, tracked straight on,
-    // they turned into the doorway and passed 0.65 m off the robot that had found no better
-    // spot): to the far side.
-    const bool inward = !far_side && !zone.Contains(person.p_MP);
-    if (inward ? distance > kIntoDoorRadiusM || towards < PeopleRoom::kSidestepMinMps
-               : distance > kThroughDoorRadiusM || towards < -PeopleRoom::kSidestepMinMps)
-      continue;
-    const Eigen::Vector2d n_MOn = inward ? Eigen::Vector2d(-pass.n_M) : pass.n_M;
-    const double speed = std::max(person.v_MP.norm(), kWalkingMps);
-    // To the middle of the opening, then on along the normal (walls turning the way).
-    const double t_centre = distance / speed;
-    int k = 1;
-    for (; k * step < t_centre && k * step <= horizon + 1e-9; ++k) {
-      const Eigen::Vector2d p = person.p_MP + to_centre * (k * step / t_centre);
-      if ((p - at).norm() < PeopleRoom::kPeopleLookM)
-        ways.push_back({p, task.config.person_radius, k * step, to_centre / distance * speed});
-    }
-    if (k * step > horizon + 1e-9) continue;
-    const std::size_t first = ways.size();
-    AppendPredictedWay(task, at, PeopleRoom::kPeopleLookM, horizon - t_centre, step, 0, pass.centre,
-                       n_MOn * speed, ways);
-    for (std::size_t i = first; i < ways.size(); ++i)
-      ways[i].t += t_centre;
+  const double speed = std::max(person.v_MP.norm(), kWalkingMps);
+  // To the middle of the opening, then on along the normal (walls turning the way).
+  const double t_centre = distance / speed;
+  int k = 1;
+  for (; k * step < t_centre && k * step <= horizon + 1e-9; ++k) {
+    const Eigen::Vector2d p = person.p_MP + to_centre * (k * step / t_centre);
+    if ((p - at).norm() < PeopleRoom::kPeopleLookM)
+      ways.push_back({p, task.config.person_radius, k * step, to_centre / distance * speed});
   }
+  if (k * step > horizon + 1e-9) return;
+  const std::size_t first = ways.size();
+  AppendPredictedWay(task, at, PeopleRoom::kPeopleLookM, horizon - t_centre, step, 0, pass.centre,
+                     n_MOn * speed, ways);
+  for (std::size_t i = first; i < ways.size(); ++i)
+    ways[i].t += t_centre;
+}
+
+// The door's zone and the robot's pass of it, for AppendThroughDoorWay.
+std::pair<perception::DoorZone, DoorPass> ZoneAndPass(const TaskServices& task,
+                                                      const std::string& door) {
+  const perception::DoorModel* model = task.map->FindDoor(door);
+  ThrowUnless(model != nullptr, "unknown door '", door, "' (not in the building map)");
+  return {perception::DoorZone{*model, task.config.zone_depth, task.config.person_radius},
+          CalcDoorPass(*task.map, door, task.belief->X_MB)};
+}
+
+}  // namespace
+
+std::vector<Occupant> ThroughDoorWays(const TaskServices& task, const std::string& door,
+                                      double horizon) {
+  const auto [zone, pass] = ZoneAndPass(task, door);
+  std::vector<Occupant> ways;
+  for (const auto& entry : task.belief->world.people)
+    AppendThroughDoorWay(task, door, zone, pass, entry, horizon, ways);
   return ways;
 }
 
@@ -365,18 +383,36 @@ std::optional<Pose2> MakeWaySpot(const TaskServices& task, double min_gain,
 }
 
 std::vector<std::pair<const perception::TrackedPerson*, double>> PeopleComing(
-    const TaskServices& task, const std::optional<Pose2>& goal) {
+    const TaskServices& task, const std::optional<Pose2>& goal, const std::string& through_door) {
   const Belief& belief = *task.belief;
   const Eigen::Vector2d at = belief.X_MB.translation();
+  std::optional<std::pair<perception::DoorZone, DoorPass>> door;
+  if (!through_door.empty()) door = ZoneAndPass(task, through_door);
+  const double near = task.config.footprint_radius + task.config.comfort_distance;
   std::vector<std::pair<const perception::TrackedPerson*, double>> coming;
+  std::vector<Occupant> way;
   for (const auto& entry : belief.world.people) {
     if (goal &&
         IsWhomTheRobotGoesTo(entry.person.p_MP, at, goal->translation(), kGoalPersonRadiusM))
       continue;
     if (const auto t_pass = OncomingPassTime(
             entry.person, at, task.config.footprint_radius, task.config.person_radius,
-            task.config.comfort_distance, task.config.give_way_horizon, kWalkingMps))
+            task.config.comfort_distance, task.config.give_way_horizon, kWalkingMps)) {
       coming.emplace_back(&entry.person, *t_pass);
+      continue;
+    }
+    // Walking, through the door: their speed may be read low (a track that has just set off
+    // from standing and coasts out of the laser's view: P1, 0.46 m/s read for 1.3 m/s), and
+    // the way through the opening's middle is at a walker's pace at least.
+    if (!door || entry.person.v_MP.norm() < PeopleRoom::kSidestepMinMps) continue;
+    way.clear();
+    AppendThroughDoorWay(task, through_door, door->first, door->second, entry,
+                         task.config.give_way_horizon, way);
+    for (const Occupant& o : way)
+      if ((o.p_M - at).norm() - o.radius < near) {
+        coming.emplace_back(&entry.person, o.t);
+        break;
+      }
   }
   return coming;
 }
@@ -386,9 +422,9 @@ void StepAsideTo(const TaskServices& task, const Pose2& spot) {
                           task.belief->now, task.config.retreat_speed, /*brisk=*/true);
 }
 
-bool WayGiver::Begin(const TaskServices& task, const std::optional<Pose2>& goal,
-                     const NoteFn& note) {
-  const auto coming = PeopleComing(task, goal);
+bool WayGiver::Begin(const TaskServices& task, const std::optional<Pose2>& goal, const NoteFn& note,
+                     const PeopleHypotheses& hypotheses) {
+  const auto coming = PeopleComing(task, goal, hypotheses.through_door);
   if (coming.empty()) return false;
   const perception::TrackedPerson& p = *coming.front().first;
   task.motion->StopBase();
@@ -414,7 +450,7 @@ NodeStatus WayGiver::Update(const TaskServices& task, const std::optional<Pose2>
     }
   }
   if (task.motion->base_failed()) task.motion->StopBase();  // blocked: stay where it is
-  for (const auto& [person, t_pass] : PeopleComing(task, goal))
+  for (const auto& [person, t_pass] : PeopleComing(task, goal, hypotheses.through_door))
     until_ = std::max(until_, now + SecondsToDuration(std::min(t_pass, kMaxPassSec)));
   const bool clear = ToSeconds(now - until_) >= task.config.give_way_clear_for;
   const bool waited = ToSeconds(now - *since_) > patience;

@@ -440,7 +440,10 @@ class WayGiver {
   static constexpr double kMaxPassSec = 15.0;
   /// True (and the base stopped, the person noted) if someone is coming; false otherwise.
   /// `goal`: whom the robot goes to, there, is not made way for (PeopleComing).
-  bool Begin(const TaskServices& task, const std::optional<Pose2>& goal, const NoteFn& note);
+  /// `hypotheses.through_door`: people walking through that door count too (PeopleComing's);
+  /// Update is to be given the same.
+  bool Begin(const TaskServices& task, const std::optional<Pose2>& goal, const NoteFn& note,
+             const PeopleHypotheses& hypotheses = {});
   NodeStatus Update(const TaskServices& task, const std::optional<Pose2>& goal, double patience,
                     const NoteFn& note, const PeopleHypotheses& hypotheses = {});
   bool active() const { return since_.has_value(); }
@@ -472,11 +475,16 @@ inline constexpr double kReAimAfterSec = 1.0;
 /// ProxemicsConfig::goal_radius).
 inline constexpr double kGoalPersonRadiusM = 1.5;
 /// The people the robot standing where it is should make way for (TaskConfig::give_way): walking
-/// at it to pass within comfort_distance within give_way_horizon (OncomingPassTime), each with
-/// when they pass nearest [s from now]; whom the robot goes to (IsWhomTheRobotGoesTo, within
+/// at it to pass within comfort_distance within give_way_horizon (OncomingPassTime), or, given
+/// `through_door` (a door's id; empty: none), walking (PeopleRoom::kSidestepMinMps or faster) on
+/// a way through its opening's middle (ThroughDoorWays) that passes within comfort_distance
+/// within give_way_horizon; each with when they pass nearest [s from now] (on the way through
+/// the door, its first point that near); whom the robot goes to (IsWhomTheRobotGoesTo, within
 /// kGoalPersonRadiusM of `goal`) excepted.
+/// @throws InvalidArgument for an unknown door.
 std::vector<std::pair<const perception::TrackedPerson*, double>> PeopleComing(
-    const TaskServices& task, const std::optional<Pose2>& goal);
+    const TaskServices& task, const std::optional<Pose2>& goal,
+    const std::string& through_door = {});
 
 /// The localizer's position standard deviation: the square root of the largest eigenvalue of
 /// the xy block of the belief's covariance [m].

@@ -357,7 +357,8 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
   // Starts making way (phase kGivingWay) if someone is coming (TaskConfig::give_way).
   bool GiveWayIfComing() {
     if (!task_.config.give_way ||
-        !give_way_.Begin(task_, std::nullopt, [this](const std::string& t) { Note(t); }))
+        !give_way_.Begin(task_, std::nullopt, [this](const std::string& t) { Note(t); },
+                         {.through_door = door_}))
       return false;
     phase_ = Phase::kGivingWay;
     return true;

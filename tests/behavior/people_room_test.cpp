@@ -299,6 +299,35 @@ TEST(ThroughDoorWaysTest, PeopleNearADoorsFarSideWalkThroughTheMiddleOfItsOpenin
   EXPECT_THROW(ThroughDoorWays(task, "no_such_door", 4.0), InvalidArgument);
 }
 
+// Someone walking at the door the robot stands beside, read slow (a track that has just set off
+// from standing and coasts out of the laser's view: P1, 0.46 m/s read for 1.3 m/s): not coming
+// by their tracked line and speed, but coming by their way through the opening's middle at a
+// walker's pace. Nobody standing, nor walking away from the door, counts so.
+TEST(PeopleComingTest, SomeoneWalkingThroughTheDoorTheRobotStandsBesideIsComing) {
+  const MissionMap map = node_testing::LabDoor();  // door line y = 3, the middle at (0, 3)
+  Belief belief;
+  belief.X_MB = {1.15, 2.43, M_PI / 2};  // at the button, beside the opening
+  TaskServices task;
+  task.map = &map;
+  task.belief = &belief;
+  const auto coming_with = [&](const Eigen::Vector2d& v_MP, const std::string& door) {
+    auto entry = node_testing::Person({1.5, 0.8}, perception::PersonIntent::kUnknown);
+    entry.person.v_MP = v_MP;
+    belief.world.people = {entry};
+    return PeopleComing(task, std::nullopt, door);
+  };
+  const Eigen::Vector2d at_the_door =
+      0.46 * (Eigen::Vector2d(0.0, 3.0) - Eigen::Vector2d(1.5, 0.8)).normalized();
+  EXPECT_TRUE(coming_with(at_the_door, "").empty()) << "slower than a walker";
+  const auto coming = coming_with(at_the_door, "lab_door");
+  ASSERT_EQ(coming.size(), 1u);
+  EXPECT_GT(coming.front().second, 0.0);
+  EXPECT_LT(coming.front().second, task.config.give_way_horizon);
+  EXPECT_TRUE(coming_with({0.1, 0.1}, "lab_door").empty()) << "standing";
+  EXPECT_TRUE(coming_with(-at_the_door, "lab_door").empty()) << "walking away from the door";
+  EXPECT_THROW(coming_with(at_the_door, "no_such_door"), InvalidArgument);
+}
+
 // A way through a doorway's middle is where they must go: PeopleRoom grants it no sidestep (P1:
 // the robot beside the opening judged a walker coming up behind it would step round it, stood,
 // and was passed 0.64 m off). Their tracked way keeps its sidestep.

@@ -64,6 +64,22 @@ TEST_F(TraverseDoorTest, MakesWayForSomeoneWalkingUpToTheDoorBeforeLiningUp) {
   EXPECT_TRUE(NotedText("lane's edge") || NotedText("lining up"));
 }
 
+// The same walker read at 0.46 m/s (they had just set off from standing as they left the
+// laser's view): by their tracked line they pass by slowly, but through the doorway they come at
+// a walker's pace (PeopleComing's through_door), and the robot makes way rather than set off
+// across their way to the lane's edge.
+TEST_F(TraverseDoorTest, MakesWayForSomeoneReadSlowWalkingUpToTheDoor) {
+  bt::Tree tree = TraverseAfterOwnPress({1.15, 2.43, M_PI / 2});
+  auto walker = node_testing::Person({1.5, 0.8}, perception::PersonIntent::kApproaching);
+  walker.person.v_MP = 0.46 * (Eigen::Vector2d(0.0, 3.0) - walker.person.p_MP).normalized();
+  belief_.now = At(1.0);
+  DoorSeenOpen(80.0, 0.0);
+  See({walker});
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(NotedText("making way: person"));
+  EXPECT_FALSE(NotedText("lane's edge"));
+}
+
 // The same walker: they may be going through the door, so the robot, standing by the lane,
 // steps away from it rather than stand where they would pass it within comfort_distance (P1:
 // judged to step round the robot, they passed it 0.64 m off). Halted as they enter the door
