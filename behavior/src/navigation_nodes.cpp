@@ -202,19 +202,13 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
     const std::optional<DoorVisit> visit = Shared<DoorVisit>("visit");
     PeopleHypotheses hypotheses;
     if (visit && task_.map->FindDoor(visit->door) != nullptr) hypotheses.through_door = visit->door;
-    const double horizon = 2.0 * task_.config.give_way_horizon;  // as MakeWaySpot's
-    const bool coming = !PeopleComing(task_, std::nullopt).empty();
-    const bool through = !hypotheses.through_door.empty() &&
-                         RoomAt(ThroughDoorWays(task_, hypotheses.through_door, horizon),
-                                belief_.X_MB.translation()) <
-                             task_.config.footprint_radius + task_.config.comfort_distance;
-    if (!coming && !through) return;
+    const std::optional<std::string> whom = WhomToMakeWayFor(task_, hypotheses.through_door);
+    if (!whom) return;
     const auto spot = MakeWaySpot(task_, kMakeWayMinGainM, hypotheses);
     if (!spot) return;
     StepAsideTo(task_, *spot);
     this->SetOutput("retreating", true);
-    Note(StrCat("making way for ", coming ? "someone coming" : "whoever comes through the doorway",
-                ": stepping aside to (", PoseText(*spot), ")"),
+    Note(StrCat("making way for ", *whom, ": stepping aside to (", PoseText(*spot), ")"),
          DecisionEvent::kRetreating);
   }
 
@@ -449,14 +443,10 @@ class WaitForClear final : public TaskNode<bt::StatefulActionNode> {
     }
     if (!task_.config.give_way || belief_.now < next_make_way_) return;
     // Stepping, the way to where it ends is judged by MakeWaySpot, whoever comes.
-    bool coming = false;
+    std::optional<std::string> whom;
     if (!stepping_) {
-      const double horizon = 2.0 * task_.config.give_way_horizon;  // as MakeWaySpot's
-      coming = !PeopleComing(task_, std::nullopt).empty();
-      const bool through =
-          RoomAt(ThroughDoorWays(task_, Door(), horizon), belief_.X_MB.translation()) <
-          task_.config.footprint_radius + task_.config.comfort_distance;
-      if ((!coming && !through) || !StoppedOrStopTimedOut(task_, started_)) return;
+      whom = WhomToMakeWayFor(task_, Door());
+      if (!whom || !StoppedOrStopTimedOut(task_, started_)) return;
     }
     next_make_way_ = belief_.now + SecondsToDuration(kMakeWayPeriodSec);
     const auto spot = MakeWaySpot(task_, kMakeWayMinGainM, {.through_door = Door()},
@@ -464,9 +454,7 @@ class WaitForClear final : public TaskNode<bt::StatefulActionNode> {
     if (!spot) return;
     StepAsideTo(task_, *spot);
     Note(StrCat(stepping_ ? "making way: re-aiming the step aside"
-                          : StrCat("making way for ",
-                                   coming ? "someone coming" : "whoever comes through the doorway",
-                                   ": stepping aside"),
+                          : StrCat("making way for ", *whom, ": stepping aside"),
                 " to (", PoseText(*spot), ")"));
     stepping_ = true;
     step_to_ = spot->translation();

@@ -417,6 +417,16 @@ std::vector<std::pair<const perception::TrackedPerson*, double>> PeopleComing(
   return coming;
 }
 
+std::optional<std::string> WhomToMakeWayFor(const TaskServices& task, const std::string& door) {
+  if (!PeopleComing(task, std::nullopt).empty()) return "someone coming";
+  if (door.empty()) return std::nullopt;
+  const double horizon = 2.0 * task.config.give_way_horizon;  // as MakeWaySpot's
+  if (RoomAt(ThroughDoorWays(task, door, horizon), task.belief->X_MB.translation()) <
+      task.config.footprint_radius + task.config.comfort_distance)
+    return "whoever comes through the doorway";
+  return std::nullopt;
+}
+
 void StepAsideTo(const TaskServices& task, const Pose2& spot) {
   task.motion->FollowPath({task.belief->X_MB, spot}, {false}, task.motion->arm_target(),
                           task.belief->now, task.config.retreat_speed, /*brisk=*/true);

@@ -486,6 +486,13 @@ std::vector<std::pair<const perception::TrackedPerson*, double>> PeopleComing(
     const TaskServices& task, const std::optional<Pose2>& goal,
     const std::string& through_door = {});
 
+/// Whom the robot standing where it is should make way for, for the notes: "someone coming"
+/// (PeopleComing), or "whoever comes through the doorway" if a way through `door`'s middle
+/// (ThroughDoorWays over MakeWaySpot's horizon; empty door: none) passes within comfort_distance
+/// of it; nullopt if neither.
+/// @throws InvalidArgument for an unknown door.
+std::optional<std::string> WhomToMakeWayFor(const TaskServices& task, const std::string& door);
+
 /// The localizer's position standard deviation: the square root of the largest eigenvalue of
 /// the xy block of the belief's covariance [m].
 double PositionSigma(const TaskServices& task);

@@ -328,6 +328,30 @@ TEST(PeopleComingTest, SomeoneWalkingThroughTheDoorTheRobotStandsBesideIsComing)
   EXPECT_THROW(coming_with(at_the_door, "no_such_door"), InvalidArgument);
 }
 
+// Whom the robot beside a door's opening makes way for: someone walking at it, or whoever may
+// come through the doorway past it within comfort_distance (someone dawdling in it); nobody
+// else, and nobody through a door it was not given.
+TEST(WhomToMakeWayForTest, SomeoneComingOrWhoeverComesThroughTheDoorway) {
+  const MissionMap map = node_testing::LabDoor();  // door line y = 3, the middle at (0, 3)
+  Belief belief;
+  belief.X_MB = {1.0, 2.4, M_PI / 2};
+  TaskServices task;
+  task.map = &map;
+  task.belief = &belief;
+  const auto whom_with = [&](const Eigen::Vector2d& p_MP, const Eigen::Vector2d& v_MP,
+                             const std::string& door) {
+    auto entry = node_testing::Person(p_MP, perception::PersonIntent::kUnknown);
+    entry.person.v_MP = v_MP;
+    belief.world.people = {entry};
+    return WhomToMakeWayFor(task, door);
+  };
+  EXPECT_EQ(whom_with({1.0, -1.0}, {0.0, 1.2}, ""), "someone coming");
+  EXPECT_EQ(whom_with({0.0, 3.2}, {0.0, -0.1}, "lab_door"), "whoever comes through the doorway");
+  EXPECT_FALSE(whom_with({0.0, 3.2}, {0.0, -0.1}, "").has_value()) << "no door given";
+  EXPECT_FALSE(whom_with({-2.5, 0.0}, {0.0, 0.0}, "lab_door").has_value()) << "standing aside";
+  EXPECT_THROW(whom_with({0.0, 3.2}, {0.0, -0.1}, "no_such_door"), InvalidArgument);
+}
+
 // A way through a doorway's middle is where they must go: PeopleRoom grants it no sidestep (P1:
 // the robot beside the opening judged a walker coming up behind it would step round it, stood,
 // and was passed 0.64 m off). Their tracked way keeps its sidestep.
