@@ -433,9 +433,10 @@ void StepAsideTo(const TaskServices& task, const Pose2& spot) {
 }
 
 bool WayGiver::Begin(const TaskServices& task, const std::optional<Pose2>& goal, const NoteFn& note,
-                     const PeopleHypotheses& hypotheses) {
+                     PeopleHypotheses hypotheses) {
   const auto coming = PeopleComing(task, goal, hypotheses.through_door);
   if (coming.empty()) return false;
+  hypotheses_ = std::move(hypotheses);
   const perception::TrackedPerson& p = *coming.front().first;
   task.motion->StopBase();
   since_ = task.belief->now;
@@ -447,12 +448,11 @@ bool WayGiver::Begin(const TaskServices& task, const std::optional<Pose2>& goal,
 }
 
 NodeStatus WayGiver::Update(const TaskServices& task, const std::optional<Pose2>& goal,
-                            double patience, const NoteFn& note,
-                            const PeopleHypotheses& hypotheses) {
+                            double patience, const NoteFn& note) {
   const Time now = task.belief->now;
   if (!chosen_ && StoppedOrStopTimedOut(task, *since_)) {
     chosen_ = true;
-    if (const auto spot = MakeWaySpot(task, kMakeWayMinGainM, hypotheses)) {
+    if (const auto spot = MakeWaySpot(task, kMakeWayMinGainM, hypotheses_)) {
       StepAsideTo(task, *spot);
       note(StrCat("stepping aside to (", PoseText(*spot), ")"));
     } else {
@@ -460,7 +460,7 @@ NodeStatus WayGiver::Update(const TaskServices& task, const std::optional<Pose2>
     }
   }
   if (task.motion->base_failed()) task.motion->StopBase();  // blocked: stay where it is
-  for (const auto& [person, t_pass] : PeopleComing(task, goal, hypotheses.through_door))
+  for (const auto& [person, t_pass] : PeopleComing(task, goal, hypotheses_.through_door))
     until_ = std::max(until_, now + SecondsToDuration(std::min(t_pass, kMaxPassSec)));
   const bool clear = ToSeconds(now - until_) >= task.config.give_way_clear_for;
   const bool waited = ToSeconds(now - *since_) > patience;

@@ -432,27 +432,27 @@ void StepAsideTo(const TaskServices& task, const Pose2& spot);
 /// to MakeWaySpot (or stands still if no spot leaves more room), and reports SUCCESS
 /// give_way_clear_for after the last person seen coming has passed (by their last prediction,
 /// at most kMaxPassSec ahead: a person the camera loses behind another is still coming), or
-/// after `patience` [s]; RUNNING until then. `hypotheses`: what people may do beyond walking on
-/// (MakeWaySpot's).
+/// after `patience` [s]; RUNNING until then.
 class WayGiver {
  public:
   /// [s] A slow walker far off is not waited for longer than this.
   static constexpr double kMaxPassSec = 15.0;
   /// True (and the base stopped, the person noted) if someone is coming; false otherwise.
   /// `goal`: whom the robot goes to, there, is not made way for (PeopleComing).
-  /// `hypotheses.through_door`: people walking through that door count too (PeopleComing's);
-  /// Update is to be given the same.
+  /// `hypotheses`: what people may do beyond walking on, kept for Update (MakeWaySpot's); with
+  /// a `through_door`, people walking through that door are coming too (PeopleComing's).
   bool Begin(const TaskServices& task, const std::optional<Pose2>& goal, const NoteFn& note,
-             const PeopleHypotheses& hypotheses = {});
+             PeopleHypotheses hypotheses = {});
   NodeStatus Update(const TaskServices& task, const std::optional<Pose2>& goal, double patience,
-                    const NoteFn& note, const PeopleHypotheses& hypotheses = {});
+                    const NoteFn& note);
   bool active() const { return since_.has_value(); }
   void Reset() { since_.reset(); }
 
  private:
   std::optional<Time> since_;
-  Time until_{};        ///< when the last person seen coming will have passed
-  bool chosen_{false};  ///< the spot is chosen (once the base has stopped)
+  Time until_{};                 ///< when the last person seen coming will have passed
+  bool chosen_{false};           ///< the spot is chosen (once the base has stopped)
+  PeopleHypotheses hypotheses_;  ///< Begin's
 };
 /// [m] The hand keeps this far off mapped walls on a step: its palm block's half-size and a
 /// margin. Out at an actuator it reaches past the round footprint every step is checked with

@@ -57,9 +57,8 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     const auto note = [this](const std::string& t) { Note(t); };
     switch (phase_) {
       case Phase::kGivingWay: {
-        // Whoever walks up may be going through the door (ThroughDoorWays).
-        if (give_way_.Update(task_, std::nullopt, Input<double>("wait_timeout"), note,
-                             {.through_door = door_}) == NodeStatus::kRunning)
+        if (give_way_.Update(task_, std::nullopt, Input<double>("wait_timeout"), note) ==
+            NodeStatus::kRunning)
           return NodeStatus::kRunning;
         return StartLineUp();
       }
@@ -355,6 +354,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
   }
 
   // Starts making way (phase kGivingWay) if someone is coming (TaskConfig::give_way).
+  // Whoever walks up may be going through the door (ThroughDoorWays).
   bool GiveWayIfComing() {
     if (!task_.config.give_way ||
         !give_way_.Begin(task_, std::nullopt, [this](const std::string& t) { Note(t); },
