@@ -19,6 +19,12 @@ namespace {
 constexpr double kAtRestTranslationM = 1e-3;
 constexpr double kAtRestRotation = 1e-3;
 
+// A beam's end point p_LQ in M, for the laser at X_ML (c, s: the cosine and sine of its yaw,
+// computed once per pose).
+Eigen::Vector2d BeamEndInM(const Pose2& X_ML, double c, double s, const Eigen::Vector2d& p_LQ) {
+  return {X_ML.x + c * p_LQ.x() - s * p_LQ.y(), X_ML.y + s * p_LQ.x() + c * p_LQ.y()};
+}
+
 }  // namespace
 
 void LocalizerConfig::Validate() const {
@@ -44,7 +50,16 @@ void LocalizerConfig::Validate() const {
               "Invalid LocalizerConfig: resample_threshold must be in (0, 1].");
   ThrowUnless(recover_below >= 0.0 && recover_below <= 1.0,
               "Invalid LocalizerConfig: recover_below (", recover_below, ") must be in [0, 1].");
-  if (recover_below > 0.0) {
+  ThrowUnless(drift_check_below >= 0.0 && drift_check_below <= 1.0,
+              "Invalid LocalizerConfig: drift_check_below (", drift_check_below,
+              ") must be in [0, 1].");
+  if (drift_check_below > 0.0) {
+    ThrowUnless(drift_gain > 0.0 && drift_gain <= 1.0, "Invalid LocalizerConfig: drift_gain (",
+                drift_gain, ") must be in (0, 1].");
+    ThrowUnless(drift_loss >= 0.0 && drift_loss <= 1.0, "Invalid LocalizerConfig: drift_loss (",
+                drift_loss, ") must be in [0, 1].");
+  }
+  if (recover_below > 0.0 || drift_check_below > 0.0) {
     ThrowUnless(fit_distance > 0.0, "Invalid LocalizerConfig: fit_distance (", fit_distance,
                 ") must be > 0.");
     ThrowUnless(recover_gain > 0.0 && recover_gain <= 1.0,
@@ -77,6 +92,22 @@ ParticleFilterLocalizer::ParticleFilterLocalizer(const OccupancyGrid& map, const
   }
   cv::Mat distance;
   cv::distanceTransform(free_mask, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+  // Inside an obstacle, the depth below its surface: the laser returns from the surface, and a
+  // field of 0 through a wall's whole thickness let a pose put the end points anywhere in it
+  // (a 0.1 m wall: the estimate up to 0.1 m off towards a wall seen from one side). An
+  // occupied cell's value is its distance to the nearest free cell less one cell, so the
+  // bilinear field (less half a cell, below) is 0 from the surface through the first cell and
+  // grows beyond it.
+  cv::Mat occupied_mask;
+  cv::bitwise_not(free_mask, occupied_mask);
+  cv::Mat depth;
+  cv::distanceTransform(occupied_mask, depth, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+  for (int iy = 0; iy < geometry_.height; ++iy) {
+    for (int ix = 0; ix < geometry_.width; ++ix) {
+      if (free_mask.at<std::uint8_t>(iy, ix) == 0)
+        distance.at<float>(iy, ix) = std::max(0.0f, depth.at<float>(iy, ix) - 1.0f);
+    }
+  }
   distance_stride_ = geometry_.width + 2;
   distance_.resize(std::size_t(distance_stride_) * std::size_t(geometry_.height + 2));
   for (int iy = -1; iy <= geometry_.height; ++iy) {
@@ -196,8 +227,8 @@ bool ParticleFilterLocalizer::Correct(const LaserScan& scan) {
   ++scans_since_search_;
   // Standing, nothing to correct — unless the robot was carried off (a kidnap): checked every
   // recover_check_scans scans, as nothing else would ever move the cloud.
-  if (!moved_since_correction_ &&
-      (config_.recover_below <= 0.0 || scans_since_search_ < config_.recover_check_scans))
+  const bool checks = config_.recover_below > 0.0 || config_.drift_check_below > 0.0;
+  if (!moved_since_correction_ && (!checks || scans_since_search_ < config_.recover_check_scans))
     return false;
   std::size_t considered = 0;
   const std::vector<Eigen::Vector2d> beams = UsableBeams(scan, &considered);
@@ -207,7 +238,7 @@ bool ParticleFilterLocalizer::Correct(const LaserScan& scan) {
       scans_since_search_ = 0;
       return false;
     }
-  } else if (config_.recover_below > 0.0 && scans_since_search_ >= config_.recover_check_scans) {
+  } else if (checks && scans_since_search_ >= config_.recover_check_scans) {
     MaybeRecover(beams, considered);
   }
   std::vector<double> log_weights(particles_.size());
@@ -249,18 +280,37 @@ std::vector<Eigen::Vector2d> ParticleFilterLocalizer::UsableBeams(const LaserSca
 }
 
 ParticleFilterLocalizer::Fit ParticleFilterLocalizer::CalcFit(
-    const Pose2& X_MB, const std::vector<Eigen::Vector2d>& beams) const {
+    const Pose2& X_MB, const std::vector<Eigen::Vector2d>& beams, double to_beat) const {
   const Pose2 X_ML = X_MB * X_BL_;
   const double c = std::cos(X_ML.yaw), s = std::sin(X_ML.yaw);
+  // No beam scores more than one ending on an obstacle's surface.
+  const double best_beam = beam_log_likelihood_.front();
   Fit fit{0.0, 0};
-  for (const Eigen::Vector2d& p_LQ : beams) {
-    const Eigen::Vector2d p(X_ML.x + c * p_LQ.x() - s * p_LQ.y(),
-                            X_ML.y + s * p_LQ.x() + c * p_LQ.y());
-    const double d = LikelihoodFieldDistance(p);
+  for (std::size_t i = 0; i < beams.size(); ++i) {
+    const double d = LikelihoodFieldDistance(BeamEndInM(X_ML, c, s, beams[i]));
     fit.log_likelihood += BeamLogLikelihood(d);
     if (d <= config_.fit_distance) ++fit.inliers;
+    // Checked every kBoundEveryBeams beams; the margin covers the rounding of the sum.
+    if (i % kBoundEveryBeams == kBoundEveryBeams - 1 &&
+        fit.log_likelihood + double(beams.size() - 1 - i) * best_beam < to_beat - kBoundMargin)
+      return {-std::numeric_limits<double>::infinity(), fit.inliers};
   }
   return fit;
+}
+
+int ParticleFilterLocalizer::CountLostInliers(const Pose2& from, const Pose2& to,
+                                              const std::vector<Eigen::Vector2d>& beams) const {
+  const Pose2 X_ML_from = from * X_BL_, X_ML_to = to * X_BL_;
+  const double c_from = std::cos(X_ML_from.yaw), s_from = std::sin(X_ML_from.yaw);
+  const double c_to = std::cos(X_ML_to.yaw), s_to = std::sin(X_ML_to.yaw);
+  int lost = 0;
+  for (const Eigen::Vector2d& p_LQ : beams) {
+    if (LikelihoodFieldDistance(BeamEndInM(X_ML_from, c_from, s_from, p_LQ)) <=
+            config_.fit_distance &&
+        LikelihoodFieldDistance(BeamEndInM(X_ML_to, c_to, s_to, p_LQ)) > config_.fit_distance)
+      ++lost;
+  }
+  return lost;
 }
 
 bool ParticleFilterLocalizer::MaybeRecover(const std::vector<Eigen::Vector2d>& beams,
@@ -269,7 +319,9 @@ bool ParticleFilterLocalizer::MaybeRecover(const std::vector<Eigen::Vector2d>& b
   const Pose2 estimate = Estimate();
   const Fit now = CalcFit(estimate, beams);
   const double n = double(beams.size());
-  if (double(now.inliers) >= config_.recover_below * n) return false;
+  const bool kidnapped = double(now.inliers) < config_.recover_below * n;
+  const bool drifted = double(now.inliers) < config_.drift_check_below * n;
+  if (!kidnapped && !drifted) return false;
   scans_since_search_ = 0;
   // A coarse grid over the window, then a fine one (a quarter of the steps) round its best.
   // Ranked by likelihood (smooth in the pose); ties go to the nearer pose, by the loop order.
@@ -288,7 +340,7 @@ bool ParticleFilterLocalizer::MaybeRecover(const std::vector<Eigen::Vector2d>& b
           const int jy = (iy + 1) / 2 * (iy % 2 == 1 ? 1 : -1);
           const Pose2 X_MB{centre.x + jx * step, centre.y + jy * step,
                            WrapAngle(centre.yaw + jyaw * step_yaw)};
-          const Fit fit = CalcFit(X_MB, beams);
+          const Fit fit = CalcFit(X_MB, beams, best_fit.log_likelihood);
           if (fit.log_likelihood > best_fit.log_likelihood) {
             best = X_MB;
             best_fit = fit;
@@ -301,7 +353,11 @@ bool ParticleFilterLocalizer::MaybeRecover(const std::vector<Eigen::Vector2d>& b
          config_.recover_step_yaw);
   search(best, config_.recover_step, config_.recover_step_yaw, config_.recover_step / 4.0,
          config_.recover_step_yaw / 4.0);
-  if (double(best_fit.inliers - now.inliers) < config_.recover_gain * n) return false;
+  const double gain = double(best_fit.inliers - now.inliers);
+  const bool take = (kidnapped && gain >= config_.recover_gain * n) ||
+                    (drifted && gain >= config_.drift_gain * n &&
+                     double(CountLostInliers(estimate, best, beams)) <= config_.drift_loss * n);
+  if (!take) return false;
   // Spread over what the fine grid cannot tell apart; the corrections that follow narrow it.
   const double sigma = config_.recover_step / 8.0, sigma_yaw = config_.recover_step_yaw / 8.0;
   Initialize(best,

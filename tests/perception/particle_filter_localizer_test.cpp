@@ -4,6 +4,7 @@
 #include <limits>
 #include <numbers>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -90,6 +91,7 @@ TEST(ParticleFilterLocalizerTest, DrivingItCorrectsEachTenthOfAMetreAndOnceMoreA
   const OccupancyGrid map = testing::TwoRoomMap();
   LocalizerConfig config;
   config.recover_below = 0.0;  // no standing relocalization checks
+  config.drift_check_below = 0.0;
   ASSERT_EQ(config.moving_update_distance, 0.1);
   ASSERT_EQ(config.update_min_distance, 0.02);
   LaserScan scan = testing::MakeScan(121, 8.0);
@@ -165,7 +167,7 @@ TEST(ParticleFilterLocalizerTest, RelocalizesAfterAKidnapWhileStanding) {
   testing::CastScan(map, truth * X_BL, &scan);
   for (const bool recover : {false, true}) {
     LocalizerConfig config;
-    if (!recover) config.recover_below = 0.0;
+    if (!recover) config.recover_below = config.drift_check_below = 0.0;
     ParticleFilterLocalizer localizer(map, X_BL, config);
     localizer.Initialize(believed, Eigen::Vector3d(1e-4, 1e-4, 1e-5).asDiagonal());
     const Pose2 odometry{5.0, -1.0, 0.2};  // standing: the same odometry at every scan
@@ -250,6 +252,76 @@ TEST(ParticleFilterLocalizerTest, PeopleCloseAroundDoNotPullThePoseAway) {
   EXPECT_EQ(localizer.recover_count(), 0);
 }
 
+// A corridor 1.6 m wide and 14 m long, closed at its east end, with a doorway in its north
+// wall: along it the side walls fit any x.
+OccupancyGrid CorridorMap() {
+  const std::vector<Box2> walls = {
+      {{7.0, 0.05, 0.0}, {14.0, 0.1}},  // south
+      {{3.0, 1.75, 0.0}, {6.0, 0.1}},   // north, west of the doorway at x in [6, 7]
+      {{10.5, 1.75, 0.0}, {7.0, 0.1}},  // north, east of it
+      {{13.95, 0.9, 0.0}, {0.1, 1.8}},  // the end wall
+  };
+  return OccupancyGrid::FromBoxes(walls, {0.0, 0.0}, {14.0, 1.8}, 0.05);
+}
+
+// Drift along a corridor: the estimate 0.25 m behind the base in x when it stops 1.5 m short of
+// the end wall (as in the two wards, after 9 m east). The side walls fit either way, so too many
+// beams fit for the kidnap check; the cloud, 1 cm wide, cannot reach the truth standing. The
+// drift check takes the pose that fits the end wall too and loses none of the side walls.
+TEST(ParticleFilterLocalizerTest, CorrectsDriftAlongACorridorWhileStanding) {
+  const OccupancyGrid map = CorridorMap();
+  const Pose2 X_BL{0.1675, 0.0, 0.0};
+  const Pose2 truth{12.3, 0.85, 0.0};
+  const Pose2 believed{truth.x - 0.25, truth.y, truth.yaw};
+  LaserScan scan = testing::MakeScan(181, 20.0);
+  testing::CastScan(map, truth * X_BL, &scan);
+  for (const bool drift : {false, true}) {
+    LocalizerConfig config;
+    if (!drift) config.drift_check_below = 0.0;
+    ParticleFilterLocalizer localizer(map, X_BL, config);
+    localizer.Initialize(believed, Eigen::Vector3d(1e-4, 1e-4, 1e-5).asDiagonal());
+    for (int i = 0; i < 3 * config.recover_check_scans; ++i)
+      localizer.Update({5.0, -1.0, 0.2}, scan);
+    const Pose2 estimate = localizer.Estimate();
+    if (!drift) {
+      EXPECT_NEAR(estimate.x, believed.x, 0.05);  // the kidnap check alone leaves it
+      EXPECT_EQ(localizer.recover_count(), 0);
+      continue;
+    }
+    EXPECT_EQ(localizer.recover_count(), 1);
+    EXPECT_NEAR(estimate.x, truth.x, 0.03);
+    EXPECT_NEAR(estimate.y, truth.y, 0.03);
+    EXPECT_NEAR(localizer.last_recovery().x, 0.25, 0.03);
+  }
+}
+
+// The same corridor, well localized, with a queue of people along its south wall ahead: their
+// legs are off the map at any pose nearby, and the poses that put some of them on a wall lose
+// the wall returns behind them. No jump, standing or driving.
+TEST(ParticleFilterLocalizerTest, PeopleAlongACorridorWallDoNotReadAsDrift) {
+  const OccupancyGrid map = CorridorMap();
+  const Pose2 X_BL{0.1675, 0.0, 0.0};
+  Pose2 truth{4.0, 0.9, 0.0};
+  std::vector<testing::Disc> people;
+  for (int i = 0; i < 8; ++i)
+    people.push_back({{5.0 + 0.6 * i, 0.35 + 0.1 * (i % 2)}, 0.2});
+  LaserScan scan = testing::MakeScan(181, 20.0);
+  ParticleFilterLocalizer localizer(map, X_BL);
+  localizer.Initialize(truth, Eigen::Vector3d(1e-4, 1e-4, 1e-5).asDiagonal());
+  Pose2 odometry;
+  for (int i = 0; i < 60; ++i) {
+    if (i >= 30) {  // on along the corridor at 0.2 m/s
+      truth = truth * Pose2{0.02, 0.0, 0.0};
+      odometry = odometry * Pose2{0.02, 0.0, 0.0};
+    }
+    testing::CastScanAtDiscs(people, truth * X_BL, &scan, &map);
+    localizer.Update(odometry, scan);
+    const Pose2 estimate = localizer.Estimate();
+    ASSERT_LT(std::hypot(estimate.x - truth.x, estimate.y - truth.y), 0.03) << "scan " << i;
+  }
+  EXPECT_EQ(localizer.recover_count(), 0);
+}
+
 TEST(ParticleFilterLocalizerTest, RejectsBadInput) {
   const OccupancyGrid map = testing::TwoRoomMap();
   ParticleFilterLocalizer localizer(map, {});
@@ -273,8 +345,24 @@ TEST(ParticleFilterLocalizerTest, RejectsBadInput) {
   EXPECT_THROW(ParticleFilterLocalizer(map, {}, config), InvalidArgument);
   config.recover_min_returns = 0.3;
   EXPECT_NO_THROW(ParticleFilterLocalizer(map, {}, config));
-  config.recover_below = 0.0;  // disabled: its other fields are not used
+  for (const auto& [field, value] :
+       std::vector<std::pair<double*, double>>{{&config.drift_check_below, -0.1},
+                                               {&config.drift_gain, 0.0},
+                                               {&config.drift_loss, std::nan("")}}) {
+    const double good = *field;
+    *field = value;
+    EXPECT_THROW(ParticleFilterLocalizer(map, {}, config), InvalidArgument) << value;
+    *field = good;
+  }
+  config.recover_below = 0.0;  // kidnap check disabled: the drift check still needs the steps
+  config.recover_step = 0.0;
+  EXPECT_THROW(ParticleFilterLocalizer(map, {}, config), InvalidArgument);
+  config.recover_step = 0.1;
+  config.drift_check_below = 0.0;  // both disabled: their other fields are not used
+  config.drift_gain = 0.0;
+  config.recover_step = 0.0;
   EXPECT_NO_THROW(ParticleFilterLocalizer(map, {}, config));
+  config = LocalizerConfig{};
   // The spacing while moving is at least that at rest; none of them NaN.
   config.moving_update_distance = 0.01;
   EXPECT_THROW(ParticleFilterLocalizer(map, {}, config), InvalidArgument);
