@@ -22,6 +22,8 @@
 #include <fstream>
 #include <map>
 #include <string>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -120,6 +122,9 @@ nlohmann::json RunStudyTrial(const twin::Scenario& scenario, const twin::WorldDe
   std::map<std::string, double> waiting_since;
   const double period = brain ? 1.0 / config.control_rate_hz : 0.1;
   double last_t = 0.0;
+  // How far the brain's belief of its base strayed from the truth (M is W in the twin): drift in
+  // a crowd or along a corridor shows here before it leaves anyone behind.
+  double localization_error_max = 0.0;
   const auto all_out = [&] {
     bool any = false;
     for (const auto& p : twin_world.people()) {
@@ -135,7 +140,12 @@ nlohmann::json RunStudyTrial(const twin::Scenario& scenario, const twin::WorldDe
   const twin::RunResult result = twin::RunScenario(
       robot,
       [&](RobotPort& port) {
-        if (brain) brain->Step(port);
+        if (brain) {
+          brain->Step(port);
+          localization_error_max = std::max(
+              localization_error_max,
+              (brain->belief().X_MB.translation() - twin_world.robot_pose().translation()).norm());
+        }
         const double t = twin_world.time(), dt = t - last_t;
         last_t = t;
         const Eigen::Vector2d p_WB = twin_world.robot_pose().translation();
@@ -232,6 +242,8 @@ nlohmann::json RunStudyTrial(const twin::Scenario& scenario, const twin::WorldDe
                                                            : nlohmann::json(nullptr)},
           {"doorway_block_s", doorway_judge.in_doorway_s()},
           {"doorway_stand_s", doorway_judge.standing_s()},
+          {"localization_error_max",
+           brain ? nlohmann::json(localization_error_max) : nlohmann::json(nullptr)},
           {"resident_operations", resident_operations},
           {"robot_operations", robot_operations},
           {"time", result.simulated_time}};
@@ -402,6 +414,9 @@ void RunStudy(const StudyOptions& o) {
     std::map<std::uint64_t, int> left_by_seed, contacts_by_seed, obstacle_contacts_by_seed;
     nlohmann::json left_people = nlohmann::json::array();  // each with its seed
     double closest = std::numeric_limits<double>::infinity(), blocking = 0.0, standing = 0.0;
+    std::vector<double> localization_errors;  // per trial, the worst [m]
+    double worst_localization = 0.0;
+    std::uint64_t worst_localization_seed = 0;
     std::map<std::string, std::vector<double>> flow, queue, by_residents, by_robot;
     for (const auto& t : trials) {
       residents = t.at("residents").get<int>();
@@ -421,6 +436,11 @@ void RunStudy(const StudyOptions& o) {
       if (!t.at("closest").is_null()) closest = std::min(closest, t.at("closest").get<double>());
       blocking += t.at("doorway_block_s").get<double>();
       standing += t.at("doorway_stand_s").get<double>();
+      if (const auto& e = t.at("localization_error_max"); !e.is_null()) {
+        if (localization_errors.empty() || e.get<double>() > worst_localization)
+          std::tie(worst_localization, worst_localization_seed) = std::pair(e.get<double>(), seed);
+        localization_errors.push_back(e.get<double>());
+      }
       for (const auto& [door, d] : t.at("doors").items()) {
         if (!d.at("flow").is_null()) flow[door].push_back(d.at("flow").get<double>());
         queue[door].push_back(d.at("queue_s").get<double>());
@@ -454,6 +474,17 @@ void RunStudy(const StudyOptions& o) {
     if (!obstacle_contacts_by_seed.empty())
       fmt::print("    the robot touched a wall or a door's leaf in seeds {}\n",
                  seeds_text(obstacle_contacts_by_seed));
+    nlohmann::json localization = nullptr;
+    if (!localization_errors.empty()) {
+      const double median = CalcMedianCi(localization_errors).median;
+      fmt::print(
+          "    localization error (belief against truth): worst {:.2f} m (seed {}), median "
+          "of the trials' worst {:.2f} m\n",
+          worst_localization, worst_localization_seed, median);
+      localization = {{"max_m", worst_localization},
+                      {"max_seed", worst_localization_seed},
+                      {"median_of_trial_max_m", median}};
+    }
     nlohmann::json doors = nlohmann::json::object();
     for (const auto& [door, q] : queue) {
       // Null (and "n/a") where no trial saw two residents through: no rate to give.
@@ -503,13 +534,15 @@ void RunStudy(const StudyOptions& o) {
          {"closest_m", std::isfinite(closest) ? nlohmann::json(closest) : nlohmann::json(nullptr)},
          {"doorway_block_s", blocking},
          {"doorway_stand_s", standing},
+         {"localization_error", localization},
          {"doors", doors}});
   }
   std::filesystem::create_directories(dir);
   std::ofstream(dir / "study.json") << study.dump(2) << "\n";
   std::ofstream csv(dir / "trials.csv");
   csv << "condition,seed,residents,out,left_behind,t_evac,contacts,closest,doorway_block_s,"
-         "doorway_stand_s,resident_operations,robot_operations,obstacle_contacts\n";
+         "doorway_stand_s,resident_operations,robot_operations,obstacle_contacts,"
+         "localization_error_max\n";
   for (const auto& r : results) {
     csv << r.at("condition").get<std::string>() << "," << r.at("seed").get<std::uint64_t>() << ","
         << r.at("residents").get<int>() << "," << r.at("out").get<int>() << ","
@@ -520,7 +553,11 @@ void RunStudy(const StudyOptions& o) {
         << "," << fmt::format("{:.1f}", r.at("doorway_block_s").get<double>()) << ","
         << fmt::format("{:.1f}", r.at("doorway_stand_s").get<double>()) << ","
         << r.at("resident_operations").get<int>() << "," << r.at("robot_operations").get<int>()
-        << "," << r.at("obstacle_contacts").get<int>() << "\n";
+        << "," << r.at("obstacle_contacts").get<int>() << ","
+        << (r.at("localization_error_max").is_null()
+                ? ""
+                : fmt::format("{:.3f}", r.at("localization_error_max").get<double>()))
+        << "\n";
   }
   DrawEvacuated(by_condition, base.time_limit, residents, dir / "evacuated.png");
   fmt::print("wrote {}, {} and {}\n", (dir / "study.json").string(), (dir / "trials.csv").string(),

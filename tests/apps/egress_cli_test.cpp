@@ -521,6 +521,14 @@ TEST(EgressCliTest, EvacStudyComparesTheThreeConditionsOnTheSameSeeds) {
   EXPECT_LE(by["propped_open"].at("t_evac_median_s").get<double>(),
             by["no_robot"].at("t_evac_median_s").get<double>());
   EXPECT_EQ(by["robot"].at("contacts").get<int>(), 0);
+  // The brain's belief against the truth: the robot's alone (no brain, no belief otherwise).
+  const auto& localization = by["robot"].at("localization_error");
+  ASSERT_TRUE(localization.is_object()) << by["robot"].dump();
+  EXPECT_GT(localization.at("max_m").get<double>(), 0.0);  // odometry drifts, the scan corrects
+  EXPECT_LT(localization.at("max_m").get<double>(), 0.2);
+  EXPECT_EQ(localization.at("max_seed").get<std::uint64_t>(), 1u);
+  EXPECT_TRUE(by["no_robot"].at("localization_error").is_null());
+  EXPECT_THAT(two.output, HasSubstr("localization error (belief against truth): worst"));
   EXPECT_EQ(study.at("crowd_social_rate_hz").get<double>(), 120.0);  // every crowd step
   // What each buys over no robot, seed by seed: one seed, one pair, the difference of the times.
   EXPECT_TRUE(by["no_robot"].at("vs_no_robot").is_null());
