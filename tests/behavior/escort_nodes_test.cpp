@@ -1271,6 +1271,46 @@ TEST_F(HoldForResidentsTest, AStepToMakeRoomEndsClearOfTheWall) {
   EXPECT_GT((to.translation() - Eigen::Vector2d(spot.x, spot.y - 0.4)).norm(), 0.4 + 0.1);
 }
 
+// A step planned from rest but begun moving runs past its end by about the braking distance
+// (two wards seed 53: begun at 0.45 m/s, it ended 0.105 m past its end, on the corridor's wall):
+// its end keeps that much more from the walls, and where braking alone takes the robot up to a
+// wall no step begins (the motion under way brakes at its own end).
+TEST_F(HoldForResidentsTest, AStepBegunMovingKeepsItsBrakingDistanceMoreFromTheWalls) {
+  const perception::Costmap2D walls = LabWalls();
+  belief_.world.costmap = &walls;
+  tree_.TickOnce();
+  OperatedAgo(1.0);
+  const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
+  constexpr double kWallFaceY = 2.95;  // the lab wall's south face
+  const double footprint = TaskConfig{}.footprint_radius;
+  // Where it steps from `at` moving at v_M (someone just south of it), if it steps.
+  const auto step_from = [&](const Pose2& at, const Eigen::Vector2d& v_M) {
+    const Eigen::Vector2d v_B = Eigen::Rotation2Dd(-at.yaw) * v_M;
+    motion_.StopBase();
+    belief_.X_MB = at;
+    belief_.V_B = Twist2{v_B.x(), v_B.y(), 0.0};
+    belief_.now = At(2.0);
+    belief_.off_map_returns = {
+        {at.x, at.y - 0.4}, {at.x - 0.5, at.y - 0.5}, {at.x + 0.5, at.y - 0.5}};  // a row south
+    log_.Take();
+    EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+    return NotedText("making room") ? std::optional(motion_.path().back()) : std::nullopt;
+  };
+  // 0.12 m beyond the footprint from the wall, with people just south: at rest the most room
+  // lies along the wall, up to the usual margin from it.
+  const Pose2 by_wall{1.6, kWallFaceY - footprint - 0.12, spot.yaw};  // room east along it
+  const double braking = 0.18;  // at 0.6 m/s and the base's 1 m/s^2
+  const std::optional<Pose2> at_rest = step_from(by_wall, {0.0, 0.0});
+  ASSERT_TRUE(at_rest);
+  EXPECT_GT(at_rest->y, kWallFaceY - footprint - 0.1 - braking) << "the case no longer tells";
+  // Moving along the wall at 0.6 m/s: a step, if any, ends the braking distance farther off.
+  if (const std::optional<Pose2> moving = step_from(by_wall, {0.6, 0.0})) {
+    EXPECT_LE(moving->y, kWallFaceY - footprint - 0.1 - braking + 1e-9);
+  }
+  // Moving at the wall at 0.6 m/s it would brake to within 0.06 m of it: no step.
+  EXPECT_FALSE(step_from(by_wall, {0.0, 0.6}));
+}
+
 // Not back into the laser's blind sector where it last saw someone (school seed 5: pressing the
 // button, the robot had the residents standing behind it; making room for a wheelchair user
 // beside it, it stepped straight back among them). The costmap's obstacle layer remembers them
