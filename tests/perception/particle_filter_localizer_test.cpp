@@ -309,16 +309,24 @@ TEST(ParticleFilterLocalizerTest, PeopleAlongACorridorWallDoNotReadAsDrift) {
   ParticleFilterLocalizer localizer(map, X_BL);
   localizer.Initialize(truth, Eigen::Vector3d(1e-4, 1e-4, 1e-5).asDiagonal());
   Pose2 odometry;
+  LaserScan walls_only = scan;
+  int low_fit = 0;  // scans with over 10 % of the beams on people: the drift check searches
   for (int i = 0; i < 60; ++i) {
     if (i >= 30) {  // on along the corridor at 0.2 m/s
       truth = truth * Pose2{0.02, 0.0, 0.0};
       odometry = odometry * Pose2{0.02, 0.0, 0.0};
     }
     testing::CastScanAtDiscs(people, truth * X_BL, &scan, &map);
+    testing::CastScan(map, truth * X_BL, &walls_only);
+    int on_people = 0;
+    for (std::size_t k = 0; k < scan.ranges.size(); ++k)
+      on_people += scan.ranges[k] < walls_only.ranges[k] - 0.05f ? 1 : 0;
+    low_fit += on_people > int(scan.ranges.size()) / 10 ? 1 : 0;
     localizer.Update(odometry, scan);
     const Pose2 estimate = localizer.Estimate();
     ASSERT_LT(std::hypot(estimate.x - truth.x, estimate.y - truth.y), 0.03) << "scan " << i;
   }
+  EXPECT_GT(low_fit, 30);  // the check had reason to search
   EXPECT_EQ(localizer.recover_count(), 0);
 }
 
