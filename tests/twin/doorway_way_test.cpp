@@ -1,6 +1,9 @@
-// Who keeps an evacuee waiting at a doorway (the rule of DoorwayTaken for evacuees).
+// Who keeps an evacuee waiting at a doorway (the rule of DoorwayTaken for evacuees), and where
+// someone who cannot operate a shut door waits clear of its actuator (ClearOfActuator's rule).
 
 #include "doorway_way.h"
+
+#include <cmath>
 
 #include <gtest/gtest.h>
 
@@ -54,6 +57,58 @@ TEST(KeepsEvacueeWaitingTest, TheRuleHoldsForEitherSideAndAnyDoorOrientation) {
   EXPECT_FALSE(KeepsEvacueeWaiting(door, evacuee, {4.65, 1.9}, {0.0, 0.6}));  // along past it
   EXPECT_FALSE(KeepsEvacueeWaiting(door, evacuee, {4.6, 2.0}, {1.0, 0.0}));   // going on
   EXPECT_FALSE(KeepsEvacueeWaiting(door, evacuee, {3.6, 2.0}, {0.0, 0.0}));   // ahead in queue
+}
+
+// The same door with a push button on its wall 1 m east of the doorway's centre, the spot where
+// one stands to press it 0.5 m out into the north room; a wheelchair user (0.35 m) who cannot
+// press it waits on the north side: they keep the spot's disc (0.3 m, and a 0.15 m margin) and
+// the way to it square to the door (0.6 m either side) clear. The leaf slides.
+const Eigen::Vector2d kSpot(5.0, 2.55);
+constexpr double kKeepM = 0.3 + 0.15 + 0.35;
+constexpr double kLaneHalfM = 0.6 + 0.35;
+const LeafSweep kSliding{};
+
+double AlongFromSpot(const Eigen::Vector2d& p) {
+  return std::abs(p.x() - kSpot.x());
+}
+
+TEST(WaitClearOfActuatorTest, SomeoneClearOfTheSpotAndItsWayStays) {
+  EXPECT_FALSE(WaitClearOfActuator(kDoor, 1.0, kSpot, {3.0, 3.0}, kKeepM, kLaneHalfM, kSliding));
+  // Along the wall beyond the spot's disc, on the far side from the doorway.
+  EXPECT_FALSE(WaitClearOfActuator(kDoor, 1.0, kSpot, {5.9, 2.5}, kKeepM, kLaneHalfM, kSliding));
+}
+
+TEST(WaitClearOfActuatorTest, SomeoneOnTheWayToTheSpotWaitsAcrossItOnTheDoorwaysSide) {
+  const auto to = WaitClearOfActuator(kDoor, 1.0, kSpot, {5.2, 3.4}, kKeepM, kLaneHalfM, kSliding);
+  ASSERT_TRUE(to);
+  EXPECT_NEAR(AlongFromSpot(*to), kLaneHalfM, 1e-9);
+  EXPECT_LT(to->x(), kSpot.x());  // the doorway's side
+  EXPECT_NEAR(to->y(), 3.4, 1e-9);
+}
+
+// Atrium west seed 36: shut out, a wheelchair user came to wait between the spot and the wall,
+// 0.07 m from the spot. Straight away from it is into the wall, which held them there for good.
+TEST(WaitClearOfActuatorTest, SomeoneBetweenTheSpotAndItsWallStepsAlongTheWallNotIntoIt) {
+  const Eigen::Vector2d at(5.05, 2.49);
+  const auto to = WaitClearOfActuator(kDoor, 1.0, kSpot, at, kKeepM, kLaneHalfM, kSliding);
+  ASSERT_TRUE(to);
+  EXPECT_GE(to->y(), at.y() - 1e-9) << "towards the wall: " << to->transpose();
+  EXPECT_GT((*to - kSpot).norm(), kKeepM);
+  EXPECT_NEAR(AlongFromSpot(*to), kLaneHalfM, 1e-9);
+}
+
+TEST(WaitClearOfActuatorTest, AcrossTheWayTheyKeepOutOfTheSweepOfALeafOpeningTowardsThem) {
+  // Hinged at the doorway's east jamb, swinging north (a 0.95 m leaf).
+  const LeafSweep leaf{{4.475, 2.05}, 1.0, 0.95 + 0.35 + 0.1};
+  const auto to = WaitClearOfActuator(kDoor, 1.0, kSpot, {5.2, 2.9}, kKeepM, kLaneHalfM, leaf);
+  ASSERT_TRUE(to);
+  EXPECT_NEAR(AlongFromSpot(*to), kLaneHalfM, 1e-9);
+  EXPECT_GE((*to - leaf.p_WH).norm(), leaf.clear_radius - 1e-9);
+  // On the side it does not swing to, the leaf is no matter.
+  const LeafSweep south{leaf.p_WH, -1.0, leaf.clear_radius};
+  const auto level = WaitClearOfActuator(kDoor, 1.0, kSpot, {5.2, 2.9}, kKeepM, kLaneHalfM, south);
+  ASSERT_TRUE(level);
+  EXPECT_NEAR(level->y(), 2.9, 1e-9);
 }
 
 }  // namespace

@@ -1,8 +1,11 @@
 #pragma once
 /// @file
-/// Who keeps an evacuee waiting at a doorway they are about to go through: the rule of
-/// TwinWorld::Impl::DoorwayTaken for evacuees, as a pure function of the doorway's geometry and
-/// the two people's places and the other's velocity (all in W, metres and m/s).
+/// Evacuees at a doorway, as pure functions of its geometry and people's places (all in W,
+/// metres and m/s): who keeps an evacuee waiting at a doorway they are about to go through (the
+/// rule of TwinWorld::Impl::DoorwayTaken for evacuees), and where someone who cannot operate a
+/// shut door waits clear of its actuator (TwinWorld::Impl::ClearOfActuator).
+
+#include <optional>
 
 #include <Eigen/Core>
 
@@ -35,5 +38,31 @@ constexpr double kInOpeningM = 0.4;
 /// were left behind).
 bool KeepsEvacueeWaiting(const DoorwayFrame& d, const Eigen::Vector2d& p_WE,
                          const Eigen::Vector2d& p_WO, const Eigen::Vector2d& v_WO);
+
+/// A door's leaf, for whoever keeps out of its sweep: its hinge, the side of the door line it
+/// swings to (+1 along the doorway's normal, -1 against it, 0 for a sliding leaf) and how far from
+/// the hinge is clear of it for the one keeping out (the leaf's reach, their body and a margin)
+/// [m].
+struct LeafSweep {
+  Eigen::Vector2d p_WH{Eigen::Vector2d::Zero()};
+  double swing_side{0.0};
+  double clear_radius{0.0};
+};
+
+/// Where someone at `p_WP`, waiting on the `side` (+1 or -1 along d.normal) of a shut door whose
+/// actuator they cannot operate, waits instead, so that whoever can (a resident, the robot) may
+/// stand at `p_WS`, the spot before the actuator, and get there:
+/// - within `lane_half` of the spot along the door line, further out into the room than it (on
+///   the way to it, square to the door from the room) or within `keep` of it (between it and
+///   its wall, where stepping straight away from it walks into the wall): across that lane, on
+///   the doorway's side, at their distance from the door line, or out of the `leaf`'s sweep if
+///   it swings to their side;
+/// - else within `keep` of the spot: `keep` from it, straight away;
+/// - else (or with the spot on the doorway's axis) nowhere else: nullopt.
+/// Walls are the caller's (the point may be in one).
+std::optional<Eigen::Vector2d> WaitClearOfActuator(const DoorwayFrame& d, double side,
+                                                   const Eigen::Vector2d& p_WS,
+                                                   const Eigen::Vector2d& p_WP, double keep,
+                                                   double lane_half, const LeafSweep& leaf);
 
 }  // namespace egress::twin::world_detail

@@ -180,37 +180,15 @@ std::optional<Eigen::Vector2d> TwinWorld::Impl::ClearOfActuator(const Person& p,
   const auto spot = ActuatorSpot(gate, side, p.walker.position);
   if (!spot) return std::nullopt;
   if (const auto aside = OutOfRobotsWayTo(p, gate, *spot, side)) return aside;
-  const Eigen::Vector2d away = p.walker.position - *spot;
-  const double keep = kPersonAtActuatorRadiusM + kActuatorClearMarginM + p.walker.radius;
-  // The way to it as well, square to the door from the room: waiting in the middle of a 2 m
-  // corridor, 1.4 m before the exit door (out of its leaf's sweep), a wheelchair user left 0.5 m
-  // by the wall to its button, and nobody could get by to press it (clinic room A seeds 11, 22).
-  // They wait across the lane, on the doorway's side of it.
-  const Eigen::Vector2d along(-d.normal.y(), d.normal.x());
-  const double u_spot = (*spot - d.centre).dot(along);
-  const double u = (p.walker.position - d.centre).dot(along);
-  const double lane = kActuatorLaneHalfM + p.walker.radius;
-  const double out_spot = (*spot - d.centre).dot(d.normal) * side;
-  const double out = (p.walker.position - d.centre).dot(d.normal) * side;
-  if (out > out_spot && std::abs(u - u_spot) < lane && std::abs(u_spot) > 1e-3) {
-    const double u_clear = u_spot - std::copysign(lane, u_spot);
-    // Across the lane may be beside the hinge: out of the sweep of a leaf that opens towards
-    // them, further back if need be (beside the clinic's exit hinge, waiting there, two held its
-    // leaf shut and 15 were left behind: two wards seed 21).
-    double out_clear = out;
-    if (d.swing_side * side > 0.0) {
-      const Eigen::Vector2d hinge = d.desc->p_WH.head<2>();
-      const double u_hinge = (hinge - d.centre).dot(along);
-      const double sweep = d.reach + p.walker.radius + kSweepMarginM;
-      const double du = u_clear - u_hinge;
-      if (std::abs(du) < sweep) out_clear = std::max(out, std::sqrt(sweep * sweep - du * du));
-    }
-    return ClearOfWalls(
-        p.walker.position + along * (u_clear - u) + d.normal * side * (out_clear - out),
-        p.walker.radius);
-  }
-  if (away.norm() >= keep || away.norm() <= 1e-6) return std::nullopt;
-  return ClearOfWalls(*spot + away.normalized() * keep, p.walker.radius);
+  // Out of the way to it as well, square to the door from the room (WaitClearOfActuator).
+  const DoorwayFrame frame{d.centre, d.normal, d.along, 0.5 * d.reach};
+  const auto to = WaitClearOfActuator(
+      frame, side, *spot, p.walker.position,
+      kPersonAtActuatorRadiusM + kActuatorClearMarginM + p.walker.radius,
+      kActuatorLaneHalfM + p.walker.radius,
+      {d.desc->p_WH.head<2>(), d.swing_side, d.reach + p.walker.radius + kSweepMarginM});
+  if (!to) return std::nullopt;
+  return ClearOfWalls(*to, p.walker.radius);
 }
 
 std::optional<Eigen::Vector2d> TwinWorld::Impl::OutOfRobotsWayTo(const Person& p, int gate,
@@ -232,9 +210,13 @@ std::optional<Eigen::Vector2d> TwinWorld::Impl::OutOfRobotsWayTo(const Person& p
   const Eigen::Vector2d way = (spot - p_WB).normalized();
   Eigen::Vector2d across(-way.y(), way.x());
   if (across.dot(off) < 0.0) across = -across;
+  // Not through a wall: cleared of the walls, a point in one may come out on its far side (atrium
+  // west seed 36: the way ran along the wall, a wheelchair user who could not operate the door
+  // made for a point beyond it, and stood pressed against it on the plate's spot for 330 s).
   for (const double s : {1.0, -1.0}) {
     const Eigen::Vector2d target = ClearOfWalls(foot + across * s * keep, p.walker.radius);
-    if ((target - egress::ClosestPointOnSegment(target, p_WB, spot)).norm() > keep - 0.02)
+    if ((target - egress::ClosestPointOnSegment(target, p_WB, spot)).norm() > keep - 0.02 &&
+        !WallBetween(p_WP, target))
       return target;
   }
   return std::nullopt;
