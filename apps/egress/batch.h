@@ -35,6 +35,9 @@ struct TrialResult {
   double time{0.0};                 ///< Time to goal, else the run's end [s].
   double min_person_distance{std::numeric_limits<double>::infinity()};  ///< [m]
   double closest_robot_speed{0.0};  ///< The robot's speed at that closest moment [m/s].
+  /// The closest approach to a person in sight (RunMetrics::min_person_distance_in_sight) [m].
+  double min_person_distance_in_sight{std::numeric_limits<double>::infinity()};
+  double closest_in_sight_robot_speed{0.0};  ///< The robot's speed then [m/s].
   int person_contacts{0};
   int static_contacts{0};  ///< The robot touching walls or furniture (not a failure; a bump).
   int presses{0};
@@ -72,6 +75,11 @@ struct ScenarioSummary {
   /// to the person, rather than the person to a standing robot).
   int close_approaches_moving{0};
   std::vector<double> person_distances;  ///< Per trial that met a person [m].
+  /// The same for people in sight (TrialResult::min_person_distance_in_sight).
+  double min_person_distance_in_sight{std::numeric_limits<double>::infinity()};
+  std::optional<double> median_person_distance_in_sight;
+  std::optional<double> p10_person_distance_in_sight;
+  std::vector<double> person_distances_in_sight;
   int person_contacts{0};
   int static_contacts{0};
   int trials_with_static_contacts{0};

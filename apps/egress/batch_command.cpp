@@ -136,6 +136,8 @@ TrialResult RunBrainTrial(const std::string& scenario_path, std::uint64_t seed,
   r.time = m.time_to_goal.value_or(m.end_time);
   r.min_person_distance = m.min_person_distance;
   r.closest_robot_speed = m.closest_robot_speed;
+  r.min_person_distance_in_sight = m.min_person_distance_in_sight;
+  r.closest_in_sight_robot_speed = m.closest_in_sight_robot_speed;
   r.person_contacts = m.contacts.count("person") ? m.contacts.at("person") : 0;
   r.static_contacts = m.contacts.count("static") ? m.contacts.at("static") : 0;
   for (const auto& [door, n] : m.button_presses)
@@ -303,18 +305,22 @@ void ReportBatch(const std::filesystem::path& dir, const nlohmann::json& plan,
   {
     std::ofstream csv(csv_path);
     csv << "scenario,name,seed,success,time_s,min_person_distance_m,closest_robot_speed_mps,"
-           "person_contacts,"
+           "closest_in_sight_m,closest_in_sight_robot_speed_mps,person_contacts,"
            "static_contacts,presses,relocalizations,failed,wall_s\n";
     for (const auto& r : results) {
       std::string failed;
       for (const auto& f : r.failed)
         failed += (failed.empty() ? "" : ";") + f;
       csv << fmt::format(
-          "{},\"{}\",{},{},{:.2f},{},{:.3f},{},{},{},{},\"{}\",{:.2f}\n", r.scenario, r.name,
-          r.seed, r.success ? 1 : 0, r.time,
+          "{},\"{}\",{},{},{:.2f},{},{:.3f},{},{:.3f},{},{},{},{},\"{}\",{:.2f}\n", r.scenario,
+          r.name, r.seed, r.success ? 1 : 0, r.time,
           std::isfinite(r.min_person_distance) ? fmt::format("{:.3f}", r.min_person_distance) : "",
-          r.closest_robot_speed, r.person_contacts, r.static_contacts, r.presses, r.relocalizations,
-          r.error.empty() ? failed : r.error, r.wall_time);
+          r.closest_robot_speed,
+          std::isfinite(r.min_person_distance_in_sight)
+              ? fmt::format("{:.3f}", r.min_person_distance_in_sight)
+              : "",
+          r.closest_in_sight_robot_speed, r.person_contacts, r.static_contacts, r.presses,
+          r.relocalizations, r.error.empty() ? failed : r.error, r.wall_time);
     }
     if (!csv) throw CommandFailed(fmt::format("cannot write '{}'", csv_path.string()));
   }
@@ -335,6 +341,15 @@ void ReportBatch(const std::filesystem::path& dir, const nlohmann::json& plan,
          {"closest_worst_m", std::isfinite(s.min_person_distance)
                                  ? nlohmann::json(s.min_person_distance)
                                  : nlohmann::json(nullptr)},
+         {"closest_in_sight_median_m", s.median_person_distance_in_sight
+                                           ? nlohmann::json(*s.median_person_distance_in_sight)
+                                           : nlohmann::json(nullptr)},
+         {"closest_in_sight_p10_m", s.p10_person_distance_in_sight
+                                        ? nlohmann::json(*s.p10_person_distance_in_sight)
+                                        : nlohmann::json(nullptr)},
+         {"closest_in_sight_worst_m", std::isfinite(s.min_person_distance_in_sight)
+                                          ? nlohmann::json(s.min_person_distance_in_sight)
+                                          : nlohmann::json(nullptr)},
          {"close_approaches_moving", s.close_approaches_moving},
          {"person_contacts", s.person_contacts},
          {"static_contacts", s.static_contacts},

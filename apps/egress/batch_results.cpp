@@ -47,6 +47,10 @@ nlohmann::json ToJson(const TrialResult& r) {
           {"preemption_total_latencies", r.preemption_total_latencies},
           {"preemption_laser_view_latencies", r.preemption_laser_view_latencies},
           {"closest_robot_speed", r.closest_robot_speed},
+          {"min_person_distance_in_sight", std::isfinite(r.min_person_distance_in_sight)
+                                               ? nlohmann::json(r.min_person_distance_in_sight)
+                                               : nlohmann::json(nullptr)},
+          {"closest_in_sight_robot_speed", r.closest_in_sight_robot_speed},
           {"standing_tracks",
            {{"robot_moving",
              {{"samples", r.standing_tracks.moving_samples},
@@ -81,6 +85,10 @@ TrialResult TrialFromJson(const nlohmann::json& j) {
   r.preemption_laser_view_latencies =
       j.value("preemption_laser_view_latencies", std::vector<double>());
   r.closest_robot_speed = j.value("closest_robot_speed", 0.0);
+  // A journal of an earlier stop has no figure in sight: unknown, as for nobody met.
+  if (const auto it = j.find("min_person_distance_in_sight"); it != j.end() && !it->is_null())
+    r.min_person_distance_in_sight = it->get<double>();
+  r.closest_in_sight_robot_speed = j.value("closest_in_sight_robot_speed", 0.0);
   if (j.contains("standing_tracks")) {
     const auto& s = j.at("standing_tracks");
     r.standing_tracks = {s.at("robot_moving").at("samples").get<int>(),
@@ -122,6 +130,10 @@ std::vector<ScenarioSummary> Summarize(const std::vector<TrialResult>& trials) {
           t.closest_robot_speed >= twin::ScenarioJudge::kWaitSpeed)
         ++s.close_approaches_moving;
     }
+    s.min_person_distance_in_sight =
+        std::min(s.min_person_distance_in_sight, t.min_person_distance_in_sight);
+    if (std::isfinite(t.min_person_distance_in_sight))
+      s.person_distances_in_sight.push_back(t.min_person_distance_in_sight);
     if (t.success) s.times.push_back(t.time);
     if (!t.success) s.failed_seeds.push_back(t.seed);
     if (t.safe_abort) {
@@ -145,28 +157,39 @@ std::vector<ScenarioSummary> Summarize(const std::vector<TrialResult>& trials) {
       s.median_person_distance = d[d.size() / 2];
       s.p10_person_distance = d[d.size() / 10];
     }
+    if (!s.person_distances_in_sight.empty()) {
+      std::vector<double> d = s.person_distances_in_sight;
+      std::sort(d.begin(), d.end());
+      s.median_person_distance_in_sight = d[d.size() / 2];
+      s.p10_person_distance_in_sight = d[d.size() / 10];
+    }
   }
   return out;
 }
 
 std::string FormatSummaryTable(const std::vector<ScenarioSummary>& summaries) {
   std::ostringstream out;
-  out << fmt::format("{:<28} {:>6} {:>5} {:>7}  {:<15} {:>5} {:>8} {:>16} {:>8} {:>6}  {}\n",
+  out << fmt::format("{:<28} {:>6} {:>5} {:>7}  {:<15} {:>5} {:>8} {:>16} {:>16} {:>8} {:>6}  {}\n",
                      "scenario", "trials", "ok", "rate", "95% Wilson", "safe", "median",
-                     "closest med/worst", "contacts", "bumps", "failure reasons");
+                     "closest med/worst", "in sight", "contacts", "bumps", "failure reasons");
   int trials = 0, successes = 0;
   for (const ScenarioSummary& s : summaries) {
     std::string reasons;
     for (const auto& [reason, n] : s.failure_reasons)
       reasons += fmt::format("{}{} x{}", reasons.empty() ? "" : ", ", reason, n);
     out << fmt::format(
-        "{:<28} {:>6} {:>5} {:>6.1f}%  [{:>5.1f}, {:>5.1f}] {:>5} {:>7} {:>16} {:>8} {:>6}  {}\n",
+        "{:<28} {:>6} {:>5} {:>6.1f}%  [{:>5.1f}, {:>5.1f}] {:>5} {:>7} {:>16} {:>16} {:>8} {:>6}  "
+        "{}\n",
         s.name.substr(0, 28), s.trials, s.successes, 100.0 * s.successes / std::max(1, s.trials),
         100 * s.rate.low, 100 * s.rate.high, s.successes + s.safe_aborts,
         s.median_time ? fmt::format("{:.1f} s", *s.median_time) : "-",
         s.median_person_distance
             ? fmt::format("{:.2f}/{:.2f} m{}", *s.median_person_distance, s.min_person_distance,
                           s.close_approaches_moving > 0 ? "*" : "")
+            : "-",
+        s.median_person_distance_in_sight
+            ? fmt::format("{:.2f}/{:.2f} m", *s.median_person_distance_in_sight,
+                          s.min_person_distance_in_sight)
             : "-",
         s.person_contacts, s.trials_with_static_contacts, reasons.empty() ? "-" : reasons);
     trials += s.trials;

@@ -761,7 +761,7 @@ TEST(EgressCliTest, SimBatchReportsClosestApproachesAndTheLaserPeopleSetting) {
             false);
   const auto& summary = j.at("summary").at(0);
   double worst = 1e9;
-  std::vector<double> closest;
+  std::vector<double> closest, in_sight;
   // How often the brain read someone standing still as walking (StandingTrackJudge): the
   // crosser waits for the door before crossing, and the robot drives and stands.
   EXPECT_THAT(run.output, HasSubstr("standing people read walking"));
@@ -776,11 +776,23 @@ TEST(EgressCliTest, SimBatchReportsClosestApproachesAndTheLaserPeopleSetting) {
     }
     closest.push_back(t.at("min_person_distance").get<double>());
     worst = std::min(worst, closest.back());
+    // In sight (nothing of the building between): never nearer than the closest approach.
+    in_sight.push_back(t.at("min_person_distance_in_sight").get<double>());
+    EXPECT_GE(in_sight.back(), closest.back());
   }
   EXPECT_GT(samples, 0);
   EXPECT_DOUBLE_EQ(summary.at("closest_worst_m").get<double>(), worst);
   // Of two, the median is the upper one (the same index rule as the times').
   EXPECT_DOUBLE_EQ(summary.at("closest_median_m").get<double>(), std::max(closest[0], closest[1]));
+  EXPECT_DOUBLE_EQ(summary.at("closest_in_sight_median_m").get<double>(),
+                   std::max(in_sight[0], in_sight[1]));
+  EXPECT_DOUBLE_EQ(summary.at("closest_in_sight_worst_m").get<double>(),
+                   std::min(in_sight[0], in_sight[1]));
+  EXPECT_THAT(run.output, HasSubstr("in sight"));
+  std::ifstream csv(dir / "lp" / "trials.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_THAT(header, HasSubstr(",closest_in_sight_m,closest_in_sight_robot_speed_mps,"));
   std::filesystem::remove_all(dir);
 }
 

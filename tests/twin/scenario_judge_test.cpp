@@ -1,5 +1,7 @@
 #include "egress/twin/scenario_judge.h"
 
+#include <cmath>
+
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
@@ -124,6 +126,38 @@ TEST(ScenarioJudgeTest, PersonalSpaceAndPersonContactsAreMeasured) {
   EXPECT_GE(v.metrics.contacts.count("person") ? v.metrics.contacts.at("person") : 0, 1);
   EXPECT_EQ(v.metrics.ObstacleContacts(), 0);  // a person is not an obstacle of the building
   EXPECT_FALSE(v.success);
+}
+
+// Issue 21: someone behind a wall is not in the robot's personal space, however near. Driving to
+// the shut lab door, the robot comes within ~1.1 m of a person standing beyond its wall, and never
+// within 1.6 m of one in its own room: the closest approach is the first, the one in sight the
+// second.
+TEST(ScenarioJudgeTest, TheClosestApproachInSightLeavesOutPeopleBehindWalls) {
+  const Verdict v = DriveThrough(
+      "doors: [{door: lab_door, operator: push, actuator: lab_button}]\n", 12.0,
+      "people:\n"
+      "  - {name: beyond, behavior: approach_and_wait, start: [-1.0, 3.9], goal: [-1.0, 3.9], "
+      "wait_s: 60}\n"
+      "  - {name: seen, behavior: approach_and_wait, start: [-1.6, -0.2], goal: [-1.6, -0.2], "
+      "wait_s: 60}\n");
+  EXPECT_LT(v.metrics.min_person_distance, 1.3);
+  EXPECT_GT(v.metrics.min_person_distance_in_sight, 1.5);
+  EXPECT_LT(v.metrics.min_person_distance_in_sight, 1.8);
+  // Standing (it waits 5 s at the start, nearest the one in its room).
+  EXPECT_LT(v.metrics.closest_in_sight_robot_speed, 0.05);
+  EXPECT_THAT(FormatVerdict(v), HasSubstr("in sight"));
+  EXPECT_THAT(VerdictToJson(v), HasSubstr("\"min_person_distance_in_sight\":1."));
+}
+
+// With nothing between them, the two figures are one.
+TEST(ScenarioJudgeTest, WithNobodyBehindAWallTheClosestApproachIsInSight) {
+  const Verdict v = DriveThrough(
+      "doors: [{door: lab_door, operator: push, actuator: lab_button, open_at: [0.5]}]\n", 20.0,
+      "people: [{name: seen, behavior: approach_and_wait, start: [-1.8, 1.2], goal: [-1.8, 1.2], "
+      "wait_s: 60}]\n");
+  ASSERT_TRUE(std::isfinite(v.metrics.min_person_distance));
+  EXPECT_DOUBLE_EQ(v.metrics.min_person_distance_in_sight, v.metrics.min_person_distance);
+  EXPECT_THAT(FormatVerdict(v), ::testing::Not(HasSubstr("in sight")));
 }
 
 }  // namespace

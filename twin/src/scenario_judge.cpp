@@ -29,6 +29,16 @@ std::string Fmt(double v, int digits = 2) {
   return buf;
 }
 
+// Whether the person `p` is in sight of the robot at p_WB: the first thing the ray from the robot
+// to them hits at ScenarioJudge::kSightHeight is a person (them, or someone between: people do
+// not shut anyone out of personal space), or nothing short of them.
+bool InSight(const TwinWorld& world, const Eigen::Vector2d& p_WB, const PersonState& p) {
+  const double h = ScenarioJudge::kSightHeight;
+  const Eigen::Vector3d from(p_WB.x(), p_WB.y(), h), to(p.position.x(), p.position.y(), h);
+  const RayHit hit = world.CastRay(from, to, GlassMode::kOpaque);
+  return !hit.hit || world.entity_kind(hit.entity) == EntityKind::kPerson;
+}
+
 }  // namespace
 
 void ScenarioJudge::Observe(const TwinWorld& world) {
@@ -55,15 +65,25 @@ void ScenarioJudge::Observe(const TwinWorld& world) {
     metrics_.time_to_goal = t;
   }
   double nearest = std::numeric_limits<double>::infinity();
+  double nearest_in_sight = std::numeric_limits<double>::infinity();
   for (const auto& p : world.people()) {
     if (p.out) continue;  // left the scene
-    nearest = std::min(nearest, (p.position - X_WB.translation()).norm() - robot_r - p.radius);
+    const double gap = (p.position - X_WB.translation()).norm() - robot_r - p.radius;
+    nearest = std::min(nearest, gap);
+    // A ray only for whoever would be the nearest in sight so far.
+    if (gap < std::min(nearest_in_sight, metrics_.min_person_distance_in_sight) &&
+        InSight(world, X_WB.translation(), p))
+      nearest_in_sight = gap;
   }
+  const Twist2 V_B = world.robot_velocity();
   if (nearest < metrics_.min_person_distance) {
     metrics_.min_person_distance = nearest;
-    const Twist2 V_B = world.robot_velocity();
     metrics_.closest_robot_speed = std::hypot(V_B.vx, V_B.vy);
     metrics_.closest_time = t;
+  }
+  if (nearest_in_sight < metrics_.min_person_distance_in_sight) {
+    metrics_.min_person_distance_in_sight = nearest_in_sight;
+    metrics_.closest_in_sight_robot_speed = std::hypot(V_B.vx, V_B.vy);
   }
   if (nearest < kPersonalSpace) metrics_.time_in_personal_space += dt;
   for (std::size_t i = 0; i < world.door_count(); ++i) {
@@ -226,6 +246,9 @@ std::string FormatVerdict(const Verdict& v) {
               ? Fmt(m.min_person_distance) + " m (at " + Fmt(m.closest_time, 1) + " s, robot at " +
                     Fmt(m.closest_robot_speed) + " m/s)"
               : "-");
+  if (std::isfinite(m.min_person_distance_in_sight) &&
+      m.min_person_distance_in_sight != m.min_person_distance)
+    out << " (in sight " << Fmt(m.min_person_distance_in_sight) << " m)";
   out << ", personal space " << Fmt(m.time_in_personal_space, 1) << " s";
   int contacts = 0;
   for (const auto& [k, n] : m.contacts)
@@ -269,6 +292,11 @@ std::string VerdictToJson(const Verdict& v) {
   s += Fmt(m.closest_robot_speed, 3);
   s += ",\"closest_time\":";
   s += Fmt(m.closest_time, 3);
+  s += ",\"min_person_distance_in_sight\":";
+  s += std::isfinite(m.min_person_distance_in_sight) ? Fmt(m.min_person_distance_in_sight, 3)
+                                                     : std::string("null");
+  s += ",\"closest_in_sight_robot_speed\":";
+  s += Fmt(m.closest_in_sight_robot_speed, 3);
   s += ",\"time_in_personal_space\":";
   s += Fmt(m.time_in_personal_space, 3);
   s += ",\"presses_per_traversal\":";

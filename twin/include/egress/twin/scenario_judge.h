@@ -44,9 +44,16 @@ struct RunMetrics {
   /// The robot's speed at the moment of min_person_distance [m/s]: below kWaitSpeed the
   /// person came to a standing robot, above it the robot came to the person.
   double closest_robot_speed{0.0};
-  double closest_time{0.0};             ///< When it was [s].
-  double time_in_personal_space{0.0};   ///< [s] with a surface gap < 1.2 m
-  std::map<std::string, int> contacts;  ///< By kind: person, static, door, payload, carried
+  double closest_time{0.0};  ///< When it was [s].
+  /// The least surface gap to a person in sight of the robot: nothing of the building (a wall,
+  /// furniture, a door leaf, glass or not) on the straight line between them at
+  /// ScenarioJudge::kSightHeight [m]. A person behind a wall is not in the robot's personal
+  /// space, however near: min_person_distance counts them too (issue 21: H12's person waits
+  /// behind the wall beside the button the robot presses).
+  double min_person_distance_in_sight{std::numeric_limits<double>::infinity()};
+  double closest_in_sight_robot_speed{0.0};  ///< The robot's speed then [m/s].
+  double time_in_personal_space{0.0};        ///< [s] with a surface gap < 1.2 m
+  std::map<std::string, int> contacts;       ///< By kind: person, static, door, payload, carried
   /// By the model touched (the robot's body or arm, or the payload it holds).
   std::map<std::string, int> contacts_with;
   std::map<std::string, double> door_wait_time;  ///< Per door [s]
@@ -77,6 +84,9 @@ class ScenarioJudge {
   static constexpr double kPersonalSpace = 1.2;  ///< [m]
   static constexpr double kWaitSpeed = 0.05;     ///< Below this the robot is waiting [m/s]
   static constexpr double kDoorZone = 2.0;       ///< Waiting counts within this of a door [m]
+  /// Whether a person is in sight is judged along a line at this height (a standing person's
+  /// chest; over tables and counters) [m].
+  static constexpr double kSightHeight = 1.2;
 
   /// Call after every world step.
   void Observe(const TwinWorld& world);
