@@ -186,7 +186,7 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // to a door 17 m away, it saw nobody there for want of range. Nor while something of the map
     // stands between: stepped aside behind the office's table, the robot saw nobody at door_a
     // for 5 s while a wheelchair user waited there, and left them behind (office seed 5).
-    const Eigen::Vector2d way_in = pass.centre + pass.n_M;
+    const Eigen::Vector2d way_in = WayIn(pass);
     if (around.near) {
       unseen_ = 0.0;
     } else if (last_tick_ && IsInLaserSight(task_, belief_.X_MB, way_in) &&
@@ -447,16 +447,23 @@ class HoldForResidents final : public TaskNode<bt::StatefulActionNode> {
     // off). The head looks the rest of the way.
     // With no path to where it would wait, it looks there (marks of someone long gone, behind
     // it, only a ray clears: seed 8's spot stayed "in collision" 340 s in the blind sector).
+    // Else both the watch point and the way in, where the clear time is counted: near the watch
+    // point, the way in may lie well off its bearing (two wards seed 56: a step to make room
+    // ended 0.4 m from door_e's watch point, which it faced 90 deg off ahead; the way in was
+    // 129 deg off, past the laser's sweep, the clear time never ran, and the robot held door_e
+    // until the time limit while the last resident waited at the exit door).
     {
-      const Eigen::Vector2d to_wait = wait_at.translation() - belief_.X_MB.translation();
-      const double look =
-          drive_failing_ && !IsInLaserSweep(task_, belief_.X_MB, wait_at.translation())
-              ? std::atan2(to_wait.y(), to_wait.x())
-              : LookYaw(pass, belief_.X_MB.translation());
-      const double off = std::remainder(look - belief_.X_MB.yaw, 2 * M_PI);
-      const double yaw = std::abs(off) <= kWatchWithinRad
-                             ? belief_.X_MB.yaw
-                             : belief_.X_MB.yaw + off - std::copysign(kWatchWithinRad, off);
+      const auto bearing = [&](const Eigen::Vector2d& p_M) {
+        const Eigen::Vector2d to = p_M - belief_.X_MB.translation();
+        return std::remainder(std::atan2(to.y(), to.x()) - belief_.X_MB.yaw, 2 * M_PI);
+      };
+      const bool look_at_spot =
+          drive_failing_ && !IsInLaserSweep(task_, belief_.X_MB, wait_at.translation());
+      const double turn =
+          look_at_spot ? WatchTurn(bearing(wait_at.translation()), bearing(wait_at.translation()),
+                                   kWatchWithinRad)
+                       : WatchTurn(bearing(WatchPoint(pass)), bearing(way_in), kWatchWithinRad);
+      const double yaw = belief_.X_MB.yaw + turn;
       if (task_.gaze != nullptr) {
         const Eigen::Vector2d p = WatchPoint(pass);
         task_.gaze->RequestLook({p.x(), p.y(), belief_.X_MC.translation().z()},

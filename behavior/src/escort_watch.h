@@ -3,6 +3,7 @@
 // hold for the residents being evacuated — who is near it on the robot's side, and whether anyone
 // is coming.
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <string>
@@ -25,6 +26,20 @@ inline Eigen::Vector2d WatchPoint(const DoorPass& pass) {
 inline double LookYaw(const DoorPass& pass, const Eigen::Vector2d& p_M) {
   const Eigen::Vector2d look = WatchPoint(pass) - p_M;
   return std::atan2(look.y(), look.x());
+}
+/// The doorway's way in on the robot's side, 1 m out from `pass`'s doorway [M]: where a hold
+/// counts its clear time (whoever waits at the door stands about there).
+inline Eigen::Vector2d WayIn(const DoorPass& pass) {
+  return pass.centre + pass.n_M;
+}
+/// The least turn [rad] that brings two bearings `a` and `b` [rad, from ahead] both within
+/// `within` of ahead; 0 if they are already. Two bearings too far apart for that (over
+/// 2 `within`) are centred on ahead instead.
+inline double WatchTurn(double a, double b, double within) {
+  b = a + std::remainder(b - a, 2 * M_PI);  // b's bearing the short way round from a
+  const double lo = std::max(a, b) - within, hi = std::min(a, b) + within;
+  if (lo > hi) return 0.5 * (a + b);
+  return std::clamp(0.0, lo, hi);
 }
 /// [m/s] A tracked person faster than this is on the move.
 inline constexpr double kMovingMps = 0.2;

@@ -1446,6 +1446,39 @@ TEST_F(HoldForResidentsTest, ClearTimeCountsOnlyWhileTheWayInIsInTheLasersSweep)
   EXPECT_TRUE(NotedText("everyone is through"));
 }
 
+// Watching, it keeps both the watch point and the way in (where the clear time is counted) within
+// a right angle of ahead: near the watch point their bearings part (two wards seed 56: a step to
+// make room ended 0.4 m from door_e's watch point, a right angle off ahead; the way in was 129
+// deg off, past the laser's sweep, the clear time never ran, and the robot held door_e until the
+// time limit while the last resident waited at the exit door).
+TEST_F(HoldForResidentsTest, WatchingItKeepsTheWayInInTheLasersSweepAsWellAsTheWatchPoint) {
+  belief_.scan = node_testing::SweepScan();
+  const double came = ResidentsCame();
+  // Someone stands at its spot: it stays where it is, 0.41 m from the watch point (0, 1), which
+  // is a right angle off ahead on its right; the way in (0, 2) is 146 deg off.
+  const Pose2 spot = ParsePose2(blackboard_->Get<std::string>("hold_spot").value());
+  See({node_testing::Person(spot.translation(), perception::PersonIntent::kStationary)});
+  const Eigen::Vector2d watch(0.0, 1.0), way_in(0.0, 2.0);
+  belief_.X_MB = {0.4, 0.9, std::atan2(0.1, -0.4) + M_PI / 2};
+  const auto off = [](const Pose2& X_MB, const Eigen::Vector2d& p_M) {
+    const Eigen::Vector2d to = p_M - X_MB.translation();
+    return std::remainder(std::atan2(to.y(), to.x()) - X_MB.yaw, 2 * M_PI);
+  };
+  ASSERT_NEAR(off(belief_.X_MB, watch), -M_PI / 2, 1e-9);
+  ASSERT_LT(off(belief_.X_MB, way_in), -0.8 * M_PI);
+  belief_.now = At(came + 0.5);
+  motion_.StopBase();
+  OperatedAgo(0.5);
+  EXPECT_EQ(tree_.TickOnce(), NodeStatus::kRunning);
+  ASSERT_GE(motion_.path().size(), 2u);
+  const Pose2 to = motion_.path().back();
+  EXPECT_LT((to.translation() - belief_.X_MB.translation()).norm(), 1e-6);  // turns in place
+  for (const Eigen::Vector2d& p : {watch, way_in})
+    EXPECT_LE(std::abs(off(to, p)), M_PI / 2 + 1e-6) << p.transpose();
+  // The least turn: the way in a right angle off ahead.
+  EXPECT_NEAR(off(to, way_in), -M_PI / 2, 1e-6);
+}
+
 // ... and only while nothing of the map stands between the laser and the way in: aside behind
 // the office's table, the robot saw nobody at door_a for 5 s while a wheelchair user waited
 // there, and left them behind (office seed 5).

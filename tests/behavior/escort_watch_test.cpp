@@ -32,6 +32,20 @@ perception::TrackedPersonWithIntent Person(int id, const Eigen::Vector2d& rest,
 
 constexpr double kWatchM = 6.0, kNearDoorM = 5.0;
 
+TEST(EscortWatchTest, WatchTurnIsTheLeastTurnBringingBothBearingsWithinReach) {
+  constexpr double kWithin = M_PI / 2;
+  EXPECT_DOUBLE_EQ(WatchTurn(0.3, -1.2, kWithin), 0.0);  // both within already
+  // One point: as far as brings it within reach.
+  EXPECT_NEAR(WatchTurn(2.5, 2.5, kWithin), 2.5 - kWithin, 1e-12);
+  EXPECT_NEAR(WatchTurn(-2.5, -2.5, kWithin), -2.5 + kWithin, 1e-12);
+  // Two: the farther one brought to the edge, the other stays within.
+  EXPECT_NEAR(WatchTurn(-M_PI / 2, -2.55, kWithin), -2.55 + kWithin, 1e-12);
+  // Across the back: -3.0 is 0.28 rad on round from 3.0, and it is brought to the edge.
+  EXPECT_NEAR(WatchTurn(3.0, -3.0, kWithin), (-3.0 + 2 * M_PI) - kWithin, 1e-12);
+  // Too far apart for both (2.38 rad the short way round, across the back): centred.
+  EXPECT_NEAR(WatchTurn(-2.0, 1.9, 0.5), 0.5 * (-2.0 + (1.9 - 2 * M_PI)), 1e-12);
+}
+
 TEST(EscortWatchTest, NobodyAboutIsNeitherNearNorMoving) {
   Belief belief;
   const Surroundings s = LookAround(belief, Pass(), kWatchM, kNearDoorM);
