@@ -14,6 +14,61 @@ namespace egress::planning {
 using perception::kInscribedCost;
 using perception::kUnknownCost;
 
+namespace {
+
+// Whether `source` and `target` lie in one component of the passable cells, 8-connected with
+// no corner cutting. A diagonal step needs both cells beside it passable, so the straight
+// steps alone join the same cells: two breadth-first floods over the 4 neighbours, one from
+// each end, a cell at a time in turn, until they meet (joined) or either runs out (not).
+// The search below would explore the whole of the start's side before it found no path; a
+// goal shut off by a queue of people (the crowd bench: the robot asks every tick for a standoff
+// beyond them, ~8 ms a time) costs here at most twice the smaller side, at a fraction of the
+// search's cost per cell. Only the verdict is used: the search's path is unchanged.
+template <class Passable>
+bool Connected(const perception::GridGeometry& g, const Passable& passable, std::size_t source,
+               std::size_t target) {
+  if (source == target) return true;
+  // Per cell of the grid framed by a blocked border (no bounds checks in the floods): 0 blocked,
+  // 1 passable and unseen, 2 reached from the source, 3 from the target.
+  constexpr std::uint8_t kFree = 1, kFromSource = 2, kFromTarget = 3;
+  const std::size_t width = std::size_t(g.width), w = width + 2;
+  std::vector<std::uint8_t> state(w * (std::size_t(g.height) + 2), 0);
+  for (int iy = 0; iy < g.height; ++iy) {
+    std::uint8_t* row = &state[(std::size_t(iy) + 1) * w + 1];
+    const std::size_t first = g.Index(0, iy);
+    for (std::size_t ix = 0; ix < width; ++ix)
+      row[ix] = passable(first + ix) ? kFree : 0;
+  }
+  const auto framed = [&](std::size_t i) { return (i / width + 1) * w + i % width + 1; };
+  const std::size_t steps[4] = {1, std::size_t(-1), w, std::size_t(0) - w};  // wrap-around adds
+  std::vector<std::size_t> queue[2];
+  std::size_t head[2] = {0, 0};
+  queue[0].reserve(4096);
+  queue[1].reserve(4096);
+  queue[0].push_back(framed(source));
+  queue[1].push_back(framed(target));
+  state[queue[0][0]] = kFromSource;
+  state[queue[1][0]] = kFromTarget;
+  for (int turn = 0;; turn ^= 1) {
+    auto& q = queue[turn];
+    if (head[turn] == q.size()) return false;
+    const std::size_t index = q[head[turn]++];
+    const std::uint8_t mine = turn == 0 ? kFromSource : kFromTarget;
+    for (const std::size_t step : steps) {
+      const std::size_t next = index + step;
+      const std::uint8_t s = state[next];
+      if (s == kFree) {
+        state[next] = mine;
+        q.push_back(next);
+      } else if (s != 0 && s != mine) {
+        return true;  // the other flood's
+      }
+    }
+  }
+}
+
+}  // namespace
+
 std::optional<double> GridShortestPathLength(const perception::Costmap2D& costmap,
                                              const Eigen::Vector2d& start,
                                              const Eigen::Vector2d& goal, bool allow_unknown) {
@@ -90,6 +145,7 @@ std::optional<std::vector<Eigen::Vector2d>> GridCheapestPath(const perception::C
   };
   const std::size_t source = g.Index(s->x(), s->y()), target = g.Index(t->x(), t->y());
   if (!passable(source) || !passable(target)) return std::nullopt;
+  if (!Connected(g, passable, source, target)) return std::nullopt;
   std::vector<float> distance(g.size(), std::numeric_limits<float>::infinity());
   std::vector<std::uint32_t> parent(g.size(), std::numeric_limits<std::uint32_t>::max());
   using Item = std::pair<float, std::uint32_t>;
