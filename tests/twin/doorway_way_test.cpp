@@ -3,6 +3,7 @@
 
 #include "doorway_way.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -109,6 +110,54 @@ TEST(WaitClearOfActuatorTest, AcrossTheWayTheyKeepOutOfTheSweepOfALeafOpeningTow
   const auto level = WaitClearOfActuator(kDoor, 1.0, kSpot, {5.2, 2.9}, kKeepM, kLaneHalfM, south);
   ASSERT_TRUE(level);
   EXPECT_NEAR(level->y(), 2.9, 1e-9);
+}
+
+// The robot at the origin coming east to a spot 2 m ahead; someone 0.2 m north of its way, 1 m
+// along; they keep 0.7 m from the way.
+const Eigen::Vector2d kRobot(0.0, 0.0), kWaySpot(2.0, 0.0), kInTheWay(1.0, 0.2);
+constexpr double kWayKeepM = 0.7;
+const auto kNoWalls = [](const Eigen::Vector2d& q) { return q; };
+const auto kNothingBetween = [](const Eigen::Vector2d&, const Eigen::Vector2d&) { return false; };
+
+TEST(AsideOfRobotsWayTest, SomeoneInTheWayStepsAsideOnTheirSide) {
+  const auto to =
+      AsideOfRobotsWay(kInTheWay, kRobot, kWaySpot, kWayKeepM, kNoWalls, kNothingBetween);
+  ASSERT_TRUE(to);
+  EXPECT_NEAR(to->x(), 1.0, 1e-9);
+  EXPECT_NEAR(to->y(), kWayKeepM, 1e-9);
+}
+
+TEST(AsideOfRobotsWayTest, SomeoneClearOfTheWayOrBehindTheRobotStays) {
+  EXPECT_FALSE(
+      AsideOfRobotsWay({1.0, 0.8}, kRobot, kWaySpot, kWayKeepM, kNoWalls, kNothingBetween));
+  EXPECT_FALSE(
+      AsideOfRobotsWay({-0.5, 0.1}, kRobot, kWaySpot, kWayKeepM, kNoWalls, kNothingBetween));
+}
+
+// A wall 0.4 m north of the way: cleared of it, their side's point comes out beyond it (a
+// wall between). They stay on their side (the caller keeps them clear of the actuator's lane),
+// not across the way, where they would stand in the way of the next one who comes to operate
+// the door (office seed 71).
+TEST(AsideOfRobotsWayTest, WithAWallOnTheirSideTheyStayOnItRatherThanCrossTheWay) {
+  const auto beyond_wall = [](const Eigen::Vector2d& q) {
+    return q.y() > 0.4 ? Eigen::Vector2d(q.x(), std::max(q.y(), 0.4 + 0.35)) : q;
+  };
+  const auto wall_between = [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    return (a.y() - 0.4) * (b.y() - 0.4) < 0.0;
+  };
+  EXPECT_FALSE(AsideOfRobotsWay(kInTheWay, kRobot, kWaySpot, kWayKeepM, beyond_wall, wall_between));
+}
+
+// Their side's point, cleared of a wall, comes back within reach of the way (no wall between):
+// they step aside on the other side.
+TEST(AsideOfRobotsWayTest, WithNoRoomOnTheirSideTheyStepToTheOther) {
+  const auto pushed_back = [](const Eigen::Vector2d& q) {
+    return Eigen::Vector2d(q.x(), std::min(q.y(), 0.3));
+  };
+  const auto to =
+      AsideOfRobotsWay(kInTheWay, kRobot, kWaySpot, kWayKeepM, pushed_back, kNothingBetween);
+  ASSERT_TRUE(to);
+  EXPECT_NEAR(to->y(), -kWayKeepM, 1e-9);
 }
 
 }  // namespace

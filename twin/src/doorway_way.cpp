@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "egress/hsr_interface/geometry.h"
+
 namespace egress::twin::world_detail {
 
 bool KeepsEvacueeWaiting(const DoorwayFrame& d, const Eigen::Vector2d& p_WE,
@@ -55,6 +57,29 @@ std::optional<Eigen::Vector2d> WaitClearOfActuator(const DoorwayFrame& d, double
   }
   if (away.norm() >= keep || away.norm() <= 1e-6) return std::nullopt;
   return p_WS + away.normalized() * keep;
+}
+
+std::optional<Eigen::Vector2d> AsideOfRobotsWay(
+    const Eigen::Vector2d& p_WP, const Eigen::Vector2d& p_WB, const Eigen::Vector2d& p_WS,
+    double keep, const std::function<Eigen::Vector2d(const Eigen::Vector2d&)>& clear_of_walls,
+    const std::function<bool(const Eigen::Vector2d&, const Eigen::Vector2d&)>& wall_between) {
+  const Eigen::Vector2d foot = egress::ClosestPointOnSegment(p_WP, p_WB, p_WS);
+  const Eigen::Vector2d off = p_WP - foot;
+  if (off.norm() >= keep || (foot - p_WB).norm() < 1e-6) return std::nullopt;
+  const Eigen::Vector2d way = (p_WS - p_WB).normalized();
+  Eigen::Vector2d across(-way.y(), way.x());
+  if (across.dot(off) < 0.0) across = -across;
+  for (const double s : {1.0, -1.0}) {
+    const Eigen::Vector2d target = clear_of_walls(foot + across * s * keep);
+    // Atrium west seed 36: the way ran along the wall; a wheelchair user who could not operate
+    // the door made for a point beyond it, and stood pressed against it on the plate's spot for
+    // 330 s. Crossing the way instead, they kept the next resident who could operate the door
+    // from it (office seed 71: 110 s to 189 s).
+    if (wall_between(p_WP, target)) return std::nullopt;
+    if ((target - egress::ClosestPointOnSegment(target, p_WB, p_WS)).norm() > keep - 0.02)
+      return target;
+  }
+  return std::nullopt;
 }
 
 }  // namespace egress::twin::world_detail

@@ -3,8 +3,10 @@
 /// Evacuees at a doorway, as pure functions of its geometry and people's places (all in W,
 /// metres and m/s): who keeps an evacuee waiting at a doorway they are about to go through (the
 /// rule of TwinWorld::Impl::DoorwayTaken for evacuees), and where someone who cannot operate a
-/// shut door waits clear of its actuator (TwinWorld::Impl::ClearOfActuator).
+/// shut door waits clear of its actuator (TwinWorld::Impl::ClearOfActuator) and of the robot's
+/// way to it (TwinWorld::Impl::OutOfRobotsWayTo).
 
+#include <functional>
 #include <optional>
 
 #include <Eigen/Core>
@@ -64,5 +66,17 @@ std::optional<Eigen::Vector2d> WaitClearOfActuator(const DoorwayFrame& d, double
                                                    const Eigen::Vector2d& p_WS,
                                                    const Eigen::Vector2d& p_WP, double keep,
                                                    double lane_half, const LeafSweep& leaf);
+
+/// Where someone at `p_WP` steps to, out of the robot's straight way from `p_WB` to the spot
+/// `p_WS` before an actuator, to stand `keep` from it [m]: square to the way, on the side they
+/// stand, moved out of any wall by `clear_of_walls`; on the other side if that point is still
+/// nearer the way than `keep` (less 2 cm). Nullopt if they stand `keep` or more from the way
+/// already, or the robot is at the spot, or a wall (`wall_between`, from them to the point) is
+/// between them and the point: cleared of the walls, a point in one may come out on its far
+/// side, and they stay on their side, out of the way of whoever comes to operate the door.
+std::optional<Eigen::Vector2d> AsideOfRobotsWay(
+    const Eigen::Vector2d& p_WP, const Eigen::Vector2d& p_WB, const Eigen::Vector2d& p_WS,
+    double keep, const std::function<Eigen::Vector2d(const Eigen::Vector2d&)>& clear_of_walls,
+    const std::function<bool(const Eigen::Vector2d&, const Eigen::Vector2d&)>& wall_between);
 
 }  // namespace egress::twin::world_detail

@@ -201,25 +201,11 @@ std::optional<Eigen::Vector2d> TwinWorld::Impl::OutOfRobotsWayTo(const Person& p
   const DoorModel& d = *doors[std::size_t(gate)].fixed;
   if ((p_WB - spot).norm() > kMakeWayForRobotM || (p_WB - d.centre).dot(d.normal) * side <= 0.0)
     return std::nullopt;
-  const Eigen::Vector2d& p_WP = p.walker.position;
-  const Eigen::Vector2d foot = egress::ClosestPointOnSegment(p_WP, p_WB, spot);
-  const double keep = robot_radius + p.walker.radius + kRobotWayMarginM;
-  const Eigen::Vector2d off = p_WP - foot;
-  if (off.norm() >= keep || (foot - p_WB).norm() < 1e-6) return std::nullopt;
-  // Aside, square to the robot's way, on the side they stand (the other if a wall is there).
-  const Eigen::Vector2d way = (spot - p_WB).normalized();
-  Eigen::Vector2d across(-way.y(), way.x());
-  if (across.dot(off) < 0.0) across = -across;
-  // Not through a wall: cleared of the walls, a point in one may come out on its far side (atrium
-  // west seed 36: the way ran along the wall, a wheelchair user who could not operate the door
-  // made for a point beyond it, and stood pressed against it on the plate's spot for 330 s).
-  for (const double s : {1.0, -1.0}) {
-    const Eigen::Vector2d target = ClearOfWalls(foot + across * s * keep, p.walker.radius);
-    if ((target - egress::ClosestPointOnSegment(target, p_WB, spot)).norm() > keep - 0.02 &&
-        !WallBetween(p_WP, target))
-      return target;
-  }
-  return std::nullopt;
+  // Aside, square to the robot's way, on their side (AsideOfRobotsWay).
+  return AsideOfRobotsWay(
+      p.walker.position, p_WB, spot, robot_radius + p.walker.radius + kRobotWayMarginM,
+      [&](const Eigen::Vector2d& q) { return ClearOfWalls(q, p.walker.radius); },
+      [&](const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return WallBetween(a, b); });
 }
 
 void TwinWorld::Impl::GiveWayIfJammed(Person& p) {
