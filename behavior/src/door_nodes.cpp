@@ -16,6 +16,9 @@ constexpr std::pair<double, double> kStandoffSeeds[] = {
     {-0.1, 0.3},  {0.1, -0.3}, {-0.1, -0.3}, {0.1, 0.3},  {-0.15, 0.6}, {0.15, -0.6},
     {-0.2, 0.0},  {0.2, 0.0},  {-0.2, 0.6},  {0.2, -0.6}, {-0.25, 0.9}, {0.25, -0.9}};
 
+// With those, the base stands this far out from the wall (in: negative) [m], first square on.
+constexpr double kStandoffOutOffsets[] = {0.0, 0.05, -0.05, 0.1};
+
 // An actuator the camera sees farther than this from where the map has it is another one [m].
 constexpr double kActuatorMatchDistance = 0.15;
 
@@ -94,19 +97,36 @@ class ApproachButton final : public TaskNode<bt::StatefulActionNode> {
       const Eigen::Vector2d n = actuator->n_M.head<2>().normalized();
       const Eigen::Vector2d t(-n.y(), n.x());
       bool found = false;
-      for (const auto& [shift, turn] : kStandoffSeeds) {
-        const Pose2 base{plan.X_MB_standoff.x + t.x() * shift, plan.X_MB_standoff.y + t.y() * shift,
-                         plan.X_MB_standoff.yaw + turn};
-        if (!task_.planner->IsValid(base)) continue;
-        const auto arm =
-            SolveArm(task_, base, plan.targets.approach, plan.approach_arm, ik.fingertip);
-        if (!arm) continue;
-        Note(StrCat("the standoff is blocked: standing ", std::round(shift * 100),
-                    " cm along the wall, turned ", std::round(turn * 180 / M_PI), " deg"));
-        plan.X_MB_standoff = base;
-        plan.approach_arm = *arm;
-        found = true;
-        break;
+      // First a standoff from which the arm holds the button's approach axis: each seed turned
+      // either way, and a little out from the wall or in; then, failing that, the seeds with the
+      // arm reaching at a slant (room A seed 6: from 20 cm along the wall, square to it, the arm
+      // reached sideways to door_a's button and the hand touched the wall beside it).
+      for (const bool square : {true, false}) {
+        for (const auto& [shift, seed_turn] : kStandoffSeeds) {
+          for (const double turn : {seed_turn, -seed_turn}) {
+            if (turn == -seed_turn && (seed_turn == 0.0 || !square)) continue;
+            for (const double out : kStandoffOutOffsets) {
+              if (out != 0.0 && !square) continue;
+              const Eigen::Vector2d p = plan.X_MB_standoff.translation() + t * shift + n * out;
+              const Pose2 base{p.x(), p.y(), plan.X_MB_standoff.yaw + turn};
+              if (!task_.planner->IsValid(base)) continue;
+              const auto arm = SolveArm(task_, base, plan.targets.approach, plan.approach_arm,
+                                        ik.fingertip, 0.0, /*allow_slant=*/!square);
+              if (!arm) continue;
+              Note(StrCat("the standoff is blocked: standing ", std::round(shift * 100),
+                          " cm along the wall, ", std::round(out * 100), " cm out, turned ",
+                          std::round(turn * 180 / M_PI), " deg",
+                          square ? "" : ", pressing at a slant"));
+              plan.X_MB_standoff = base;
+              plan.approach_arm = *arm;
+              found = true;
+              break;
+            }
+            if (found) break;
+          }
+          if (found) break;
+        }
+        if (found) break;
       }
       if (!found) {
         if (LookAgainAt(visit, plan.X_MB_standoff)) return NodeStatus::kRunning;

@@ -258,7 +258,7 @@ NodeStatus DriveStatus(const TaskServices& task,
 // damping creeps over the last millimetres, which a grasp does not need).
 std::optional<ArmPose> SolveArm(const TaskServices& task, const Pose2& X_MB,
                                 const planning::IkTarget& target, const ArmPose& from,
-                                bool fingertip, double accept_error) {
+                                bool fingertip, double accept_error, bool allow_slant) {
   planning::IkConfig ik = task.config.ik;
   ik.fingertip = fingertip;
   ik.use_base = false;
@@ -273,7 +273,7 @@ std::optional<ArmPose> SolveArm(const TaskServices& task, const Pose2& X_MB,
                            r.orientation_error <= task.config.ik.orientation_tolerance);
   };
   planning::IkResult r = solver.Solve(target, q);
-  if (!good(r) && target.approach_M) {
+  if (!good(r) && target.approach_M && allow_slant) {
     // With the base a little off its planned pose the arm alone may not hold the approach
     // axis too: the position is what presses.
     planning::IkTarget position_only = target;

@@ -195,9 +195,11 @@ bool IsPathAheadBlocked(const TaskServices& task);
 /// BaseMotionStatus for a planned drive that plans again when the path ahead becomes blocked.
 NodeStatus DriveStatus(const TaskServices& task, const NoteFn& note, bool door_speed = false);
 /// Arm-only IK at a fixed base pose; `accept_error` [m] accepts a solve that ends this close.
+/// Where the arm cannot also hold the target's approach axis, the position alone is solved (a
+/// press at a slant), unless `allow_slant` is false: then nullopt.
 std::optional<ArmPose> SolveArm(const TaskServices& task, const Pose2& X_MB,
                                 const planning::IkTarget& target, const ArmPose& from,
-                                bool fingertip, double accept_error = 0.0);
+                                bool fingertip, double accept_error = 0.0, bool allow_slant = true);
 /// Arm-only IK for `steps` points evenly along the straight line from `from_target` (where the
 /// arm `from` already is) to `to_target`, each solved warm from the one before: knots that keep
 /// a press on the button's normal instead of the curve a joint-space move would draw. nullopt

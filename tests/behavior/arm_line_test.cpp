@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "egress/hsr_interface/error.h"
+#include "egress/planning/ik_solver.h"
 #include "task_node_support.h"
 
 namespace egress::behavior::detail {
@@ -48,6 +49,36 @@ TEST(SolveArmLineTest, APointOutOfReachFailsTheLineAndBadStepsAreAnError) {
   const planning::IkTarget far{{2.0, 0.0, 1.0}, std::nullopt};  // beyond the arm from here
   EXPECT_FALSE(SolveArmLine(ctx, X_MB, from, far, TuckedArm(model), true, 4).has_value());
   EXPECT_THROW(SolveArmLine(ctx, X_MB, from, far, TuckedArm(model), true, 0), InvalidArgument);
+}
+
+// A button pressed along +x: from where whole-body IK stands the base the arm alone holds the
+// approach axis; from 20 cm to the side, square on, it reaches the button only at a slant, which
+// a standoff choice that wants the axis held must be told (room A seed 6: pressed at a slant
+// from 20 cm along the wall, the hand touched the wall beside the button).
+TEST(SolveArmTest, WithoutSlantAnArmThatCannotHoldTheApproachAxisIsNone) {
+  const RobotModel model = RobotModel::LoadDefault();
+  TaskServices ctx;
+  ctx.model = &model;
+  const planning::IkTarget button{{0.55, 0.0, 1.0}, Eigen::Vector3d::UnitX()};
+  planning::IkConfig ik;
+  ik.fingertip = true;
+  ik.use_base = true;
+  const planning::IkResult whole = planning::DlsIkSolver(model, ik).Solve(
+      button, WithArm(WholeBodyVector::Zero(), TuckedArm(model)));
+  ASSERT_TRUE(whole.converged);
+  const Pose2 X_MB{whole.q[kBaseX], whole.q[kBaseY], whole.q[kBaseYaw]};
+  const auto square = SolveArm(ctx, X_MB, button, ArmOf(whole.q), true, 0.0, false);
+  ASSERT_TRUE(square.has_value());
+  EXPECT_EQ(*square, *SolveArm(ctx, X_MB, button, ArmOf(whole.q), true));
+  const Pose2 aside{X_MB.x, X_MB.y - 0.2, X_MB.yaw};
+  const auto slant = SolveArm(ctx, aside, button, ArmOf(whole.q), true);
+  ASSERT_TRUE(slant.has_value());
+  WholeBodyVector q = WithArm(WholeBodyVector::Zero(), *slant);
+  q[kBaseX] = aside.x;
+  q[kBaseY] = aside.y;
+  q[kBaseYaw] = aside.yaw;
+  EXPECT_LT((model.CalcFingertipPosition(q) - button.p_MT).norm(), 2e-3);
+  EXPECT_FALSE(SolveArm(ctx, aside, button, ArmOf(whole.q), true, 0.0, false).has_value());
 }
 
 }  // namespace

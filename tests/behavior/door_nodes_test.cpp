@@ -9,6 +9,7 @@ namespace egress::behavior {
 namespace {
 
 using bt::NodeStatus;
+using detail::SolveArm;
 using node_testing::At;
 
 class DoorNodesTest : public node_testing::TaskNodeFixture {
@@ -82,6 +83,41 @@ TEST_F(DoorNodesTest, ApproachButtonDrivesToAStandoffFacingTheButton) {
   ASSERT_GE(motion_.path().size(), 2u);
   EXPECT_LT((motion_.path().back().translation() - plan.X_MB_standoff.translation()).norm(), 1e-6);
   EXPECT_TRUE(motion_.base_moving());
+}
+
+// Something 0.15 m before the whole-body standoff blocks it and the standoffs up to 15 cm along
+// the wall: the first free seed along the wall, 20 cm, reaches the button only at a slant (room
+// A seed 6: the hand touched the wall beside door_a's button). A standoff from which the arm
+// holds the button's approach axis comes first: here 5 cm nearer the wall.
+TEST_F(DoorNodesTest, ABlockedStandoffGivesWayToOneFromWhichTheArmPressesSquareOn) {
+  const auto plan_from = [&](const std::string& what) {
+    auto blackboard = bt::Blackboard::Create();
+    bt::Tree tree = Tree(R"(<ApproachButton door="lab_door"/>)", blackboard);
+    belief_.X_MB = {0.0, 1.0, M_PI / 2};
+    belief_.now = At(1.0);
+    EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning) << what;
+    const auto visit = blackboard->Get<DoorVisit>("door_visit");
+    EXPECT_TRUE(visit && visit->button_plan) << what;
+    motion_.StopBase();
+    return *visit->button_plan;
+  };
+  const ButtonPlan nominal = plan_from("free");
+  const Pose2 X_MB = nominal.X_MB_standoff;
+  const Eigen::Vector2d along = Eigen::Vector2d::UnitX(), out = -Eigen::Vector2d::UnitY();
+  costmap_.SetProjectedObstacles({X_MB.translation() + 0.15 * out});
+  ASSERT_FALSE(planner_.IsValid(X_MB));
+  const planning::IkTarget& approach = nominal.targets.approach;
+  const Pose2 slanted{X_MB.x - 0.2 * along.x(), X_MB.y, X_MB.yaw};
+  ASSERT_TRUE(planner_.IsValid(slanted));
+  ASSERT_FALSE(SolveArm(services_, slanted, approach, nominal.approach_arm, true, 0.0, false))
+      << "the seed 20 cm along reaches only at a slant";
+  const ButtonPlan plan = plan_from("blocked");
+  EXPECT_TRUE(planner_.IsValid(plan.X_MB_standoff));
+  EXPECT_TRUE(
+      SolveArm(services_, plan.X_MB_standoff, approach, nominal.approach_arm, true, 0.0, false))
+      << "square on from " << plan.X_MB_standoff.x << ", " << plan.X_MB_standoff.y;
+  EXPECT_FALSE(NotedText("pressing at a slant"));
+  EXPECT_TRUE(NotedText("cm out, turned"));
 }
 
 // A scan from (1.2, 1.0) facing north, 81 beams over +-0.7 rad, each ending at y = `y_hit`
