@@ -35,6 +35,7 @@
 #include "egress/twin/scenario.h"
 #include "egress/twin/sdf_world_loader.h"
 #include "egress/twin/twin_run.h"
+#include "study_stats.h"
 #include "workers.h"
 
 namespace egress::apps {
@@ -266,10 +267,9 @@ void ReportBatch(const std::filesystem::path& dir, const nlohmann::json& plan,
     for (const auto& r : results)
       l.insert(l.end(), (r.*member).begin(), (r.*member).end());
     if (l.empty()) return;
-    std::sort(l.begin(), l.end());
-    const auto q = [&](double f) { return l[std::min(l.size() - 1, std::size_t(f * l.size()))]; };
     fmt::print("preemption, {}: {} events, median {:.3f} s, p90 {:.3f} s, max {:.3f} s\n", what,
-               l.size(), q(0.5), q(0.9), l.back());
+               l.size(), CalcQuantile(l, 0.5), CalcQuantile(l, 0.9),
+               *std::max_element(l.begin(), l.end()));
   };
   report("stack's share (person in the zone in the world model -> stop command)",
          &TrialResult::preemption_latencies);

@@ -14,6 +14,7 @@
 #include "batch.h"
 #include "egress/hsr_interface/error.h"
 #include "egress/twin/scenario_judge.h"
+#include "study_stats.h"
 
 namespace egress::apps {
 
@@ -146,22 +147,14 @@ std::vector<ScenarioSummary> Summarize(const std::vector<TrialResult>& trials) {
   }
   for (ScenarioSummary& s : out) {
     s.rate = CalcWilsonInterval(s.successes, s.trials);
-    if (!s.times.empty()) {
-      std::vector<double> t = s.times;
-      std::nth_element(t.begin(), t.begin() + std::ptrdiff_t(t.size() / 2), t.end());
-      s.median_time = t[t.size() / 2];
-    }
+    if (!s.times.empty()) s.median_time = CalcQuantile(s.times, 0.5);
     if (!s.person_distances.empty()) {
-      std::vector<double> d = s.person_distances;
-      std::sort(d.begin(), d.end());
-      s.median_person_distance = d[d.size() / 2];
-      s.p10_person_distance = d[d.size() / 10];
+      s.median_person_distance = CalcQuantile(s.person_distances, 0.5);
+      s.p10_person_distance = CalcQuantile(s.person_distances, 0.1);
     }
     if (!s.person_distances_in_sight.empty()) {
-      std::vector<double> d = s.person_distances_in_sight;
-      std::sort(d.begin(), d.end());
-      s.median_person_distance_in_sight = d[d.size() / 2];
-      s.p10_person_distance_in_sight = d[d.size() / 10];
+      s.median_person_distance_in_sight = CalcQuantile(s.person_distances_in_sight, 0.5);
+      s.p10_person_distance_in_sight = CalcQuantile(s.person_distances_in_sight, 0.1);
     }
   }
   return out;

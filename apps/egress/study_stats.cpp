@@ -21,6 +21,15 @@ MedianCi CalcMedianCi(std::vector<double> v) {
   return out;
 }
 
+double CalcQuantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const double rank = std::clamp(q, 0.0, 1.0) * double(v.size() - 1);
+  const std::size_t below = std::size_t(std::floor(rank));
+  const std::size_t above = std::min(below + 1, v.size() - 1);
+  return v[below] + (rank - double(below)) * (v[above] - v[below]);
+}
+
 PairedDifference CalcPairedDifference(const std::map<std::uint64_t, double>& a,
                                       const std::map<std::uint64_t, double>& b, double tie) {
   PairedDifference out;

@@ -1,6 +1,7 @@
 #pragma once
-// Order statistics for `egress evac study`: a median with its 95 % interval, and the paired
-// difference between two conditions run on the same seeds (what one buys over the other).
+// Order statistics for `egress evac study` and `egress sim batch`: a median with its 95 %
+// interval, a quantile, and the paired difference between two conditions run on the same seeds
+// (what one buys over the other).
 
 #include <cstdint>
 #include <map>
@@ -16,6 +17,11 @@ struct MedianCi {
 };
 // Of `v` (any order; empty: all zero).
 MedianCi CalcMedianCi(std::vector<double> v);
+
+// The q-quantile (0 <= q <= 1) of `v` (any order; empty: 0), interpolated linearly between the
+// order statistics at rank q (n - 1), as numpy and R's default do: q = 0.5 is the median (of an
+// even count, the mean of the middle two), not the upper of the two.
+double CalcQuantile(std::vector<double> v, double q);
 
 // `b - a` per seed run under both conditions: the effect of the change from a to b with the
 // variation between seeds (how fast that seed's people walk, where they stand) taken out. Two

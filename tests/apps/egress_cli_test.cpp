@@ -782,10 +782,10 @@ TEST(EgressCliTest, SimBatchReportsClosestApproachesAndTheLaserPeopleSetting) {
   }
   EXPECT_GT(samples, 0);
   EXPECT_DOUBLE_EQ(summary.at("closest_worst_m").get<double>(), worst);
-  // Of two, the median is the upper one (the same index rule as the times').
-  EXPECT_DOUBLE_EQ(summary.at("closest_median_m").get<double>(), std::max(closest[0], closest[1]));
+  // Of two, the median is their mean (the same rule as the times').
+  EXPECT_DOUBLE_EQ(summary.at("closest_median_m").get<double>(), (closest[0] + closest[1]) / 2);
   EXPECT_DOUBLE_EQ(summary.at("closest_in_sight_median_m").get<double>(),
-                   std::max(in_sight[0], in_sight[1]));
+                   (in_sight[0] + in_sight[1]) / 2);
   EXPECT_DOUBLE_EQ(summary.at("closest_in_sight_worst_m").get<double>(),
                    std::min(in_sight[0], in_sight[1]));
   EXPECT_THAT(run.output, HasSubstr("in sight"));
