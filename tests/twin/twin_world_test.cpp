@@ -315,6 +315,37 @@ people:
   EXPECT_LT((world.people()[0].position - Eigen::Vector2d(2.6, 3.6)).norm(), 0.5);
 }
 
+// The first time an event of this kind and subject fired, or -1.
+double FirstEventTime(const TwinWorld& w, const std::string& kind, const std::string& subject) {
+  for (const auto& e : w.events())
+    if (e.kind == kind && e.subject == subject) return e.t;
+  return -1.0;
+}
+
+TEST(TwinWorldTest, APersonStartsTheRandomizedDelayAfterTheirTriggerWhateverItsKind) {
+  // person_delay_s was added to time triggers only: a person waiting for an event or for the
+  // robot to come near started at once, and the scenarios' delays did nothing.
+  const std::string yaml = R"(world: lab.sdf
+robot: {start: {x: 0.0, y: 1.0}}
+doors: [{door: lab_door, operator: push, actuator: lab_button, open_at: [0.5]}]
+people:
+  - {name: on_event, behavior: walk_past, start: [-2.6, 3.9], goal: [2.6, 3.9], trigger: {event: "door_opened:lab_door"}}
+  - {name: on_robot, behavior: walk_past, start: [-2.0, 0.0], goal: [2.0, 0.0], trigger: {robot_within: 3.0}}
+  - {name: at_time, behavior: walk_past, start: [-2.0, 6.0], goal: [2.0, 6.0], trigger: {at: 1.0}}
+randomize:
+  person_delay_s: [1.5, 1.5]
+)";
+  auto loaded = LoadText(yaml, WorldsDir() / "lab");
+  TwinWorld world(loaded.scenario, loaded.world, 1, Hsr());
+  world.StepFor(12.0);
+  const double opened = FirstEventTime(world, "door_opened", "lab_door");
+  ASSERT_GT(opened, 0.5);
+  const double step = 1.0 / 240.0 + 1e-9;
+  EXPECT_NEAR(FirstEventTime(world, "person_started", "on_event"), opened + 1.5, step);
+  EXPECT_NEAR(FirstEventTime(world, "person_started", "on_robot"), 1.5, step);
+  EXPECT_NEAR(FirstEventTime(world, "person_started", "at_time"), 2.5, step);
+}
+
 class GraspTest : public ::testing::Test {
  protected:
   // A bottle on the office table; the robot reaches it from the table's north side.

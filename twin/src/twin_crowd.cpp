@@ -194,21 +194,27 @@ void TwinWorld::Impl::UpdatePeople() {
   const Pose2 X_WB = RobotPose();
   for (auto& p : people) {
     if (!p.state.started) {
-      bool go = false;
+      // The moment the trigger's condition first held; the person starts trigger_delay after
+      // it, whatever the kind of trigger (a scenario's person_delay_s applies to each).
+      std::optional<double> since;
       switch (p.trigger.kind) {
         case TriggerSpec::Kind::kImmediately:
-          go = time >= p.trigger_delay;
+          since = 0.0;
           break;
         case TriggerSpec::Kind::kAtTime:
-          go = time >= p.trigger.value + p.trigger_delay;
+          since = p.trigger.value;
           break;
         case TriggerSpec::Kind::kRobotWithin:
-          go = (X_WB.translation() - p.walker.position).norm() <= p.trigger.value;
+          if (p.robot_came_within_at < 0.0 &&
+              (X_WB.translation() - p.walker.position).norm() <= p.trigger.value)
+            p.robot_came_within_at = time;
+          if (p.robot_came_within_at >= 0.0) since = p.robot_came_within_at;
           break;
         case TriggerSpec::Kind::kEvent:
-          go = HasEvent(p.trigger.event);
+          since = FirstEventTime(p.trigger.event);
           break;
       }
+      const bool go = since && time >= *since + p.trigger_delay;
       if (go) {
         p.state.started = true;
         p.state.phase = PersonPhase::kWalking;

@@ -102,7 +102,7 @@ int TwinWorld::Impl::EntityOf(const btCollisionObject* object, int triangle) con
 void TwinWorld::Impl::AddEvent(const std::string& kind, const std::string& subject,
                                const std::string& detail) {
   events.push_back({time, kind, subject, detail});
-  fired_events.insert(kind + ":" + subject);
+  fired_events.emplace(kind + ":" + subject, time);  // keeps the first
 }
 
 void TwinWorld::Impl::RecordContacts() {

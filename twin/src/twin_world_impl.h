@@ -6,6 +6,9 @@
 // twin_robot_body.cpp (base, arm, gripper, payloads), twin_rays.cpp (ray casting for the
 // sensors).
 
+#include <map>
+#include <optional>
+
 #include "ray_convex.h"
 #include "ray_fan.h"
 #include "twin_model_compiled.h"
@@ -38,7 +41,8 @@ struct Person {
   // (TwinConfig::crowd_social_rate_hz).
   Eigen::Vector2d social_acceleration{Eigen::Vector2d::Zero()};
   TriggerSpec trigger;
-  double trigger_delay{0.0};
+  double trigger_delay{0.0};  // [s] after the trigger's moment (RandomizeSpec::person_delay_s)
+  double robot_came_within_at{-1.0};  // [s] when a robot_within trigger's condition first held
   double speed{1.3};
   std::vector<Eigen::Vector2d> route;  // waypoints still to go
   // An exit route's waypoints as planned (route rewinds to them when the crowd pushes someone
@@ -151,7 +155,11 @@ struct TwinWorld::Impl {
   int FindDoor(const std::string& name) const;
 
   // ----- per-step updates ------------------------------------------------------------
-  bool HasEvent(const std::string& name) const { return fired_events.count(name) > 0; }
+  // When the event "kind:subject" first fired [s], if it has.
+  std::optional<double> FirstEventTime(const std::string& name) const {
+    const auto it = fired_events.find(name);
+    return it == fired_events.end() ? std::nullopt : std::optional<double>(it->second);
+  }
 
   void AddEvent(const std::string& kind, const std::string& subject,
                 const std::string& detail = "");
@@ -377,7 +385,7 @@ struct TwinWorld::Impl {
   bool arm_pose_cache_valid{false};
 
   std::vector<TwinEvent> events;
-  std::set<std::string> fired_events;
+  std::map<std::string, double> fired_events;  // "kind:subject" -> first time [s]
   std::set<std::pair<int, int>> touching;
   std::set<std::pair<int, int>> arm_touching, arm_touching_now;
 };

@@ -199,7 +199,9 @@ struct RandomizeSpec {
   double payload_xy{0.0};                ///< Payload xy jitter half-width [m].
   Range hold_open_s;                     ///< Overrides doors' hold time when non-zero.
   Range hold_angle_deg;  ///< Overrides hold_door people's hold angle when non-zero [deg].
-  Range person_delay_s;  ///< Added to each person's trigger.
+  /// Each person starts this long after their trigger's moment: the start time, the robot's
+  /// coming within reach, or the event's first firing [s].
+  Range person_delay_s;
   Range person_speed_scale{1.0, 1.0};  ///< Multiplies sampled speeds.
   // A scenario family: each seed draws a variant (DrawScenarioVariant) before the run.
   std::vector<std::string> start_places;   ///< The robot starts at one of these places.
