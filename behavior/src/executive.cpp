@@ -171,6 +171,7 @@ Executive::Executive(std::shared_ptr<const RobotModel> model, MissionMap map, Mi
   services_.log = &log_;
   services_.gaze = &m.gaze;
   services_.belief = &belief_;
+  services_.proxemics = &m.config.proxemics;
   belief_.X_BL = m.model->laser_pose().ToPose2();
   belief_.X_MB = X_MB_initial;
   belief_.last_safe = X_MB_initial;

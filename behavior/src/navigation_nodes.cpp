@@ -139,6 +139,8 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
     failure_noted_ = false;
     looked_back_ = false;
     looking_back_until_.reset();
+    retreat_to_.reset();
+    rechoices_ = 0;
     started_ = belief_.now;
     pending_ = Input<bool>("back_off") && belief_.last_safe &&
                (belief_.last_safe->translation() - belief_.X_MB.translation()).norm() > 0.05;
@@ -165,6 +167,18 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
   NodeStatus OnRunning() override {
     if (pending_) {
       StartRetreatOnceStopped();
+      return NodeStatus::kRunning;
+    }
+    if (IsRetreatHeldBack()) {
+      // Chosen on a first glimpse of someone (a track a few frames old, its velocity still that
+      // of their turn round the leaf), the way now heads where they go: stop and choose again.
+      ++rechoices_;
+      retreat_to_.reset();
+      task_.motion->StopBase();
+      pending_ = true;
+      looked_back_ = true;  // no turning to look: someone is coming now
+      started_ = belief_.now;
+      Note("the way back heads where someone is going: choosing again");
       return NodeStatus::kRunning;
     }
     if (make_way_pending_) {
@@ -322,6 +336,7 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
     const auto [spot, aside] = *chosen;
     if ((path.back().translation() - spot.translation()).norm() > 0.05) path.push_back(spot);
     if (path.size() < 2) return;
+    retreat_to_ = spot.translation();
     task_.motion->FollowPath(path, std::vector<bool>(path.size() - 1, false),
                              TuckedArm(*task_.model), belief_.now, task_.config.retreat_speed,
                              /*brisk=*/true);
@@ -353,7 +368,7 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
     for (const Pose2& p : way)
       corners.push_back(p.translation());
     corners.push_back(safe.translation());
-    const bool safe_ok = room.IsWayClear(corners);
+    const bool safe_ok = room.IsWayClear(corners) && !room.IsWayHeldBack(corners);
     if (safe_ok && room.Predicted(safe.translation()) >= comfortable) return std::pair{safe, false};
     const double beat = safe_ok ? room.Score(corners) : -std::numeric_limits<double>::infinity();
     if (const auto aside = room.BestSpotAround(way, beat)) return std::pair{*aside, true};
@@ -374,12 +389,29 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
   // After turning to see the way back: long enough for the laser's people tracks to confirm
   // whoever stands there [s].
   static constexpr double kLookBackDwellSec = 0.5;
+  // A retreat held back by the pace is chosen again at most this often.
+  static constexpr int kMaxRechoices = 2;
+
+  // Whether the retreat under way heads at someone (where they are or will be) so that the
+  // executive's pace (ApproachSpeedScale) holds it to a crawl.
+  bool IsRetreatHeldBack() const {
+    if (!retreat_to_ || rechoices_ >= kMaxRechoices || task_.proxemics == nullptr ||
+        !task_.motion->base_moving())
+      return false;
+    const Eigen::Vector2d v_M = task_.motion->planned_velocity();
+    if (v_M.norm() < kStoppedMps) return false;
+    return ApproachSpeedScale(belief_.X_MB, v_M, *retreat_to_, belief_.world.people,
+                              task_.config.footprint_radius, task_.config.person_radius,
+                              *task_.proxemics) < ApproachPace::kHeldScale;
+  }
 
   bool pending_{false};
   bool make_way_pending_{false};  ///< MakeWayInPlace once the base has stopped
   bool failure_noted_{false};
   bool looked_back_{false};
-  std::optional<Time> looking_back_until_;  ///< turning to see the way back until then, at least
+  std::optional<Time> looking_back_until_;     ///< turning to see the way back until then, at least
+  std::optional<Eigen::Vector2d> retreat_to_;  ///< where the retreat under way ends
+  int rechoices_{0};                           ///< retreats chosen again, held back
   Time started_{};
 };
 

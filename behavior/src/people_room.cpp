@@ -102,9 +102,16 @@ void AppendThroughDoorWay(const TaskServices& task, const std::string& door,
       ways.push_back({p, task.config.person_radius, k * step, to_centre / distance * speed});
   }
   if (k * step > horizon + 1e-9) return;
+  // On through it along the normal at their speed, bent by the drift they have along the door
+  // line (someone coming round the leaf towards the opening's middle, H12 and P5's runner,
+  // walks on that way past it, not straight down the normal: the robot stepped aside to the
+  // side they went).
+  const Eigen::Vector2d along_door(-pass.n_M.y(), pass.n_M.x());
+  const Eigen::Vector2d v_on =
+      (n_MOn * speed + along_door * person.v_MP.dot(along_door)).normalized() * speed;
   const std::size_t first = ways.size();
   AppendPredictedWay(task, at, PeopleRoom::kPeopleLookM, horizon - t_centre, step, 0, pass.centre,
-                     n_MOn * speed, ways);
+                     v_on, ways);
   for (std::size_t i = first; i < ways.size(); ++i)
     ways[i].t += t_centre;
 }
@@ -357,12 +364,28 @@ std::optional<Pose2> PeopleRoom::BestSpotAround(const std::vector<Pose2>& way, d
         continue;
       const Pose2 candidate{q.x(), q.y(), yaw};
       if (!HandClearOfWalls(task_, way.back(), q)) continue;
+      if (IsWayHeldBack(corners)) continue;
       if (!task_.planner->IsPathValid({way.back(), candidate})) continue;
       best = candidate;
       beat = s;
     }
   }
   return best;
+}
+
+bool PeopleRoom::IsWayHeldBack(const std::vector<Eigen::Vector2d>& corners) const {
+  if (task_.proxemics == nullptr || corners.size() < 2) return false;
+  const Pose2& X_MB = task_.belief->X_MB;
+  // The first leg that goes anywhere: its direction is the velocity the pace is asked about.
+  for (std::size_t i = 1; i < corners.size(); ++i) {
+    const Eigen::Vector2d leg = corners[i] - corners[0];
+    if (leg.norm() < 1e-3) continue;
+    return ApproachSpeedScale(X_MB, leg.normalized() * task_.config.retreat_speed, corners.back(),
+                              task_.belief->world.people, task_.config.footprint_radius,
+                              task_.config.person_radius,
+                              *task_.proxemics) < ApproachPace::kHeldScale;
+  }
+  return false;
 }
 
 bool StoppedOrStopTimedOut(const TaskServices& task, Time since) {

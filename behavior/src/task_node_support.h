@@ -360,8 +360,16 @@ class PeopleRoom {
   /// Of the spots round the robot (kSpotRadiiM x kSpotHeadings, at its heading) outside every
   /// door's zone, at least kSpotWallClearanceM beyond the footprint from every mapped wall,
   /// reachable from `way` (the robot's pose first) by a clear straight line the planner finds
-  /// valid: the best-scoring one, if it scores above `beat`.
+  /// valid, and whose way the pace lets the robot drive (IsWayHeldBack): the best-scoring one,
+  /// if it scores above `beat`.
   std::optional<Pose2> BestSpotAround(const std::vector<Pose2>& way, double beat) const;
+  /// Whether the executive's pace (ApproachSpeedScale, TaskServices::proxemics) would hold the
+  /// robot to a crawl from its first step along the straight lines through `corners` (the
+  /// robot's position first): it heads at someone near, or where they will be. A retreat
+  /// aside that way stands still (H12, P5: the runner from behind the leaf came through the
+  /// doorway at the robot waiting on its axis; the spot chosen was on the side they were
+  /// heading for, the pace stopped the robot after 3 cm, and they squeezed past at 5 cm).
+  bool IsWayHeldBack(const std::vector<Eigen::Vector2d>& corners) const;
 
   static constexpr double kSpotRadiiM[] = {0.6, 1.0, 1.5};
   static constexpr int kSpotHeadings = 16;

@@ -43,6 +43,8 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     phase_ = Phase::kWaiting;
     waiting_since_ = belief_.now;
     passage_wait_over_ = false;
+    aside_for_passage_ = false;
+    peek_side_.reset();
     give_way_.Reset();
     if (lateral > 0.05 || offset.dot(pass_.n_M) > entry_distance_ + 0.05) {
       // Out of the way of anyone walking up to the door first: the line-up crosses the
@@ -60,6 +62,12 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
         if (give_way_.Update(task_, std::nullopt, Input<double>("wait_timeout"), note) ==
             NodeStatus::kRunning)
           return NodeStatus::kRunning;
+        if (aside_for_passage_) {
+          // Still waiting for the passage beside the lane (kPeeking lines up once it is quiet).
+          phase_ = Phase::kPeeking;
+          waiting_since_ = belief_.now;
+          return NodeStatus::kRunning;
+        }
         return StartLineUp();
       }
       case Phase::kToPeek: {
@@ -91,6 +99,11 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
                                : DoorWindowLeavesTime(task_, door_, &visit, t);
         };
         const bool window_leaves_time = window_leaves(slide_time);
+        // Stepped back here for people passing the doorway: until they have passed.
+        if (aside_for_passage_ &&
+            PassageBusy(slide_time +
+                        DoorPathDuration(task_, {Pose2{entry.x(), entry.y(), yaw_}, ExitPose()})))
+          return NodeStatus::kRunning;
         if (looked < task_.config.door_peek_time || LeafOpening() || !window_leaves_time) {
           if (looked > Input<double>("wait_timeout")) {
             Note("the door did not open in time");
@@ -153,7 +166,10 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
         }
         path.push_back({exit.x(), exit.y(), yaw_});
         through.push_back(true);
-        if (PassageBusy(DoorPathDuration(task_, path))) return NodeStatus::kRunning;
+        if (PassageBusy(DoorPathDuration(task_, path))) {
+          WaitBesideTheLane();
+          return NodeStatus::kRunning;
+        }
         task_.motion->FollowPath(path, through, TuckedArm(*task_.model), belief_.now);
         Note(StrCat("door open: driving through at ", task_.motion->trajectory_config().door_speed,
                     " m/s"));
@@ -219,6 +235,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
         task_.motion->FollowPath(path, {true}, TuckedArm(*task_.model), belief_.now);
         Note("to the lane's edge, to look through the door before lining up");
         phase_ = Phase::kToPeek;
+        peek_side_ = LateralOf(peek->translation()) > 0.0 ? 1.0 : -1.0;
         return NodeStatus::kRunning;
       }
     }
@@ -250,17 +267,51 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     if (task_.config.door_peek_time <= 0.0) return std::nullopt;
     const perception::DoorModel& door = *task_.map->FindDoor(door_);
     if (pass_.n_M.dot(door.SwingSide()) > 0.0) return std::nullopt;
+    constexpr double kMinSlide = 0.15;  // [m] nearer than this, straight onto the axis
+    const double lateral = LateralOf(belief_.X_MB.translation());
+    if (std::abs(lateral) < LaneEdgeLateral() + kMinSlide) return std::nullopt;
+    return LaneEdgePose(lateral > 0.0 ? 1.0 : -1.0);
+  }
+
+  // How far from the door's axis the footprint clears the lane through the opening [m].
+  double LaneEdgeLateral() const {
     constexpr double kEdgeClearance = 0.05;  // [m] between the footprint and the lane
-    constexpr double kMinSlide = 0.15;       // [m] nearer than this, straight onto the axis
+    return task_.map->FindDoor(door_)->width() / 2 + task_.config.footprint_radius + kEdgeClearance;
+  }
+  // Where p_M is across the door's axis (along the door line) [m].
+  double LateralOf(const Eigen::Vector2d& p_M) const {
+    return (p_M - pass_.centre).dot(Eigen::Vector2d(-pass_.n_M.y(), pass_.n_M.x()));
+  }
+  // PeekPose's spot on the `side` (+1 or -1, LateralOf's sign) of the lane.
+  Pose2 LaneEdgePose(double side) const {
     const Eigen::Vector2d along(-pass_.n_M.y(), pass_.n_M.x());
-    const double lateral = (belief_.X_MB.translation() - pass_.centre).dot(along);
-    const double edge = door.width() / 2 + task_.config.footprint_radius + kEdgeClearance;
-    if (std::abs(lateral) < edge + kMinSlide) return std::nullopt;
-    const Eigen::Vector2d p = EntryPoint() + along * std::copysign(edge, lateral);
+    const Eigen::Vector2d p = EntryPoint() + along * (side * LaneEdgeLateral());
     const double turn = task_.config.door_peek_turn_deg * M_PI / 180.0;
-    const Eigen::Vector2d facing =
-        -pass_.n_M * std::cos(turn) - along * std::copysign(std::sin(turn), lateral);
+    const Eigen::Vector2d facing = -pass_.n_M * std::cos(turn) - along * (side * std::sin(turn));
     return Pose2{p.x(), p.y(), std::atan2(facing.y(), facing.x())};
+  }
+  Pose2 ExitPose() const {
+    const Eigen::Vector2d exit =
+        ClearOpeningCentre(task_, door_) - pass_.n_M * ExitDistance(task_, door_);
+    return Pose2{exit.x(), exit.y(), yaw_};
+  }
+
+  // Waiting at the entry for people passing the doorway, the robot stands in front of the
+  // opening: anyone near it on the far side may turn through it, and walks at the robot (H12,
+  // P5 with their delays: someone from behind the leaf came through at the robot lined up on the
+  // axis, stopped there for a passer-by, and squeezed past it at 5 cm). Come from the lane's
+  // edge (PeekPose), it steps back there to wait, once per visit, and lines up again when they
+  // have passed (phase kPeeking).
+  void WaitBesideTheLane() {
+    if (aside_for_passage_ || !peek_side_ || task_.motion->base_moving()) return;
+    if (std::abs(LateralOf(belief_.X_MB.translation())) > 0.5 * LaneEdgeLateral()) return;
+    const Pose2 aside = LaneEdgePose(*peek_side_);
+    const std::vector<Pose2> path{belief_.X_MB, aside};
+    if (!task_.planner->IsPathValid(path)) return;
+    task_.motion->FollowPath(path, {true}, TuckedArm(*task_.model), belief_.now);
+    Note("waiting beside the lane: someone by the doorway may come through it");
+    aside_for_passage_ = true;
+    phase_ = Phase::kToPeek;
   }
 
   // Whether the robot waits at the entry for people to pass the doorway (IsPassageClear over the
@@ -373,7 +424,9 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
   double yaw_{0.0};
   Phase phase_{Phase::kWaiting};
   Time waiting_since_{};
-  bool passage_wait_over_{false};  // waited the longest for them: going regardless
+  bool passage_wait_over_{false};    // waited the longest for them: going regardless
+  bool aside_for_passage_{false};    // stepped back to the lane's edge to wait for them
+  std::optional<double> peek_side_;  // the side of the lane it looked through from (+1/-1)
 };
 
 }  // namespace

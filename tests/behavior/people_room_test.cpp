@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "egress/behavior/proxemics.h"
 #include "task_node_fixture.h"
 #include "task_node_support.h"
 
@@ -299,6 +300,38 @@ TEST(ThroughDoorWaysTest, PeopleNearADoorsFarSideWalkThroughTheMiddleOfItsOpenin
   EXPECT_THROW(ThroughDoorWays(task, "no_such_door", 4.0), InvalidArgument);
 }
 
+// Someone coming round the leaf towards the opening's middle (walking along the door line as
+// well as at it) walks on through it with that drift, not straight down the normal: H12 and P5's
+// runner went on the way they were drifting, and a spot aside on that side was in their way.
+TEST(ThroughDoorWaysTest, ThroughTheOpeningTheyKeepTheirDriftAlongTheDoorLine) {
+  const MissionMap map = node_testing::LabDoor();  // door line y = 3, the middle at (0, 3)
+  Belief belief;
+  belief.X_MB = {0.0, 2.3, M_PI / 2};  // on the axis, at the entry
+  TaskServices task;
+  task.map = &map;
+  task.belief = &belief;
+  auto entry = node_testing::Person({0.3, 4.4}, perception::PersonIntent::kUnknown);
+  entry.person.v_MP = {-0.6, -0.8};  // 1 m/s, towards -x and the door
+  belief.world.people = {entry};
+  const std::vector<Occupant> way = ThroughDoorWays(task, "lab_door", 4.0);
+  ASSERT_FALSE(way.empty());
+  const double t_middle = std::hypot(0.3, 1.4) / 1.0;
+  int after = 0;
+  for (const Occupant& o : way) {
+    if (o.t <= t_middle + 1e-9) continue;
+    ++after;
+    // From (0, 3) along the normal at their speed (0, -1) bent by their drift (-0.6, 0), at
+    // their speed.
+    const Eigen::Vector2d v = Eigen::Vector2d(-0.6, -1.0).normalized();
+    EXPECT_NEAR(o.p_M.x(), v.x() * (o.t - t_middle), 1e-6) << "at t = " << o.t;
+    EXPECT_NEAR(o.p_M.y(), 3.0 + v.y() * (o.t - t_middle), 1e-6) << "at t = " << o.t;
+  }
+  EXPECT_GT(after, 3);
+  // So a spot on the side they drift to has less room than its mirror image.
+  const PeopleRoom room(task, 4.0, {.through_door = "lab_door"});
+  EXPECT_LT(room.Predicted({-1.0, 2.3}), room.Predicted({1.0, 2.3}) - 0.2);
+}
+
 // Someone walking at the door the robot stands beside, read slow (a track that has just set off
 // from standing and coasts out of the laser's view: P1, 0.46 m/s read for 1.3 m/s): not coming
 // by their tracked line and speed, but coming by their way through the opening's middle at a
@@ -376,6 +409,38 @@ TEST_F(PeopleRoomTest, AWayThroughADoorwaysMiddleHasNoRoomToStepOff) {
 }
 
 // The base has stopped below kStoppedMps, or is given kStopWithinSec to.
+// A way aside the executive's pace would hold to a crawl (it heads at someone near, or where
+// they will be within its horizon) is no way aside: the robot would stand still on it (H12, P5:
+// chosen on a first glimpse, it stopped after 3 cm and the runner squeezed past at 5 cm).
+TEST_F(PeopleRoomTest, AWayThePaceHoldsBackIsNoWayAside) {
+  Stepping stepping(*this);
+  const ProxemicsConfig proxemics;
+  belief_.X_MB = {5.0, 1.0, 0.0};
+  // Walking down the corridor at the robot, 1.5 m off: in a second, 0.3 m from it.
+  belief_.world.people = {Walker({6.5, 1.0}, {-1.2, 0.0})};
+  const Eigen::Vector2d at = belief_.X_MB.translation();
+  const std::vector<Eigen::Vector2d> towards{at, {5.8, 1.4}}, away{at, {4.0, 1.0}};
+  {
+    const PeopleRoom room(task_, 3.0);
+    EXPECT_FALSE(room.IsWayHeldBack(towards)) << "without a pace nothing holds it back";
+  }
+  task_.proxemics = &proxemics;
+  const PeopleRoom room(task_, 3.0);
+  EXPECT_TRUE(room.IsWayHeldBack(towards));
+  EXPECT_FALSE(room.IsWayHeldBack(away));
+  EXPECT_FALSE(room.IsWayHeldBack({at})) << "no way";
+  // No spot chosen aside is one the pace holds back.
+  const std::optional<Pose2> spot = room.BestSpotAround({belief_.X_MB}, -1e9);
+  ASSERT_TRUE(spot.has_value());
+  EXPECT_FALSE(room.IsWayHeldBack({at, spot->translation()}))
+      << "to " << spot->x << ", " << spot->y;
+  // Without the pace, one of the spots most to the side, ahead, is held back.
+  ProxemicsConfig none = proxemics;
+  none.slow_near_people = false;
+  task_.proxemics = &none;
+  EXPECT_FALSE(PeopleRoom(task_, 3.0).IsWayHeldBack(towards));
+}
+
 TEST_F(PeopleRoomTest, StoppedOnceSlowOrOnceTheStopTimeHasRunOut) {
   belief_.now = SecondsToDuration(10.0);
   belief_.V_B = {0.3, 0.0, 0.0};

@@ -485,5 +485,63 @@ TEST_F(TraverseDoorTest, TraverseDoorStopsShortOfTheDoorwayForSomeoneComingIntoV
   EXPECT_TRUE(motion_.base_moving());
 }
 
+// Lined up on the axis after looking through from the lane's edge, the robot finds someone by
+// the doorway's far side: anyone there may turn through the opening at it (H12, P5: a person
+// stepping out from behind the leaf came through at the robot waiting on the axis and squeezed
+// past at 5 cm). It waits back at the lane's edge it came from, and lines up again once the
+// passage has been quiet.
+TEST_F(TraverseDoorTest, WaitingForSomeoneByTheDoorwayItStepsBackToTheLanesEdge) {
+  services_.config.door_hold_window = 30.0;
+  std::optional<bt::Tree> tree;
+  SlideOntoTheAxisAfterLookingThrough(&tree);
+  ASSERT_TRUE(tree.has_value());
+  const Pose2 entry = motion_.path().back();
+  const double edge_x = 0.475 + services_.config.footprint_radius + 0.05;
+  // At the entry: the slide is done.
+  motion_.StopBase();
+  belief_.X_MB = entry;
+  belief_.now = At(8.0);
+  DoorSeenOpen(90.0, 0.0);
+  See({});
+  ASSERT_EQ(tree->TickOnce(), NodeStatus::kRunning);
+  ASSERT_TRUE(NotedText("driving through"));
+  // Someone comes into view along the passage beyond: it stops short of the doorway.
+  auto passer = node_testing::Person({1.5, 4.0}, perception::PersonIntent::kApproaching);
+  passer.person.v_MP = {-1.0, 0.0};
+  belief_.now = At(8.5);
+  DoorSeenOpen(90.0, 0.0);
+  See({passer});
+  ASSERT_EQ(tree->TickOnce(), NodeStatus::kRunning);
+  ASSERT_TRUE(NotedText("stopping short"));
+  ASSERT_FALSE(motion_.base_moving());
+  // A tick later, back to the edge it looked through from.
+  belief_.now = At(8.6);
+  DoorSeenOpen(90.0, 0.0);
+  See({passer});
+  ASSERT_EQ(tree->TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(NotedText("waiting beside the lane"));
+  ASSERT_TRUE(motion_.base_moving());
+  EXPECT_NEAR(motion_.path().back().x, edge_x, 1e-6);
+  EXPECT_NEAR(motion_.path().back().y, entry.y, 1e-6);
+  // There, while they are by the doorway, it stays.
+  motion_.StopBase();
+  belief_.X_MB = {edge_x, entry.y, M_PI / 2};
+  for (const double t : {10.0, 11.0}) {
+    belief_.now = At(t);
+    DoorSeenOpen(90.0, 0.0);
+    passer.person.p_MP.x() = 1.5 - (t - 8.5);
+    See({passer});
+    EXPECT_EQ(tree->TickOnce(), NodeStatus::kRunning);
+    EXPECT_FALSE(motion_.base_moving()) << t;
+  }
+  // Gone and quiet for passage_quiet_time: onto the axis again.
+  belief_.now = At(11.0 + services_.config.passage_quiet_time + 0.5);
+  DoorSeenOpen(90.0, 0.0);
+  See({});
+  EXPECT_EQ(tree->TickOnce(), NodeStatus::kRunning);
+  ASSERT_TRUE(motion_.base_moving());
+  EXPECT_NEAR(motion_.path().back().x, 0.0, 1e-6);
+}
+
 }  // namespace
 }  // namespace egress::behavior

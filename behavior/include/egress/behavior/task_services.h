@@ -225,6 +225,8 @@ struct ReleasePlan {
   double give{0.0};
 };
 
+struct ProxemicsConfig;
+
 /// What the task nodes act through, handed to each at construction. The executive owns every
 /// piece and keeps them alive as long as its trees.
 struct TaskServices {
@@ -239,6 +241,9 @@ struct TaskServices {
   HeadGaze* gaze{nullptr};
   /// The robot's belief, refreshed by the executive before every tick; read-only to the nodes.
   const Belief* belief{nullptr};
+  /// How the executive slows the base near people (ApproachPace): a step aside it would hold
+  /// to a crawl is no step aside. May be null (no pace, e.g. in node tests).
+  const ProxemicsConfig* proxemics{nullptr};
 };
 
 }  // namespace egress::behavior
