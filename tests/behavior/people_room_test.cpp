@@ -33,6 +33,19 @@ perception::TrackedPersonWithIntent Walker(const Eigen::Vector2d& p_MP,
   return entry;
 }
 
+// The lab door's map (door line y = 3, the middle at (0, 3)) and a belief with the robot at
+// X_MB, wired into task services.
+struct AtTheLabDoor {
+  explicit AtTheLabDoor(const Pose2& X_MB) {
+    belief.X_MB = X_MB;
+    task.map = &map;
+    task.belief = &belief;
+  }
+  const MissionMap map = node_testing::LabDoor();
+  Belief belief;
+  TaskServices task;
+};
+
 class PeopleRoomTest : public ::testing::Test {
  protected:
   PeopleRoomTest() : costmap_(DeadEndCorridor()) {
@@ -242,12 +255,9 @@ TEST_F(PeopleRoomTest, SomeoneNearComingNearerMayWalkStraightThroughTheRobotsPla
 // now, then along the normal, at their speed (or a walker's, if they dawdle). Nobody walking
 // away from the opening, or farther than kThroughDoorRadiusM, has such a way.
 TEST(ThroughDoorWaysTest, PeopleNearADoorsFarSideWalkThroughTheMiddleOfItsOpening) {
-  const MissionMap map = node_testing::LabDoor();  // door line y = 3, the middle at (0, 3)
-  Belief belief;
-  belief.X_MB = {1.0, 2.4, M_PI / 2};  // beside the opening, on its south side
-  TaskServices task;
-  task.map = &map;
-  task.belief = &belief;
+  AtTheLabDoor at({1.0, 2.4, M_PI / 2});  // beside the opening, on its south side
+  Belief& belief = at.belief;
+  TaskServices& task = at.task;
   const auto ways_of = [&](const Eigen::Vector2d& p_MP, const Eigen::Vector2d& v_MP) {
     auto entry = node_testing::Person(p_MP, perception::PersonIntent::kUnknown);
     entry.person.v_MP = v_MP;
@@ -304,12 +314,9 @@ TEST(ThroughDoorWaysTest, PeopleNearADoorsFarSideWalkThroughTheMiddleOfItsOpenin
 // well as at it) walks on through it with that drift, not straight down the normal: H12 and P5's
 // runner went on the way they were drifting, and a spot aside on that side was in their way.
 TEST(ThroughDoorWaysTest, ThroughTheOpeningTheyKeepTheirDriftAlongTheDoorLine) {
-  const MissionMap map = node_testing::LabDoor();  // door line y = 3, the middle at (0, 3)
-  Belief belief;
-  belief.X_MB = {0.0, 2.3, M_PI / 2};  // on the axis, at the entry
-  TaskServices task;
-  task.map = &map;
-  task.belief = &belief;
+  AtTheLabDoor at({0.0, 2.3, M_PI / 2});  // on the axis, at the entry
+  Belief& belief = at.belief;
+  TaskServices& task = at.task;
   auto entry = node_testing::Person({0.3, 4.4}, perception::PersonIntent::kUnknown);
   entry.person.v_MP = {-0.6, -0.8};  // 1 m/s, towards -x and the door
   belief.world.people = {entry};
@@ -337,12 +344,9 @@ TEST(ThroughDoorWaysTest, ThroughTheOpeningTheyKeepTheirDriftAlongTheDoorLine) {
 // by their tracked line and speed, but coming by their way through the opening's middle at a
 // walker's pace. Nobody standing, nor walking away from the door, counts so.
 TEST(PeopleComingTest, SomeoneWalkingThroughTheDoorTheRobotStandsBesideIsComing) {
-  const MissionMap map = node_testing::LabDoor();  // door line y = 3, the middle at (0, 3)
-  Belief belief;
-  belief.X_MB = {1.15, 2.43, M_PI / 2};  // at the button, beside the opening
-  TaskServices task;
-  task.map = &map;
-  task.belief = &belief;
+  AtTheLabDoor at({1.15, 2.43, M_PI / 2});  // at the button, beside the opening
+  Belief& belief = at.belief;
+  TaskServices& task = at.task;
   const auto coming_with = [&](const Eigen::Vector2d& v_MP, const std::string& door) {
     auto entry = node_testing::Person({1.5, 0.8}, perception::PersonIntent::kUnknown);
     entry.person.v_MP = v_MP;
@@ -365,12 +369,9 @@ TEST(PeopleComingTest, SomeoneWalkingThroughTheDoorTheRobotStandsBesideIsComing)
 // come through the doorway past it within comfort_distance (someone dawdling in it); nobody
 // else, and nobody through a door it was not given.
 TEST(WhomToMakeWayForTest, SomeoneComingOrWhoeverComesThroughTheDoorway) {
-  const MissionMap map = node_testing::LabDoor();  // door line y = 3, the middle at (0, 3)
-  Belief belief;
-  belief.X_MB = {1.0, 2.4, M_PI / 2};
-  TaskServices task;
-  task.map = &map;
-  task.belief = &belief;
+  AtTheLabDoor at({1.0, 2.4, M_PI / 2});
+  Belief& belief = at.belief;
+  TaskServices& task = at.task;
   const auto whom_with = [&](const Eigen::Vector2d& p_MP, const Eigen::Vector2d& v_MP,
                              const std::string& door) {
     auto entry = node_testing::Person(p_MP, perception::PersonIntent::kUnknown);
