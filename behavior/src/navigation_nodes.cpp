@@ -395,14 +395,9 @@ class RetractToSafe final : public TaskNode<bt::StatefulActionNode> {
   // Whether the retreat under way heads at someone (where they are or will be) so that the
   // executive's pace (ApproachSpeedScale) holds it to a crawl.
   bool IsRetreatHeldBack() const {
-    if (!retreat_to_ || rechoices_ >= kMaxRechoices || task_.proxemics == nullptr ||
-        !task_.motion->base_moving())
-      return false;
+    if (!retreat_to_ || rechoices_ >= kMaxRechoices || !task_.motion->base_moving()) return false;
     const Eigen::Vector2d v_M = task_.motion->planned_velocity();
-    if (v_M.norm() < kStoppedMps) return false;
-    return ApproachSpeedScale(belief_.X_MB, v_M, *retreat_to_, belief_.world.people,
-                              task_.config.footprint_radius, task_.config.person_radius,
-                              *task_.proxemics) < ApproachPace::kHeldScale;
+    return v_M.norm() >= kStoppedMps && IsHeldBackByPace(task_, v_M, *retreat_to_);
   }
 
   bool pending_{false};

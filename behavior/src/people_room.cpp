@@ -373,17 +373,20 @@ std::optional<Pose2> PeopleRoom::BestSpotAround(const std::vector<Pose2>& way, d
   return best;
 }
 
+bool IsHeldBackByPace(const TaskServices& task, const Eigen::Vector2d& v_M,
+                      const Eigen::Vector2d& p_MGoal) {
+  if (task.proxemics == nullptr) return false;
+  return ApproachSpeedScale(task.belief->X_MB, v_M, p_MGoal, task.belief->world.people,
+                            task.config.footprint_radius, task.config.person_radius,
+                            *task.proxemics) < ApproachPace::kHeldScale;
+}
+
 bool PeopleRoom::IsWayHeldBack(const std::vector<Eigen::Vector2d>& corners) const {
-  if (task_.proxemics == nullptr || corners.size() < 2) return false;
-  const Pose2& X_MB = task_.belief->X_MB;
   // The first leg that goes anywhere: its direction is the velocity the pace is asked about.
   for (std::size_t i = 1; i < corners.size(); ++i) {
     const Eigen::Vector2d leg = corners[i] - corners[0];
     if (leg.norm() < 1e-3) continue;
-    return ApproachSpeedScale(X_MB, leg.normalized() * task_.config.retreat_speed, corners.back(),
-                              task_.belief->world.people, task_.config.footprint_radius,
-                              task_.config.person_radius,
-                              *task_.proxemics) < ApproachPace::kHeldScale;
+    return IsHeldBackByPace(task_, leg.normalized() * task_.config.retreat_speed, corners.back());
   }
   return false;
 }

@@ -421,6 +421,12 @@ inline constexpr double kStopWithinSec = 1.5;
 /// frame go 0.6).
 inline constexpr double kWalkingMps = 0.5;
 
+/// Whether the executive's pace (ApproachSpeedScale with TaskServices::proxemics) would hold the
+/// robot to a crawl heading along v_M [m/s] to p_MGoal: it heads at someone near, or where they
+/// will be. False without a pace.
+bool IsHeldBackByPace(const TaskServices& task, const Eigen::Vector2d& v_M,
+                      const Eigen::Vector2d& p_MGoal);
+
 /// The base has stopped (kStoppedMps), or has had kStopWithinSec since `since` to.
 bool StoppedOrStopTimedOut(const TaskServices& task, Time since);
 
