@@ -140,7 +140,6 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
         }
         // Through the middle of the clear opening, between the latch jamb and the leaf.
         const Eigen::Vector2d centre = ClearOpeningCentre(task_, door_);
-        const Eigen::Vector2d exit = centre - pass_.n_M * ExitDistance(task_, door_);
         const Eigen::Vector2d offset = belief_.X_MB.translation() - centre;
         std::vector<Pose2> path{belief_.X_MB};
         std::vector<bool> through;
@@ -164,7 +163,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
           path.push_back({p.x(), p.y(), yaw_});
           through.push_back(true);
         }
-        path.push_back({exit.x(), exit.y(), yaw_});
+        path.push_back(ExitPose());
         through.push_back(true);
         if (PassageBusy(DoorPathDuration(task_, path))) {
           WaitBesideTheLane();
@@ -290,6 +289,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     const Eigen::Vector2d facing = -pass_.n_M * std::cos(turn) - along * (side * std::sin(turn));
     return Pose2{p.x(), p.y(), std::atan2(facing.y(), facing.x())};
   }
+  // Beyond the door, through the middle of the clear opening, facing on.
   Pose2 ExitPose() const {
     const Eigen::Vector2d exit =
         ClearOpeningCentre(task_, door_) - pass_.n_M * ExitDistance(task_, door_);

@@ -497,28 +497,26 @@ TEST_F(TraverseDoorTest, WaitingForSomeoneByTheDoorwayItStepsBackToTheLanesEdge)
   ASSERT_TRUE(tree.has_value());
   const Pose2 entry = motion_.path().back();
   const double edge_x = 0.475 + services_.config.footprint_radius + 0.05;
+  // A tick at t [s] with the leaf open and `people` in view.
+  const auto tick_at = [&](double t, std::vector<perception::TrackedPersonWithIntent> people) {
+    belief_.now = At(t);
+    DoorSeenOpen(90.0, 0.0);
+    See(std::move(people));
+    return tree->TickOnce();
+  };
   // At the entry: the slide is done.
   motion_.StopBase();
   belief_.X_MB = entry;
-  belief_.now = At(8.0);
-  DoorSeenOpen(90.0, 0.0);
-  See({});
-  ASSERT_EQ(tree->TickOnce(), NodeStatus::kRunning);
+  ASSERT_EQ(tick_at(8.0, {}), NodeStatus::kRunning);
   ASSERT_TRUE(NotedText("driving through"));
   // Someone comes into view along the passage beyond: it stops short of the doorway.
   auto passer = node_testing::Person({1.5, 4.0}, perception::PersonIntent::kApproaching);
   passer.person.v_MP = {-1.0, 0.0};
-  belief_.now = At(8.5);
-  DoorSeenOpen(90.0, 0.0);
-  See({passer});
-  ASSERT_EQ(tree->TickOnce(), NodeStatus::kRunning);
+  ASSERT_EQ(tick_at(8.5, {passer}), NodeStatus::kRunning);
   ASSERT_TRUE(NotedText("stopping short"));
   ASSERT_FALSE(motion_.base_moving());
   // A tick later, back to the edge it looked through from.
-  belief_.now = At(8.6);
-  DoorSeenOpen(90.0, 0.0);
-  See({passer});
-  ASSERT_EQ(tree->TickOnce(), NodeStatus::kRunning);
+  ASSERT_EQ(tick_at(8.6, {passer}), NodeStatus::kRunning);
   EXPECT_TRUE(NotedText("waiting beside the lane"));
   ASSERT_TRUE(motion_.base_moving());
   EXPECT_NEAR(motion_.path().back().x, edge_x, 1e-6);
@@ -527,18 +525,12 @@ TEST_F(TraverseDoorTest, WaitingForSomeoneByTheDoorwayItStepsBackToTheLanesEdge)
   motion_.StopBase();
   belief_.X_MB = {edge_x, entry.y, M_PI / 2};
   for (const double t : {10.0, 11.0}) {
-    belief_.now = At(t);
-    DoorSeenOpen(90.0, 0.0);
     passer.person.p_MP.x() = 1.5 - (t - 8.5);
-    See({passer});
-    EXPECT_EQ(tree->TickOnce(), NodeStatus::kRunning);
+    EXPECT_EQ(tick_at(t, {passer}), NodeStatus::kRunning);
     EXPECT_FALSE(motion_.base_moving()) << t;
   }
   // Gone and quiet for passage_quiet_time: onto the axis again.
-  belief_.now = At(11.0 + services_.config.passage_quiet_time + 0.5);
-  DoorSeenOpen(90.0, 0.0);
-  See({});
-  EXPECT_EQ(tree->TickOnce(), NodeStatus::kRunning);
+  EXPECT_EQ(tick_at(11.0 + services_.config.passage_quiet_time + 0.5, {}), NodeStatus::kRunning);
   ASSERT_TRUE(motion_.base_moving());
   EXPECT_NEAR(motion_.path().back().x, 0.0, 1e-6);
 }
