@@ -20,7 +20,7 @@ void HeadGazeConfig::Validate() const {
               "HeadGazeConfig: camera_hfov_deg must be in (0, 180)");
   ThrowUnless(glance_range >= 0 && approach_speed >= 0 && glance_time >= 0 &&
                   glance_cooldown >= 0 && max_blind_glance >= 0 && door_look_range >= 0 &&
-                  door_look_beyond >= 0,
+                  door_look_beyond >= 0 && approach_look_range >= 0,
               "HeadGazeConfig: ranges, speeds and times must be >= 0");
   ThrowUnless(door_open_fraction >= 0 && door_open_fraction <= 1,
               "HeadGazeConfig: door_open_fraction must be in [0, 1]");
@@ -89,6 +89,47 @@ bool HeadGaze::InLaserBlindSector(const Belief& belief, const Eigen::Vector2d& p
   const double bearing_L =
       std::remainder(std::atan2(d.y(), d.x()) - belief.X_MB.yaw - belief.X_BL.yaw, 2 * M_PI);
   return bearing_L < belief.scan->angle_min || bearing_L > belief.scan->angle_max();
+}
+
+std::optional<Eigen::Vector2d> HeadGaze::NearestBehind(const Belief& belief) const {
+  std::optional<Eigen::Vector2d> nearest;
+  double nearest_distance = config_.glance_range;
+  for (const auto& entry : belief.world.people) {
+    const double distance = (entry.person.p_MP - belief.X_MB.translation()).norm();
+    if (distance < nearest_distance && InLaserBlindSector(belief, entry.person.p_MP)) {
+      nearest_distance = distance;
+      nearest = entry.person.p_MP;
+    }
+  }
+  return nearest;
+}
+
+double HeadGaze::BehindPan(const Belief& belief, double looking) const {
+  if (const auto person = NearestBehind(belief)) return PanTowards(belief.X_MB, *person, looking);
+  const double fallback = config_.blind_look_pan_deg * kDegToRad;
+  if (watch_behind_door_.empty() || !belief.scan || belief.scan->ranges.empty()) return fallback;
+  const auto door = std::find_if(belief.world.doors.begin(), belief.world.doors.end(),
+                                 [&](const auto& d) { return d.model.id == watch_behind_door_; });
+  if (door == belief.world.doors.end()) return fallback;
+  const Eigen::Vector2d at = belief.X_MB.translation();
+  const Eigen::Vector2d centre = (door->model.p_MHinge + door->model.p_MLatch) / 2;
+  const Eigen::Vector2d along = (door->model.p_MLatch - door->model.p_MHinge).normalized();
+  Eigen::Vector2d n(-along.y(), along.x());
+  if (n.dot(at - centre) < 0) n = -n;  // towards the robot's side
+  const Eigen::Vector2d d = centre + n * config_.approach_look_range - at;
+  // The blind sector in the base frame runs anticlockwise from the scan's last beam to its
+  // first; a bearing the laser sees is brought to the nearer edge.
+  const double yaw_L = belief.X_BL.yaw;
+  const double from = belief.scan->angle_max() + yaw_L;
+  const double width = 2 * M_PI - (belief.scan->angle_max() - belief.scan->angle_min);
+  if (width <= 0) return fallback;
+  double into = std::atan2(d.y(), d.x()) - belief.X_MB.yaw - from;
+  into -= 2 * M_PI * std::floor(into / (2 * M_PI));  // in [0, 2 pi)
+  if (into > width) into = into - width < 2 * M_PI - into ? width : 0.0;
+  const double bearing = from + into;
+  const Eigen::Vector2d towards(std::cos(belief.X_MB.yaw + bearing),
+                                std::sin(belief.X_MB.yaw + bearing));
+  return PanTowards(belief.X_MB, at + towards, looking);
 }
 
 void HeadGaze::ExpectOpening(const std::string& door, Time until) {
@@ -169,14 +210,14 @@ std::optional<HeadCommand> HeadGaze::Update(const Belief& belief, std::optional<
   // 3. Through the nearest door that is open or opening.
   if (!pan) {
     // Someone tracked in the laser's blind sector keeps the head behind until the door really
-    // opens (P1: people waiting there set off as the robot presses).
-    bool someone_behind = false;
-    for (const auto& entry : belief.world.people) {
-      someone_behind |= (entry.person.p_MP - at).norm() < config_.glance_range &&
-                        InLaserBlindSector(belief, entry.person.p_MP);
-    }
+    // opens (P1: people waiting there set off as the robot presses), and while the robot is at
+    // the actuator watching behind (rule 4), even then (P4 seed 2073: the head turned to the
+    // opening door, and the one waiting behind set off unseen).
+    const bool someone_behind = NearestBehind(belief).has_value();
+    const bool watching_behind = belief.now < watch_behind_until_;
     double nearest = config_.door_look_range;
     for (const auto& door : belief.world.doors) {
+      if (someone_behind && watching_behind) break;
       const auto expected = expected_opening_.find(door.model.id);
       const bool operated =
           expected != expected_opening_.end() && belief.now < expected->second && !someone_behind;
@@ -201,7 +242,7 @@ std::optional<HeadCommand> HeadGaze::Update(const Belief& belief, std::optional<
   }
   // 4. Behind, at an actuator with only a wall to see ahead.
   if (!pan && belief.now < watch_behind_until_ && WallAhead(belief)) {
-    pan = config_.blind_look_pan_deg * kDegToRad;
+    pan = BehindPan(belief, looking);
     reason = GazeReason::kBehind;
   }
   if (!pan) pan = 0.0;

@@ -88,7 +88,7 @@ class TaskNode : public Base {
   /// kLookRequestSec (HeadGaze::WatchBehind, rule 4).
   void WatchBehind() const {
     if (task_.gaze != nullptr)
-      task_.gaze->WatchBehind(belief_.now + SecondsToDuration(kLookRequestSec));
+      task_.gaze->WatchBehind(belief_.now + SecondsToDuration(kLookRequestSec), Door());
   }
   /// The visit to this node's door on the `visit` port; a new one if there is none yet or the
   /// port holds a visit to another door.

@@ -25,6 +25,9 @@ void TaskConfig::Validate() const {
               "must be >= 0");
   ThrowUnless(right_of_way_radius >= 0 && right_of_way_time >= 0,
               "TaskConfig: right_of_way_radius and right_of_way_time must be >= 0");
+  ThrowUnless(std::isfinite(near_waiter_radius) && near_waiter_radius >= 0 &&
+                  std::isfinite(near_waiter_time) && near_waiter_time >= 0,
+              "TaskConfig: near_waiter_radius (m) and near_waiter_time (s) must be >= 0");
   ThrowUnless(std::isfinite(comfort_distance) && comfort_distance >= 0,
               "TaskConfig: comfort_distance must be >= 0 (m)");
   ThrowUnless(std::isfinite(retreat_speed) && retreat_speed > 0,

@@ -50,6 +50,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
       // Out of the way of anyone walking up to the door first: the line-up crosses the
       // approach to the doorway (P1: someone walking up behind the robot at the button to go
       // through met it driving to the lane's edge, 0.38 m off).
+      if (WatchSomeoneForTheDoor()) return OnRunning();
       if (GiveWayIfComing()) return NodeStatus::kRunning;
       if (const NodeStatus s = StartLineUp(); s != NodeStatus::kRunning) return s;
     }
@@ -68,6 +69,21 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
           waiting_since_ = belief_.now;
           return NodeStatus::kRunning;
         }
+        return StartLineUp();
+      }
+      case Phase::kWatchingWaiter: {
+        // The step clear of their way is a way made for them already: it ends first.
+        const std::optional<ForTheDoor> someone = SomeoneForTheDoor();
+        if (someone) LookAt({someone->p_M.x(), someone->p_M.y(), belief_.X_MC.translation().z()});
+        if (stood_clear_ && task_.motion->base_moving()) return NodeStatus::kRunning;
+        if (someone) StandClearOfTheWayIn(someone->p_M);
+        if (task_.motion->base_moving()) return NodeStatus::kRunning;
+        if (GiveWayIfComing()) return NodeStatus::kRunning;
+        if (someone && ToSeconds(belief_.now - waiting_since_) < task_.config.near_waiter_time)
+          return NodeStatus::kRunning;
+        if (task_.motion->base_moving()) return NodeStatus::kRunning;  // the step clear ends
+        Note(someone ? "they stay where they are: lining up"
+                     : "nobody for the door now: lining up");
         return StartLineUp();
       }
       case Phase::kToPeek: {
@@ -218,19 +234,10 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     if (const auto peek = PeekPose()) {
       // Only when the hold window leaves time for the stop as well (a press that restarted the
       // window of an open door leaves 10 s, about what the direct line-up and the pass take).
-      const auto& trajectory = task_.motion->trajectory_config();
-      const Eigen::Vector2d entry = EntryPoint();
-      const double turn = std::remainder(peek->yaw - belief_.X_MB.yaw, 2 * M_PI);
-      const double turn_back = std::remainder(yaw_ - peek->yaw, 2 * M_PI);
-      const double lead =
-          planning::SegmentDuration((peek->translation() - belief_.X_MB.translation()).norm(), turn,
-                                    true, trajectory) +
-          task_.config.door_peek_time +
-          planning::SegmentDuration((entry - peek->translation()).norm(), turn_back, true,
-                                    trajectory);
       const std::vector<Pose2> path{belief_.X_MB, *peek};
       if (const DoorVisit visit = Visit();
-          DoorWindowLeavesTime(task_, door_, &visit, lead) && task_.planner->IsPathValid(path)) {
+          DoorWindowLeavesTime(task_, door_, &visit, PeekLead(*peek)) &&
+          task_.planner->IsPathValid(path)) {
         task_.motion->FollowPath(path, {true}, TuckedArm(*task_.model), belief_.now);
         Note("to the lane's edge, to look through the door before lining up");
         phase_ = Phase::kToPeek;
@@ -255,6 +262,19 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     }
     phase_ = Phase::kToEntry;
     return NodeStatus::kRunning;
+  }
+
+  // How long the line-up by the lane's edge takes to the entry: to `peek`, the look through
+  // (TaskConfig::door_peek_time) and the slide, at the door speed [s].
+  double PeekLead(const Pose2& peek) const {
+    const auto& trajectory = task_.motion->trajectory_config();
+    const double turn = std::remainder(peek.yaw - belief_.X_MB.yaw, 2 * M_PI);
+    const double turn_back = std::remainder(yaw_ - peek.yaw, 2 * M_PI);
+    return planning::SegmentDuration((peek.translation() - belief_.X_MB.translation()).norm(), turn,
+                                     true, trajectory) +
+           task_.config.door_peek_time +
+           planning::SegmentDuration((EntryPoint() - peek.translation()).norm(), turn_back, true,
+                                     trajectory);
   }
 
   // Where the robot stops to look through the door before lining up: on the entry line, just
@@ -404,6 +424,109 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
            ToSeconds(belief_.now - d->state.stamp) < kOperatorOpeningTime;
   }
 
+  // Someone on the robot's side of the door, within TaskConfig::near_waiter_radius of the
+  // doorway's centre and not holding the door aside, who is for the door: standing in front of
+  // the doorway (within the lane's edges, LaneEdgeLateral), or walking towards the opening
+  // (within kForTheDoorRad of straight at its middle). The nearest, and whether they walk.
+  // Someone standing off to the side is not waiting for the door (S2, P5: a walker who has
+  // crossed stands at their goal beside the approach).
+  struct ForTheDoor {
+    Eigen::Vector2d p_M;
+    bool walking{false};
+  };
+  std::optional<ForTheDoor> SomeoneForTheDoor() const {
+    std::optional<ForTheDoor> nearest;
+    double nearest_distance = task_.config.near_waiter_radius;
+    for (const auto& entry : belief_.world.people) {
+      const Eigen::Vector2d& p = entry.person.p_MP;
+      const Eigen::Vector2d& v = entry.person.v_MP;
+      const Eigen::Vector2d to_middle = pass_.centre - p;
+      const double distance = to_middle.norm();
+      if (distance >= nearest_distance || -to_middle.dot(pass_.n_M) <= 0.0 ||
+          IsHoldingDoorAside(task_, entry, door_))
+        continue;
+      const bool walking = v.norm() >= kWalkingMps;
+      if (walking ? v.dot(to_middle) < std::cos(kForTheDoorRad) * v.norm() * distance
+                  : std::abs(LateralOf(p)) > LaneEdgeLateral())
+        continue;
+      nearest_distance = distance;
+      nearest = ForTheDoor{p, walking};
+    }
+    return nearest;
+  }
+  // [rad] Walking within this of straight at the opening's middle is walking to the door.
+  static constexpr double kForTheDoorRad = M_PI / 4;
+  // Watching someone for the door (kWatchingWaiter), the robot steps along
+  // the door line away from the lane, once, far enough that their straight way in would pass it
+  // comfort_distance off, by at most kMaxStandClearM: a robot at the button's standoff is
+  // 0.6-0.7 m from their way (P4). Their way in runs from where they stand to the opening's
+  // side nearer the robot, a body's radius in from the jamb: walkers do not keep to the middle
+  // (P4 seed 2073 passed 0.13 m on the robot's side of it).
+  void StandClearOfTheWayIn(const Eigen::Vector2d& waiter) {
+    if (stood_clear_ || task_.motion->base_moving()) return;
+    stood_clear_ = true;
+    const Eigen::Vector2d at = belief_.X_MB.translation();
+    const Eigen::Vector2d away =
+        Eigen::Vector2d(-pass_.n_M.y(), pass_.n_M.x()) * (LateralOf(at) > 0.0 ? 1.0 : -1.0);
+    const double comfortable =
+        task_.config.footprint_radius + task_.config.person_radius + task_.config.comfort_distance;
+    const double in_from_middle =
+        std::max(task_.map->FindDoor(door_)->width() / 2 - task_.config.person_radius, 0.0);
+    const Eigen::Vector2d way_in = pass_.centre + away * in_from_middle;
+    const auto room = [&](const Eigen::Vector2d& q) {
+      return (ClosestPointOnSegment(q, waiter, way_in) - q).norm();
+    };
+    if (room(at) >= comfortable) return;
+    // The nearest shift that leaves them comfortable room, else the one that leaves the most; no
+    // step that gains less than kMakeWayMinGainM (someone walking up from the far side of the
+    // robot has their way in across the step: P1's walker from behind the button).
+    const perception::Costmap2D* costmap = belief_.world.costmap;
+    std::optional<Pose2> spot;
+    double best_room = room(at) + kMakeWayMinGainM;
+    constexpr double kStepM = 0.05;
+    for (double shift = kStepM; shift <= kMaxStandClearM + 1e-9; shift += kStepM) {
+      const Eigen::Vector2d q = at + away * shift;
+      const Pose2 candidate{q.x(), q.y(), belief_.X_MB.yaw};
+      if ((costmap != nullptr &&
+           costmap->IsNearMappedObstacle(
+               q, task_.config.footprint_radius + PeopleRoom::kSpotWallClearanceM)) ||
+          !task_.planner->IsPathValid({belief_.X_MB, candidate}))
+        break;
+      if (room(q) < best_room) continue;
+      best_room = room(q);
+      spot = candidate;
+      if (best_room >= comfortable) break;
+    }
+    if (!spot) return;
+    StepAsideTo(task_, *spot);
+    Note(StrCat("standing clear of their way in: to (", PoseText(*spot), ")"));
+  }
+  // [m] The farthest StandClearOfTheWayIn steps.
+  static constexpr double kMaxStandClearM = 0.6;
+
+  // Starts watching someone for the door (phase kWatchingWaiter, SomeoneForTheDoor) if there is
+  // one: someone walking up, at once (making way for them ends the window's chance as much as
+  // the watch); someone standing, if the hold window leaves time for the watch, the direct
+  // line-up and the pass after it (the look through from the lane's edge comes after only if the
+  // window still leaves time for it).
+  bool WatchSomeoneForTheDoor() {
+    if (task_.config.near_waiter_time <= 0.0) return false;
+    const std::optional<ForTheDoor> someone = SomeoneForTheDoor();
+    if (!someone) return false;
+    const DoorVisit visit = Visit();
+    const double line_up = DoorPathDuration(task_, LineUpPath(task_, door_, pass_, belief_.X_MB));
+    if (!someone->walking &&
+        !DoorWindowLeavesTime(task_, door_, &visit, task_.config.near_waiter_time + line_up))
+      return false;
+    Note(StrCat("someone ", someone->walking ? "walks up to" : "stands by", " the door at (",
+                PoseText({someone->p_M.x(), someone->p_M.y(), 0.0}),
+                "): watching whether they go through first"));
+    phase_ = Phase::kWatchingWaiter;
+    waiting_since_ = belief_.now;
+    stood_clear_ = false;
+    return true;
+  }
+
   // Starts making way (phase kGivingWay) if someone is coming (TaskConfig::give_way).
   // Whoever walks up may be going through the door (ThroughDoorWays).
   bool GiveWayIfComing() {
@@ -415,8 +538,9 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     return true;
   }
 
-  // kGivingWay: making way for people walking up before the line-up (WayGiver).
-  enum class Phase { kGivingWay, kToPeek, kPeeking, kToEntry, kWaiting, kThrough };
+  // kGivingWay: making way for people walking up before the line-up (WayGiver);
+  // kWatchingWaiter: watching someone for the door before it (WatchSomeoneForTheDoor).
+  enum class Phase { kWatchingWaiter, kGivingWay, kToPeek, kPeeking, kToEntry, kWaiting, kThrough };
   WayGiver give_way_;
   std::string door_;
   DoorPass pass_;
@@ -426,6 +550,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
   Time waiting_since_{};
   bool passage_wait_over_{false};    // waited the longest for them: going regardless
   bool aside_for_passage_{false};    // stepped back to the lane's edge to wait for them
+  bool stood_clear_{false};          // StandClearOfTheWayIn has had its one go
   std::optional<double> peek_side_;  // the side of the lane it looked through from (+1/-1)
 };
 

@@ -432,6 +432,9 @@ TEST(ExecutiveTest, BadConfigurationsAreRefusedNamingTheField) {
   ExecutiveConfig peek;
   peek.tasks.door_peek_turn_deg = 120.0;  // it would turn its back on the door
   refused_naming(peek, "door_peek_turn_deg");
+  ExecutiveConfig watch;
+  watch.tasks.near_waiter_time = std::nan("");
+  refused_naming(watch, "near_waiter_time");
   ExecutiveConfig grasp;
   grasp.grasp.min_opening = 0.0;
   EXPECT_THROW(Executive(std::make_shared<const RobotModel>(RobotModel::LoadDefault()), EmptyRoom(),

@@ -294,6 +294,53 @@ TEST_F(HeadGazeTest, ADoorBeingOperatedIsLookedThroughUnlessSomeoneIsBehind) {
   EXPECT_EQ(gaze_.reason(), GazeReason::kBehind);
 }
 
+// Given the door at whose actuator it stands, the look behind goes towards where people walk up
+// to that door from (approach_look_range out from its centre on the robot's side), kept within
+// the laser's blind sector; at anyone tracked there first, and while they are there, the door
+// opening beside the robot does not take the head from them (P4 seed 2073).
+TEST_F(HeadGazeTest, BehindAnActuatorItWatchesTheDoorsApproachAndWhoeverStandsThere) {
+  const auto pan_of = [&](const Eigen::Vector2d& p_M) {
+    const Eigen::Vector2d d = p_M - belief_.X_MB.translation();
+    return std::atan2(d.y(), d.x()) - belief_.X_MB.yaw;
+  };
+  const auto same_angle = [](double a, double b) {
+    return std::abs(std::remainder(a - b, 2 * M_PI)) < 1e-9;
+  };
+  belief_.scan = Scan(4.0, 0.4, 40.0);  // facing the wall at the button
+  belief_.world.doors = {LabDoor(0.0)};
+  gaze_.WatchBehind(At(10.0), "lab_door");
+  auto look = Update(0.0);
+  ASSERT_TRUE(look.has_value());
+  EXPECT_EQ(gaze_.reason(), GazeReason::kBehind);
+  // (0, 0), 3 m out from the doorway's centre (0, 3): behind the robot, to its left, the way
+  // round the joint allows (the pan reaches -220 deg, not +154).
+  EXPECT_TRUE(same_angle(look->pan, pan_of({0.0, 0.0}))) << look->pan;
+  EXPECT_LT(look->pan, -M_PI);
+  // Turned so that the laser sees that point: the blind sector's nearer edge (-135 deg).
+  belief_.X_MB.yaw = 0.17;
+  look = Update(look->pan);
+  ASSERT_TRUE(look.has_value());
+  EXPECT_NEAR(look->pan, -135.0 * M_PI / 180.0, 1e-9);
+  belief_.X_MB.yaw = M_PI / 2;
+  // No such door in the belief: straight behind.
+  gaze_.WatchBehind(At(10.0), "no_such_door");
+  look = Update(0.0);
+  ASSERT_TRUE(look.has_value());
+  EXPECT_NEAR(look->pan, -M_PI, 1e-9);
+  // Someone standing in the blind sector, and the door opening: the head stays on them ...
+  gaze_.WatchBehind(At(10.0), "lab_door");
+  belief_.world.doors = {LabDoor(0.3)};
+  belief_.world.people = {Walker(4, {2.0, 0.5}, {0.0, 0.0})};
+  look = Update(0.0);
+  ASSERT_TRUE(look.has_value());
+  EXPECT_EQ(gaze_.reason(), GazeReason::kBehind);
+  EXPECT_TRUE(same_angle(look->pan, pan_of({2.0, 0.5}))) << look->pan;
+  // ... while the task watches behind; then through the door.
+  belief_.now = At(10.1);
+  Update(look->pan);
+  EXPECT_EQ(gaze_.reason(), GazeReason::kDoor);
+}
+
 TEST_F(HeadGazeTest, DisabledSendsNothingAndBadConfigsAreRefused) {
   HeadGazeConfig config;
   config.enabled = false;
@@ -314,6 +361,9 @@ TEST_F(HeadGazeTest, DisabledSendsNothingAndBadConfigsAreRefused) {
   EXPECT_THROW(HeadGaze{c}, InvalidArgument);
   c = {};
   c.wall_ahead_range = -1.0;
+  EXPECT_THROW(HeadGaze{c}, InvalidArgument);
+  c = {};
+  c.approach_look_range = -1.0;
   EXPECT_THROW(HeadGaze{c}, InvalidArgument);
 }
 

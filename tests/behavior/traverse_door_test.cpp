@@ -4,6 +4,8 @@
 
 #include "task_node_support.h"
 
+#include "egress/behavior/head_gaze.h"
+
 namespace egress::behavior {
 namespace {
 
@@ -46,11 +48,17 @@ TEST_F(TraverseDoorTest, MakesWayForSomeoneWalkingUpToTheDoorBeforeLiningUp) {
     return tree.TickOnce();
   };
   EXPECT_EQ(tick(1.0), NodeStatus::kRunning);
+  // Someone for the door (walking at its middle): the robot stands clear of their way in first.
+  EXPECT_TRUE(NotedText("someone walks up to the door"));
+  EXPECT_TRUE(NotedText("standing clear of their way in"));
+  ASSERT_TRUE(motion_.base_moving());
+  EXPECT_GT(motion_.path().back().x, 1.15) << "not off towards the lane across their way";
+  motion_.StopBase();  // stood clear
+  walker.person.p_MP += heading * 0.6;
+  EXPECT_EQ(tick(1.5), NodeStatus::kRunning);
   EXPECT_TRUE(NotedText("making way: person"));
-  EXPECT_FALSE(motion_.base_moving() && motion_.path().back().x < 1.0)
-      << "not off towards the lane across their way";
   // Still coming.
-  walker.person.p_MP += heading * 1.2;
+  walker.person.p_MP += heading * 0.6;
   EXPECT_EQ(tick(2.0), NodeStatus::kRunning);
   EXPECT_FALSE(NotedText("lane's edge"));
   EXPECT_FALSE(NotedText("lining up"));
@@ -81,10 +89,10 @@ TEST_F(TraverseDoorTest, MakesWayForSomeoneReadSlowWalkingUpToTheDoor) {
 }
 
 // The same walker: they may be going through the door, so the robot, standing by the lane,
-// steps away from it rather than stand where they would pass it within comfort_distance (P1:
-// judged to step round the robot, they passed it 0.64 m off). Halted as they enter the door
-// zone, the node lets the step end (the executive stops the base when it halts the whole tree);
-// any other drive it stops.
+// steps away from it (standing clear of their way in) rather than stand where they would pass it
+// within comfort_distance (P1: judged to step round the robot, they passed it 0.64 m off).
+// Halted as they enter the door zone, the node lets the step end (the executive stops the base
+// when it halts the whole tree); any other drive it stops.
 TEST_F(TraverseDoorTest, StepsAwayFromTheLaneForSomeoneWalkingUpAndLetsTheStepEndWhenHalted) {
   const Pose2 at_button{1.15, 2.43, M_PI / 2};
   bt::Tree tree = TraverseAfterOwnPress(at_button);
@@ -98,8 +106,9 @@ TEST_F(TraverseDoorTest, StepsAwayFromTheLaneForSomeoneWalkingUpAndLetsTheStepEn
     EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
   }
   ASSERT_TRUE(motion_.stepping_out_of_way());
-  EXPECT_TRUE(NotedText("stepping aside"));
+  EXPECT_TRUE(NotedText("standing clear of their way in"));
   EXPECT_GT(motion_.path().back().x, at_button.x + 0.3) << "away from the lane";
+  EXPECT_NEAR(motion_.path().back().y, at_button.y, 1e-9) << "along the door line";
   tree.HaltTree();
   EXPECT_TRUE(motion_.stepping_out_of_way()) << "the step goes on";
 
@@ -115,6 +124,103 @@ TEST_F(TraverseDoorTest, StepsAwayFromTheLaneForSomeoneWalkingUpAndLetsTheStepEn
   ASSERT_FALSE(motion_.stepping_out_of_way());
   lining_up.HaltTree();
   EXPECT_FALSE(motion_.base_moving());
+}
+
+// P4: someone standing behind the robot, 3.4 m back from the door it has just opened, may have
+// waited for it. The robot watches them (the head turned to them) before lining up across their
+// way to the doorway, standing clear of that way first (along the door line, away from the lane):
+// if they set off, it makes way; if they stay where they are for near_waiter_time, it lines up.
+TEST_F(TraverseDoorTest, WatchesSomeoneStandingByTheDoorBeforeLiningUp) {
+  HeadGaze gaze;
+  services_.gaze = &gaze;
+  const Pose2 at_button{1.15, 2.43, M_PI / 2};
+  const auto waiter = node_testing::Person({-0.4, -0.6}, perception::PersonIntent::kUnknown);
+  const auto tick_at = [&](bt::Tree& tree, double t,
+                           const std::vector<perception::TrackedPersonWithIntent>& people) {
+    belief_.now = At(t);
+    DoorSeenOpen(80.0, 0.0);
+    See(people);
+    return tree.TickOnce();
+  };
+  // Their way in, from (-0.4, -0.6) to the opening's side nearer the robot (0.175, 3), passes the
+  // button's standoff 0.99 m off, centre to centre: comfortable is 0.215 + 0.3 + 0.8 = 1.315.
+  const auto room_at = [&](double x) {
+    const Eigen::Vector2d q(x, at_button.y);
+    return (ClosestPointOnSegment(q, waiter.person.p_MP, {0.175, 3.0}) - q).norm();
+  };
+  ASSERT_LT(room_at(at_button.x), 1.3);
+  // They stay: watched for near_waiter_time (2 s), then the line-up.
+  bt::Tree staying = TraverseAfterOwnPress(at_button);
+  EXPECT_EQ(tick_at(staying, 1.0, {waiter}), NodeStatus::kRunning);
+  EXPECT_TRUE(NotedText("someone stands by the door"));
+  EXPECT_TRUE(NotedText("standing clear of their way in"));
+  ASSERT_TRUE(motion_.base_moving());
+  const Pose2 clear = motion_.path().back();
+  EXPECT_NEAR(clear.y, at_button.y, 1e-9);
+  EXPECT_NEAR(clear.yaw, at_button.yaw, 1e-9);
+  EXPECT_GE(room_at(clear.x), 1.315) << "comfortably clear: " << clear.x;
+  EXPECT_LT(room_at(clear.x - 0.05), 1.315) << "and no farther than that";
+  // The head is asked to look at them (rule 2 of HeadGaze): behind the robot, to its left.
+  belief_.X_MC = Pose3::FromXyzRpy({1.15, 2.43, 1.0}, {0.0, 0.0, M_PI / 2});
+  ASSERT_TRUE(gaze.Update(belief_, 0.0).has_value());
+  EXPECT_EQ(gaze.reason(), GazeReason::kTask);
+  const Eigen::Vector2d to_them = waiter.person.p_MP - at_button.translation();
+  EXPECT_NEAR(
+      std::remainder(gaze.commanded_pan() + at_button.yaw - std::atan2(to_them.y(), to_them.x()),
+                     2 * M_PI),
+      0.0, 1e-6);
+  motion_.StopBase();  // stood clear
+  belief_.X_MB = clear;
+  EXPECT_EQ(tick_at(staying, 2.9, {waiter}), NodeStatus::kRunning);
+  EXPECT_FALSE(motion_.base_moving()) << "one step clear, then it watches";
+  EXPECT_EQ(tick_at(staying, 3.1, {waiter}), NodeStatus::kRunning);
+  EXPECT_TRUE(NotedText("they stay where they are: lining up"));
+  EXPECT_TRUE(motion_.base_moving());
+
+  // They set off for the door while the robot stands clear: the step ends, then it makes way,
+  // not off towards the lane.
+  motion_.StopBase();
+  log_.Take();
+  bt::Tree coming = TraverseAfterOwnPress(at_button);
+  EXPECT_EQ(tick_at(coming, 1.0, {waiter}), NodeStatus::kRunning);
+  ASSERT_TRUE(motion_.base_moving());
+  auto walker = waiter;
+  const Eigen::Vector2d heading = (Eigen::Vector2d(0.0, 3.0) - walker.person.p_MP).normalized();
+  walker.person.p_MP += heading * 0.6;
+  walker.person.v_MP = 1.2 * heading;
+  EXPECT_EQ(tick_at(coming, 1.5, {walker}), NodeStatus::kRunning);
+  EXPECT_TRUE(motion_.base_moving()) << "the step clear goes on";
+  EXPECT_FALSE(NotedText("making way"));
+  motion_.StopBase();
+  walker.person.p_MP += heading * 0.6;
+  EXPECT_EQ(tick_at(coming, 2.0, {walker}), NodeStatus::kRunning);
+  EXPECT_TRUE(NotedText("making way: person"));
+  EXPECT_FALSE(NotedText("lining up"));
+
+  // Nobody for the door on the robot's side (one on the far side, one standing off to the side
+  // of the doorway do not count), or, for someone standing, no time in the hold window for the
+  // watch: it lines up at once.
+  const auto far_side = node_testing::Person({-0.4, 4.5}, perception::PersonIntent::kUnknown);
+  const auto off_side = node_testing::Person({-1.7, 0.6}, perception::PersonIntent::kUnknown);
+  for (const int k : {0, 1, 2}) {
+    motion_.StopBase();
+    log_.Take();
+    bt::Tree tree = TraverseAfterOwnPress(at_button);
+    if (k == 2) {
+      DoorVisit visit;
+      visit.door = "lab_door";
+      visit.operated_at = At(-8.5);
+      tree.root_blackboard()->Set("door_visit", bt::Any(visit));
+    }
+    EXPECT_EQ(tick_at(tree, 1.0,
+                      {k == 0   ? far_side
+                       : k == 1 ? off_side
+                                : waiter}),
+              NodeStatus::kRunning);
+    EXPECT_FALSE(NotedText("watching whether")) << k;
+    EXPECT_TRUE(motion_.base_moving()) << k;
+    EXPECT_FALSE(motion_.stepping_out_of_way()) << k;
+  }
 }
 
 // Without give_way the robot lines up at once (the way it did before).

@@ -12,14 +12,18 @@
 ///   3. through a door ahead of the robot (its centre within 90 deg of the heading: not one it
 ///      has passed) that it is near while that door is open or opening, or while the robot
 ///      operates its actuator (ExpectOpening; unless someone tracked is in the laser's blind
-///      sector: they are watched until the leaf really moves): at the point `door_look_beyond`
+///      sector: they are watched until the leaf really moves, and while a task watches behind,
+///      rule 4, as long as they are there): at the point `door_look_beyond`
 ///      past the doorway's centre, on its far side, where people wait for it and come through;
 ///   4. while a task asks (WatchBehind: at a door's actuator) and a wall is close ahead (every
 ///      laser return in the camera's view straight ahead nearer than `wall_ahead_range`), over
-///      the laser's blind sector behind the base (`blind_look_pan_deg`): ahead the camera would
-///      see only the wall, and people walking up behind the robot to the door are in neither
-///      sensor's view (only on a task's word: at a table, the default look ahead finds the
-///      payload);
+///      the laser's blind sector behind the base: ahead the camera would see only the wall, and
+///      people walking up behind the robot to the door are in neither sensor's view (only on a
+///      task's word: at a table, the default look ahead finds the payload). At the nearest
+///      person tracked there (within `glance_range`: rule 3 leaves the door to them while the
+///      task watches behind); else, given the door, at the point `approach_look_range` out from
+///      its centre on the robot's side, where people walk up to it from, kept within the blind
+///      sector (the laser sees the rest); else at `blind_look_pan_deg`;
 ///   5. straight ahead (pan 0, tilt 0), the paper's fixed gaze.
 /// The tilt moves only for a task's request (a payload on a table below the camera, near the
 /// robot, is below a level camera's view); people and doors are looked at level. Pan angles are
@@ -59,8 +63,13 @@ struct HeadGazeConfig {
   double min_change_deg{3.0};      ///< A new target nearer than this to the last is not sent.
   /// [m] A wall this close ahead (rule 4) turns the head to the blind sector; 0: never.
   double wall_ahead_range{1.0};
-  /// The pan of rule 4's look behind (within [min_pan_deg, max_pan_deg]).
+  /// The pan of rule 4's look behind (within [min_pan_deg, max_pan_deg]) when no door is given
+  /// or no scan says where the blind sector is.
   double blind_look_pan_deg{-180.0};
+  /// [m] Rule 4 with a door: the point looked at out from the doorway's centre on the robot's
+  /// side. Straight behind, the camera missed by 2 deg someone waiting 3.4 m back from the lab
+  /// door to go through it (P4 seed 2073).
+  double approach_look_range{3.0};
   /// @throws InvalidArgument naming the field.
   void Validate() const;
 };
@@ -82,8 +91,13 @@ class HeadGaze {
   /// (the robot clock), so the head is turned through it by the time the leaf swings (from a
   /// look behind, the head takes 4 s to come round). Renewed each tick by the operating node.
   void ExpectOpening(const std::string& door, Time until);
-  /// A task at a door's actuator: rule 4 may look behind until `until`. Renewed each tick.
-  void WatchBehind(Time until) { watch_behind_until_ = until; }
+  /// A task at `door`'s actuator: rule 4 may look behind until `until`, towards where people
+  /// walk up to that door (empty, or a door not in the belief: straight behind). Renewed each
+  /// tick.
+  void WatchBehind(Time until, std::string door = {}) {
+    watch_behind_until_ = until;
+    watch_behind_door_ = std::move(door);
+  }
   GazeReason reason() const { return reason_; }
   /// The pan last commanded [rad] (0 before any).
   double commanded_pan() const { return commanded_pan_; }
@@ -98,6 +112,11 @@ class HeadGaze {
   /// True if every valid laser return within the camera's half view of straight ahead is
   /// nearer than wall_ahead_range (and there is at least one).
   bool WallAhead(const Belief& belief) const;
+  /// The nearest tracked person within glance_range in the laser's blind sector, if any.
+  std::optional<Eigen::Vector2d> NearestBehind(const Belief& belief) const;
+  /// Rule 4's pan [rad]: at NearestBehind, else towards watch_behind_door_'s approach, within
+  /// the blind sector.
+  double BehindPan(const Belief& belief, double looking) const;
   /// True if p_M is outside the latest laser scan's angular range (no scan: false).
   bool InLaserBlindSector(const Belief& belief, const Eigen::Vector2d& p_M) const;
   /// The tilt that points the camera (at X_MC) at p_M, clamped [rad].
@@ -115,6 +134,7 @@ class HeadGaze {
   Time glance_began_{};
   std::map<int, Time> glance_ended_;  ///< Track id -> when its last glance ended (or ends).
   Time watch_behind_until_{};
+  std::string watch_behind_door_;
   std::map<std::string, Time> expected_opening_;  ///< ExpectOpening: door -> until.
 };
 

@@ -81,6 +81,19 @@ struct TaskConfig {
   /// a door the robot could not see open from the actuator left too little of it: S2 seeds
   /// 2000-2003, 4/4 -> 0/4 with 2 s. Removed.)
   double right_of_way_time{0.0};
+  /// Before lining up from beside a door's lane (its actuator's standoff), the robot watches
+  /// anyone for the door on its side within this of the doorway's centre (TraverseDoor's
+  /// SomeoneForTheDoor: standing in front of the doorway, or walking at its opening; not holding
+  /// the door aside), the head turned to them: someone standing there may have waited for the
+  /// door and sets off as it opens, walking up behind the robot (P4 seed 2073: seen standing
+  /// 3.4 m back while the robot pressed, they set off as it drove to the lane's edge, out of
+  /// view, and passed it 0.39 m off). It first steps along the door line away from the lane,
+  /// clear of their straight way in (comfort_distance, at most 0.6 m), makes way if they come,
+  /// and lines up after near_waiter_time if they stay. For someone standing, only when the hold
+  /// window leaves time for the watch, the line-up and the pass. 0: no watch [m] ...
+  double near_waiter_radius{4.0};
+  /// ... [s], from the line-up's start; 0: no watch.
+  double near_waiter_time{2.0};
   /// The gap the robot keeps from people where it can (surface to surface; personal space is
   /// 0.45-1.2 m): a standby retreat goes where people will stay at least this far [m].
   double comfort_distance{0.8};
