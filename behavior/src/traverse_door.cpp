@@ -152,6 +152,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
             Note("the door did not open in time");
             return NodeStatus::kFailure;
           }
+          BackOutOfTheSweep();
           return NodeStatus::kRunning;  // the leaf is still opening
         }
         // Through the middle of the clear opening, between the latch jamb and the leaf.
@@ -182,7 +183,7 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
         path.push_back(ExitPose());
         through.push_back(true);
         if (PassageBusy(DoorPathDuration(task_, path))) {
-          WaitBesideTheLane();
+          if (!BackOutOfTheSweep()) WaitBesideTheLane();
           return NodeStatus::kRunning;
         }
         task_.motion->FollowPath(path, through, TuckedArm(*task_.model), belief_.now);
@@ -332,6 +333,26 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
     Note("waiting beside the lane: someone by the doorway may come through it");
     aside_for_passage_ = true;
     phase_ = Phase::kToPeek;
+  }
+
+  // Waiting (for the leaf, or for people passing the doorway) nearer a leaf that opens towards
+  // the robot than the entry, in its sweep, the robot backs out to the entry first: stopped short
+  // of the doorway there for a stream of residents, it stood while the window ran out, and the
+  // leaf closed onto it (two wards seed 17, five strikes). True if it set off.
+  bool BackOutOfTheSweep() {
+    constexpr double kInSweepToleranceM = 0.05;
+    if (task_.motion->base_moving() ||
+        pass_.n_M.dot(task_.map->FindDoor(door_)->SwingSide()) <= 0.0 ||
+        (belief_.X_MB.translation() - pass_.centre).dot(pass_.n_M) >
+            entry_distance_ - kInSweepToleranceM)
+      return false;
+    const Eigen::Vector2d entry = EntryPoint();
+    const std::vector<Pose2> path{belief_.X_MB, {entry.x(), entry.y(), yaw_}};
+    if (!task_.planner->IsPathValid(path)) return false;
+    task_.motion->FollowPath(path, {true}, TuckedArm(*task_.model), belief_.now);
+    Note("backing out of the leaf's sweep to the entry to wait there");
+    phase_ = Phase::kToEntry;
+    return true;
   }
 
   // Whether the robot waits at the entry for people to pass the doorway (IsPassageClear over the

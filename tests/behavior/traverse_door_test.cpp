@@ -591,6 +591,51 @@ TEST_F(TraverseDoorTest, TraverseDoorStopsShortOfTheDoorwayForSomeoneComingIntoV
   EXPECT_TRUE(motion_.base_moving());
 }
 
+// Two wards seed 17: coming to a door whose leaf opens towards the robot, stopped short of the
+// doorway for someone passing beyond it, the robot stood in the leaf's sweep while the window ran
+// out, and the closing leaf struck it. Waiting nearer the line than the entry (beyond the sweep),
+// it backs out to the entry first.
+TEST_F(TraverseDoorTest, WaitingInTheSweepOfALeafOpeningTowardsItItBacksOutToTheEntry) {
+  services_.config.door_peek_time = 0.0;
+  const double entry = detail::ExitDistance(services_, "lab_door");  // beyond the sweep
+  bt::Tree tree = Tree(R"(<TraverseDoor door="lab_door"/>)");
+  belief_.X_MB = {0.0, 3.0 + entry, -M_PI / 2};  // north of the line, facing south through it
+  belief_.now = At(1.0);
+  DoorSeenOpen(90.0, 0.0);
+  See({});
+  motion_.StopBase();
+  ASSERT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  ASSERT_TRUE(motion_.base_moving());
+  // Set off; 0.8 m from the line (in the sweep, short of the commit distance), someone comes
+  // into view along the passage beyond: it stops short.
+  belief_.X_MB = {0.0, 3.8, -M_PI / 2};
+  belief_.now = At(2.0);
+  auto passer = node_testing::Person({-1.8, 2.0}, perception::PersonIntent::kApproaching);
+  passer.person.v_MP = {1.0, 0.0};
+  See({passer});
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(NotedText("stopping short of the doorway"));
+  EXPECT_FALSE(motion_.base_moving());
+  // Stopped there, waiting for them: back to the entry, facing through the door still.
+  belief_.now = At(2.2);
+  See({passer});
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_TRUE(NotedText("backing out of the leaf's sweep"));
+  ASSERT_TRUE(motion_.base_moving());
+  const Pose2 back_out = motion_.path().back();
+  EXPECT_NEAR(back_out.y, 3.0 + entry, 1e-9);
+  EXPECT_NEAR(back_out.yaw, -M_PI / 2, 1e-9);
+  // Waiting at the entry, it stays there.
+  motion_.StopBase();
+  log_.Take();
+  belief_.X_MB = back_out;
+  belief_.now = At(2.5);
+  See({passer});
+  EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  EXPECT_FALSE(motion_.base_moving());
+  EXPECT_FALSE(NotedText("backing out"));
+}
+
 // Lined up on the axis after looking through from the lane's edge, the robot finds someone by
 // the doorway's far side: anyone there may turn through the opening at it (H12, P5: a person
 // stepping out from behind the leaf came through at the robot waiting on the axis and squeezed
