@@ -30,6 +30,20 @@ class TraverseDoorTest : public node_testing::TaskNodeFixture {
     belief_.world.doors[0].state.motion = perception::DoorMotion::kOpening;
     return tree;
   }
+  // A TraverseDoor of the lab door from its north, whose leaf opens towards the robot: from the
+  // entry beyond the leaf's sweep (as far out as the exit pose), facing south through the open
+  // door, ticked once at 1 s (no look through from the lane's edge).
+  bt::Tree SetOffFromBeyondTheSweep() {
+    services_.config.door_peek_time = 0.0;
+    bt::Tree tree = Tree(R"(<TraverseDoor door="lab_door"/>)");
+    belief_.X_MB = {0.0, 3.0 + detail::ExitDistance(services_, "lab_door"), -M_PI / 2};
+    belief_.now = At(1.0);
+    DoorSeenOpen(90.0, 0.0);
+    See({});
+    motion_.StopBase();
+    EXPECT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+    return tree;
+  }
 };
 
 // P1: someone walking up behind the robot at the button, to go through the door it has just
@@ -478,17 +492,9 @@ TEST_F(TraverseDoorTest, TheDriveThroughStopsNowhereBetweenTheEntryAndTheExit) {
 // doorway, so that it crosses the commit distance slowly (a stop short from speed slid into the
 // doorway beside someone come into view: two wards seed 35). From the ordinary entry, straight.
 TEST_F(TraverseDoorTest, FromBeyondTheLeafsSweepThePassStopsFirstAtTheOrdinaryEntry) {
-  services_.config.door_peek_time = 0.0;
-  // Beyond the sweep of the 0.95 m leaf opening north (as far out as the exit pose).
   const double entry = detail::ExitDistance(services_, "lab_door");
   ASSERT_GT(entry, services_.config.door_entry_distance + 0.2);
-  bt::Tree tree = Tree(R"(<TraverseDoor door="lab_door"/>)");
-  belief_.X_MB = {0.0, 3.0 + entry, -M_PI / 2};  // north of the line, facing south through it
-  belief_.now = At(1.0);
-  DoorSeenOpen(90.0, 0.0);
-  See({});
-  motion_.StopBase();
-  ASSERT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  bt::Tree tree = SetOffFromBeyondTheSweep();
   ASSERT_TRUE(motion_.base_moving());
   const std::vector<Pose2>& path = motion_.path();
   ASSERT_EQ(path.size(), 3u);
@@ -596,15 +602,8 @@ TEST_F(TraverseDoorTest, TraverseDoorStopsShortOfTheDoorwayForSomeoneComingIntoV
 // out, and the closing leaf struck it. Waiting nearer the line than the entry (beyond the sweep),
 // it backs out to the entry first.
 TEST_F(TraverseDoorTest, WaitingInTheSweepOfALeafOpeningTowardsItItBacksOutToTheEntry) {
-  services_.config.door_peek_time = 0.0;
-  const double entry = detail::ExitDistance(services_, "lab_door");  // beyond the sweep
-  bt::Tree tree = Tree(R"(<TraverseDoor door="lab_door"/>)");
-  belief_.X_MB = {0.0, 3.0 + entry, -M_PI / 2};  // north of the line, facing south through it
-  belief_.now = At(1.0);
-  DoorSeenOpen(90.0, 0.0);
-  See({});
-  motion_.StopBase();
-  ASSERT_EQ(tree.TickOnce(), NodeStatus::kRunning);
+  const double entry = detail::ExitDistance(services_, "lab_door");
+  bt::Tree tree = SetOffFromBeyondTheSweep();
   ASSERT_TRUE(motion_.base_moving());
   // Set off; 0.8 m from the line (in the sweep, short of the commit distance), someone comes
   // into view along the passage beyond: it stops short.
