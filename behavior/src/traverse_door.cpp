@@ -72,16 +72,16 @@ class TraverseDoor final : public TaskNode<bt::StatefulActionNode> {
         return StartLineUp();
       }
       case Phase::kWatchingWaiter: {
-        // The step clear of their way is a way made for them already: it ends first.
         const std::optional<ForTheDoor> someone = SomeoneForTheDoor();
-        if (someone) LookAt({someone->p_M.x(), someone->p_M.y(), belief_.X_MC.translation().z()});
-        if (stood_clear_ && task_.motion->base_moving()) return NodeStatus::kRunning;
-        if (someone) StandClearOfTheWayIn(someone->p_M);
+        if (someone) {
+          LookAt({someone->p_M.x(), someone->p_M.y(), belief_.X_MC.translation().z()});
+          StandClearOfTheWayIn(someone->p_M);
+        }
+        // The step clear of their way is a way made for them already: it ends first.
         if (task_.motion->base_moving()) return NodeStatus::kRunning;
         if (GiveWayIfComing()) return NodeStatus::kRunning;
         if (someone && ToSeconds(belief_.now - waiting_since_) < task_.config.near_waiter_time)
           return NodeStatus::kRunning;
-        if (task_.motion->base_moving()) return NodeStatus::kRunning;  // the step clear ends
         Note(someone ? "they stay where they are: lining up"
                      : "nobody for the door now: lining up");
         return StartLineUp();
