@@ -13,6 +13,13 @@ constexpr double kDegToRad = M_PI / 180.0;
 constexpr double kDoorAheadRad = M_PI / 2;
 // [s] A glance kept on someone in the laser's blind sector is renewed by this much at a time.
 constexpr double kGlanceRenewSec = 0.2;
+
+// The unit normal of `door`'s line pointing to the side p_M is on.
+Eigen::Vector2d NormalTowards(const perception::DoorModel& door, const Eigen::Vector2d& p_M) {
+  const Eigen::Vector2d along = (door.p_MLatch - door.p_MHinge).normalized();
+  const Eigen::Vector2d n(-along.y(), along.x());
+  return n.dot(p_M - (door.p_MHinge + door.p_MLatch) / 2) < 0 ? Eigen::Vector2d(-n) : n;
+}
 }  // namespace
 
 void HeadGazeConfig::Validate() const {
@@ -113,10 +120,8 @@ double HeadGaze::BehindPan(const Belief& belief, double looking) const {
   if (door == belief.world.doors.end()) return fallback;
   const Eigen::Vector2d at = belief.X_MB.translation();
   const Eigen::Vector2d centre = (door->model.p_MHinge + door->model.p_MLatch) / 2;
-  const Eigen::Vector2d along = (door->model.p_MLatch - door->model.p_MHinge).normalized();
-  Eigen::Vector2d n(-along.y(), along.x());
-  if (n.dot(at - centre) < 0) n = -n;  // towards the robot's side
-  const Eigen::Vector2d d = centre + n * config_.approach_look_range - at;
+  const Eigen::Vector2d d =
+      centre + NormalTowards(door->model, at) * config_.approach_look_range - at;
   // The blind sector in the base frame runs anticlockwise from the scan's last beam to its
   // first; a bearing the laser sees is brought to the nearer edge.
   const double yaw_L = belief.X_BL.yaw;
@@ -214,10 +219,11 @@ std::optional<HeadCommand> HeadGaze::Update(const Belief& belief, std::optional<
     // the actuator watching behind (rule 4), even then (P4 seed 2073: the head turned to the
     // opening door, and the one waiting behind set off unseen).
     const bool someone_behind = NearestBehind(belief).has_value();
-    const bool watching_behind = belief.now < watch_behind_until_;
+    const bool keep_behind = someone_behind && belief.now < watch_behind_until_;
     double nearest = config_.door_look_range;
+    // (Watched behind: no door is looked through.)
     for (const auto& door : belief.world.doors) {
-      if (someone_behind && watching_behind) break;
+      if (keep_behind) break;
       const auto expected = expected_opening_.find(door.model.id);
       const bool operated =
           expected != expected_opening_.end() && belief.now < expected->second && !someone_behind;
@@ -232,11 +238,9 @@ std::optional<HeadCommand> HeadGaze::Update(const Belief& belief, std::optional<
       const double bearing =
           std::remainder(std::atan2(to_centre.y(), to_centre.x()) - X_MB.yaw, 2 * M_PI);
       if (std::abs(bearing) > kDoorAheadRad) continue;
-      const Eigen::Vector2d along = (door.model.p_MLatch - door.model.p_MHinge).normalized();
-      Eigen::Vector2d n(-along.y(), along.x());
-      if (n.dot(at - centre) < 0) n = -n;  // towards the robot's side
       nearest = distance;
-      pan = PanTowards(X_MB, centre - n * config_.door_look_beyond, looking);
+      pan = PanTowards(X_MB, centre - NormalTowards(door.model, at) * config_.door_look_beyond,
+                       looking);
       reason = GazeReason::kDoor;
     }
   }
